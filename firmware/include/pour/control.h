@@ -1,0 +1,76 @@
+/* SPDX-License-Identifier: MIT */
+/* The 1 kHz control step: state in, torque out, inside the safety envelope. Pure: no I/O, no float. */
+#ifndef POUR_CONTROL_H
+#define POUR_CONTROL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pour/fixed.h"
+#include "pour/obs.h"
+#include "pour/policy.h"
+#include "pour/safety.h"
+
+typedef enum {
+  POUR_MODE_IDLE = 0,  /* no state yet (or faults just cleared): safe torque */
+  POUR_MODE_RUN = 1,   /* policy in command, inside the envelope */
+  POUR_MODE_FAULT = 2, /* a latched fault: safe torque until clear_faults */
+  POUR_MODE_ESTOP = 3  /* e-stop asserted: zero torque while it lasts, then FAULT until cleared */
+} pour_mode_t;
+
+/* Latched fault bits (pour_control_t.faults); only clear_faults resets them. */
+#define POUR_FAULT_STALE_INPUT 0x0001u /* no fresh state for longer than input_timeout_ms */
+#define POUR_FAULT_ESTOP 0x0002u       /* e-stop was asserted */
+#define POUR_FAULT_BAD_INPUT 0x0004u   /* a state outside its physical range was received */
+
+typedef struct {
+  pour_safety_config_t safety;
+  uint16_t input_timeout_ms;   /* fresh state required at least this often in RUN, >= 1 */
+  q15_t safe_torque;           /* command in IDLE and FAULT, within the envelope, Q15 */
+  pour_policy_mode_t policy_mode;
+  uint32_t seed;               /* sampled mode's PRNG seed */
+} pour_control_config_t;
+
+/* Inputs of one tick. */
+typedef struct {
+  bool state_fresh;  /* a new state arrived since the last tick */
+  pour_state_t state;
+  bool estop;        /* e-stop line/frame asserted (level) */
+  bool clear_faults; /* request to clear latched faults (acted on when e-stop is released) */
+} pour_control_input_t;
+
+/* Outputs of one tick. */
+typedef struct {
+  q15_t torque;   /* command, fraction of tau_max Q15 */
+  uint8_t action; /* index of the current policy action */
+  q15_t probs[POUR_POLICY_MAX_ACTIONS]; /* probabilities of the latest decision, Q15 */
+  uint8_t mode;   /* pour_mode_t */
+  uint16_t faults; /* POUR_FAULT_* */
+  uint8_t limits;  /* POUR_LIMIT_* active this tick */
+  uint32_t tick;   /* ticks since init */
+} pour_control_output_t;
+
+typedef struct {
+  pour_control_config_t config;
+  pour_policy_t policy;
+  pour_safety_t safety;
+  pour_mode_t mode;
+  uint16_t faults;
+  uint32_t tick;
+  uint32_t ms_since_fresh;
+  uint32_t ms_to_decision;
+  pour_obs_t obs;
+  pour_policy_eval_t eval;
+} pour_control_t;
+
+/* Defaults: docs/safety.md lists them with their reasons. */
+pour_control_config_t pour_control_default_config(void);
+
+/* Validates config and weights once; the controller starts in IDLE at zero torque. */
+pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
+                                const pour_policy_weights_t *weights);
+
+/* One 1 ms tick. Never fails: problems show as mode and fault bits in the output. */
+void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
+
+#endif /* POUR_CONTROL_H */

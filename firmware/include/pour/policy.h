@@ -1,0 +1,59 @@
+/* SPDX-License-Identifier: MIT */
+/* Softmax-linear policy in fixed point: logits = [x, 1]·W, greedy argmax or seeded sampling. */
+#ifndef POUR_POLICY_H
+#define POUR_POLICY_H
+
+#include <stdint.h>
+
+#include "pour/fixed.h"
+#include "pour/obs.h"
+
+#define POUR_POLICY_N_FEATURES (POUR_OBS_N + 1) /* the five observations, then a bias of exactly 1.0 */
+#define POUR_POLICY_MIN_ACTIONS 2
+#define POUR_POLICY_MAX_ACTIONS 16
+#define POUR_WEIGHTS_FORMAT_VERSION 1
+
+/* A policy as weights.h describes it (docs/weights-h.md). Arrays are borrowed, not copied. */
+typedef struct {
+  uint8_t n_actions;            /* 2 .. 16 */
+  uint8_t w_frac_bits;          /* weights are int16 with this many fraction bits, 0 .. 15 */
+  uint16_t decision_period_ms;  /* a new action every this many 1 ms ticks, >= 1 */
+  const int16_t *w;             /* [POUR_POLICY_N_FEATURES][n_actions], row-major, Q(15-f).f */
+  const q15_t *action_levels;   /* [n_actions] torque as a fraction of tau_max, Q15 */
+  pour_obs_norm_t norm;         /* observation normalisation the policy was trained with */
+  int32_t tau_max_mnm;          /* tau_max the policy was trained with [mN·m], metadata */
+  uint32_t content_hash;        /* FNV-1a 32 of the content (docs/weights-h.md) */
+} pour_policy_weights_t;
+
+typedef enum {
+  POUR_POLICY_GREEDY = 0, /* argmax of the logits, ties to the lowest index */
+  POUR_POLICY_SAMPLED = 1 /* sample from the fixed-point softmax with a seeded xorshift32 */
+} pour_policy_mode_t;
+
+typedef struct {
+  const pour_policy_weights_t *weights;
+  pour_policy_mode_t mode;
+  uint32_t rng; /* xorshift32 state, never 0 */
+} pour_policy_t;
+
+/* One evaluation: logits Q16.15 in int32, probabilities Q15 (sum within docs' LSB bound of 1). */
+typedef struct {
+  int32_t logits[POUR_POLICY_MAX_ACTIONS];
+  q15_t probs[POUR_POLICY_MAX_ACTIONS];
+  uint8_t action;
+} pour_policy_eval_t;
+
+/* FNV-1a 32 content hash of weights, as docs/weights-h.md defines it. */
+uint32_t pour_policy_weights_hash(const pour_policy_weights_t *weights);
+
+/* Checks shape, formats, levels, normalisation and the content hash. */
+pour_status_t pour_policy_weights_validate(const pour_policy_weights_t *weights);
+
+/* Validates the weights and binds them; seed 0 is replaced by a fixed non-zero seed. */
+pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_t *weights,
+                               pour_policy_mode_t mode, uint32_t seed);
+
+/* Evaluates the policy on one observation. Never fails on an initialised policy. */
+void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
+
+#endif /* POUR_POLICY_H */

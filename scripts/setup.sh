@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs everything pour needs on Debian 12 (bookworm): apt packages, a pinned Python venv in .venv,
+# and the Unity test framework in .deps/unity. Idempotent: a second run checks and changes nothing.
+set -euo pipefail
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+
+log() { printf '[setup] %s\n' "$*" >&2; }
+
+# Debian 12 packages. Versions are those of the bookworm release (and its security updates).
+APT_PACKAGES=(
+  cmake ninja-build gcc g++ make pkgconf git
+  libeigen3-dev
+  gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
+  can-utils user-mode-linux iproute2
+  default-jdk-headless xvfb xauth x11-apps
+  python3 python3-venv python3-dev libglib2.0-0
+  ca-certificates xz-utils
+)
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then
+  command -v sudo >/dev/null || { log "not root and no sudo: install ${APT_PACKAGES[*]} by hand"; exit 1; }
+  SUDO=sudo
+fi
+
+apt_missing=()
+for p in "${APT_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || apt_missing+=("$p")
+done
+if [ ${#apt_missing[@]} -gt 0 ]; then
+  log "apt: installing ${apt_missing[*]}"
+  $SUDO apt-get update -qq
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${apt_missing[@]}" >/dev/null
+fi
+
+# Python: Debian's interpreter, so a fresh machine and CI run the same one.
+PY=/usr/bin/python3
+if [ ! -x .venv/bin/python ]; then
+  log "venv: creating .venv"
+  "$PY" -m venv .venv
+fi
+stamp_want=$(cat tools/requirements.lock tools/pyproject.toml | sha256sum | cut -c1-16)
+if [ "$(cat .venv/.pour-stamp 2>/dev/null)" != "$stamp_want" ]; then
+  log "venv: installing tools/requirements.lock"
+  .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.lock
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps -e tools
+  echo "$stamp_want" > .venv/.pour-stamp
+fi
+
+# Unity 2.5 (ThrowTheSwitch), as carried in Debian's ntpsec source package, pinned by hash.
+UNITY_DIR=.deps/unity
+UNITY_TARBALL=ntpsec_1.2.2+dfsg1.orig.tar.xz
+UNITY_TARBALL_SHA256=53e527e3d04d551d41af2d359c2715c2de5f5bfa2a695d4ec1a811b3e9137f63
+if [ ! -f "$UNITY_DIR/unity.c" ]; then
+  log "unity: fetching Debian source package ntpsec"
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  mkdir -p "$work/parts" "$work/lists/partial" "$work/cache/archives/partial"
+  # deb-src entry derived from the system's own sources, in a private apt state: nothing global changes.
+  sed 's/^Types: deb$/Types: deb-src/' /etc/apt/sources.list.d/debian.sources > "$work/parts/src.sources"
+  aptopts=(-o Dir::Etc::SourceList=/dev/null -o "Dir::Etc::SourceParts=$work/parts"
+           -o "Dir::State::Lists=$work/lists" -o "Dir::Cache=$work/cache" -o APT::Sandbox::User=root)
+  apt-get "${aptopts[@]}" update -qq
+  (cd "$work" && apt-get "${aptopts[@]}" source --download-only -qq ntpsec >/dev/null 2>&1)
+  echo "$UNITY_TARBALL_SHA256  $work/$UNITY_TARBALL" | sha256sum -c --quiet - \
+    || { log "unity: $UNITY_TARBALL does not match its pinned hash"; exit 1; }
+  mkdir -p "$UNITY_DIR"
+  tar -xJf "$work/$UNITY_TARBALL" -C "$UNITY_DIR" --strip-components=3 \
+    --wildcards '*/tests/unity/unity.c' '*/tests/unity/unity.h' '*/tests/unity/unity_internals.h'
+fi
+
+log "ok"

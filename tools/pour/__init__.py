@@ -1,0 +1,1 @@
+"""pour: offline tools for the soymilk-pouring controller."""
