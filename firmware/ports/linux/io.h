@@ -1,0 +1,69 @@
+/* SPDX-License-Identifier: MIT */
+/* The controller process's I/O, behind one narrow interface: one implementation per transport
+ * (io_lcm.c: LCM; a SocketCAN backend plugs in the same way). The loop in controller.c never
+ * sees a transport. */
+#ifndef POUR_LINUX_IO_H
+#define POUR_LINUX_IO_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pour/control.h"
+
+/* What arrived during one wait. Only the latest state and the latest command are kept. */
+typedef struct {
+  uint32_t n_states;     /* states decoded during this wait (> 1: older ones were superseded) */
+  pour_state_t state;    /* the latest state, already in the core's fixed-point units */
+  int64_t state_utime;   /* its source time stamp [µs], echoed in the answer */
+  int64_t state_seq;     /* its full sequence number (state.seq is the low 32 bits) */
+  int32_t episode;       /* its episode index (transports without one report 0) */
+  bool have_command;     /* a command arrived */
+  bool estop;            /* e-stop level of the latest command */
+  bool clear_faults;     /* any command during this wait asked to clear faults */
+  uint32_t n_dropped;    /* messages on our channels that failed to decode */
+} pour_io_input_t;
+
+/* The answer to one state. */
+typedef struct {
+  int64_t utime;         /* send time [µs], controller wall clock */
+  int64_t state_seq;     /* seq of the answered state */
+  int64_t state_utime;   /* utime of the answered state [µs] */
+  const pour_control_output_t *out;
+  uint8_t n_actions;
+  const pour_obs_t *obs; /* observation the policy saw */
+  int32_t tau_max_mnm;   /* scale of the torque command [mN·m] */
+} pour_io_answer_t;
+
+/* Controller health, published at about 10 Hz. */
+typedef struct {
+  int64_t utime;           /* [µs], controller wall clock */
+  int64_t tick;            /* ticks since start */
+  uint8_t mode;            /* pour_mode_t */
+  uint16_t faults;         /* POUR_FAULT_* */
+  uint8_t limits;          /* POUR_LIMIT_* */
+  bool lockstep;           /* one tick per state instead of a 1 kHz wall clock */
+  int64_t overruns;        /* ticks that finished after their deadline */
+  int32_t late_max_us;     /* worst tick-start lateness since the last status [µs] */
+  int32_t step_time_ns;    /* last pour_control_step [ns] */
+  int32_t step_time_max_ns;/* longest step since the last status [ns] */
+  int64_t states_received;
+  int64_t messages_dropped;
+  int64_t stale_ticks;
+  uint32_t weights_hash;
+} pour_io_status_t;
+
+typedef struct pour_io pour_io_t;
+struct pour_io {
+  void *ctx;
+  /* Waits at most timeout_us (0: poll) for input and accumulates it into *in (which the caller
+   * zeroes). Returns 1 if a state arrived, 0 if not, negative on a transport error. */
+  int (*wait)(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in);
+  /* Sends the answer to a state; returns 0 or negative on a transport error. */
+  int (*send_torque)(pour_io_t *io, const pour_io_answer_t *answer);
+  /* Sends the health status; returns 0 or negative on a transport error. */
+  int (*send_status)(pour_io_t *io, const pour_io_status_t *status);
+  /* Releases the transport. */
+  void (*close)(pour_io_t *io);
+};
+
+#endif /* POUR_LINUX_IO_H */

@@ -1,0 +1,172 @@
+/* SPDX-License-Identifier: MIT */
+/* pour_controller: the firmware core as a Linux process, talking to host_sim (or a bench) over a
+ * transport chosen with --io. */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "controller.h"
+#include "io_lcm.h"
+#include "weights_builtin.h"
+
+static volatile sig_atomic_t g_stop = 0;
+
+static void on_signal(int sig) {
+  (void)sig;
+  g_stop = 1;
+}
+
+static void usage(FILE *f) {
+  fprintf(f,
+          "usage: pour_controller [options]\n"
+          "  --io lcm[:URL]         transport (default lcm with its default URL)\n"
+          "  --lockstep             one tick per received state (deterministic; host_sim --lockstep)\n"
+          "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a state (200)\n"
+          "  --duration S           stop after S seconds (default: run until SIGINT/SIGTERM)\n"
+          "  --max-states N         stop after answering N states\n"
+          "  --input-timeout-ms N   the core's input timeout (default from the core)\n"
+          "  --sampled              sample actions instead of the greedy argmax\n"
+          "  --seed N               seed of the sampled mode\n"
+          "  --verbose              a status line on stderr every 100 ms\n"
+          "  --help\n"
+          "Weights: %s (compiled in).\n",
+          pour_weights_builtin_path());
+}
+
+/* Parses a whole decimal integer in [lo, hi]; prints a message naming the option otherwise. */
+static int parse_int(const char *opt, const char *s, long long lo, long long hi, long long *out) {
+  char *end = NULL;
+  errno = 0;
+  const long long v = s != NULL ? strtoll(s, &end, 10) : 0;
+  if (s == NULL || end == s || *end != '\0' || errno != 0 || v < lo || v > hi) {
+    fprintf(stderr, "pour_controller: %s needs an integer in [%lld, %lld], got '%s'\n", opt, lo, hi,
+            s != NULL ? s : "(nothing)");
+    return -1;
+  }
+  *out = v;
+  return 0;
+}
+
+static int parse_seconds(const char *opt, const char *s, long long *out_ms) {
+  char *end = NULL;
+  errno = 0;
+  const double v = s != NULL ? strtod(s, &end) : 0.0;
+  if (s == NULL || end == s || *end != '\0' || errno != 0 || !(v > 0.0) || v > 1e7) {
+    fprintf(stderr, "pour_controller: %s needs a number of seconds in (0, 1e7], got '%s'\n", opt,
+            s != NULL ? s : "(nothing)");
+    return -1;
+  }
+  *out_ms = (long long)(v * 1000.0 + 0.5);
+  if (*out_ms < 1) {
+    *out_ms = 1;
+  }
+  return 0;
+}
+
+/* Opens the transport named by spec: "lcm" or "lcm:URL". Other backends add a branch here. */
+static int open_io(const char *spec, pour_io_t *io) {
+  if (strcmp(spec, "lcm") == 0) {
+    return pour_io_lcm_open(io, NULL);
+  }
+  if (strncmp(spec, "lcm:", 4) == 0) {
+    return pour_io_lcm_open(io, spec + 4);
+  }
+  fprintf(stderr, "pour_controller: unknown transport '%s' (known: lcm[:URL])\n", spec);
+  return -1;
+}
+
+int main(int argc, char **argv) {
+  pour_linux_config_t cfg = pour_linux_default_config();
+  cfg.weights = pour_weights_builtin();
+  const char *io_spec = "lcm";
+  for (int i = 1; i < argc; i++) {
+    const char *a = argv[i];
+    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    long long n = 0;
+    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+      usage(stdout);
+      return 0;
+    } else if (strcmp(a, "--io") == 0) {
+      if (v == NULL) {
+        fprintf(stderr, "pour_controller: --io needs a transport, e.g. lcm or lcm:URL\n");
+        return 2;
+      }
+      io_spec = v;
+      i++;
+    } else if (strcmp(a, "--lockstep") == 0) {
+      cfg.lockstep = true;
+    } else if (strcmp(a, "--stall-ms") == 0) {
+      if (parse_int(a, v, 1, 3600000, &n) != 0) {
+        return 2;
+      }
+      cfg.stall_ms = n;
+      i++;
+    } else if (strcmp(a, "--duration") == 0) {
+      if (parse_seconds(a, v, &n) != 0) {
+        return 2;
+      }
+      cfg.duration_ms = n;
+      i++;
+    } else if (strcmp(a, "--max-states") == 0) {
+      if (parse_int(a, v, 1, INT64_MAX, &n) != 0) {
+        return 2;
+      }
+      cfg.max_states = n;
+      i++;
+    } else if (strcmp(a, "--input-timeout-ms") == 0) {
+      if (parse_int(a, v, 1, UINT16_MAX, &n) != 0) {
+        return 2;
+      }
+      cfg.control.input_timeout_ms = (uint16_t)n;
+      i++;
+    } else if (strcmp(a, "--sampled") == 0) {
+      cfg.control.policy_mode = POUR_POLICY_SAMPLED;
+    } else if (strcmp(a, "--seed") == 0) {
+      if (parse_int(a, v, 0, UINT32_MAX, &n) != 0) {
+        return 2;
+      }
+      cfg.control.seed = (uint32_t)n;
+      i++;
+    } else if (strcmp(a, "--verbose") == 0) {
+      cfg.verbose = true;
+    } else {
+      fprintf(stderr, "pour_controller: unknown option '%s' (see --help)\n", a);
+      return 2;
+    }
+  }
+
+  pour_io_t io;
+  memset(&io, 0, sizeof io);
+  if (open_io(io_spec, &io) != 0) {
+    return 1;
+  }
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+
+  fprintf(stderr, "pour_controller: %s, io %s, weights %s (hash 0x%08x)\n",
+          cfg.lockstep ? "lockstep" : "real time 1 kHz", io_spec, pour_weights_builtin_path(),
+          (unsigned)cfg.weights->content_hash);
+  pour_linux_stats_t st;
+  const int rc = pour_linux_run(&cfg, &io, &g_stop, &st);
+  io.close(&io);
+  if (rc != 0) {
+    fprintf(stderr, "pour_controller: the core refused its configuration: %s\n",
+            pour_status_name((pour_status_t)rc));
+    return 1;
+  }
+  printf("pour_controller: ticks %lld states %lld answers %lld duplicates %lld dropped %lld stale_ticks %lld "
+         "overruns %lld late_mean_us %.1f late_max_us %lld step_max_ns %lld io_errors %lld episodes %lld "
+         "mode %u faults 0x%04x\n",
+         (long long)st.ticks, (long long)st.states_received, (long long)st.answers, (long long)st.duplicates,
+         (long long)st.messages_dropped, (long long)st.stale_ticks, (long long)st.overruns,
+         st.ticks > 0 ? (double)st.late_sum_us / (double)st.ticks : 0.0, (long long)st.late_max_us,
+         (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.episodes, (unsigned)st.mode,
+         (unsigned)st.faults);
+  return 0;
+}
