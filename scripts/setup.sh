@@ -60,7 +60,12 @@ if [ ! -f "$UNITY_DIR/unity.c" ]; then
   trap 'rm -rf "$work"' EXIT
   mkdir -p "$work/parts" "$work/lists/partial" "$work/cache/archives/partial"
   # deb-src entry derived from the system's own sources, in a private apt state: nothing global changes.
-  sed 's/^Types: deb$/Types: deb-src/' /etc/apt/sources.list.d/debian.sources > "$work/parts/src.sources"
+  for f in /etc/apt/sources.list.d/*.sources; do
+    if [ -f "$f" ]; then sed 's/^Types: deb$/Types: deb-src/' "$f" > "$work/parts/$(basename "$f")"; fi
+  done
+  for f in /etc/apt/sources.list /etc/apt/sources.list.d/*.list; do
+    if [ -f "$f" ]; then sed -n 's/^deb \(.*\)$/deb-src \1/p' "$f" >> "$work/parts/src.list"; fi
+  done
   aptopts=(-o Dir::Etc::SourceList=/dev/null -o "Dir::Etc::SourceParts=$work/parts"
            -o "Dir::State::Lists=$work/lists" -o "Dir::Cache=$work/cache" -o APT::Sandbox::User=root)
   apt-get "${aptopts[@]}" update -qq

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The main job: one pour of the simulated bucket with the shipped trained policy, run through the real
+# firmware control step (linked in-process), with the numbers printed and a rendered picture written.
+# Installs what is missing first. Extra arguments go to host_sim (e.g. --seed 7, --episodes 20).
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+./scripts/setup.sh
+cmake --preset host >/dev/null
+cmake --build --preset host --target host_sim
+mkdir -p out
+./build/host/host_sim/host_sim --policy policy/weights.h --seed 1 --render out/pour.gif "$@"
+echo
+echo "Rendered pour: out/pour.gif (animation) and out/pour.png (snapshot)"
