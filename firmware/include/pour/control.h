@@ -29,6 +29,10 @@ typedef struct {
   q15_t safe_torque;           /* command in IDLE and FAULT, within the envelope, Q15 */
   pour_policy_mode_t policy_mode;
   uint32_t seed;               /* sampled mode's PRNG seed */
+  /* A fresh state outside these bounds is physically impossible: BAD_INPUT fault. */
+  int32_t plausible_theta_urad;    /* |θ| <= this [µrad], > 0 */
+  int32_t plausible_omega_urad_s;  /* |θ̇| <= this [µrad/s], > 0 */
+  int32_t plausible_volume_sum;    /* V_rot + V_tgt + V_spill <= this, Q15 (32768 = all the liquid) */
 } pour_control_config_t;
 
 /* Inputs of one tick. */
@@ -59,6 +63,7 @@ typedef struct {
   uint32_t tick;
   uint32_t ms_since_fresh;
   uint32_t ms_to_decision;
+  pour_state_t state; /* latest fresh, plausible state */
   pour_obs_t obs;
   pour_policy_eval_t eval;
 } pour_control_t;
@@ -66,11 +71,15 @@ typedef struct {
 /* Defaults: docs/safety.md lists them with their reasons. */
 pour_control_config_t pour_control_default_config(void);
 
-/* Validates config and weights once; the controller starts in IDLE at zero torque. */
+/* Validates config and weights once; the controller starts in IDLE at zero torque.
+ * POUR_EINVAL for a bad config, else pour_policy_weights_validate's status. */
 pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
                                 const pour_policy_weights_t *weights);
 
-/* One 1 ms tick. Never fails: problems show as mode and fault bits in the output. */
+/* One 1 ms tick. Never fails: problems show as mode and fault bits in the output.
+ * Order: e-stop (zero torque now), clear request, input check (BAD_INPUT), timeout (STALE_INPUT,
+ * armed in RUN only), IDLE -> RUN on the first fresh state, policy decision on the first RUN tick and
+ * every decision_period_ms ticks after, envelope. out->tick counts the steps including this one. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
 
 #endif /* POUR_CONTROL_H */

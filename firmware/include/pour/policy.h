@@ -56,4 +56,23 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
 /* Evaluates the policy on one observation. Never fails on an initialised policy. */
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
 
+/* The kernels pour_policy_eval is made of, exposed for tests and the benchmark. */
+
+/* logits[a] = round((x·W)[a] / 2^f), x = [obs Q15, 1.0], W Q(15-f).f, int64 accumulator; Q16.15,
+ * rounded half up, saturated to int32. logits has weights->n_actions entries. */
+void pour_policy_logits(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits);
+
+/* Softmax of n (1..16) Q16.15 logits into Q15 probabilities: max subtracted, exp in Q16 by table and
+ * linear interpolation, p = round(32768 e / sum e) saturated to 32767; |sum p - 32768| <= n/2 LSB. */
+void pour_policy_softmax_q15(const int32_t *logits, unsigned n, q15_t *probs);
+
+/* Index of the largest of n logits; ties go to the lowest index. */
+unsigned pour_policy_argmax(const int32_t *logits, unsigned n);
+
+/* Marsaglia's xorshift32 (13, 17, 5): advances *state (non-zero) and returns the new value. */
+uint32_t pour_policy_xorshift32(uint32_t *state);
+
+/* Draws an action from n Q15 probabilities: u = (xorshift32 * sum p) >> 32, first a with u < cum p. */
+unsigned pour_policy_sample(const q15_t *probs, unsigned n, uint32_t *rng);
+
 #endif /* POUR_POLICY_H */

@@ -60,6 +60,7 @@ static void send_answer(loop_t *l) {
       .utime = wall_us(),
       .state_seq = l->last_seq,
       .state_utime = l->last_utime,
+      .episode = l->last_episode,
       .out = &l->out,
       .n_actions = l->config->weights->n_actions,
       .obs = &l->ctl.obs,

@@ -28,6 +28,7 @@ typedef struct {
   int64_t utime;         /* send time [µs], controller wall clock */
   int64_t state_seq;     /* seq of the answered state */
   int64_t state_utime;   /* utime of the answered state [µs] */
+  int32_t episode;       /* episode of the answered state */
   const pour_control_output_t *out;
   uint8_t n_actions;
   const pour_obs_t *obs; /* observation the policy saw */

@@ -110,6 +110,7 @@ static int io_lcm_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
   msg.utime = a->utime;
   msg.seq = a->state_seq;
   msg.state_utime = a->state_utime;
+  msg.episode = a->episode;
   msg.torque_q15 = a->out->torque;
   msg.torque = (double)a->out->torque / 32768.0 * (double)a->tau_max_mnm * 1e-3;
   msg.action = (int8_t)a->out->action;

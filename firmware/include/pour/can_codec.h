@@ -1,0 +1,130 @@
+/* SPDX-License-Identifier: MIT */
+/* The pour CAN protocol (can/pour.dbc): frame ids, message structs, pack and unpack. Pure: no I/O.
+ * Classic CAN, 11-bit ids, id = (node_id << 5) | cmd; all signals little-endian (DBC "@1"). */
+#ifndef POUR_CAN_CODEC_H
+#define POUR_CAN_CODEC_H
+
+#include <stdint.h>
+
+#include "pour/fixed.h"
+
+#define POUR_CAN_NODE_ID_MAX 63u /* node ids 0 .. 63 (6 bits) */
+#define POUR_CAN_CMD_MASK 0x1Fu  /* cmd ids 0 .. 31 (5 bits) */
+#define POUR_CAN_NODE_SHIFT 5u
+#define POUR_CAN_NODE_MASK 0x7E0u /* acceptance mask that selects one node's ids */
+#define POUR_CAN_STD_ID_MAX 0x7FFu
+
+/* Command ids (the DBC's frame ids for node 0). */
+#define POUR_CAN_CMD_HEARTBEAT 0x01u    /* controller -> host, every heartbeat period */
+#define POUR_CAN_CMD_ESTOP 0x02u        /* host -> controller */
+#define POUR_CAN_CMD_STATE_A 0x10u      /* host -> controller: θ, θ̇, seq low byte */
+#define POUR_CAN_CMD_STATE_B 0x11u      /* host -> controller: seq, three volumes; completes a state */
+#define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
+#define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
+
+/* Data length of each message [bytes]; a frame with another DLC is malformed. */
+#define POUR_CAN_DLC_HEARTBEAT 8u
+#define POUR_CAN_DLC_ESTOP 1u
+#define POUR_CAN_DLC_STATE_A 8u
+#define POUR_CAN_DLC_STATE_B 8u
+#define POUR_CAN_DLC_TORQUE 7u
+#define POUR_CAN_DLC_CLEAR_ERRORS 0u
+
+/* Signal ranges, as the DBC's [min|max] in raw units; a value outside is out of range. */
+#define POUR_CAN_THETA_MAX_URAD 3200000   /* |θ| <= 3.2 rad; 24-bit signed field [µrad] */
+#define POUR_CAN_OMEGA_MAX_URAD_S 50000000 /* |θ̇| <= 50 rad/s [µrad/s] */
+#define POUR_CAN_VOLUME_MAX_Q15 32767      /* volumes in [0, 32767] Q15 */
+#define POUR_CAN_MODE_MAX 3u               /* pour_mode_t */
+#define POUR_CAN_ACTION_MAX 15u
+#define POUR_CAN_LIMITS_MAX 15u
+
+/* Controller fault bits carried in the heartbeat beside the control core's POUR_FAULT_* (bits 0..7). */
+#define POUR_CAN_FAULT_WATCHDOG 0x0100u /* latched: no valid frame within the command watchdog timeout */
+
+/* A classic CAN data frame with an 11-bit id. */
+typedef struct {
+  uint16_t id;     /* 0 .. 0x7FF */
+  uint8_t dlc;     /* 0 .. 8 */
+  uint8_t data[8]; /* bytes past dlc are zero in packed frames and ignored on unpack */
+} pour_can_frame_t;
+
+typedef struct {
+  int32_t theta_urad;   /* [µrad], |θ| <= POUR_CAN_THETA_MAX_URAD */
+  int32_t omega_urad_s; /* [µrad/s], |θ̇| <= POUR_CAN_OMEGA_MAX_URAD_S */
+  uint8_t seq_low;      /* low byte of the matching StateB seq */
+} pour_can_state_a_t;
+
+typedef struct {
+  uint16_t seq;     /* sample counter, wraps */
+  q15_t v_rotating; /* [0, 32767] Q15 */
+  q15_t v_target;   /* [0, 32767] Q15 */
+  q15_t v_spill;    /* [0, 32767] Q15 */
+} pour_can_state_b_t;
+
+typedef struct {
+  uint16_t seq;   /* seq of the latest complete state */
+  q15_t torque;   /* fraction of tau_max, Q15 */
+  uint8_t action; /* 0 .. 15 */
+  uint8_t mode;   /* pour_mode_t, 0 .. 3 */
+  uint8_t limits; /* POUR_LIMIT_* bits, 0 .. 15 */
+} pour_can_torque_t;
+
+typedef struct {
+  uint8_t mode;        /* pour_mode_t, 0 .. 3 */
+  uint16_t faults;     /* POUR_FAULT_* | POUR_CAN_FAULT_*; only the bits the DBC names are carried */
+  uint16_t rx_dropped; /* malformed frames dropped, wraps */
+  uint16_t overruns;   /* missed control deadlines, wraps */
+  uint8_t counter;     /* +1 per heartbeat, wraps */
+} pour_can_heartbeat_t;
+
+typedef struct {
+  uint8_t assert_estop; /* 1 assert, 0 release */
+} pour_can_estop_t;
+
+/* The fault bits the heartbeat carries (POUR_FAULT_STALE_INPUT, _ESTOP, _BAD_INPUT, POUR_CAN_FAULT_WATCHDOG). */
+#define POUR_CAN_HEARTBEAT_FAULT_MASK 0x0107u
+
+/* Decoded frame classes and the reasons a frame is not accepted. */
+typedef enum {
+  POUR_CAN_RX_OK = 0,          /* a well-formed frame of ours */
+  POUR_CAN_RX_OTHER_NODE = 1,  /* another node's id: not ours, silently ignored */
+  POUR_CAN_RX_BAD_ID = -1,     /* our node, but no such cmd (or a cmd we only send) */
+  POUR_CAN_RX_BAD_DLC = -2,    /* known cmd with the wrong data length */
+  POUR_CAN_RX_OUT_OF_RANGE = -3, /* a signal outside its DBC range */
+  POUR_CAN_RX_UNPAIRED = -4      /* (node) a StateB whose StateA was lost or did not match */
+} pour_can_rx_t;
+
+/* id of cmd for node_id (both masked to their field widths). */
+static inline uint16_t pour_can_id(uint8_t node_id, uint8_t cmd) {
+  return (uint16_t)(((uint32_t)(node_id & POUR_CAN_NODE_ID_MAX) << POUR_CAN_NODE_SHIFT) |
+                    (cmd & POUR_CAN_CMD_MASK));
+}
+
+/* Pack functions: POUR_EINVAL for a null pointer, a node id > 63 or a field outside its DBC range
+ * (the frame is then left untouched). */
+pour_status_t pour_can_pack_state_a(uint8_t node_id, const pour_can_state_a_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_state_b(uint8_t node_id, const pour_can_state_b_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
+                                      pour_can_frame_t *frame);
+pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_clear_errors(uint8_t node_id, pour_can_frame_t *frame);
+
+/* Unpack functions check the id's cmd, the DLC and every range; msg is written only on POUR_CAN_RX_OK.
+ * The node id of the frame is not checked here (pour_can_classify does that). */
+pour_can_rx_t pour_can_unpack_state_a(const pour_can_frame_t *frame, pour_can_state_a_t *msg);
+pour_can_rx_t pour_can_unpack_state_b(const pour_can_frame_t *frame, pour_can_state_b_t *msg);
+pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg);
+pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg);
+pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg);
+pour_can_rx_t pour_can_unpack_clear_errors(const pour_can_frame_t *frame);
+
+/* Classifies a frame for a receiver: POUR_CAN_RX_OTHER_NODE, or for node_id's frames whether cmd is one
+ * of the accepted ones (accept_mask bit cmd set) with the expected DLC; *cmd gets the cmd id. */
+pour_can_rx_t pour_can_classify(const pour_can_frame_t *frame, uint8_t node_id, uint32_t accept_mask,
+                                uint8_t *cmd);
+
+/* Expected DLC of a cmd, or -1 for a cmd the protocol does not define. */
+int pour_can_dlc_of(uint8_t cmd);
+
+#endif /* POUR_CAN_CODEC_H */

@@ -1,0 +1,71 @@
+/* SPDX-License-Identifier: MIT */
+/* The controller's side of the CAN protocol: received frames -> control input, control output -> frames,
+ * plus the command watchdog and the heartbeat schedule. Pure: no I/O; the port moves the frames. */
+#ifndef POUR_CAN_NODE_H
+#define POUR_CAN_NODE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pour/can_codec.h"
+#include "pour/control.h"
+#include "pour/fixed.h"
+
+#define POUR_CAN_NODE_MAX_TX 2u /* frames one tick can produce: torque and heartbeat */
+
+typedef struct {
+  uint8_t node_id;              /* 0 .. 63 */
+  uint16_t watchdog_ms;         /* >= 1: no valid state or command for longer trips the watchdog [ms] */
+  uint16_t heartbeat_period_ms; /* >= 1: a heartbeat every this many ticks [ms] */
+  q15_t safe_torque;            /* torque while the watchdog fault is latched, Q15 */
+} pour_can_node_config_t;
+
+/* Receive counters; they saturate at UINT32_MAX. */
+typedef struct {
+  uint32_t accepted;     /* well-formed frames of ours */
+  uint32_t bad_id;       /* our node, unknown or send-only cmd */
+  uint32_t bad_dlc;      /* wrong data length */
+  uint32_t out_of_range; /* a signal outside its DBC range */
+  uint32_t unpaired;     /* StateB without the StateA of the same sample */
+  uint32_t other_node;   /* other nodes' frames (ignored, not an error) */
+} pour_can_node_counters_t;
+
+typedef struct {
+  pour_can_node_config_t config;
+  pour_can_state_a_t pending_a; /* the latest StateA, waiting for its StateB */
+  bool have_a;
+  pour_state_t state;           /* latest complete state */
+  bool state_fresh;             /* completed since the last tick */
+  bool estop;                   /* level, from the latest Estop frame */
+  bool clear_request;           /* one-shot, from ClearErrors */
+  bool armed;                   /* watchdog runs once the first valid state or command arrived */
+  uint32_t ms_since_valid;
+  uint16_t faults;              /* POUR_CAN_FAULT_* (latched) */
+  uint16_t ms_to_heartbeat;
+  uint8_t heartbeat_counter;
+  pour_can_node_counters_t counters;
+} pour_can_node_t;
+
+/* Node 0, watchdog 50 ms (above the core's input timeout, so the core trips first), heartbeat 100 ms,
+ * safe torque 0. */
+pour_can_node_config_t pour_can_node_default_config(void);
+
+/* Validates config (POUR_EINVAL otherwise); no state, no faults, heartbeat due on the first tick. */
+pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config);
+
+/* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
+pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
+
+/* Start of a 1 ms tick: the control input from what arrived since the last tick. */
+void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
+
+/* End of a tick: runs the watchdog (a latched trip overrides out->torque with safe torque and
+ * out->mode with FAULT and adds its bit to out->faults), then writes the torque frame and, when due,
+ * the heartbeat into tx. overruns: the port's missed deadlines. Returns the number of frames (1 or 2). */
+uint8_t pour_can_node_end_tick(pour_can_node_t *node, pour_control_output_t *out, uint32_t overruns,
+                               pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
+
+/* Total of the dropped-frame counters (what the heartbeat's RxDropped carries, mod 2^16). */
+uint32_t pour_can_node_dropped(const pour_can_node_t *node);
+
+#endif /* POUR_CAN_NODE_H */

@@ -1,0 +1,252 @@
+/* SPDX-License-Identifier: MIT */
+#include "pour/can_codec.h"
+
+#include <stddef.h>
+
+/* Little-endian field access. Signed fields are assembled as unsigned and sign-extended explicitly,
+ * so no shift ever touches a negative value. */
+static void put_u16(uint8_t *p, uint16_t v) {
+  p[0] = (uint8_t)(v & 0xFFu);
+  p[1] = (uint8_t)(v >> 8);
+}
+
+static void put_u24(uint8_t *p, uint32_t v) {
+  p[0] = (uint8_t)(v & 0xFFu);
+  p[1] = (uint8_t)((v >> 8) & 0xFFu);
+  p[2] = (uint8_t)((v >> 16) & 0xFFu);
+}
+
+static void put_u32(uint8_t *p, uint32_t v) {
+  put_u16(p, (uint16_t)(v & 0xFFFFu));
+  put_u16(p + 2, (uint16_t)(v >> 16));
+}
+
+static uint16_t get_u16(const uint8_t *p) { return (uint16_t)(p[0] | (uint16_t)(p[1] << 8)); }
+
+static uint32_t get_u24(const uint8_t *p) {
+  return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16);
+}
+
+static uint32_t get_u32(const uint8_t *p) { return (uint32_t)get_u16(p) | ((uint32_t)get_u16(p + 2) << 16); }
+
+static int32_t as_i32(uint32_t v) {
+  /* Two's complement reinterpretation without implementation-defined conversion. */
+  return (v & 0x80000000u) ? -(int32_t)(~v) - 1 : (int32_t)v;
+}
+
+static int32_t sext24(uint32_t v) { return as_i32((v & 0x800000u) ? (v | 0xFF000000u) : v); }
+
+static q15_t as_q15(uint16_t v) { return (q15_t)((v & 0x8000u) ? -(int32_t)(uint16_t)(~v) - 1 : (int32_t)v); }
+
+static uint16_t q15_bits(q15_t v) { return (uint16_t)((uint32_t)(int32_t)v & 0xFFFFu); }
+
+static void frame_begin(pour_can_frame_t *frame, uint8_t node_id, uint8_t cmd, uint8_t dlc) {
+  frame->id = pour_can_id(node_id, cmd);
+  frame->dlc = dlc;
+  for (size_t i = 0; i < sizeof frame->data; ++i) {
+    frame->data[i] = 0;
+  }
+}
+
+static int in_range_i32(int32_t v, int32_t lim) { return v >= -lim && v <= lim; }
+
+/* q15_t tops out at 32767 = POUR_CAN_VOLUME_MAX_Q15: only the sign needs checking. */
+static int volume_ok(q15_t v) { return v >= 0; }
+
+pour_status_t pour_can_pack_state_a(uint8_t node_id, const pour_can_state_a_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX ||
+      !in_range_i32(msg->theta_urad, POUR_CAN_THETA_MAX_URAD) ||
+      !in_range_i32(msg->omega_urad_s, POUR_CAN_OMEGA_MAX_URAD_S)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_STATE_A, POUR_CAN_DLC_STATE_A);
+  put_u24(&frame->data[0], (uint32_t)msg->theta_urad & 0xFFFFFFu);
+  put_u32(&frame->data[3], (uint32_t)msg->omega_urad_s);
+  frame->data[7] = msg->seq_low;
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_state_b(uint8_t node_id, const pour_can_state_b_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !volume_ok(msg->v_rotating) ||
+      !volume_ok(msg->v_target) || !volume_ok(msg->v_spill)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_STATE_B, POUR_CAN_DLC_STATE_B);
+  put_u16(&frame->data[0], msg->seq);
+  put_u16(&frame->data[2], q15_bits(msg->v_rotating));
+  put_u16(&frame->data[4], q15_bits(msg->v_target));
+  put_u16(&frame->data[6], q15_bits(msg->v_spill));
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->action > POUR_CAN_ACTION_MAX ||
+      msg->mode > POUR_CAN_MODE_MAX || msg->limits > POUR_CAN_LIMITS_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_TORQUE, POUR_CAN_DLC_TORQUE);
+  put_u16(&frame->data[0], msg->seq);
+  put_u16(&frame->data[2], q15_bits(msg->torque));
+  frame->data[4] = msg->action;
+  frame->data[5] = msg->mode;
+  frame->data[6] = msg->limits;
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
+                                      pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->mode > POUR_CAN_MODE_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_HEARTBEAT, POUR_CAN_DLC_HEARTBEAT);
+  frame->data[0] = msg->mode;
+  /* Faults occupy bits 8..23: the core's bits in byte 1, the CAN node's in byte 2. */
+  uint16_t faults = (uint16_t)(msg->faults & POUR_CAN_HEARTBEAT_FAULT_MASK);
+  put_u16(&frame->data[1], faults);
+  put_u16(&frame->data[3], msg->rx_dropped);
+  put_u16(&frame->data[5], msg->overruns);
+  frame->data[7] = msg->counter;
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->assert_estop > 1u) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_ESTOP, POUR_CAN_DLC_ESTOP);
+  frame->data[0] = msg->assert_estop;
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_clear_errors(uint8_t node_id, pour_can_frame_t *frame) {
+  if (frame == NULL || node_id > POUR_CAN_NODE_ID_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_CLEAR_ERRORS, POUR_CAN_DLC_CLEAR_ERRORS);
+  return POUR_OK;
+}
+
+int pour_can_dlc_of(uint8_t cmd) {
+  switch (cmd) {
+    case POUR_CAN_CMD_HEARTBEAT: return (int)POUR_CAN_DLC_HEARTBEAT;
+    case POUR_CAN_CMD_ESTOP: return (int)POUR_CAN_DLC_ESTOP;
+    case POUR_CAN_CMD_STATE_A: return (int)POUR_CAN_DLC_STATE_A;
+    case POUR_CAN_CMD_STATE_B: return (int)POUR_CAN_DLC_STATE_B;
+    case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
+    case POUR_CAN_CMD_CLEAR_ERRORS: return (int)POUR_CAN_DLC_CLEAR_ERRORS;
+    default: return -1;
+  }
+}
+
+/* Checks that frame carries cmd with its DLC. */
+static pour_can_rx_t check_header(const pour_can_frame_t *frame, uint8_t cmd) {
+  if (frame == NULL || frame->id > POUR_CAN_STD_ID_MAX || (frame->id & POUR_CAN_CMD_MASK) != cmd) {
+    return POUR_CAN_RX_BAD_ID;
+  }
+  if (frame->dlc != (uint8_t)pour_can_dlc_of(cmd)) {
+    return POUR_CAN_RX_BAD_DLC;
+  }
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_state_a(const pour_can_frame_t *frame, pour_can_state_a_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_STATE_A);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  int32_t theta = sext24(get_u24(&frame->data[0]));
+  int32_t omega = as_i32(get_u32(&frame->data[3]));
+  if (!in_range_i32(theta, POUR_CAN_THETA_MAX_URAD) || !in_range_i32(omega, POUR_CAN_OMEGA_MAX_URAD_S)) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->theta_urad = theta;
+  msg->omega_urad_s = omega;
+  msg->seq_low = frame->data[7];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_state_b(const pour_can_frame_t *frame, pour_can_state_b_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_STATE_B);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  q15_t vr = as_q15(get_u16(&frame->data[2]));
+  q15_t vt = as_q15(get_u16(&frame->data[4]));
+  q15_t vs = as_q15(get_u16(&frame->data[6]));
+  if (!volume_ok(vr) || !volume_ok(vt) || !volume_ok(vs)) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->seq = get_u16(&frame->data[0]);
+  msg->v_rotating = vr;
+  msg->v_target = vt;
+  msg->v_spill = vs;
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_TORQUE);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if (frame->data[4] > POUR_CAN_ACTION_MAX || frame->data[5] > POUR_CAN_MODE_MAX ||
+      frame->data[6] > POUR_CAN_LIMITS_MAX) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->seq = get_u16(&frame->data[0]);
+  msg->torque = as_q15(get_u16(&frame->data[2]));
+  msg->action = frame->data[4];
+  msg->mode = frame->data[5];
+  msg->limits = frame->data[6];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_HEARTBEAT);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if (frame->data[0] > POUR_CAN_MODE_MAX) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->mode = frame->data[0];
+  msg->faults = (uint16_t)(get_u16(&frame->data[1]) & POUR_CAN_HEARTBEAT_FAULT_MASK);
+  msg->rx_dropped = get_u16(&frame->data[3]);
+  msg->overruns = get_u16(&frame->data[5]);
+  msg->counter = frame->data[7];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_ESTOP);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if (frame->data[0] > 1u) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->assert_estop = frame->data[0];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_clear_errors(const pour_can_frame_t *frame) {
+  return check_header(frame, POUR_CAN_CMD_CLEAR_ERRORS);
+}
+
+pour_can_rx_t pour_can_classify(const pour_can_frame_t *frame, uint8_t node_id, uint32_t accept_mask,
+                                uint8_t *cmd) {
+  if (frame == NULL || frame->id > POUR_CAN_STD_ID_MAX) {
+    return POUR_CAN_RX_BAD_ID;
+  }
+  if ((frame->id >> POUR_CAN_NODE_SHIFT) != node_id) {
+    return POUR_CAN_RX_OTHER_NODE;
+  }
+  uint8_t c = (uint8_t)(frame->id & POUR_CAN_CMD_MASK);
+  if (cmd != NULL) {
+    *cmd = c;
+  }
+  int dlc = pour_can_dlc_of(c);
+  if (dlc < 0 || (accept_mask & (1u << c)) == 0u) {
+    return POUR_CAN_RX_BAD_ID;
+  }
+  return frame->dlc == (uint8_t)dlc ? POUR_CAN_RX_OK : POUR_CAN_RX_BAD_DLC;
+}

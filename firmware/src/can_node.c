@@ -1,0 +1,174 @@
+/* SPDX-License-Identifier: MIT */
+#include "pour/can_node.h"
+
+#include <stddef.h>
+
+/* Commands a controller accepts; HEARTBEAT and TORQUE are its own transmissions. */
+#define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STATE_A) | (1u << POUR_CAN_CMD_STATE_B) | \
+                     (1u << POUR_CAN_CMD_CLEAR_ERRORS))
+
+pour_can_node_config_t pour_can_node_default_config(void) {
+  pour_can_node_config_t c;
+  c.node_id = 0;
+  c.watchdog_ms = 50;
+  c.heartbeat_period_ms = 100;
+  c.safe_torque = 0;
+  return c;
+}
+
+pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config) {
+  if (node == NULL || config == NULL || config->node_id > POUR_CAN_NODE_ID_MAX || config->watchdog_ms == 0u ||
+      config->heartbeat_period_ms == 0u) {
+    return POUR_EINVAL;
+  }
+  pour_can_node_t zero = {0};
+  *node = zero;
+  node->config = *config;
+  node->ms_to_heartbeat = 0;
+  return POUR_OK;
+}
+
+static void count(uint32_t *c) {
+  if (*c != UINT32_MAX) {
+    ++*c;
+  }
+}
+
+/* A valid state or command: feeds the watchdog, and arms it on the first one. */
+static void kick(pour_can_node_t *node) {
+  node->armed = true;
+  node->ms_since_valid = 0;
+}
+
+static pour_can_rx_t drop(pour_can_node_t *node, pour_can_rx_t why) {
+  switch (why) {
+    case POUR_CAN_RX_BAD_DLC: count(&node->counters.bad_dlc); break;
+    case POUR_CAN_RX_OUT_OF_RANGE: count(&node->counters.out_of_range); break;
+    case POUR_CAN_RX_OTHER_NODE: count(&node->counters.other_node); break;
+    default: count(&node->counters.bad_id); break;
+  }
+  return why;
+}
+
+pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame) {
+  if (node == NULL) {
+    return POUR_CAN_RX_BAD_ID;
+  }
+  uint8_t cmd = 0;
+  pour_can_rx_t rc = pour_can_classify(frame, node->config.node_id, ACCEPT_MASK, &cmd);
+  if (rc != POUR_CAN_RX_OK) {
+    return drop(node, rc);
+  }
+  switch (cmd) {
+    case POUR_CAN_CMD_STATE_A: {
+      pour_can_state_a_t a;
+      rc = pour_can_unpack_state_a(frame, &a);
+      if (rc != POUR_CAN_RX_OK) {
+        return drop(node, rc);
+      }
+      node->pending_a = a;
+      node->have_a = true;
+      break;
+    }
+    case POUR_CAN_CMD_STATE_B: {
+      pour_can_state_b_t b;
+      rc = pour_can_unpack_state_b(frame, &b);
+      if (rc != POUR_CAN_RX_OK) {
+        return drop(node, rc);
+      }
+      /* A lost or corrupt StateA must not pair its neighbour's angle with these volumes. */
+      if (!node->have_a || node->pending_a.seq_low != (uint8_t)(b.seq & 0xFFu)) {
+        count(&node->counters.unpaired);
+        return POUR_CAN_RX_UNPAIRED;
+      }
+      node->have_a = false;
+      node->state.seq = b.seq;
+      node->state.theta_urad = node->pending_a.theta_urad;
+      node->state.omega_urad_s = node->pending_a.omega_urad_s;
+      node->state.v_rotating = b.v_rotating;
+      node->state.v_target = b.v_target;
+      node->state.v_spill = b.v_spill;
+      node->state_fresh = true;
+      kick(node);
+      break;
+    }
+    case POUR_CAN_CMD_ESTOP: {
+      pour_can_estop_t e;
+      rc = pour_can_unpack_estop(frame, &e);
+      if (rc != POUR_CAN_RX_OK) {
+        return drop(node, rc);
+      }
+      node->estop = e.assert_estop != 0u;
+      kick(node);
+      break;
+    }
+    default: /* POUR_CAN_CMD_CLEAR_ERRORS: classify checked its DLC, it has no signals. */
+      node->clear_request = true;
+      kick(node);
+      break;
+  }
+  count(&node->counters.accepted);
+  return POUR_CAN_RX_OK;
+}
+
+void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
+  in->state_fresh = node->state_fresh;
+  in->state = node->state;
+  in->estop = node->estop;
+  in->clear_faults = node->clear_request;
+  if (node->clear_request) {
+    node->faults = 0;
+  }
+  node->state_fresh = false;
+  node->clear_request = false;
+}
+
+uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
+  const pour_can_node_counters_t *c = &node->counters;
+  uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range + c->unpaired;
+  return sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
+}
+
+uint8_t pour_can_node_end_tick(pour_can_node_t *node, pour_control_output_t *out, uint32_t overruns,
+                               pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]) {
+  if (node->armed) {
+    if (node->ms_since_valid < UINT32_MAX) {
+      ++node->ms_since_valid;
+    }
+    if (node->ms_since_valid > node->config.watchdog_ms) {
+      node->faults |= POUR_CAN_FAULT_WATCHDOG;
+    }
+  }
+  if ((node->faults & POUR_CAN_FAULT_WATCHDOG) != 0u) {
+    out->torque = node->config.safe_torque;
+    if (out->mode == (uint8_t)POUR_MODE_RUN || out->mode == (uint8_t)POUR_MODE_IDLE) {
+      out->mode = (uint8_t)POUR_MODE_FAULT;
+    }
+  }
+  out->faults = (uint16_t)(out->faults | node->faults);
+
+  uint8_t n = 0;
+  pour_can_torque_t t;
+  t.seq = (uint16_t)(node->state.seq & 0xFFFFu);
+  t.torque = out->torque;
+  t.action = (uint8_t)(out->action & POUR_CAN_ACTION_MAX);
+  t.mode = (uint8_t)(out->mode & 0x03u);
+  t.limits = (uint8_t)(out->limits & POUR_CAN_LIMITS_MAX);
+  if (pour_can_pack_torque(node->config.node_id, &t, &tx[n]) == POUR_OK) {
+    ++n;
+  }
+  if (node->ms_to_heartbeat == 0u) {
+    pour_can_heartbeat_t hb;
+    hb.mode = t.mode;
+    hb.faults = out->faults;
+    hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
+    hb.overruns = (uint16_t)(overruns & 0xFFFFu);
+    hb.counter = node->heartbeat_counter++;
+    if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[n]) == POUR_OK) {
+      ++n;
+    }
+    node->ms_to_heartbeat = node->config.heartbeat_period_ms;
+  }
+  --node->ms_to_heartbeat;
+  return n;
+}

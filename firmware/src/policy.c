@@ -1,0 +1,202 @@
+/* SPDX-License-Identifier: MIT */
+#include "pour/policy.h"
+
+#include <stddef.h>
+
+/* Rounding right shifts below rely on >> of a negative int64 being arithmetic (floor), as GCC and
+ * Clang define it and as Python's >> behaves. */
+_Static_assert((-3 >> 1) == -2, "arithmetic right shift required");
+
+#define FNV_OFFSET_BASIS 2166136261u
+#define FNV_PRIME 16777619u
+#define DEFAULT_SEED 2463534242u
+
+/* 2^(-j/64) in Q24 for j = 0..64: round(2^(-j/64) * 2^24), regenerated and checked by
+ * tools/pour/fixedpoint.py (EXP2_TABLE_Q24). */
+static const uint32_t exp2_neg_q24[65] = {
+    16777216u, 16596492u, 16417715u, 16240863u, 16065917u, 15892855u, 15721658u, 15552304u,
+    15384775u, 15219050u, 15055111u, 14892937u, 14732511u, 14573813u, 14416824u, 14261526u,
+    14107901u, 13955931u, 13805598u, 13656884u, 13509772u, 13364245u, 13220286u, 13077877u,
+    12937002u, 12797645u, 12659789u, 12523418u, 12388516u, 12255067u, 12123055u, 11992466u,
+    11863283u, 11735492u, 11609078u, 11484025u, 11360319u, 11237946u, 11116891u, 10997140u,
+    10878679u, 10761494u, 10645571u, 10530897u, 10417458u, 10305242u, 10194234u, 10084422u,
+    9975792u,  9868333u,  9762032u,  9656875u,  9552851u,  9449948u,  9348154u,  9247455u,
+    9147842u,  9049301u,  8951823u,  8855394u,  8760003u,  8665641u,  8572295u,  8479954u,
+    8388608u,
+};
+
+static uint32_t fnv1a(uint32_t h, uint32_t value, unsigned n_bytes) {
+  for (unsigned i = 0; i < n_bytes; ++i) {
+    h ^= (value >> (8u * i)) & 0xFFu;
+    h *= FNV_PRIME;
+  }
+  return h;
+}
+
+uint32_t pour_policy_weights_hash(const pour_policy_weights_t *weights) {
+  const int32_t header[9] = {
+      POUR_WEIGHTS_FORMAT_VERSION,  POUR_POLICY_N_FEATURES,       (int32_t)weights->n_actions,
+      (int32_t)weights->w_frac_bits, (int32_t)weights->decision_period_ms, weights->norm.theta_min_urad,
+      weights->norm.theta_max_urad, weights->norm.omega_max_urad_s, weights->tau_max_mnm,
+  };
+  uint32_t h = FNV_OFFSET_BASIS;
+  for (unsigned i = 0; i < 9u; ++i) {
+    h = fnv1a(h, (uint32_t)header[i], 4u);
+  }
+  const unsigned n_w = (unsigned)POUR_POLICY_N_FEATURES * weights->n_actions;
+  for (unsigned i = 0; i < n_w; ++i) {
+    h = fnv1a(h, (uint16_t)weights->w[i], 2u);
+  }
+  for (unsigned i = 0; i < weights->n_actions; ++i) {
+    h = fnv1a(h, (uint16_t)weights->action_levels[i], 2u);
+  }
+  return h;
+}
+
+pour_status_t pour_policy_weights_validate(const pour_policy_weights_t *weights) {
+  if (weights == NULL || weights->w == NULL || weights->action_levels == NULL) {
+    return POUR_EINVAL;
+  }
+  if (weights->n_actions < POUR_POLICY_MIN_ACTIONS || weights->n_actions > POUR_POLICY_MAX_ACTIONS) {
+    return POUR_ESHAPE;
+  }
+  if (weights->w_frac_bits > 15u) {
+    return POUR_EFORMAT;
+  }
+  if (weights->decision_period_ms < 1u || weights->tau_max_mnm <= 0) {
+    return POUR_EINVAL;
+  }
+  if (pour_obs_norm_validate(&weights->norm) != POUR_OK) {
+    return POUR_EINVAL;
+  }
+  /* Levels are torque fractions in increasing order: action i+1 always pushes harder than action i. */
+  for (unsigned i = 1; i < weights->n_actions; ++i) {
+    if (weights->action_levels[i] <= weights->action_levels[i - 1u]) {
+      return POUR_EINVAL;
+    }
+  }
+  if (pour_policy_weights_hash(weights) != weights->content_hash) {
+    return POUR_ECORRUPT;
+  }
+  return POUR_OK;
+}
+
+pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_t *weights,
+                               pour_policy_mode_t mode, uint32_t seed) {
+  if (policy == NULL || (mode != POUR_POLICY_GREEDY && mode != POUR_POLICY_SAMPLED)) {
+    return POUR_EINVAL;
+  }
+  const pour_status_t status = pour_policy_weights_validate(weights);
+  if (status != POUR_OK) {
+    return status;
+  }
+  policy->weights = weights;
+  policy->mode = mode;
+  policy->rng = seed != 0u ? seed : DEFAULT_SEED;
+  return POUR_OK;
+}
+
+void pour_policy_logits(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
+  const unsigned n = weights->n_actions;
+  const unsigned f = weights->w_frac_bits;
+  const int64_t half = f > 0u ? ((int64_t)1 << (f - 1u)) : 0;
+  for (unsigned a = 0; a < n; ++a) {
+    /* Q15 x (>= 0, <= 32767) times Q(15-f).f w (|w| <= 32768): each product fits int32 (< 2^30), the
+     * bias term is 32768 * w; |acc| <= 6 * 2^30 < 2^33, so int64 never overflows. acc is Q(15+f). */
+    int64_t acc = (int64_t)POUR_Q15_ONE_INT * weights->w[POUR_OBS_N * n + a];
+    for (unsigned k = 0; k < POUR_OBS_N; ++k) {
+      acc += (int32_t)obs->x[k] * (int32_t)weights->w[k * n + a];
+    }
+    logits[a] = pour_sat_i32((acc + half) >> f);
+  }
+}
+
+/* exp(-d) for d = max - logit >= 0 (Q16.15 difference, as uint32), in Q16 (1.0 = 65536).
+ * exp(-d) = 2^-y with y = d * log2(e), y in Q15 (log2(e) in Q16 = 94548, rounded). y = k + r:
+ * 2^-r from the 65-entry Q24 table with linear interpolation over 9 fraction bits (error < 1 LSB of
+ * Q16), then >> (8 + k) rounded. k > 16 gives 0 (below half a Q16 LSB). */
+static uint32_t exp_neg_q16(uint32_t d) {
+  const uint64_t y = ((uint64_t)d * 94548u + 32768u) >> 16;
+  const uint64_t k = y >> 15;
+  if (k > 16u) {
+    return 0u;
+  }
+  const uint32_t r = (uint32_t)y & 0x7FFFu;
+  const uint32_t j = r >> 9;
+  const uint32_t frac = r & 0x1FFu;
+  const uint32_t step = exp2_neg_q24[j] - exp2_neg_q24[j + 1u]; /* < 2^18: step * 511 fits */
+  const uint32_t v = exp2_neg_q24[j] - ((step * frac + 256u) >> 9);
+  const uint32_t shift = 8u + (uint32_t)k;
+  return (v + (1u << (shift - 1u))) >> shift;
+}
+
+void pour_policy_softmax_q15(const int32_t *logits, unsigned n, q15_t *probs) {
+  int32_t max = logits[0];
+  for (unsigned a = 1; a < n; ++a) {
+    max = logits[a] > max ? logits[a] : max;
+  }
+  uint32_t e[POUR_POLICY_MAX_ACTIONS];
+  uint32_t sum = 0u; /* >= 65536 (the max's term), <= 16 * 65536 */
+  for (unsigned a = 0; a < n; ++a) {
+    e[a] = exp_neg_q16((uint32_t)max - (uint32_t)logits[a]); /* exact: 0 <= max - logit < 2^32 */
+    sum += e[a];
+  }
+  /* p = round(32768 * e / sum): e * 32768 <= 2^31 and sum / 2 < 2^20, so the numerator fits uint32 and
+   * the divide is one UDIV on the Cortex-M4. Each p is within half an LSB of the exact ratio, so
+   * |sum(p) - 32768| <= n/2 LSB; p = 32768 (one action holds all the mass) saturates to 32767. */
+  for (unsigned a = 0; a < n; ++a) {
+    const uint32_t p = (e[a] * 32768u + sum / 2u) / sum;
+    probs[a] = (q15_t)(p > (uint32_t)POUR_Q15_MAX ? (uint32_t)POUR_Q15_MAX : p);
+  }
+}
+
+unsigned pour_policy_argmax(const int32_t *logits, unsigned n) {
+  unsigned best = 0;
+  for (unsigned a = 1; a < n; ++a) {
+    if (logits[a] > logits[best]) { /* strict: a tie keeps the lower index */
+      best = a;
+    }
+  }
+  return best;
+}
+
+uint32_t pour_policy_xorshift32(uint32_t *state) {
+  uint32_t x = *state;
+  x ^= x << 13;
+  x ^= x >> 17;
+  x ^= x << 5;
+  *state = x;
+  return x;
+}
+
+unsigned pour_policy_sample(const q15_t *probs, unsigned n, uint32_t *rng) {
+  int32_t total = 0; /* probabilities are >= 0 */
+  for (unsigned a = 0; a < n; ++a) {
+    total += probs[a];
+  }
+  /* u uniform in [0, total) from the top of the 32-bit draw; actions with p = 0 are never picked. */
+  const int32_t u = (int32_t)(((uint64_t)pour_policy_xorshift32(rng) * (uint32_t)total) >> 32);
+  int32_t cum = 0;
+  for (unsigned a = 0; a < n; ++a) {
+    cum += probs[a];
+    if (u < cum) {
+      return a;
+    }
+  }
+  return n - 1u; /* unreachable: cum reaches total > u */
+}
+
+void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
+  const pour_policy_weights_t *w = policy->weights;
+  const unsigned n = w->n_actions;
+  pour_policy_logits(w, obs, out->logits);
+  pour_policy_softmax_q15(out->logits, n, out->probs);
+  for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    out->logits[a] = 0;
+    out->probs[a] = 0;
+  }
+  const unsigned action = policy->mode == POUR_POLICY_SAMPLED
+                              ? pour_policy_sample(out->probs, n, &policy->rng)
+                              : pour_policy_argmax(out->logits, n);
+  out->action = (uint8_t)action;
+}
