@@ -1,0 +1,129 @@
+# SPDX-License-Identifier: MIT
+"""Policy-gradient maths: gradients against finite differences, estimators, optimiser, NaN guard."""
+import numpy as np
+import pytest
+
+from pour import config as cfgmod
+from pour import envs, reinforce, train
+
+
+def _problem(seed=0, t=7, f=6, a=5):
+    rng = np.random.default_rng(seed)
+    w = rng.normal(0, 0.7, (f, a))
+    x = rng.uniform(0, 1, (t, f))
+    x[:, -1] = 1.0
+    acts = rng.integers(0, a, t)
+    weights = rng.normal(0, 1, t)
+    return w, x, acts, weights
+
+
+@pytest.mark.parametrize("entropy_coef", [0.0, 0.3])
+def test_grad_surrogate_matches_finite_differences(entropy_coef):
+    w, x, acts, weights = _problem()
+    g = reinforce.grad_surrogate(w, x, acts, weights, entropy_coef)
+    num = np.zeros_like(w)
+    h = 1e-6
+    for i in np.ndindex(w.shape):
+        wp, wm = w.copy(), w.copy()
+        wp[i] += h
+        wm[i] -= h
+        num[i] = (reinforce.surrogate(wp, x, acts, weights, entropy_coef)
+                  - reinforce.surrogate(wm, x, acts, weights, entropy_coef)) / (2 * h)
+    np.testing.assert_allclose(g, num, rtol=1e-6, atol=1e-8)
+
+
+def test_batch_gradient_matches_finite_differences_of_mean_surrogate():
+    rng = np.random.default_rng(3)
+    n, t, f, a = 4, 6, 6, 3
+    w = rng.normal(0, 0.5, (f, a))
+    b = reinforce.Batch(rng.uniform(0, 1, (n, t, f)), rng.integers(0, a, (n, t)), rng.normal(0, 1, (n, t)))
+    adv = reinforce.advantages(b, 0.9, True, "loo", True)
+    coef = 0.05
+
+    def obj(wv):
+        # Mean over episodes of the advantage term; the entropy bonus is coef x (decisions per
+        # episode) x (mean entropy over all decisions), spread over the n episodes of the mean.
+        pg = np.mean([reinforce.surrogate(wv, b.x[i], b.actions[i], adv[i]) for i in range(n)])
+        return pg + coef * t * np.mean(reinforce.entropy(reinforce.probs(wv, b.x.reshape(n * t, f)))) / n
+
+    g = reinforce.batch_gradient(w, b, adv, coef)
+    num = np.zeros_like(w)
+    h = 1e-6
+    for i in np.ndindex(w.shape):
+        wp, wm = w.copy(), w.copy()
+        wp[i] += h
+        wm[i] -= h
+        num[i] = (obj(wp) - obj(wm)) / (2 * h)
+    np.testing.assert_allclose(g, num, rtol=1e-5, atol=1e-8)
+
+
+def test_vanilla_weights_every_step_by_the_full_discounted_return():
+    r = np.array([[1.0, 2.0, 3.0]])
+    b = reinforce.Batch(np.ones((1, 3, 6)), np.zeros((1, 3), dtype=int), r)
+    adv = reinforce.advantages(b, 0.5, reward_to_go=False, baseline="none", normalize=False)
+    np.testing.assert_allclose(adv, [[2.75, 2.75, 2.75]])  # 1 + 0.5*2 + 0.25*3
+
+
+def test_rewards_to_go():
+    np.testing.assert_allclose(reinforce.rewards_to_go(np.array([1.0, 2.0, 3.0]), 0.5), [2.75, 3.5, 3.0])
+
+
+def test_leave_one_out_baseline_subtracts_mean_of_the_others():
+    r = np.array([[1.0, 0.0], [3.0, 0.0], [8.0, 0.0]])
+    b = reinforce.Batch(np.ones((3, 2, 6)), np.zeros((3, 2), dtype=int), r)
+    adv = reinforce.advantages(b, 1.0, reward_to_go=True, baseline="loo", normalize=False)
+    np.testing.assert_allclose(adv[:, 0], [1 - 5.5, 3 - 4.5, 8 - 2.0])
+    with pytest.raises(ValueError, match="at least 2"):
+        reinforce.advantages(reinforce.Batch(b.x[:1], b.actions[:1], r[:1]), 1.0, True, "loo", False)
+
+
+def test_normalised_advantages_have_zero_mean_unit_std():
+    rng = np.random.default_rng(1)
+    b = reinforce.Batch(np.ones((5, 9, 6)), np.zeros((5, 9), dtype=int), rng.normal(3, 10, (5, 9)))
+    adv = reinforce.advantages(b, 0.99, True, "loo", True)
+    assert abs(adv.mean()) < 1e-12 and abs(adv.std() - 1) < 1e-12
+
+
+def test_softmax_survives_huge_logits():
+    p = reinforce.softmax(np.array([[1e300, 0.0, -1e300], [1000.0, 1000.0, 0.0]]))
+    assert np.all(np.isfinite(p))
+    np.testing.assert_allclose(p[0], [1, 0, 0])
+    np.testing.assert_allclose(p[1], [0.5, 0.5, 0])
+
+
+def test_adam_first_step_is_lr_times_sign_and_state_round_trips():
+    opt = reinforce.Adam((2, 2), lr=0.1)
+    g = np.array([[3.0, -0.001], [0.0, 5.0]])
+    step = opt.step(g)
+    np.testing.assert_allclose(step, 0.1 * np.sign(g), atol=1e-6)
+    st = opt.state_dict()
+    opt2 = reinforce.Adam((2, 2), lr=0.1)
+    opt2.load_state_dict(st)
+    np.testing.assert_array_equal(opt.step(g), opt2.step(g))
+
+
+def test_clip_norm():
+    g, n = reinforce.clip_norm(np.array([3.0, 4.0]), 1.0)
+    assert n == 5.0
+    np.testing.assert_allclose(g, [0.6, 0.8])
+    g, _ = reinforce.clip_norm(np.array([3.0, 4.0]), 0.0)
+    np.testing.assert_allclose(g, [3.0, 4.0])
+
+
+def test_nan_reward_gives_a_clear_gradient_error():
+    cfg = cfgmod.from_dict({"env": {"kind": "toy"}, "algo": {"batch_episodes": 2}})
+    ep = envs.Episode(np.ones((4, 6)), np.zeros(4, dtype=int), np.array([1.0, np.nan, 0.0, 0.0]),
+                      {"v_target": 0, "v_spill": 0, "finish_s": 0})
+    with pytest.raises(reinforce.GradientError, match=r"iteration 7: gradient has .* non-finite.*lower algo.lr"):
+        train.update(cfg, np.zeros((6, 11)), [ep, ep], reinforce.Adam((6, 11), 0.1), 7)
+
+
+def test_overflowing_weights_give_a_clear_gradient_error():
+    cfg = cfgmod.from_dict({"env": {"kind": "toy"}, "algo": {"kind": "vanilla", "batch_episodes": 1,
+                                                              "optimizer": "sgd", "baseline": "none",
+                                                              "normalize_advantages": False, "lr": 10.0,
+                                                              "reward_to_go": False, "entropy_coef": 0.0}})
+    ep = envs.Episode(np.ones((4, 6)), np.array([0, 1, 2, 3]), np.full(4, 1e307),
+                      {"v_target": 0, "v_spill": 0, "finish_s": 0})
+    with pytest.raises(reinforce.GradientError, match="non-finite"):
+        train.update(cfg, np.zeros((6, 11)), [ep], None, 0)

@@ -1,0 +1,173 @@
+# SPDX-License-Identifier: MIT
+"""The trainer on the toy plant: reproducible from its config, resumable after a kill, clear errors."""
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pour import config as cfgmod
+from pour import envs, train
+
+TOY = {"seed": 5, "iterations": 6, "workers": 1,
+       "policy": {"n_actions": 5, "decision_period_ms": 10},
+       "algo": {"batch_episodes": 4, "lr": 0.1},
+       "eval": {"every": 2, "episodes": 2},
+       "env": {"kind": "toy", "episode_s": 3.0}}
+
+
+def _cfg(**top):
+    d = {k: (dict(v) if isinstance(v, dict) else v) for k, v in TOY.items()}
+    d.update(top)
+    return cfgmod.from_dict(d)
+
+
+def _rows(run_dir):
+    with open(Path(run_dir) / "log.csv", newline="") as f:
+        return [{k: v for k, v in r.items() if k != "wall_s"} for r in csv.DictReader(f)]
+
+
+def _toml(d, path):
+    lines = []
+    for k, v in d.items():
+        if not isinstance(v, dict):
+            lines.append(f"{k} = {v!r}".replace("'", '"'))
+    for k, v in d.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            for kk, vv in v.items():
+                lines.append(f"{kk} = {str(vv).lower() if isinstance(vv, bool) else repr(vv)}".replace("'", '"'))
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def test_same_config_same_run_whatever_the_worker_count(tmp_path):
+    a = train.train(_cfg(workers=1), tmp_path / "a", quiet=True)
+    b = train.train(_cfg(workers=2), tmp_path / "b", quiet=True)
+    np.testing.assert_array_equal(a.w, b.w)
+    np.testing.assert_array_equal(a.best_w, b.best_w)
+    assert _rows(tmp_path / "a") == _rows(tmp_path / "b")
+    assert len(_rows(tmp_path / "a")) == 6
+    c = train.train(_cfg(seed=6), tmp_path / "c", quiet=True)
+    assert not np.array_equal(a.w, c.w)
+
+
+def test_resume_after_a_partial_run_is_bit_identical(tmp_path):
+    full = train.train(_cfg(), tmp_path / "full", quiet=True)
+    part = train.train(_cfg(), tmp_path / "part", quiet=True, stop_after=3)
+    assert part.iterations == 3
+    resumed = train.train(_cfg(), tmp_path / "part", quiet=True)
+    assert resumed.iterations == 6
+    np.testing.assert_array_equal(full.w, resumed.w)
+    assert _rows(tmp_path / "full") == _rows(tmp_path / "part")
+
+
+def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
+    d = dict(TOY, iterations=16, env={"kind": "toy", "episode_s": 10.0})
+    cfg_file = tmp_path / "toy.toml"
+    _toml(d, cfg_file)
+    run = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-m", "pour.train", str(cfg_file), "--out", str(run), "--quiet"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    try:
+        while time.monotonic() < deadline:
+            if (run / "checkpoint.npz").exists() and len(_rows(run)) >= 4:
+                break
+            time.sleep(0.01)
+        assert proc.poll() is None, "the run finished before it could be killed"
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.wait(timeout=30)
+    with np.load(run / "checkpoint.npz") as z:
+        done = int(z["iteration"])
+    assert 3 <= done < 16
+    rows_before = _rows(run)
+    assert len(rows_before) >= done  # the log may hold one row more than the checkpoint, never fewer
+    cfg = cfgmod.load(cfg_file)
+    resumed = train.train(cfg, run, quiet=True)
+    assert resumed.iterations == 16
+    ref = train.train(cfg, tmp_path / "ref", quiet=True)
+    np.testing.assert_array_equal(ref.w, resumed.w)
+    assert _rows(run) == _rows(tmp_path / "ref")
+    assert not list(run.glob("*.tmp"))
+
+
+def test_resume_with_another_config_is_refused(tmp_path):
+    train.train(_cfg(), tmp_path / "r", quiet=True, stop_after=1)
+    with pytest.raises(train.TrainError, match="different config"):
+        train.train(_cfg(seed=99), tmp_path / "r", quiet=True)
+    train.train(_cfg(workers=2), tmp_path / "r", quiet=True, stop_after=1)  # workers do not matter
+
+
+def test_training_improves_the_toy_policy(tmp_path):
+    cfg = _cfg(iterations=40, workers=2, eval={"every": 39, "episodes": 4}, env={"kind": "toy", "episode_s": 6.0},
+               algo={"batch_episodes": 8, "lr": 0.15, "entropy_coef": 0.0})
+    res = train.train(cfg, tmp_path / "t", quiet=True)
+    env = envs.ToyEnv(5, 10, 6.0)
+    seeds = train.episode_seeds(123, train.STREAM_TEST, 0, 8)
+    before = np.mean([env.rollout(np.zeros((6, 5)), s, False).metrics["v_target"] for s in seeds])
+    after = np.mean([env.rollout(res.w, s, False).metrics["v_target"] for s in seeds])
+    assert before < 0.05  # the uniform policy hardly tilts the bucket
+    assert after > 0.5
+
+
+BAD = [
+    ({"seed": -1}, "seed = -1"),
+    ({"iterations": 0}, "iterations = 0"),
+    ({"workers": 1.5}, "workers = 1.5: expected an integer"),
+    ({"policy": {"n_actions": 1}}, "policy.n_actions = 1: expected 2..16"),
+    ({"policy": {"n_actions": 17}}, "policy.n_actions = 17"),
+    ({"policy": {"decision_period_ms": 0}}, "policy.decision_period_ms = 0"),
+    ({"policy": {"decision_period_ms": 7}}, "not a whole number of decision periods"),
+    ({"algo": {"gamma": 1.5}}, "algo.gamma = 1.5"),
+    ({"algo": {"gamma": float("nan")}}, "algo.gamma = nan: expected a finite number"),
+    ({"algo": {"lr": 0.0}}, "algo.lr = 0.0"),
+    ({"algo": {"optimizer": "rmsprop"}}, "algo.optimizer = 'rmsprop'"),
+    ({"algo": {"kind": "ppo"}}, "algo.kind = 'ppo'"),
+    ({"algo": {"baseline": "loo", "batch_episodes": 1}}, "needs algo.batch_episodes >= 2"),
+    ({"algo": {"entropy_coef": -0.1}}, "algo.entropy_coef = -0.1"),
+    ({"algo": {"reward_to_go": "yes"}}, "algo.reward_to_go = 'yes': expected true or false"),
+    ({"algo": {"learning_rate": 0.1}}, "unknown key(s) learning_rate"),
+    ({"env": {"kind": "mujoco"}}, "env.kind = 'mujoco'"),
+    ({"eval": {"every": 0}}, "eval.every = 0"),
+    ({"colour": "blue"}, "unknown top-level key(s) colour"),
+    ({"algo": 3}, r"\[algo\]: expected a table"),
+]
+
+
+@pytest.mark.parametrize("change,message", BAD)
+def test_bad_config_values_are_named(change, message):
+    d = {k: (dict(v) if isinstance(v, dict) else v) for k, v in TOY.items()}
+    for k, v in change.items():
+        if isinstance(v, dict) and isinstance(d.get(k), dict):
+            d[k].update(v)
+        else:
+            d[k] = v
+    with pytest.raises(cfgmod.ConfigError, match=message.replace("(", r"\(").replace(")", r"\)")
+                       if "\\" not in message else message):
+        cfgmod.from_dict(d)
+
+
+def test_cli_reports_bad_files_and_values_with_exit_code_2(tmp_path):
+    env = dict(os.environ)
+    cases = {"missing.toml": None, "broken.toml": "seed = = 3\n", "badvalue.toml": "iterations = -5\n"}
+    for name, text in cases.items():
+        p = tmp_path / name
+        if text is not None:
+            p.write_text(text)
+        r = subprocess.run([sys.executable, "-m", "pour.train", str(p), "--out", str(tmp_path / "o")],
+                           capture_output=True, text=True, env=env, timeout=60)
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.startswith("pour-train: error: ") and name in r.stderr
+        assert "Traceback" not in r.stderr
+    assert "iterations = -5" in r.stderr
+
+
+def test_unknown_toy_option_is_an_env_error():
+    with pytest.raises(envs.EnvError, match="unknown option 'gravty'"):
+        envs.make_env("toy", 5, 10, 1.0, {"gravty": 9.8})

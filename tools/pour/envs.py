@@ -1,0 +1,139 @@
+# SPDX-License-Identifier: MIT
+"""Episode sources for the trainer: the Box2D simulator (through tools/pour/sim.py) and a toy.
+
+Both produce the same Episode record: per decision the six features the policy saw, the action it
+took and the reward summed over the decision period, plus end-of-episode metrics. The toy is a
+one-dimensional tilt model with a crude liquid: fast to run, used by the unit tests of the trainer
+(convergence, resume, reproducibility) where the simulator's library is not needed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pour import reinforce
+
+# Normalisation the policy is trained with (weights.h carries the same numbers).
+THETA_MIN_RAD = 0.0
+THETA_MAX_RAD = 2.356194        # 135 deg
+OMEGA_MAX_RAD_S = 4.0
+N_FEATURES = 6
+
+
+class EnvError(RuntimeError):
+    """The episode source cannot be used (library missing, bad option)."""
+
+
+@dataclass
+class Episode:
+    """One episode, as the trainer sees it."""
+    x: np.ndarray                  # [T][6] features at each decision
+    actions: np.ndarray            # [T] action index
+    rewards: np.ndarray            # [T] reward summed over each decision period
+    metrics: dict[str, float] = field(default_factory=dict)  # v_target, v_spill, v_rotating, finish_s, ...
+    seed: int = 0
+
+
+def normalise(theta: float, omega: float, v_rot: float, v_tgt: float, v_spill: float) -> np.ndarray:
+    """Float normalisation of the spec: clip to [0, 1]; bias feature 1.0 last."""
+    def c(v: float) -> float:
+        return 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
+    return np.array([c((theta - THETA_MIN_RAD) / (THETA_MAX_RAD - THETA_MIN_RAD)),
+                     c((omega + OMEGA_MAX_RAD_S) / (2 * OMEGA_MAX_RAD_S)),
+                     c(v_rot), c(v_tgt), c(v_spill), 1.0])
+
+
+def finish_time_s(t_s: np.ndarray, v_rot: np.ndarray, threshold: float = 0.02) -> float:
+    """First time the rotating bucket holds at most `threshold` of the liquid (inf if never)."""
+    idx = np.flatnonzero(np.asarray(v_rot) <= threshold)
+    return float(t_s[idx[0]]) if idx.size else math.inf
+
+
+def choose(w: np.ndarray, x: np.ndarray, greedy: bool, rng: np.random.Generator) -> int:
+    """Greedy: argmax of the logits, ties to the lowest index. Sampled: inverse CDF of softmax."""
+    logits = x @ w
+    if greedy:
+        return int(np.argmax(logits))
+    p = reinforce.softmax(logits)
+    u = rng.random()
+    return int(min(np.searchsorted(np.cumsum(p), u, side="right"), p.size - 1))
+
+
+class ToyEnv:
+    """A 1-D tilt plant with a liquid that pours past an angle that grows as the bucket empties.
+
+    Spill grows with the outflow rate and with the tilt speed, so the best policy tilts fast to the
+    pouring angle, then follows it at a controlled rate -- the same shape of problem as the real one.
+    """
+
+    DEFAULTS = {"k_target": 1.0, "k_spill": 5.0, "tau_max": 4.0, "inertia": 0.25, "damping": 0.3,
+                "gravity": 1.5, "flow": 2.0, "flow_safe": 0.6, "omega_safe": 1.5}
+
+    def __init__(self, n_actions: int, decision_period_ms: int, episode_s: float,
+                 options: dict[str, Any] | None = None):
+        opts = dict(self.DEFAULTS)
+        for k, v in (options or {}).items():
+            if k not in self.DEFAULTS:
+                raise EnvError(f"toy env: unknown option {k!r}; known: {', '.join(sorted(self.DEFAULTS))}")
+            opts[k] = float(v)
+        self.o = opts
+        self.levels = reinforce.action_levels(n_actions)
+        self.period = decision_period_ms
+        self.steps = int(round(episode_s * 1000))
+
+    def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> Episode:
+        o = self.o
+        rng = np.random.default_rng(seed)
+        theta, omega = 0.0, 0.0
+        v_rot, v_tgt, v_spill = 1.0, 0.0, 0.0
+        pour_at = 0.55 + 0.05 * rng.standard_normal()  # the full bucket's first-pour angle [rad]
+        dt = 1e-3
+        n_dec = self.steps // self.period
+        xs = np.empty((n_dec, N_FEATURES))
+        acts = np.empty(n_dec, dtype=np.int64)
+        rews = np.zeros(n_dec)
+        vrot_trace = np.empty(n_dec)
+        for d in range(n_dec):
+            x = normalise(theta, omega, v_rot, v_tgt, v_spill)
+            a = choose(w, x, greedy, rng)
+            xs[d], acts[d], vrot_trace[d] = x, a, v_rot
+            tau = self.levels[a] * o["tau_max"]
+            r_sum = 0.0
+            for _ in range(self.period):
+                inertia = o["inertia"] * (0.4 + 0.6 * v_rot)
+                alpha = (tau - o["gravity"] * v_rot * math.sin(theta) - o["damping"] * omega) / inertia
+                omega += alpha * dt
+                theta += omega * dt
+                if theta >= THETA_MAX_RAD:
+                    theta, omega = THETA_MAX_RAD, min(omega, 0.0)
+                elif theta <= 0.0:
+                    theta, omega = 0.0, max(omega, 0.0)
+                onset = pour_at + 1.2 * (1.0 - v_rot)
+                q = o["flow"] * max(0.0, theta - onset) * (0.3 + v_rot)
+                dv = min(v_rot, q * dt)
+                if dv > 0.0:
+                    spill = min(1.0, max(0.0, (q - o["flow_safe"]) / o["flow_safe"])
+                                + max(0.0, (abs(omega) - o["omega_safe"]) / o["omega_safe"]))
+                    v_rot -= dv
+                    v_spill += dv * spill
+                    v_tgt += dv * (1.0 - spill)
+                r_sum += o["k_target"] * v_tgt - o["k_spill"] * v_spill
+            rews[d] = r_sum
+        t_s = np.arange(n_dec) * self.period * 1e-3
+        metrics = {"v_target": v_tgt, "v_spill": v_spill, "v_rotating": v_rot,
+                   "finish_s": finish_time_s(t_s, vrot_trace)}
+        return Episode(xs, acts, rews, metrics, seed)
+
+
+def make_env(kind: str, n_actions: int, decision_period_ms: int, episode_s: float,
+             options: dict[str, Any] | None = None):
+    """An object with rollout(w, seed, greedy) -> Episode."""
+    if kind == "toy":
+        return ToyEnv(n_actions, decision_period_ms, episode_s, options)
+    if kind == "sim":
+        from pour import sim_adapter  # loads libpoursim; EnvError if it cannot
+        return sim_adapter.SimEnv(n_actions, decision_period_ms, episode_s, options)
+    raise EnvError(f"unknown env kind {kind!r}: expected 'sim' or 'toy'")

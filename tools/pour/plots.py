@@ -1,0 +1,138 @@
+# SPDX-License-Identifier: MIT
+"""pour-plots: PNG figures of training runs (the paper's Figs. 3-6, and volumes over time).
+
+  reward curve  -- per-iteration mean episode return, mean and spread over seeds, one band per method
+  angle         -- tilt angle over time of the best training episode of a run (Figs. 4 and 6)
+  volumes       -- V_rotating, V_target, V_spill over time of an episode
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+from typing import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from pour import envs  # noqa: E402
+
+
+def _log(run_dir: Path) -> dict[str, np.ndarray]:
+    with open(run_dir / "log.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        raise ValueError(f"{run_dir}/log.csv has no rows")
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def reward_curve(groups: dict[str, Sequence[Path]], out: Path, column: str = "return_mean",
+                 title: str = "Episode return during training") -> None:
+    """One line per group: mean over its runs, shaded +-1 std over runs, dotted min/max over runs."""
+    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=120)
+    for label, dirs in groups.items():
+        logs = [_log(Path(d)) for d in dirs]
+        n = min(len(lg[column]) for lg in logs)
+        y = np.stack([lg[column][:n] for lg in logs])
+        x = logs[0]["episodes"][:n]
+        m, s = y.mean(0), y.std(0)
+        (line,) = ax.plot(x, m, label=f"{label} (n={len(dirs)} seeds)")
+        ax.fill_between(x, m - s, m + s, color=line.get_color(), alpha=0.2)
+        ax.plot(x, y.min(0), ":", color=line.get_color(), lw=0.8)
+        ax.plot(x, y.max(0), ":", color=line.get_color(), lw=0.8)
+    ax.set_xlabel("training episodes")
+    ax.set_ylabel(column.replace("_", " "))
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out)
+    plt.close(fig)
+
+
+def episode_traces(x: np.ndarray, period_ms: int) -> dict[str, np.ndarray]:
+    """Time [s], angle [deg] and volumes from the features of an episode's decisions."""
+    t = np.arange(x.shape[0]) * period_ms * 1e-3
+    theta = envs.THETA_MIN_RAD + x[:, 0] * (envs.THETA_MAX_RAD - envs.THETA_MIN_RAD)
+    return {"t": t, "theta_deg": np.degrees(theta), "v_rot": x[:, 2], "v_tgt": x[:, 3], "v_spill": x[:, 4]}
+
+
+def angle(episodes: dict[str, np.ndarray], period_ms: int, out: Path, title: str) -> None:
+    """Angle over time, one line per labelled episode (features array)."""
+    fig, ax = plt.subplots(figsize=(7, 3.6), dpi=120)
+    for label, x in episodes.items():
+        tr = episode_traces(x, period_ms)
+        ax.plot(tr["t"], tr["theta_deg"], label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("tilt angle θ [deg]")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out)
+    plt.close(fig)
+
+
+def volumes(x: np.ndarray, period_ms: int, out: Path, title: str) -> None:
+    """V_rotating, V_target and V_spill over time of one episode."""
+    tr = episode_traces(x, period_ms)
+    fig, ax = plt.subplots(figsize=(7, 3.6), dpi=120)
+    ax.plot(tr["t"], tr["v_rot"], label="V rotating")
+    ax.plot(tr["t"], tr["v_tgt"], label="V target")
+    ax.plot(tr["t"], tr["v_spill"], label="V spill")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("fraction of the liquid")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out)
+    plt.close(fig)
+
+
+def best_episode(run_dir: Path) -> np.ndarray:
+    """Features of the run's best training episode (by return)."""
+    with np.load(Path(run_dir) / "checkpoint.npz") as z:
+        return np.array(z["best_ep_x"])
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
+    ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), required=True,
+                    help="a label and its run directories (repeat per method)")
+    ap.add_argument("--out", required=True, help="output folder for the PNGs")
+    ap.add_argument("--prefix", default="", help="file name prefix")
+    ap.add_argument("--period-ms", type=int, default=10)
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    groups = {}
+    for g in args.group:
+        if len(g) < 2:
+            print(f"pour-plots: error: --group {g[0]} has no run directory", file=sys.stderr)
+            return 2
+        groups[g[0]] = [Path(d) for d in g[1:]]
+    try:
+        reward_curve(groups, out / f"{args.prefix}reward_curve.png")
+        for label, dirs in groups.items():
+            # The best training episode over the group's runs.
+            best = max(dirs, key=lambda d: float(np.load(d / "checkpoint.npz")["best_ep_return"]))
+            x = best_episode(best)
+            slug = label.lower().replace(" ", "_")
+            angle({label: x}, args.period_ms, out / f"{args.prefix}{slug}_best_angle.png",
+                  f"Best training episode, {label}")
+            volumes(x, args.period_ms, out / f"{args.prefix}{slug}_best_volumes.png",
+                    f"Best training episode, {label}")
+    except (OSError, ValueError, KeyError) as exc:
+        print(f"pour-plots: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,181 @@
+# SPDX-License-Identifier: MIT
+"""Policy-gradient maths for the softmax-linear policy pi(a|x) = softmax(x.W).
+
+x is the feature row [theta_n, omega_n, V_rot, V_tgt, V_spill, 1.0]; W is [6][n_actions].
+Two updates are provided:
+  * vanilla  -- the paper's eq. 19: every grad log pi(a_t|x_t) of an episode is multiplied by the
+                episode's full discounted return R(tau); plain gradient ascent.
+  * pg       -- reward-to-go, a leave-one-out time-indexed baseline over a batch of episodes,
+                normalised advantages, an entropy bonus, Adam and optional gradient-norm clipping.
+Everything here is pure numpy and deterministic.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class GradientError(FloatingPointError):
+    """A gradient or weight that is not finite: training stops instead of corrupting the run."""
+
+
+def softmax(logits: np.ndarray) -> np.ndarray:
+    """Row-wise softmax; the row max is subtracted before exp so large logits cannot overflow."""
+    z = logits - np.max(logits, axis=-1, keepdims=True)
+    e = np.exp(z)
+    return e / np.sum(e, axis=-1, keepdims=True)
+
+
+def probs(w: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """pi(.|x) for each row of x [T][F] under weights w [F][A]."""
+    return softmax(x @ w)
+
+
+def action_levels(n_actions: int) -> np.ndarray:
+    """Torque levels evenly spaced in [-1, 1], as fractions of tau_max."""
+    return np.linspace(-1.0, 1.0, n_actions)
+
+
+def discounted_return(rewards: np.ndarray, gamma: float) -> float:
+    """R(tau) = sum_t gamma^t r_t."""
+    r = np.asarray(rewards, dtype=np.float64)
+    return float(np.sum(r * gamma ** np.arange(r.size)))
+
+
+def rewards_to_go(rewards: np.ndarray, gamma: float) -> np.ndarray:
+    """G_t = sum_{k>=t} gamma^(k-t) r_k, for every t."""
+    r = np.asarray(rewards, dtype=np.float64)
+    out = np.empty_like(r)
+    acc = 0.0
+    for t in range(r.size - 1, -1, -1):
+        acc = r[t] + gamma * acc
+        out[t] = acc
+    return out
+
+
+def entropy(p: np.ndarray) -> np.ndarray:
+    """Entropy of each row of probabilities [nats]."""
+    return -np.sum(p * np.log(np.clip(p, 1e-300, None)), axis=-1)
+
+
+def surrogate(w: np.ndarray, x: np.ndarray, actions: np.ndarray, weights: np.ndarray,
+              entropy_coef: float = 0.0) -> float:
+    """sum_t weights_t log pi(a_t|x_t) + entropy_coef * mean_t H(pi(.|x_t)).
+
+    Its gradient in w is the policy-gradient estimate; grad_surrogate computes it in closed form and
+    the tests check it against finite differences of this function.
+    """
+    logits = x @ w
+    z = logits - np.max(logits, axis=1, keepdims=True)
+    logp = z - np.log(np.sum(np.exp(z), axis=1, keepdims=True))
+    lp_a = logp[np.arange(x.shape[0]), actions]
+    p = np.exp(logp)
+    h = -np.sum(p * logp, axis=1)
+    return float(np.sum(weights * lp_a) + entropy_coef * np.mean(h))
+
+
+def grad_surrogate(w: np.ndarray, x: np.ndarray, actions: np.ndarray, weights: np.ndarray,
+                   entropy_coef: float = 0.0) -> np.ndarray:
+    """Closed-form gradient of surrogate() in w, shape [F][A].
+
+    d log pi(a|x)/dW = x (e_a - pi)^T;  dH/dlogits_j = -pi_j (log pi_j + H).
+    """
+    t, a = x.shape[0], w.shape[1]
+    p = probs(w, x)
+    onehot = np.zeros((t, a))
+    onehot[np.arange(t), actions] = 1.0
+    g_logits = weights[:, None] * (onehot - p)
+    if entropy_coef:
+        logp = np.log(np.clip(p, 1e-300, None))
+        h = -np.sum(p * logp, axis=1, keepdims=True)
+        g_logits = g_logits + (entropy_coef / t) * (-p * (logp + h))
+    return x.T @ g_logits
+
+
+@dataclass
+class Batch:
+    """Decisions of a batch of equally long episodes: x [N][T][F], actions [N][T], rewards [N][T]."""
+    x: np.ndarray
+    actions: np.ndarray
+    rewards: np.ndarray
+
+
+def advantages(batch: Batch, gamma_decision: float, reward_to_go: bool, baseline: str,
+               normalize: bool) -> np.ndarray:
+    """Per-decision weights of grad log pi, [N][T], for the chosen estimator.
+
+    baseline 'loo' subtracts, at each decision index t, the mean over the *other* episodes of the
+    batch (leave-one-out keeps the estimate unbiased; episodes all have the same length).
+    """
+    r = batch.rewards
+    n, t = r.shape
+    if reward_to_go:
+        g = np.stack([rewards_to_go(r[i], gamma_decision) for i in range(n)])
+    else:
+        g = np.repeat(np.array([discounted_return(r[i], gamma_decision) for i in range(n)])[:, None], t, 1)
+    if baseline == "loo":
+        if n < 2:
+            raise ValueError("baseline 'loo' needs at least 2 episodes per batch")
+        g = g - (np.sum(g, axis=0, keepdims=True) - g) / (n - 1)
+    elif baseline != "none":
+        raise ValueError(f"unknown baseline {baseline!r}")
+    if normalize:
+        sd = float(np.std(g))
+        g = (g - float(np.mean(g))) / (sd if sd > 1e-12 else 1.0)
+    return g
+
+
+def batch_gradient(w: np.ndarray, batch: Batch, adv: np.ndarray, entropy_coef: float) -> np.ndarray:
+    """Mean over episodes of the per-episode surrogate gradient (sum over decisions)."""
+    n, t, f = batch.x.shape
+    x = batch.x.reshape(n * t, f)
+    acts = batch.actions.reshape(n * t)
+    # Entropy term: the mean over all decisions, times the number of decisions per episode, so its
+    # scale matches the per-episode sum of the advantage term.
+    g = grad_surrogate(w, x, acts, adv.reshape(n * t), entropy_coef * t)
+    return g / n
+
+
+def check_finite(name: str, arr: np.ndarray, iteration: int) -> None:
+    """Raises GradientError if arr holds NaN or infinity."""
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
+        raise GradientError(
+            f"iteration {iteration}: {name} has {bad} non-finite value(s) (NaN or inf); "
+            "lower algo.lr or algo.reward_scale, or enable algo.grad_clip / normalize_advantages")
+
+
+class Adam:
+    """Adam for gradient *ascent* on one array; its state round-trips through state_dict()."""
+
+    def __init__(self, shape: tuple, lr: float, b1: float = 0.9, b2: float = 0.999, eps: float = 1e-8):
+        self.lr, self.b1, self.b2, self.eps = lr, b1, b2, eps
+        self.m = np.zeros(shape)
+        self.v = np.zeros(shape)
+        self.t = 0
+
+    def step(self, grad: np.ndarray) -> np.ndarray:
+        """The increment to add to the parameters."""
+        self.t += 1
+        self.m = self.b1 * self.m + (1 - self.b1) * grad
+        self.v = self.b2 * self.v + (1 - self.b2) * grad * grad
+        mh = self.m / (1 - self.b1 ** self.t)
+        vh = self.v / (1 - self.b2 ** self.t)
+        return self.lr * mh / (np.sqrt(vh) + self.eps)
+
+    def state_dict(self) -> dict:
+        return {"adam_m": self.m.copy(), "adam_v": self.v.copy(), "adam_t": np.array(self.t)}
+
+    def load_state_dict(self, d: dict) -> None:
+        self.m = np.array(d["adam_m"], dtype=np.float64)
+        self.v = np.array(d["adam_v"], dtype=np.float64)
+        self.t = int(d["adam_t"])
+
+
+def clip_norm(g: np.ndarray, max_norm: float) -> tuple[np.ndarray, float]:
+    """Scales g down to L2 norm max_norm if larger (max_norm 0 = off); returns (g, original norm)."""
+    norm = float(np.linalg.norm(g))
+    if max_norm > 0 and norm > max_norm:
+        g = g * (max_norm / norm)
+    return g, norm

@@ -1,0 +1,309 @@
+# SPDX-License-Identifier: MIT
+"""pour-train: REINFORCE on the softmax-linear pour policy, rollouts in C on every core.
+
+A run lives in one directory: config.json (the config it was started with), log.csv (one row per
+iteration) and checkpoint.npz (weights, optimiser state, best weights), each written atomically
+(temporary file, then rename), so a killed run resumes with no finished iteration lost and ends
+bit-identical to an uninterrupted one. Episode seeds derive from (config seed, stream, iteration),
+never from the worker that runs them, so the number of workers does not change the result.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import multiprocessing as mp
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from pour import config as cfgmod
+from pour import envs, reinforce
+
+STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
+
+LOG_FIELDS = ["iteration", "episodes", "wall_s", "return_mean", "return_std", "return_min", "return_max",
+              "reward_sum_mean", "v_target_mean", "v_spill_mean", "finish_s_mean", "entropy_mean",
+              "grad_norm", "eval_score", "eval_v_target", "eval_v_spill", "eval_finish_s", "best_score"]
+
+
+class TrainError(RuntimeError):
+    """A run that cannot start or continue (bad run directory, config mismatch)."""
+
+
+def episode_seeds(seed: int, stream: int, index: int, n: int) -> list[int]:
+    """n episode seeds (uint32) for one iteration (or evaluation set) of one stream."""
+    ss = np.random.SeedSequence([seed, stream, index])
+    return [int(s) for s in ss.generate_state(n, dtype=np.uint32)]
+
+
+# --- rollouts on a process pool -----------------------------------------------------------------
+
+_ENV: Any = None
+
+
+def _init_worker(env_args: tuple) -> None:
+    global _ENV
+    _ENV = envs.make_env(*env_args)
+
+
+def _run(job: tuple) -> envs.Episode:
+    w, seed, greedy = job
+    return _ENV.rollout(w, seed, greedy)
+
+
+class Runner:
+    """Runs episodes in order on `workers` processes (or in-process for one worker)."""
+
+    def __init__(self, cfg: cfgmod.TrainConfig):
+        self.env_args = (cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
+                         cfg.env.episode_s, cfg.env.options)
+        _init_worker(self.env_args)  # fail early and clearly in the parent (missing library, bad option)
+        self.pool = None
+        if cfg.workers > 1:
+            self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
+
+    def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
+        jobs = [(w, s, greedy) for s in seeds]
+        if self.pool is None:
+            return [_run(j) for j in jobs]
+        return self.pool.map(_run, jobs, chunksize=1)
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.close()
+            self.pool.join()
+            self.pool = None
+
+    def __enter__(self) -> "Runner":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool.join()
+            self.pool = None
+
+
+# --- atomic files ---------------------------------------------------------------------------------
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Writes data to path so that a reader (or a crash) sees the old or the new file, never half."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as f:
+        f.write(data)
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+
+
+def save_checkpoint(path: Path, state: dict[str, Any]) -> None:
+    buf = io.BytesIO()
+    np.savez(buf, **{k: np.asarray(v) for k, v in state.items()})
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def load_checkpoint(path: Path) -> dict[str, Any]:
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+    except (OSError, ValueError, KeyError) as exc:
+        raise TrainError(f"{path}: not a readable checkpoint ({exc})") from exc
+
+
+def read_log(path: Path) -> list[dict[str, str]]:
+    if not path.exists():
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def write_log(path: Path, rows: list[dict[str, Any]]) -> None:
+    buf = io.StringIO()
+    wr = csv.DictWriter(buf, fieldnames=LOG_FIELDS, lineterminator="\n")
+    wr.writeheader()
+    for r in rows:
+        wr.writerow({k: r[k] for k in LOG_FIELDS})
+    atomic_write_bytes(path, buf.getvalue().encode())
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, str):
+        return v
+    return f"{float(v):.9g}"
+
+
+# --- the training loop ------------------------------------------------------------------------------
+
+@dataclass
+class RunResult:
+    run_dir: Path
+    w: np.ndarray
+    best_w: np.ndarray
+    best_score: float
+    iterations: int
+    wall_s: float
+
+
+def episode_return(ep: envs.Episode, gamma_decision: float) -> float:
+    return reinforce.discounted_return(ep.rewards, gamma_decision)
+
+
+def score(episodes: Sequence[envs.Episode], steps: int) -> float:
+    """Validation score: the per-tick reward averaged over the episode and over the episodes."""
+    return float(np.mean([np.sum(e.rewards) for e in episodes])) / steps
+
+
+def _entropy_coef(cfg: cfgmod.TrainConfig, it: int) -> float:
+    a = cfg.algo
+    frac = it / max(1, cfg.iterations - 1)
+    return a.entropy_coef + (a.entropy_coef_final - a.entropy_coef) * frac
+
+
+def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
+           it: int) -> tuple[np.ndarray, float]:
+    """One policy-gradient step on a batch of episodes; returns (new weights, gradient norm)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # non-finite results are caught below, by name
+        return _update(cfg, w, eps, opt, it)
+
+
+def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
+            it: int) -> tuple[np.ndarray, float]:
+    a = cfg.algo
+    gamma_d = a.gamma ** cfg.policy.decision_period_ms
+    batch = reinforce.Batch(np.stack([e.x for e in eps]), np.stack([e.actions for e in eps]),
+                            np.stack([e.rewards for e in eps]) * a.reward_scale)
+    adv = reinforce.advantages(batch, gamma_d, a.reward_to_go, a.baseline, a.normalize_advantages)
+    g = reinforce.batch_gradient(w, batch, adv, _entropy_coef(cfg, it))
+    reinforce.check_finite("gradient", g, it)
+    g, norm = reinforce.clip_norm(g, a.grad_clip)
+    step = opt.step(g) if opt is not None else a.lr * g
+    w_new = w + step
+    reinforce.check_finite("weights", w_new, it)
+    return w_new, norm
+
+
+def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, quiet: bool = False,
+          stop_after: int | None = None) -> RunResult:
+    """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call."""
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
+    digest = cfg.digest()
+    n_feat, n_act = envs.N_FEATURES, cfg.policy.n_actions
+    steps = int(round(cfg.env.episode_s * 1000))
+
+    w = np.zeros((n_feat, n_act))
+    best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
+    opt = reinforce.Adam(w.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
+    best_ep: dict[str, np.ndarray] = {}
+    rows: list[dict[str, Any]] = []
+    if ckpt_path.exists() and resume:
+        st = load_checkpoint(ckpt_path)
+        if str(st["config_digest"]) != digest:
+            raise TrainError(f"{run_dir}: checkpoint was made with a different config "
+                             f"(digest {str(st['config_digest'])[:12]} vs {digest[:12]}); "
+                             "use a new run directory or --fresh")
+        w, best_w, best_score = st["w"], st["best_w"], float(st["best_score"])
+        start, wall_prev = int(st["iteration"]), float(st["wall_s"])
+        if opt is not None:
+            opt.load_state_dict(st)
+        best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
+        rows = [r for r in read_log(log_path) if int(r["iteration"]) < start]
+        if not quiet:
+            print(f"[pour-train] resuming {run_dir} at iteration {start}", file=sys.stderr)
+    elif ckpt_path.exists() or log_path.exists():
+        for p in (ckpt_path, log_path):
+            if p.exists():
+                p.unlink()
+    atomic_write_bytes(cfg_path, (json.dumps(cfg.to_dict(), indent=2, sort_keys=True) + "\n").encode())
+    write_log(log_path, rows)
+
+    gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
+    valid_seeds = episode_seeds(cfg.seed, STREAM_VALID, 0, cfg.eval.episodes)
+    t0 = time.monotonic()
+    done = 0
+    with Runner(cfg) as runner:
+        for it in range(start, cfg.iterations):
+            if stop_after is not None and done >= stop_after:
+                break
+            eps = runner.run(w, episode_seeds(cfg.seed, STREAM_TRAIN, it, cfg.algo.batch_episodes), greedy=False)
+            rets = np.array([episode_return(e, gamma_d) for e in eps])
+            ent = float(np.mean([np.mean(reinforce.entropy(reinforce.probs(w, e.x))) for e in eps]))
+            ib = int(np.argmax(rets))
+            if not best_ep or rets[ib] > float(best_ep["best_ep_return"]):
+                e = eps[ib]
+                best_ep = {"best_ep_x": e.x, "best_ep_actions": e.actions, "best_ep_rewards": e.rewards,
+                           "best_ep_return": np.array(rets[ib]), "best_ep_iteration": np.array(it)}
+            w, gnorm = update(cfg, w, eps, opt, it)
+            ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
+            last = it == cfg.iterations - 1
+            if cfg.eval.episodes and ((it + 1) % cfg.eval.every == 0 or last):
+                veps = runner.run(w, valid_seeds, greedy=True)
+                sc = score(veps, steps)
+                ev = {"eval_score": sc,
+                      "eval_v_target": np.mean([e.metrics["v_target"] for e in veps]),
+                      "eval_v_spill": np.mean([e.metrics["v_spill"] for e in veps]),
+                      "eval_finish_s": np.mean([e.metrics["finish_s"] for e in veps])}
+                if sc > best_score or not cfg.eval.select_best:
+                    best_score, best_w = sc, w.copy()
+            wall = wall_prev + time.monotonic() - t0
+            row = {"iteration": it, "episodes": (it + 1) * cfg.algo.batch_episodes, "wall_s": wall,
+                   "return_mean": rets.mean(), "return_std": rets.std(), "return_min": rets.min(),
+                   "return_max": rets.max(),
+                   "reward_sum_mean": np.mean([np.sum(e.rewards) for e in eps]),
+                   "v_target_mean": np.mean([e.metrics["v_target"] for e in eps]),
+                   "v_spill_mean": np.mean([e.metrics["v_spill"] for e in eps]),
+                   "finish_s_mean": np.mean([e.metrics["finish_s"] for e in eps]),
+                   "entropy_mean": ent, "grad_norm": gnorm, **ev, "best_score": best_score}
+            rows.append({k: _fmt(v) for k, v in row.items()})
+            state = {"w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
+                     "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep}
+            # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
+            write_log(log_path, rows)
+            save_checkpoint(ckpt_path, state)
+            done += 1
+            if not quiet:
+                print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
+                      f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
+                      f"eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]",
+                      file=sys.stderr, flush=True)
+        runner.close()
+    final = load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
+    return RunResult(run_dir, w, best_w, best_score, int(final["iteration"]), float(final["wall_s"]))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
+    ap.add_argument("config", help="TOML config (configs/train/*.toml)")
+    ap.add_argument("--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
+    ap.add_argument("--seed", type=int, help="override the config's seed")
+    ap.add_argument("--iterations", type=int, help="override the config's iterations")
+    ap.add_argument("--workers", type=int, help="override the config's workers")
+    ap.add_argument("--fresh", action="store_true", help="discard an existing checkpoint in --out")
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args(argv)
+    try:
+        cfg = cfgmod.load(args.config)
+        over = {k: getattr(args, k) for k in ("seed", "iterations", "workers") if getattr(args, k) is not None}
+        if over:
+            cfg = cfgmod.with_overrides(cfg, **over)
+        res = train(cfg, args.out, resume=not args.fresh, quiet=args.quiet)
+    except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError) as exc:
+        print(f"pour-train: error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps({"run_dir": str(res.run_dir), "iterations": res.iterations, "wall_s": round(res.wall_s, 1),
+                      "best_score": res.best_score}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
