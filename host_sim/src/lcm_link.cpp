@@ -1,0 +1,336 @@
+// SPDX-License-Identifier: MIT
+#include "lcm_link.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <sys/select.h>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "pour/particles_t.hpp"
+#include "pour/plant_state_t.hpp"
+#include "pour/torque_t.hpp"
+#include "pour_lcm/channels.h"
+
+namespace poursim {
+
+namespace {
+
+int64_t mono_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1000000000LL + ts.tv_nsec;
+}
+
+int64_t wall_us() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1000000LL + ts.tv_nsec / 1000;
+}
+
+void sleep_until_ns(int64_t t_ns) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t_ns / 1000000000LL);
+  ts.tv_nsec = static_cast<long>(t_ns % 1000000000LL);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+constexpr int64_t kPeriodNs = 1000000;
+constexpr size_t kRing = 4096; // send times of recent states, by seq modulo the ring size
+
+} // namespace
+
+struct LcmLink::Impl {
+  LcmLinkDef def;
+  lcm::LCM lcm;
+  LcmLinkStats stats;
+  std::array<int64_t, kRing> sent_ns{};  // publish time of seq % kRing
+  std::array<int64_t, kRing> sent_seq{}; // which seq the slot holds
+  int episode = 0;
+  int64_t waiting_seq = -1;   // the state whose answer the current tick waits for
+  bool got_waited = false;
+  int16_t answer_q15 = 0;     // torque of the latest accepted answer
+  int64_t answer_ns = 0;      // when it arrived (real time: age check)
+  bool have_answer = false;
+  int64_t t0_ns = 0;          // real time: slot of tick 0
+  int64_t next_particles_step = 0;
+  pour::plant_state_t last_state{};
+
+  explicit Impl(const LcmLinkDef &d) : def(d), lcm(d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url) {}
+
+  void on_torque(const lcm::ReceiveBuffer *rbuf, const std::string & /*channel*/) {
+    pour::torque_t msg;
+    const int n = msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size));
+    if (n < 0 || static_cast<uint32_t>(n) != rbuf->data_size) {
+      stats.dropped++;
+      return;
+    }
+    const int64_t now = mono_ns();
+    const size_t slot = static_cast<size_t>(msg.seq) % kRing;
+    const bool ours = msg.episode == episode && msg.seq >= 0 && sent_seq[slot] == msg.seq && sent_ns[slot] != 0;
+    if (!ours) {
+      stats.stale_answers++;
+      return;
+    }
+    if (msg.seq == waiting_seq && !got_waited) {
+      got_waited = true;
+      stats.on_time++;
+    } else if (msg.seq < waiting_seq || (!def.lockstep && msg.seq != waiting_seq)) {
+      // Real time: the answer to an earlier tick, whose torque was already chosen.
+      stats.late++;
+    } else {
+      stats.stale_answers++; // a duplicate (resend) answer
+      return;
+    }
+    stats.answers++;
+    stats.rtt_us.push_back(static_cast<int32_t>(std::min<int64_t>((now - sent_ns[slot]) / 1000, INT32_MAX)));
+    sent_ns[slot] = 0; // one round trip per state
+    // Real time uses the newest answer, whichever state it answers; lockstep only the awaited one.
+    if (!def.lockstep || msg.seq == waiting_seq) {
+      answer_q15 = msg.torque_q15;
+      answer_ns = now;
+      have_answer = true;
+    }
+  }
+
+  // Handles messages until the awaited answer arrived or deadline_ns passed; returns got_waited.
+  bool pump_until(int64_t deadline_ns) {
+    const int fd = lcm.getFileno();
+    while (!got_waited) {
+      const int64_t left_ns = deadline_ns - mono_ns();
+      if (left_ns <= 0) {
+        break;
+      }
+      fd_set fds;
+      FD_ZERO(&fds);
+      FD_SET(fd, &fds);
+      timeval tv{};
+      tv.tv_sec = static_cast<time_t>(left_ns / 1000000000LL);
+      tv.tv_usec = static_cast<suseconds_t>((left_ns % 1000000000LL) / 1000);
+      const int r = select(fd + 1, &fds, nullptr, nullptr, &tv);
+      if (r < 0 && errno != EINTR) {
+        break;
+      }
+      if (r > 0) {
+        lcm.handle();
+      }
+    }
+    return got_waited;
+  }
+
+  void poll_all() {
+    const int fd = lcm.getFileno();
+    for (int i = 0; i < 10000; i++) {
+      fd_set fds;
+      FD_ZERO(&fds);
+      FD_SET(fd, &fds);
+      timeval tv{};
+      if (select(fd + 1, &fds, nullptr, nullptr, &tv) <= 0) {
+        break;
+      }
+      lcm.handle();
+    }
+  }
+
+  void publish_state(int64_t seq) {
+    const size_t slot = static_cast<size_t>(seq) % kRing;
+    sent_seq[slot] = seq;
+    sent_ns[slot] = mono_ns();
+    lcm.publish(POUR_LCM_CHANNEL_STATE, &last_state);
+  }
+};
+
+LcmLink::LcmLink(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+LcmLink::~LcmLink() = default;
+
+std::unique_ptr<LcmLink> LcmLink::open(const LcmLinkDef &def, std::string *err) {
+  auto impl = std::make_unique<Impl>(def);
+  if (!impl->lcm.good()) {
+    if (err != nullptr) {
+      *err = "cannot open LCM at '" + (def.url.empty() ? std::string(POUR_LCM_DEFAULT_URL) : def.url) + "'";
+    }
+    return nullptr;
+  }
+  if (def.answer_timeout_ms < 1 || def.resend_ms < 1 || def.rt_budget_us < 0 || def.rt_budget_us > 1000 ||
+      def.rt_safe_after_ms < 1 || def.particles_period_ms < 0) {
+    if (err != nullptr) {
+      *err = "LCM link: a timeout or period is out of range";
+    }
+    return nullptr;
+  }
+  impl->lcm.subscribe(POUR_LCM_CHANNEL_TORQUE, &Impl::on_torque, impl.get());
+  impl->stats.rtt_us.reserve(1 << 16);
+  return std::unique_ptr<LcmLink>(new LcmLink(std::move(impl)));
+}
+
+bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q15, std::string *err) {
+  Impl &s = *impl_;
+  const int64_t seq = obs.step;
+  if (episode != s.episode || seq == 0) {
+    // A new episode: earlier answers mean nothing to it.
+    s.episode = episode;
+    s.sent_ns.fill(0);
+    s.have_answer = false;
+    s.answer_q15 = 0;
+    s.next_particles_step = 0;
+    if (!s.def.lockstep && seq == 0) {
+      s.t0_ns = 0;
+    }
+  }
+  pour::plant_state_t &m = s.last_state;
+  m.seq = seq;
+  m.episode = episode;
+  m.theta = obs.theta;
+  m.omega = obs.omega;
+  m.v_rotating = obs.v_rotating;
+  m.v_target = obs.v_target;
+  m.v_spill = obs.v_spill;
+  for (int i = 0; i < 5; i++) {
+    m.obs[i] = static_cast<float>(obs.obs[i]);
+  }
+  s.waiting_seq = seq;
+  s.got_waited = false;
+
+  if (s.def.lockstep) {
+    m.utime = std::llround(obs.t * 1e6);
+    s.stats.states_sent++;
+    s.publish_state(seq);
+    const int64_t start = mono_ns();
+    const int64_t give_up = start + static_cast<int64_t>(s.def.answer_timeout_ms) * 1000000LL;
+    int64_t resend_at = start + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
+    while (!s.pump_until(std::min(resend_at, give_up))) {
+      if (mono_ns() >= give_up) {
+        if (err != nullptr) {
+          char buf[256];
+          std::snprintf(buf, sizeof buf,
+                        "no answer on %s to %s seq %lld (episode %d) within %d ms: is pour_controller "
+                        "running (--lockstep) on the same LCM URL?",
+                        POUR_LCM_CHANNEL_TORQUE, POUR_LCM_CHANNEL_STATE, static_cast<long long>(seq), episode,
+                        s.def.answer_timeout_ms);
+          *err = buf;
+        }
+        return false;
+      }
+      // Lost on the way (or the controller started late): the controller answers a resend again.
+      s.stats.resends++;
+      const size_t slot = static_cast<size_t>(seq) % kRing;
+      const int64_t first = s.sent_ns[slot];
+      s.lcm.publish(POUR_LCM_CHANNEL_STATE, &m);
+      s.sent_ns[slot] = first; // the round trip counts from the first publish
+      resend_at = mono_ns() + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
+    }
+    *torque_q15 = s.answer_q15;
+    return true;
+  }
+
+  // Real time: tick k owns the wall-clock slot [t0 + k ms, t0 + (k+1) ms).
+  if (s.t0_ns == 0) {
+    s.t0_ns = mono_ns() - static_cast<int64_t>(seq) * kPeriodNs;
+  }
+  const int64_t slot_ns = s.t0_ns + static_cast<int64_t>(seq) * kPeriodNs;
+  sleep_until_ns(slot_ns);
+  const int64_t late_ns = mono_ns() - slot_ns;
+  if (late_ns / 1000 > s.stats.late_max_us) {
+    s.stats.late_max_us = late_ns / 1000;
+  }
+  if (late_ns > kPeriodNs) {
+    s.stats.overruns++;
+  }
+  m.utime = wall_us();
+  s.stats.states_sent++;
+  s.publish_state(seq);
+  s.poll_all();
+  s.pump_until(slot_ns + static_cast<int64_t>(s.def.rt_budget_us) * 1000);
+  const int64_t now = mono_ns();
+  if (s.have_answer && now - s.answer_ns <= static_cast<int64_t>(s.def.rt_safe_after_ms) * 1000000LL) {
+    *torque_q15 = s.answer_q15;
+  } else {
+    *torque_q15 = 0;
+    s.stats.safe_ticks++;
+  }
+  return true;
+}
+
+void LcmLink::maybe_publish_particles(const poursim_world_t *world, const poursim_obs_t &obs) {
+  Impl &s = *impl_;
+  if (s.def.particles_period_ms <= 0 || static_cast<int64_t>(obs.step) < s.next_particles_step) {
+    return;
+  }
+  s.next_particles_step = static_cast<int64_t>(obs.step) + s.def.particles_period_ms;
+  const poursim_config_t *c = poursim_world_config(world);
+  const int n = poursim_particle_count(world);
+  std::vector<float> xy(static_cast<size_t>(2 * n)), r(static_cast<size_t>(n));
+  const int got = poursim_particles(world, xy.data(), r.data(), n);
+  pour::particles_t m;
+  m.utime = s.def.lockstep ? std::llround(obs.t * 1e6) : wall_us();
+  m.seq = obs.step;
+  m.theta = obs.theta;
+  m.pivot_x = 0.0f;
+  m.pivot_y = static_cast<float>(c->pivot_height);
+  m.target_x = static_cast<float>(c->target_dx);
+  m.target_y = static_cast<float>(0.5 * c->bucket_height);
+  m.bucket_inner_width = static_cast<float>(c->bucket_inner_width);
+  m.bucket_height = static_cast<float>(c->bucket_height);
+  m.bucket_wall = static_cast<float>(c->bucket_wall);
+  m.n = got;
+  m.x.resize(static_cast<size_t>(got));
+  m.y.resize(static_cast<size_t>(got));
+  m.r.assign(r.begin(), r.begin() + got);
+  for (int i = 0; i < got; i++) {
+    m.x[static_cast<size_t>(i)] = xy[static_cast<size_t>(2 * i)];
+    m.y[static_cast<size_t>(i)] = xy[static_cast<size_t>(2 * i + 1)];
+  }
+  s.lcm.publish(POUR_LCM_CHANNEL_PARTICLES, &m);
+  s.stats.particles_sent++;
+}
+
+void LcmLink::drain(int wait_ms) {
+  Impl &s = *impl_;
+  s.waiting_seq = -1;
+  s.got_waited = false;
+  s.pump_until(mono_ns() + static_cast<int64_t>(wait_ms) * 1000000LL);
+}
+
+const LcmLinkStats &LcmLink::stats() const { return impl_->stats; }
+const LcmLinkDef &LcmLink::def() const { return impl_->def; }
+
+void LcmLink::rtt_percentiles(double *median_us, double *p99_us) const {
+  std::vector<int32_t> v = impl_->stats.rtt_us;
+  if (v.empty()) {
+    *median_us = 0.0;
+    *p99_us = 0.0;
+    return;
+  }
+  std::sort(v.begin(), v.end());
+  auto pick = [&v](double q) {
+    const size_t i = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1;
+    return static_cast<double>(v[std::min(i, v.size() - 1)]);
+  };
+  *median_us = pick(0.5);
+  *p99_us = pick(0.99);
+}
+
+std::string LcmLink::summary() const {
+  const LcmLinkStats &st = impl_->stats;
+  double med = 0.0, p99 = 0.0;
+  rtt_percentiles(&med, &p99);
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "lcm %s: states %lld answers %lld on_time %lld late %lld missing %lld resends %lld "
+                "dropped %lld stale_answers %lld safe_ticks %lld overruns %lld late_max_us %lld particles %lld "
+                "rtt_median_us %.0f rtt_p99_us %.0f",
+                impl_->def.lockstep ? "lockstep" : "realtime", static_cast<long long>(st.states_sent),
+                static_cast<long long>(st.answers), static_cast<long long>(st.on_time), static_cast<long long>(st.late),
+                static_cast<long long>(st.states_sent - st.on_time - st.late), static_cast<long long>(st.resends),
+                static_cast<long long>(st.dropped), static_cast<long long>(st.stale_answers),
+                static_cast<long long>(st.safe_ticks), static_cast<long long>(st.overruns),
+                static_cast<long long>(st.late_max_us), static_cast<long long>(st.particles_sent), med, p99);
+  return buf;
+}
+
+} // namespace poursim

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: MIT
+// The host side of the LCM loop: publishes POUR_STATE each tick, applies the torque from POUR_TORQUE,
+// publishes POUR_PARTICLES at a viewing rate. Lockstep (wait for each answer, deterministic) or real
+// time (1 kHz wall clock, latest answer, misses counted and covered by safe torque).
+#ifndef POURSIM_LCM_LINK_HPP
+#define POURSIM_LCM_LINK_HPP
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "poursim/poursim.h"
+
+namespace poursim {
+
+struct LcmLinkDef {
+  std::string url;               // empty: POUR_LCM_DEFAULT_URL
+  bool lockstep = true;          // false: real time at 1 kHz wall clock
+  int answer_timeout_ms = 2000;  // lockstep: no answer this long → error naming POUR_TORQUE
+  int resend_ms = 100;           // lockstep: resend the state after this long without an answer
+  int rt_budget_us = 800;        // real time: how long a tick waits for the answer to its own state
+  int rt_safe_after_ms = 20;     // real time: no answer for this long → safe (zero) torque
+  int particles_period_ms = 33;  // POUR_PARTICLES period in simulated time [ms]; 0: none
+};
+
+struct LcmLinkStats {
+  int64_t states_sent = 0;   // distinct states (resends not counted)
+  int64_t resends = 0;       // lockstep: states sent again after resend_ms
+  int64_t answers = 0;       // decoded answers to our states
+  int64_t on_time = 0;       // answers that arrived before their tick's torque was applied
+  int64_t late = 0;          // real time: answers that came after their tick was stepped
+  int64_t stale_answers = 0; // answers to states we no longer wait for (duplicates, other episodes)
+  int64_t dropped = 0;       // messages on POUR_TORQUE that failed to decode (foreign, truncated)
+  int64_t safe_ticks = 0;    // real time: ticks stepped with safe torque (no recent answer)
+  int64_t overruns = 0;      // real time: ticks that started more than one period late
+  int64_t late_max_us = 0;   // real time: worst tick-start lateness [µs]
+  int64_t particles_sent = 0;
+  std::vector<int32_t> rtt_us; // round trip per on-time or late answer [µs], state publish → answer
+};
+
+class LcmLink {
+ public:
+  // Opens LCM and subscribes to POUR_TORQUE. nullptr with *err set on failure.
+  static std::unique_ptr<LcmLink> open(const LcmLinkDef &def, std::string *err);
+  ~LcmLink();
+  LcmLink(const LcmLink &) = delete;
+  LcmLink &operator=(const LcmLink &) = delete;
+
+  // Publishes the state in obs (seq = obs.step) and gives the torque command to apply now, as a
+  // fraction of tau_max in Q15 (the controller's pour_control_output_t.torque). Lockstep: blocks for
+  // the answer; false with *err naming the channel after answer_timeout_ms. Real time: sleeps to the
+  // tick's slot first; always true.
+  bool exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q15, std::string *err);
+
+  // Publishes POUR_PARTICLES if particles_period_ms of simulated time passed since the last one.
+  void maybe_publish_particles(const poursim_world_t *world, const poursim_obs_t &obs);
+
+  // Reads whatever answers are still in flight (for a final count); waits at most wait_ms.
+  void drain(int wait_ms);
+
+  const LcmLinkStats &stats() const;
+  const LcmLinkDef &def() const;
+
+  // Median and 99th percentile of stats().rtt_us [µs]; 0 if there are none.
+  void rtt_percentiles(double *median_us, double *p99_us) const;
+
+  // One line: mode, counts, latency.
+  std::string summary() const;
+
+  struct Impl;
+
+ private:
+  explicit LcmLink(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace poursim
+
+#endif // POURSIM_LCM_LINK_HPP
