@@ -1,0 +1,175 @@
+/* SPDX-License-Identifier: MIT */
+/* A line protocol around the C CAN codec, so that tests/python/test_can_dbc.py can compare it with the DBC
+ * (through cantools) bit for bit. One request per line on stdin, one answer per line on stdout:
+ *   pack <msg> <node> <raw fields...>   -> "ok <id> <dlc> <hex>" | "einval"
+ *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
+ * msg: state_a (theta omega seq_low), state_b (seq vr vt vs), torque (seq torque action mode limits),
+ * heartbeat (mode faults rx_dropped overruns counter), estop (assert), clear_errors (no fields).
+ * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pour/can_codec.h"
+
+#define MAX_FIELDS 8
+
+static int parse_longs(char *rest, long *v, int max) {
+  int n = 0;
+  for (char *tok = strtok(rest, " \t\r\n"); tok != NULL; tok = strtok(NULL, " \t\r\n")) {
+    if (n == max) {
+      return -1;
+    }
+    char *end = NULL;
+    v[n++] = strtol(tok, &end, 0);
+    if (end == tok || *end != '\0') {
+      return -1;
+    }
+  }
+  return n;
+}
+
+static void print_frame(pour_status_t st, const pour_can_frame_t *f) {
+  if (st != POUR_OK) {
+    puts("einval");
+    return;
+  }
+  printf("ok %u %u ", (unsigned)f->id, (unsigned)f->dlc);
+  for (unsigned i = 0; i < f->dlc; ++i) {
+    printf("%02x", f->data[i]);
+  }
+  if (f->dlc == 0u) {
+    printf("-");
+  }
+  putchar('\n');
+}
+
+static void do_pack(const char *msg, long *v, int n) {
+  pour_can_frame_t f;
+  memset(&f, 0, sizeof f);
+  if (n < 1 || v[0] < 0 || v[0] > 255) {
+    puts("error node");
+    return;
+  }
+  uint8_t node = (uint8_t)v[0];
+  if (strcmp(msg, "state_a") == 0 && n == 4) {
+    pour_can_state_a_t m = {(int32_t)v[1], (int32_t)v[2], (uint8_t)v[3]};
+    print_frame(pour_can_pack_state_a(node, &m, &f), &f);
+  } else if (strcmp(msg, "state_b") == 0 && n == 5) {
+    pour_can_state_b_t m = {(uint16_t)v[1], (q15_t)v[2], (q15_t)v[3], (q15_t)v[4]};
+    print_frame(pour_can_pack_state_b(node, &m, &f), &f);
+  } else if (strcmp(msg, "torque") == 0 && n == 6) {
+    pour_can_torque_t m = {(uint16_t)v[1], (q15_t)v[2], (uint8_t)v[3], (uint8_t)v[4], (uint8_t)v[5]};
+    print_frame(pour_can_pack_torque(node, &m, &f), &f);
+  } else if (strcmp(msg, "heartbeat") == 0 && n == 6) {
+    pour_can_heartbeat_t m = {(uint8_t)v[1], (uint16_t)v[2], (uint16_t)v[3], (uint16_t)v[4], (uint8_t)v[5]};
+    print_frame(pour_can_pack_heartbeat(node, &m, &f), &f);
+  } else if (strcmp(msg, "estop") == 0 && n == 2) {
+    pour_can_estop_t m = {(uint8_t)v[1]};
+    print_frame(pour_can_pack_estop(node, &m, &f), &f);
+  } else if (strcmp(msg, "clear_errors") == 0 && n == 1) {
+    print_frame(pour_can_pack_clear_errors(node, &f), &f);
+  } else {
+    puts("error message or field count");
+  }
+}
+
+static int parse_hex(const char *hex, uint8_t *data, unsigned dlc) {
+  if (strcmp(hex, "-") == 0) {
+    return dlc == 0u ? 0 : -1;
+  }
+  if (strlen(hex) != 2u * dlc) {
+    return -1;
+  }
+  for (unsigned i = 0; i < dlc; ++i) {
+    char byte[3] = {hex[2 * i], hex[2 * i + 1], '\0'};
+    char *end = NULL;
+    data[i] = (uint8_t)strtoul(byte, &end, 16);
+    if (*end != '\0') {
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static void do_unpack(const char *msg, char *rest) {
+  char *id_s = strtok(rest, " \t\r\n");
+  char *dlc_s = strtok(NULL, " \t\r\n");
+  char *hex = strtok(NULL, " \t\r\n");
+  if (id_s == NULL || dlc_s == NULL || hex == NULL) {
+    puts("error unpack needs id dlc hex");
+    return;
+  }
+  pour_can_frame_t f;
+  memset(&f, 0, sizeof f);
+  unsigned long id = strtoul(id_s, NULL, 0);
+  unsigned long dlc = strtoul(dlc_s, NULL, 0);
+  if (id > 0x7FFu || dlc > 8u || parse_hex(hex, f.data, (unsigned)dlc) != 0) {
+    puts("error frame");
+    return;
+  }
+  f.id = (uint16_t)id;
+  f.dlc = (uint8_t)dlc;
+  pour_can_rx_t rc;
+  char out[128];
+  if (strcmp(msg, "state_a") == 0) {
+    pour_can_state_a_t m = {0};
+    rc = pour_can_unpack_state_a(&f, &m);
+    snprintf(out, sizeof out, "%ld %ld %u", (long)m.theta_urad, (long)m.omega_urad_s, (unsigned)m.seq_low);
+  } else if (strcmp(msg, "state_b") == 0) {
+    pour_can_state_b_t m = {0};
+    rc = pour_can_unpack_state_b(&f, &m);
+    snprintf(out, sizeof out, "%u %d %d %d", (unsigned)m.seq, m.v_rotating, m.v_target, m.v_spill);
+  } else if (strcmp(msg, "torque") == 0) {
+    pour_can_torque_t m = {0};
+    rc = pour_can_unpack_torque(&f, &m);
+    snprintf(out, sizeof out, "%u %d %u %u %u", (unsigned)m.seq, m.torque, (unsigned)m.action,
+             (unsigned)m.mode, (unsigned)m.limits);
+  } else if (strcmp(msg, "heartbeat") == 0) {
+    pour_can_heartbeat_t m = {0};
+    rc = pour_can_unpack_heartbeat(&f, &m);
+    snprintf(out, sizeof out, "%u %u %u %u %u", (unsigned)m.mode, (unsigned)m.faults, (unsigned)m.rx_dropped,
+             (unsigned)m.overruns, (unsigned)m.counter);
+  } else if (strcmp(msg, "estop") == 0) {
+    pour_can_estop_t m = {0};
+    rc = pour_can_unpack_estop(&f, &m);
+    snprintf(out, sizeof out, "%u", (unsigned)m.assert_estop);
+  } else if (strcmp(msg, "clear_errors") == 0) {
+    rc = pour_can_unpack_clear_errors(&f);
+    out[0] = '\0';
+  } else {
+    puts("error message");
+    return;
+  }
+  if (rc == POUR_CAN_RX_OK) {
+    printf("ok %s\n", out);
+  } else {
+    printf("rx %d\n", (int)rc);
+  }
+}
+
+int main(void) {
+  char line[512];
+  while (fgets(line, sizeof line, stdin) != NULL) {
+    char *verb = strtok(line, " \t\r\n");
+    char *msg = strtok(NULL, " \t\r\n");
+    char *rest = strtok(NULL, "");
+    if (verb == NULL || msg == NULL) {
+      puts("error need verb and message");
+    } else if (strcmp(verb, "pack") == 0) {
+      long v[MAX_FIELDS];
+      int n = parse_longs(rest != NULL ? rest : (char[]){""}, v, MAX_FIELDS);
+      if (n < 0) {
+        puts("error fields");
+      } else {
+        do_pack(msg, v, n);
+      }
+    } else if (strcmp(verb, "unpack") == 0 && rest != NULL) {
+      do_unpack(msg, rest);
+    } else {
+      puts("error verb");
+    }
+    fflush(stdout);
+  }
+  return 0;
+}
