@@ -80,6 +80,7 @@ class ToyEnv:
                 raise EnvError(f"toy env: unknown option {k!r}; known: {', '.join(sorted(self.DEFAULTS))}")
             opts[k] = float(v)
         self.o = opts
+        self.tau_max_nm = opts["tau_max"]
         self.levels = reinforce.action_levels(n_actions)
         self.period = decision_period_ms
         self.steps = int(round(episode_s * 1000))

@@ -65,6 +65,7 @@ class Runner:
         self.env_args = (cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
                          cfg.env.episode_s, cfg.env.options)
         _init_worker(self.env_args)  # fail early and clearly in the parent (missing library, bad option)
+        self.tau_max_nm = float(_ENV.tau_max_nm)
         self.pool = None
         if cfg.workers > 1:
             self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
@@ -151,6 +152,18 @@ class RunResult:
     best_score: float
     iterations: int
     wall_s: float
+
+
+def write_policy_json(path: Path, cfg: cfgmod.TrainConfig, tau_max_nm: float, iteration: int, w: np.ndarray,
+                      best_w: np.ndarray, best_score: float) -> None:
+    """The exporter's input: deterministic bytes (no times), so a re-run exports the same weights.h."""
+    doc = {"format": "pour-policy-1", "config": cfg.to_dict(), "config_digest": cfg.digest(),
+           "iteration": iteration, "n_actions": cfg.policy.n_actions,
+           "decision_period_ms": cfg.policy.decision_period_ms, "tau_max_nm": tau_max_nm,
+           "norm": {"theta_min_rad": envs.THETA_MIN_RAD, "theta_max_rad": envs.THETA_MAX_RAD,
+                    "omega_max_rad_s": envs.OMEGA_MAX_RAD_S},
+           "best_score": best_score, "w": w.tolist(), "best_w": best_w.tolist()}
+    atomic_write_bytes(path, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
 
 
 def episode_return(ep: envs.Episode, gamma_decision: float) -> float:
@@ -269,6 +282,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                      "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep}
             # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
             write_log(log_path, rows)
+            write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
             save_checkpoint(ckpt_path, state)
             done += 1
             if not quiet:

@@ -1,0 +1,108 @@
+# SPDX-License-Identifier: MIT
+"""pour-eval: held-out evaluation of a policy, and float-vs-fixed-point agreement.
+
+  pour-eval agree RUN_DIR --header policy/weights.h   # greedy float vs firmware fixed point on visited states
+  pour-eval heldout --header policy/weights.h         # host_sim with the firmware core, and the baselines
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from pour import envs
+from pour import fixedpoint as fp
+from pour import weights_h
+
+
+def state_of_features(x: np.ndarray, norm: fp.ObsNorm) -> list[int]:
+    """The physical state (θ µrad, θ̇ µrad/s, volumes Q15) behind one float feature row.
+
+    Exact inside the normalisation range, which is where the simulator's states are.
+    """
+    span = (norm.theta_max_urad - norm.theta_min_urad) * 1e-6
+    theta = norm.theta_min_urad * 1e-6 + float(x[0]) * span
+    wmax = norm.omega_max_urad_s * 1e-6
+    omega = float(x[1]) * 2.0 * wmax - wmax
+    return [int(round(theta * 1e6)), int(round(omega * 1e6))] + [fp.float_to_q15(float(v)) for v in x[2:5]]
+
+
+def agreement(w_float: np.ndarray, header: weights_h.WeightsH, xs: np.ndarray) -> float:
+    """Fraction of feature rows on which the float greedy action equals the fixed-point one."""
+    pol = fp.FixedPolicy(header.w_q, header.w_frac_bits)
+    float_act = np.argmax(np.asarray(xs) @ np.asarray(w_float), axis=1)
+    same = 0
+    for x, a in zip(xs, float_act):
+        obs = fp.quantize_obs(header.norm, *state_of_features(x, header.norm))
+        same += int(pol.eval(obs).action == int(a))
+    return same / len(xs)
+
+
+def held_out_seeds(n: int, base: int = 1_000_000) -> list[int]:
+    """Seeds never used by training (training draws from SeedSequence streams)."""
+    return [base + i for i in range(n)]
+
+
+def host_sim_binary(build_dir: str | Path | None = None) -> Path:
+    """The host_sim executable of a build directory (POUR_BUILD_DIR, or build/host)."""
+    root = Path(__file__).resolve().parents[2]
+    cands = [Path(build_dir)] if build_dir else []
+    if os.environ.get("POUR_BUILD_DIR"):
+        cands.append(Path(os.environ["POUR_BUILD_DIR"]))
+    cands += [root / "build" / "host"]
+    for c in cands:
+        for p in (c / "host_sim" / "host_sim", c / "host_sim"):
+            if p.is_file() and os.access(p, os.X_OK):
+                return p
+    found = shutil.which("host_sim")
+    if found:
+        return Path(found)
+    raise FileNotFoundError("host_sim not found: build it (cmake --build build/host) or pass --build-dir")
+
+
+def run_host_sim(args: Sequence[str], build_dir: str | Path | None = None) -> Any:
+    exe = host_sim_binary(build_dir)
+    r = subprocess.run([str(exe), *args, "--json"], capture_output=True, text=True, timeout=3600)
+    if r.returncode != 0:
+        raise RuntimeError(f"{exe.name} {' '.join(args)} failed ({r.returncode}): {r.stderr.strip()[-500:]}")
+    return json.loads(r.stdout)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="pour-eval", description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    ag = sub.add_parser("agree", help="greedy float vs fixed-point agreement on held-out visited states")
+    ag.add_argument("run", help="run directory (its policy.json gives the float W)")
+    ag.add_argument("--header", required=True, help="the weights.h exported from that run")
+    ag.add_argument("--episodes", type=int, default=20)
+    ag.add_argument("--which", default="best", choices=("best", "last"))
+    args = ap.parse_args(argv)
+    from pour import export
+    try:
+        doc = export.load_policy(args.run)
+        w = export.weights_of(doc, args.which)
+        hdr = weights_h.parse_weights_h(args.header)
+        if not np.array_equal(hdr.w_q, weights_h.quantize_weights(w, hdr.w_frac_bits)):
+            raise ValueError(f"{args.header} was not exported from {args.run} ({args.which} weights)")
+        cfg = doc["config"]
+        env = envs.make_env(cfg["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]),
+                            float(cfg["env"]["episode_s"]), cfg["env"]["options"])
+        xs = np.concatenate([env.rollout(w, s, True).x for s in held_out_seeds(args.episodes)])
+        a = agreement(w, hdr, xs)
+    except (export.ExportError, weights_h.WeightsHError, envs.EnvError, ValueError) as exc:
+        print(f"pour-eval: error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps({"states": int(len(xs)), "agreement": a, "episodes": args.episodes}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
