@@ -16,7 +16,7 @@
 extern "C" {
 #include "pour/control.h"
 #include "state_si.h"
-#include "weights_builtin.h"
+#include "pour/weights_compiled.h"
 }
 
 namespace {
@@ -121,7 +121,7 @@ int main(int argc, char **argv) {
   int rc = 0;
   for (long ep = 0; ep < episodes && rc == 0; ep++) {
     poursim_reset(world, static_cast<uint32_t>(seed + ep));
-    if (pour_control_init(&ctl, &ccfg, pour_weights_builtin()) != POUR_OK) {
+    if (pour_control_init(&ctl, &ccfg, &pour_weights_compiled) != POUR_OK) {
       std::fprintf(stderr, "lcm_loop_driver: the core refused the built-in weights\n");
       return 1;
     }

@@ -9,7 +9,7 @@
 
 #include "controller.h"
 #include "io_lcm.h"
-#include "weights_builtin.h"
+#include "pour/weights_compiled.h"
 
 static volatile sig_atomic_t g_stop = 0;
 
@@ -31,8 +31,8 @@ static void usage(FILE *f) {
           "  --seed N               seed of the sampled mode\n"
           "  --verbose              a status line on stderr every 100 ms\n"
           "  --help\n"
-          "Weights: %s (compiled in).\n",
-          pour_weights_builtin_path());
+          "Weights: the weights.h named by CMake's POUR_WEIGHTS (compiled in, hash 0x%08x).\n",
+          (unsigned)pour_weights_compiled.content_hash);
 }
 
 /* Parses a whole decimal integer in [lo, hi]; prints a message naming the option otherwise. */
@@ -79,7 +79,7 @@ static int open_io(const char *spec, pour_io_t *io) {
 
 int main(int argc, char **argv) {
   pour_linux_config_t cfg = pour_linux_default_config();
-  cfg.weights = pour_weights_builtin();
+  cfg.weights = &pour_weights_compiled;
   const char *io_spec = "lcm";
   for (int i = 1; i < argc; i++) {
     const char *a = argv[i];
@@ -149,9 +149,8 @@ int main(int argc, char **argv) {
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGTERM, &sa, NULL);
 
-  fprintf(stderr, "pour_controller: %s, io %s, weights %s (hash 0x%08x)\n",
-          cfg.lockstep ? "lockstep" : "real time 1 kHz", io_spec, pour_weights_builtin_path(),
-          (unsigned)cfg.weights->content_hash);
+  fprintf(stderr, "pour_controller: %s, io %s, weights hash 0x%08x\n",
+          cfg.lockstep ? "lockstep" : "real time 1 kHz", io_spec, (unsigned)cfg.weights->content_hash);
   pour_linux_stats_t st;
   const int rc = pour_linux_run(&cfg, &io, &g_stop, &st);
   io.close(&io);

@@ -1,0 +1,123 @@
+# SPDX-License-Identifier: MIT
+"""Shared by the LCM tests: per-process URLs, the controller process, waiting for messages."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+from typing import Callable
+
+import lcm
+
+from pour import channels, lcm_types
+
+msgs = lcm_types.load()
+
+
+def url(offset: int) -> str:
+    """A multicast URL of its own for this test process, so that parallel runs do not hear each other."""
+    port = 20000 + (os.getpid() * 7 + offset * 131) % 30000
+    return f"udpm://239.255.76.67:{port}?ttl=0"
+
+
+def binary(build_dir: Path, name: str) -> Path:
+    path = build_dir / "bin" / name
+    assert path.is_file(), f"{path} not built"
+    return path
+
+
+class Proc:
+    """A child process that is always stopped (SIGINT, then SIGKILL) when the block ends."""
+
+    def __init__(self, argv: list[str]):
+        self.argv = [str(a) for a in argv]
+        self.p: subprocess.Popen | None = None
+        self.out = ""
+        self.err = ""
+
+    def __enter__(self) -> "Proc":
+        self.p = subprocess.Popen(self.argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        return self
+
+    def stop(self, timeout: float = 10.0) -> int:
+        assert self.p is not None
+        if self.p.poll() is None:
+            self.p.send_signal(signal.SIGINT)
+        try:
+            self.out, self.err = self.p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.p.kill()
+            self.out, self.err = self.p.communicate()
+        return self.p.returncode
+
+    def __exit__(self, *exc) -> None:
+        if self.p is not None and self.p.returncode is None:
+            self.stop()
+
+
+class Bus:
+    """An LCM instance that records what arrives on the channels it is asked to watch."""
+
+    def __init__(self, u: str):
+        self.lc = lcm.LCM(u)
+        self.got: dict[str, list[bytes]] = {}
+
+    def watch(self, channel: str) -> None:
+        self.got.setdefault(channel, [])
+        self.lc.subscribe(channel, lambda ch, data: self.got[ch].append(data))
+
+    def pump(self, seconds: float) -> None:
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            self.lc.handle_timeout(max(1, int(left * 1000)))
+
+    def wait_for(self, pred: Callable[[], bool], seconds: float) -> bool:
+        end = time.monotonic() + seconds
+        while not pred():
+            left = end - time.monotonic()
+            if left <= 0:
+                return False
+            self.lc.handle_timeout(max(1, min(50, int(left * 1000))))
+        return True
+
+    def state(self, seq: int, episode: int = 0, theta: float = 0.1, omega: float = 0.0,
+              v: tuple[float, float, float] = (1.0, 0.0, 0.0)) -> bytes:
+        m = msgs.plant_state_t()
+        m.utime, m.seq, m.episode = seq * 1000, seq, episode
+        m.theta, m.omega = theta, omega
+        m.v_rotating, m.v_target, m.v_spill = v
+        return m.encode()
+
+    def ask(self, seq: int, seconds: float = 5.0, **kw) -> "msgs.torque_t":
+        """Publishes a state (again every 100 ms, as host_sim does) and waits for the torque answering it."""
+        if channels.TORQUE not in self.got:
+            self.watch(channels.TORQUE)
+        data = self.state(seq, **kw)
+        episode = kw.get("episode", 0)
+
+        def answers() -> list:
+            return [t for t in map(msgs.torque_t.decode, self.got[channels.TORQUE])
+                    if t.seq == seq and t.episode == episode]
+
+        end = time.monotonic() + seconds
+        while time.monotonic() < end:
+            self.lc.publish(channels.STATE, data)
+            if self.wait_for(lambda: bool(answers()), min(0.1, end - time.monotonic())):
+                return answers()[-1]
+        raise AssertionError(f"no answer on {channels.TORQUE} to seq {seq} within {seconds} s")
+
+    def wait_up(self, seconds: float = 5.0) -> None:
+        """Waits for the controller's first status (it publishes one as it starts)."""
+        if channels.STATUS not in self.got:
+            self.watch(channels.STATUS)
+        assert self.wait_for(lambda: bool(self.got[channels.STATUS]), seconds), "controller did not start"
+
+    def last_status(self) -> "msgs.controller_status_t":
+        return msgs.controller_status_t.decode(self.got[channels.STATUS][-1])
+
+    def command(self, estop: bool = False, clear_faults: bool = False) -> None:
+        m = msgs.command_t()
+        m.utime, m.estop, m.clear_faults = int(time.time() * 1e6), estop, clear_faults
+        self.lc.publish(channels.COMMAND, m.encode())
