@@ -33,7 +33,8 @@ class Episode:
     x: np.ndarray                  # [T][6] features at each decision
     actions: np.ndarray            # [T] action index
     rewards: np.ndarray            # [T] reward summed over each decision period
-    metrics: dict[str, float] = field(default_factory=dict)  # v_target, v_spill, v_rotating, finish_s, ...
+    metrics: dict[str, float] = field(default_factory=dict)  # v_target, v_spill, v_rotating, finish_s
+    # finish_s: first time V_target + V_spill reached 99 % of its final value [s]; -1 if < 1 % moved
     seed: int = 0
 
 
@@ -44,12 +45,6 @@ def normalise(theta: float, omega: float, v_rot: float, v_tgt: float, v_spill: f
     return np.array([c((theta - THETA_MIN_RAD) / (THETA_MAX_RAD - THETA_MIN_RAD)),
                      c((omega + OMEGA_MAX_RAD_S) / (2 * OMEGA_MAX_RAD_S)),
                      c(v_rot), c(v_tgt), c(v_spill), 1.0])
-
-
-def finish_time_s(t_s: np.ndarray, v_rot: np.ndarray, threshold: float = 0.02) -> float:
-    """First time the rotating bucket holds at most `threshold` of the liquid (inf if never)."""
-    idx = np.flatnonzero(np.asarray(v_rot) <= threshold)
-    return float(t_s[idx[0]]) if idx.size else math.inf
 
 
 def choose(w: np.ndarray, x: np.ndarray, greedy: bool, rng: np.random.Generator) -> int:
@@ -85,47 +80,62 @@ class ToyEnv:
         self.period = decision_period_ms
         self.steps = int(round(episode_s * 1000))
 
-    def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> Episode:
-        o = self.o
+    def reset(self, seed: int) -> np.random.Generator:
+        """Starts an episode: full bucket, upright, at rest; the seed varies the pouring angle."""
         rng = np.random.default_rng(seed)
-        theta, omega = 0.0, 0.0
-        v_rot, v_tgt, v_spill = 1.0, 0.0, 0.0
-        pour_at = 0.55 + 0.05 * rng.standard_normal()  # the full bucket's first-pour angle [rad]
-        dt = 1e-3
+        self.theta, self.omega = 0.0, 0.0
+        self.v_rot, self.v_tgt, self.v_spill = 1.0, 0.0, 0.0
+        self.pour_at = 0.55 + 0.05 * rng.standard_normal()  # the full bucket's first-pour angle [rad]
+        return rng
+
+    def features(self) -> np.ndarray:
+        return normalise(self.theta, self.omega, self.v_rot, self.v_tgt, self.v_spill)
+
+    def advance(self, level: float, ticks: int) -> float:
+        """ticks 1 ms steps at torque level x tau_max; returns the reward summed over them."""
+        o = self.o
+        tau = level * o["tau_max"]
+        theta, omega, v_rot, v_tgt, v_spill = self.theta, self.omega, self.v_rot, self.v_tgt, self.v_spill
+        dt, r_sum = 1e-3, 0.0
+        for _ in range(ticks):
+            inertia = o["inertia"] * (0.4 + 0.6 * v_rot)
+            alpha = (tau - o["gravity"] * v_rot * math.sin(theta) - o["damping"] * omega) / inertia
+            omega += alpha * dt
+            theta += omega * dt
+            if theta >= THETA_MAX_RAD:
+                theta, omega = THETA_MAX_RAD, min(omega, 0.0)
+            elif theta <= 0.0:
+                theta, omega = 0.0, max(omega, 0.0)
+            onset = self.pour_at + 1.2 * (1.0 - v_rot)
+            q = o["flow"] * max(0.0, theta - onset) * (0.3 + v_rot)
+            dv = min(v_rot, q * dt)
+            if dv > 0.0:
+                spill = min(1.0, max(0.0, (q - o["flow_safe"]) / o["flow_safe"])
+                            + max(0.0, (abs(omega) - o["omega_safe"]) / o["omega_safe"]))
+                v_rot -= dv
+                v_spill += dv * spill
+                v_tgt += dv * (1.0 - spill)
+            r_sum += o["k_target"] * v_tgt - o["k_spill"] * v_spill
+        self.theta, self.omega, self.v_rot, self.v_tgt, self.v_spill = theta, omega, v_rot, v_tgt, v_spill
+        return r_sum
+
+    def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> Episode:
+        rng = self.reset(seed)
         n_dec = self.steps // self.period
         xs = np.empty((n_dec, N_FEATURES))
         acts = np.empty(n_dec, dtype=np.int64)
         rews = np.zeros(n_dec)
-        vrot_trace = np.empty(n_dec)
         for d in range(n_dec):
-            x = normalise(theta, omega, v_rot, v_tgt, v_spill)
+            x = self.features()
             a = choose(w, x, greedy, rng)
-            xs[d], acts[d], vrot_trace[d] = x, a, v_rot
-            tau = self.levels[a] * o["tau_max"]
-            r_sum = 0.0
-            for _ in range(self.period):
-                inertia = o["inertia"] * (0.4 + 0.6 * v_rot)
-                alpha = (tau - o["gravity"] * v_rot * math.sin(theta) - o["damping"] * omega) / inertia
-                omega += alpha * dt
-                theta += omega * dt
-                if theta >= THETA_MAX_RAD:
-                    theta, omega = THETA_MAX_RAD, min(omega, 0.0)
-                elif theta <= 0.0:
-                    theta, omega = 0.0, max(omega, 0.0)
-                onset = pour_at + 1.2 * (1.0 - v_rot)
-                q = o["flow"] * max(0.0, theta - onset) * (0.3 + v_rot)
-                dv = min(v_rot, q * dt)
-                if dv > 0.0:
-                    spill = min(1.0, max(0.0, (q - o["flow_safe"]) / o["flow_safe"])
-                                + max(0.0, (abs(omega) - o["omega_safe"]) / o["omega_safe"]))
-                    v_rot -= dv
-                    v_spill += dv * spill
-                    v_tgt += dv * (1.0 - spill)
-                r_sum += o["k_target"] * v_tgt - o["k_spill"] * v_spill
-            rews[d] = r_sum
+            xs[d], acts[d] = x, a
+            rews[d] = self.advance(float(self.levels[a]), self.period)
+        moved = xs[:, 3] + xs[:, 4]
+        final = self.v_tgt + self.v_spill
         t_s = np.arange(n_dec) * self.period * 1e-3
-        metrics = {"v_target": v_tgt, "v_spill": v_spill, "v_rotating": v_rot,
-                   "finish_s": finish_time_s(t_s, vrot_trace)}
+        done = np.flatnonzero(moved >= 0.99 * final) if final >= 0.01 else np.array([], dtype=int)
+        metrics = {"v_target": self.v_tgt, "v_spill": self.v_spill, "v_rotating": self.v_rot,
+                   "finish_s": float(t_s[done[0]]) if done.size else -1.0}
         return Episode(xs, acts, rews, metrics, seed)
 
 
@@ -137,4 +147,15 @@ def make_env(kind: str, n_actions: int, decision_period_ms: int, episode_s: floa
     if kind == "sim":
         from pour import sim_adapter  # loads libpoursim; EnvError if it cannot
         return sim_adapter.SimEnv(n_actions, decision_period_ms, episode_s, options)
+    raise EnvError(f"unknown env kind {kind!r}: expected 'sim' or 'toy'")
+
+
+def make_stepper(kind: str, n_actions: int, decision_period_ms: int, episode_s: float,
+                 options: dict[str, Any] | None = None):
+    """An object with reset(seed), features(), advance(level, ticks) -> reward, v_tgt, v_spill."""
+    if kind == "toy":
+        return ToyEnv(n_actions, decision_period_ms, episode_s, options)
+    if kind == "sim":
+        from pour import sim_adapter
+        return sim_adapter.SimStepper(options)
     raise EnvError(f"unknown env kind {kind!r}: expected 'sim' or 'toy'")
