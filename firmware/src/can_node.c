@@ -123,6 +123,27 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
   node->clear_request = false;
 }
 
+uint16_t pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {
+  if (node->armed) {
+    uint64_t t = (uint64_t)node->ms_since_valid + elapsed_ms;
+    node->ms_since_valid = t > UINT32_MAX ? UINT32_MAX : (uint32_t)t;
+    if (node->ms_since_valid > node->config.watchdog_ms) {
+      node->faults |= POUR_CAN_FAULT_WATCHDOG;
+    }
+  }
+  return node->faults;
+}
+
+void pour_can_node_override(const pour_can_node_t *node, pour_control_output_t *out) {
+  if ((node->faults & POUR_CAN_FAULT_WATCHDOG) != 0u) {
+    out->torque = node->config.safe_torque;
+    if (out->mode == (uint8_t)POUR_MODE_RUN || out->mode == (uint8_t)POUR_MODE_IDLE) {
+      out->mode = (uint8_t)POUR_MODE_FAULT;
+    }
+  }
+  out->faults = (uint16_t)(out->faults | node->faults);
+}
+
 uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
   const pour_can_node_counters_t *c = &node->counters;
   uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range + c->unpaired;
@@ -131,21 +152,8 @@ uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
 
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]) {
-  if (node->armed) {
-    if (node->ms_since_valid < UINT32_MAX) {
-      ++node->ms_since_valid;
-    }
-    if (node->ms_since_valid > node->config.watchdog_ms) {
-      node->faults |= POUR_CAN_FAULT_WATCHDOG;
-    }
-  }
-  if ((node->faults & POUR_CAN_FAULT_WATCHDOG) != 0u) {
-    out->torque = node->config.safe_torque;
-    if (out->mode == (uint8_t)POUR_MODE_RUN || out->mode == (uint8_t)POUR_MODE_IDLE) {
-      out->mode = (uint8_t)POUR_MODE_FAULT;
-    }
-  }
-  out->faults = (uint16_t)(out->faults | node->faults);
+  pour_can_node_watchdog(node, 1);
+  pour_can_node_override(node, out);
 
   uint8_t n = 0;
   pour_can_torque_t t;

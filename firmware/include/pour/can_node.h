@@ -65,6 +65,13 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
 
+/* Advances the command watchdog by elapsed_ms (end_tick does it by 1 each tick; a port without a
+ * tick of its own, such as the Linux one, by wall-clock time). Returns the latched POUR_CAN_FAULT_* bits. */
+uint16_t pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms);
+
+/* With the watchdog fault latched: safe torque and mode FAULT in *out. Always ORs the node's faults in. */
+void pour_can_node_override(const pour_can_node_t *node, pour_control_output_t *out);
+
 /* Total of the dropped-frame counters (what the heartbeat's RxDropped carries, mod 2^16). */
 uint32_t pour_can_node_dropped(const pour_can_node_t *node);
 

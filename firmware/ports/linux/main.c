@@ -9,6 +9,7 @@
 
 #include "controller.h"
 #include "io_lcm.h"
+#include "io_socketcan.h"
 #include "pour/weights_compiled.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -22,6 +23,8 @@ static void usage(FILE *f) {
   fprintf(f,
           "usage: pour_controller [options]\n"
           "  --io lcm[:URL]         transport (default lcm with its default URL)\n"
+          "  --io can:IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n"
+          "                         SocketCAN, the protocol of can/pour.dbc (defaults 0, 100, 50)\n"
           "  --lockstep             one tick per received state (deterministic; host_sim --lockstep)\n"
           "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a state (200)\n"
           "  --duration S           stop after S seconds (default: run until SIGINT/SIGTERM)\n"
@@ -65,15 +68,21 @@ static int parse_seconds(const char *opt, const char *s, long long *out_ms) {
   return 0;
 }
 
-/* Opens the transport named by spec: "lcm" or "lcm:URL". Other backends add a branch here. */
-static int open_io(const char *spec, pour_io_t *io) {
+/* Opens the transport named by spec: "lcm", "lcm:URL" or "can:IFACE[,...]". Other backends add a branch here. */
+static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *cfg) {
   if (strcmp(spec, "lcm") == 0) {
     return pour_io_lcm_open(io, NULL);
   }
   if (strncmp(spec, "lcm:", 4) == 0) {
     return pour_io_lcm_open(io, spec + 4);
   }
-  fprintf(stderr, "pour_controller: unknown transport '%s' (known: lcm[:URL])\n", spec);
+  if (strncmp(spec, "can:", 4) == 0) {
+    pour_io_socketcan_config_t can = {.node = pour_can_node_default_config()};
+    /* In lockstep the loop itself waits stall_ms before it treats silence as stale input. */
+    can.watchdog_grace_ms = cfg->lockstep ? (uint32_t)cfg->stall_ms : 0u;
+    return pour_io_socketcan_parse(spec + 4, &can) == 0 ? pour_io_socketcan_open(io, &can) : -1;
+  }
+  fprintf(stderr, "pour_controller: unknown transport '%s' (known: lcm[:URL], can:IFACE)\n", spec);
   return -1;
 }
 
@@ -139,7 +148,7 @@ int main(int argc, char **argv) {
 
   pour_io_t io;
   memset(&io, 0, sizeof io);
-  if (open_io(io_spec, &io) != 0) {
+  if (open_io(io_spec, &io, &cfg) != 0) {
     return 1;
   }
   struct sigaction sa;

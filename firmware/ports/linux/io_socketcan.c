@@ -1,0 +1,311 @@
+/* SPDX-License-Identifier: MIT */
+#include "io_socketcan.h"
+
+#include <errno.h>
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+typedef struct {
+  int fd;
+  pour_io_socketcan_config_t config;
+  pour_can_node_t node;
+  int64_t last_ms;          /* wall clock of the last watchdog update [ms] */
+  int64_t next_heartbeat_ms;
+  uint32_t dropped_reported;
+  uint32_t rx_errors;       /* frames the codec never saw: error, RTR, extended or FD frames */
+  uint16_t last_seq16;
+  int64_t last_seq64;
+  uint8_t mode;             /* latest mode, faults and overruns the loop told us of */
+  uint16_t faults;
+  uint32_t overruns;
+} socketcan_t;
+
+static socketcan_t g_can; /* one transport per process */
+
+static int64_t mono_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (int64_t)ts.tv_sec * 1000LL + ts.tv_nsec / 1000000L;
+}
+
+static int send_frame(socketcan_t *s, const pour_can_frame_t *f) {
+  struct can_frame cf;
+  memset(&cf, 0, sizeof cf);
+  cf.can_id = f->id;
+  cf.can_dlc = f->dlc;
+  memcpy(cf.data, f->data, f->dlc);
+  /* A full TX queue (ENOBUFS) is reported, not retried: the next tick sends fresher data anyway. */
+  return write(s->fd, &cf, sizeof cf) == (ssize_t)sizeof cf ? 0 : -1;
+}
+
+static void heartbeat(socketcan_t *s) {
+  pour_can_heartbeat_t hb;
+  hb.mode = s->mode;
+  hb.faults = (uint16_t)(s->faults | s->node.faults);
+  hb.rx_dropped = (uint16_t)((pour_can_node_dropped(&s->node) + s->rx_errors) & 0xFFFFu);
+  hb.overruns = (uint16_t)(s->overruns & 0xFFFFu);
+  hb.counter = s->node.heartbeat_counter++;
+  if ((s->node.faults & POUR_CAN_FAULT_WATCHDOG) != 0u && hb.mode != (uint8_t)POUR_MODE_ESTOP) {
+    hb.mode = (uint8_t)POUR_MODE_FAULT;
+  }
+  pour_can_frame_t f;
+  if (pour_can_pack_heartbeat(s->config.node.node_id, &hb, &f) == POUR_OK) {
+    (void)send_frame(s, &f);
+  }
+}
+
+/* Wall-clock housekeeping: the watchdog and the heartbeat schedule. */
+static void housekeeping(socketcan_t *s) {
+  const int64_t now = mono_ms();
+  if (now > s->last_ms) {
+    pour_can_node_watchdog(&s->node, (uint32_t)(now - s->last_ms));
+    s->last_ms = now;
+  }
+  if (now >= s->next_heartbeat_ms) {
+    heartbeat(s);
+    s->next_heartbeat_ms += s->config.node.heartbeat_period_ms;
+    if (s->next_heartbeat_ms <= now) {
+      s->next_heartbeat_ms = now + s->config.node.heartbeat_period_ms;
+    }
+  }
+}
+
+/* CAN carries 16 bits of seq: extend it to the loop's 64-bit seq (0 always starts an episode). */
+static int64_t unwrap_seq(socketcan_t *s, uint32_t seq32) {
+  const uint16_t seq16 = (uint16_t)(seq32 & 0xFFFFu);
+  int64_t seq64;
+  if (seq16 == 0u) {
+    seq64 = 0;
+  } else {
+    const int32_t delta = (int32_t)(int16_t)(uint16_t)(seq16 - s->last_seq16);
+    seq64 = s->last_seq64 + delta;
+    if (seq64 < 0) {
+      seq64 = seq16;
+    }
+  }
+  s->last_seq16 = seq16;
+  s->last_seq64 = seq64;
+  return seq64;
+}
+
+/* Reads the frames waiting on the socket; stops after the first completed state. */
+static int drain(socketcan_t *s, pour_io_input_t *in) {
+  for (;;) {
+    struct can_frame cf;
+    const ssize_t n = recv(s->fd, &cf, sizeof cf, MSG_DONTWAIT);
+    if (n < 0) {
+      return (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) ? 0 : -1;
+    }
+    if (n != (ssize_t)sizeof cf || (cf.can_id & (CAN_ERR_FLAG | CAN_RTR_FLAG | CAN_EFF_FLAG)) != 0u ||
+        cf.can_dlc > 8u) {
+      s->rx_errors++;
+      in->n_dropped++;
+      continue;
+    }
+    pour_can_frame_t f;
+    f.id = (uint16_t)(cf.can_id & CAN_SFF_MASK);
+    f.dlc = cf.can_dlc;
+    memcpy(f.data, cf.data, sizeof f.data);
+    const pour_can_rx_t rc = pour_can_node_receive(&s->node, &f);
+    if (rc != POUR_CAN_RX_OK) {
+      const uint32_t d = pour_can_node_dropped(&s->node);
+      in->n_dropped += d - s->dropped_reported;
+      s->dropped_reported = d;
+      continue;
+    }
+    pour_control_input_t ci;
+    const uint8_t cmd = (uint8_t)(f.id & POUR_CAN_CMD_MASK);
+    pour_can_node_begin_tick(&s->node, &ci);
+    if (cmd == POUR_CAN_CMD_ESTOP || cmd == POUR_CAN_CMD_CLEAR_ERRORS) {
+      in->have_command = true;
+      in->estop = ci.estop;
+      in->clear_faults = in->clear_faults || ci.clear_faults;
+    }
+    if (ci.state_fresh) {
+      in->n_states++;
+      in->state = ci.state;
+      in->state_seq = unwrap_seq(s, ci.state.seq);
+      in->state.seq = (uint32_t)in->state_seq;
+      in->state_utime = 0; /* CAN carries no time stamp; the bridge restores it */
+      in->episode = 0;
+      return 1;
+    }
+  }
+}
+
+static int can_wait(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in) {
+  socketcan_t *s = io->ctx;
+  const int64_t deadline = mono_ms() + (timeout_us + 999) / 1000;
+  for (;;) {
+    const int r = drain(s, in);
+    housekeeping(s);
+    if (r != 0) {
+      return r;
+    }
+    const int64_t now = mono_ms();
+    if (now >= deadline) {
+      return 0;
+    }
+    int64_t until = deadline < s->next_heartbeat_ms ? deadline : s->next_heartbeat_ms;
+    struct pollfd p = {.fd = s->fd, .events = POLLIN, .revents = 0};
+    const int64_t wait_ms = until > now ? until - now : 0;
+    if (poll(&p, 1, (int)(wait_ms > 1000 ? 1000 : wait_ms)) < 0 && errno != EINTR) {
+      return -1;
+    }
+  }
+}
+
+static int can_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
+  socketcan_t *s = io->ctx;
+  housekeeping(s);
+  pour_control_output_t out = *a->out;
+  pour_can_node_override(&s->node, &out);
+  s->mode = out.mode;
+  s->faults = out.faults;
+  pour_can_torque_t t;
+  t.seq = (uint16_t)((uint64_t)a->state_seq & 0xFFFFu);
+  t.torque = out.torque;
+  t.action = (uint8_t)(out.action & POUR_CAN_ACTION_MAX);
+  t.mode = (uint8_t)(out.mode & 0x03u);
+  t.limits = (uint8_t)(out.limits & POUR_CAN_LIMITS_MAX);
+  pour_can_frame_t f;
+  if (pour_can_pack_torque(s->config.node.node_id, &t, &f) != POUR_OK) {
+    return -1;
+  }
+  return send_frame(s, &f);
+}
+
+static int can_send_status(pour_io_t *io, const pour_io_status_t *st) {
+  socketcan_t *s = io->ctx;
+  /* The heartbeat keeps its own period; the status only refreshes what it reports. */
+  s->mode = st->mode;
+  s->faults = st->faults;
+  s->overruns = st->overruns > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)st->overruns;
+  housekeeping(s);
+  return 0;
+}
+
+static void can_close(pour_io_t *io) {
+  socketcan_t *s = io->ctx;
+  if (s->fd >= 0) {
+    close(s->fd);
+    s->fd = -1;
+  }
+}
+
+static int parse_field(const char *what, const char *v, unsigned long max, unsigned long min, unsigned long *out) {
+  char *end = NULL;
+  errno = 0;
+  const unsigned long n = strtoul(v, &end, 10);
+  if (end == v || *end != '\0' || errno != 0 || n < min || n > max || v[0] == '-') {
+    fprintf(stderr, "pour_controller: --io can: %s needs an integer in [%lu, %lu], got '%s'\n", what, min, max, v);
+    return -1;
+  }
+  *out = n;
+  return 0;
+}
+
+int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config) {
+  char buf[128];
+  if (spec == NULL || strlen(spec) >= sizeof buf) {
+    fprintf(stderr, "pour_controller: --io can: needs IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n");
+    return -1;
+  }
+  strcpy(buf, spec);
+  char *save = NULL;
+  char *iface = strtok_r(buf, ",", &save);
+  if (iface == NULL || strlen(iface) == 0u || strlen(iface) >= sizeof config->iface) {
+    fprintf(stderr, "pour_controller: --io can: needs an interface name of 1..15 characters, got '%s'\n", spec);
+    return -1;
+  }
+  strcpy(config->iface, iface);
+  for (char *kv = strtok_r(NULL, ",", &save); kv != NULL; kv = strtok_r(NULL, ",", &save)) {
+    char *eq = strchr(kv, '=');
+    unsigned long n = 0;
+    if (eq == NULL) {
+      fprintf(stderr, "pour_controller: --io can: '%s' is not key=value\n", kv);
+      return -1;
+    }
+    *eq = '\0';
+    const char *v = eq + 1;
+    if (strcmp(kv, "node") == 0) {
+      if (parse_field("node", v, POUR_CAN_NODE_ID_MAX, 0, &n) != 0) {
+        return -1;
+      }
+      config->node.node_id = (uint8_t)n;
+    } else if (strcmp(kv, "heartbeat-ms") == 0) {
+      if (parse_field("heartbeat-ms", v, UINT16_MAX, 1, &n) != 0) {
+        return -1;
+      }
+      config->node.heartbeat_period_ms = (uint16_t)n;
+    } else if (strcmp(kv, "watchdog-ms") == 0) {
+      if (parse_field("watchdog-ms", v, UINT16_MAX, 1, &n) != 0) {
+        return -1;
+      }
+      config->node.watchdog_ms = (uint16_t)n;
+    } else {
+      fprintf(stderr, "pour_controller: --io can: unknown key '%s' (node, heartbeat-ms, watchdog-ms)\n", kv);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *config) {
+  socketcan_t *s = &g_can;
+  memset(s, 0, sizeof *s);
+  s->fd = -1;
+  s->config = *config;
+  pour_can_node_config_t nc = config->node;
+  const uint32_t wd = (uint32_t)nc.watchdog_ms + config->watchdog_grace_ms;
+  nc.watchdog_ms = (uint16_t)(wd > UINT16_MAX ? UINT16_MAX : wd);
+  if (pour_can_node_init(&s->node, &nc) != POUR_OK) {
+    fprintf(stderr, "pour_controller: --io can: bad node configuration\n");
+    return -1;
+  }
+  s->fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+  if (s->fd < 0) {
+    fprintf(stderr, "pour_controller: --io can:%s: cannot open a CAN socket (%s); this kernel may have no CAN support\n",
+            config->iface, strerror(errno));
+    return -1;
+  }
+  const unsigned ifindex = if_nametoindex(config->iface);
+  if (ifindex == 0u) {
+    fprintf(stderr, "pour_controller: --io can:%s: no such CAN interface (%s)\n", config->iface, strerror(errno));
+    close(s->fd);
+    s->fd = -1;
+    return -1;
+  }
+  /* Only this node's standard data frames reach us; everything else on the bus is someone else's. */
+  struct can_filter filter = {
+      .can_id = (canid_t)pour_can_id(config->node.node_id, 0),
+      .can_mask = POUR_CAN_NODE_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG,
+  };
+  struct sockaddr_can addr;
+  memset(&addr, 0, sizeof addr);
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = (int)ifindex;
+  if (setsockopt(s->fd, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof filter) < 0 ||
+      bind(s->fd, (struct sockaddr *)&addr, sizeof addr) < 0) {
+    fprintf(stderr, "pour_controller: --io can:%s: cannot bind (%s)\n", config->iface, strerror(errno));
+    close(s->fd);
+    s->fd = -1;
+    return -1;
+  }
+  s->last_ms = mono_ms();
+  s->next_heartbeat_ms = s->last_ms;
+  io->ctx = s;
+  io->wait = can_wait;
+  io->send_torque = can_send_torque;
+  io->send_status = can_send_status;
+  io->close = can_close;
+  return 0;
+}

@@ -1,0 +1,28 @@
+/* SPDX-License-Identifier: MIT */
+/* SocketCAN transport for the controller: the pour CAN protocol (can/pour.dbc) on a Linux CAN interface.
+ * StateA/StateB, Estop and ClearErrors in; Torque (one per answered state) and Heartbeat out. Frame
+ * handling, the command watchdog and the heartbeat contents are the core's pour_can_node; this file only
+ * moves frames and keeps the wall clock. */
+#ifndef POUR_LINUX_IO_SOCKETCAN_H
+#define POUR_LINUX_IO_SOCKETCAN_H
+
+#include <stdint.h>
+
+#include "io.h"
+#include "pour/can_node.h"
+
+typedef struct {
+  char iface[16];                /* interface name, e.g. "vcan0" (IFNAMSIZ) */
+  pour_can_node_config_t node;   /* node id, watchdog [ms], heartbeat period [ms], safe torque */
+  uint32_t watchdog_grace_ms;    /* added to the watchdog (lockstep: the loop's stall time) [ms] */
+} pour_io_socketcan_config_t;
+
+/* Parses "IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]" onto *config (whose other fields keep their
+ * values). Returns 0, or -1 with a message naming the bad part on stderr. */
+int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config);
+
+/* Opens a CAN_RAW socket on the interface, filtered to the node's ids. Returns 0, or -1 with a message
+ * on stderr (no such interface, no CAN support in the kernel, ...). */
+int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *config);
+
+#endif /* POUR_LINUX_IO_SOCKETCAN_H */
