@@ -1,0 +1,201 @@
+/* SPDX-License-Identifier: MIT */
+/* libpoursim: the pouring world (Box2D 3), its configuration, and a whole-episode rollout for training.
+ * Plain C API (usable from C, C++ and Python ctypes). Units: SI (m, kg, s, rad, N·m) unless stated.
+ * Angles: θ = 0 upright, positive tilts the rotating bucket toward the target (clockwise on screen,
+ * target on the right). */
+#ifndef POURSIM_POURSIM_H
+#define POURSIM_POURSIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define POURSIM_N_FEATURES 6    /* θn, ωn, V_rotating, V_target, V_spill, bias 1.0 */
+#define POURSIM_MAX_ACTIONS 16
+#define POURSIM_MAX_PARTICLES 1024
+#define POURSIM_ERR_LEN 256     /* size of the error buffers the API fills */
+
+/* Status of every fallible call: 0 = OK, negative = error (the error text says what). */
+typedef enum {
+  POURSIM_OK = 0,
+  POURSIM_EINVAL = -1, /* an argument or config value out of range */
+  POURSIM_EIO = -2,    /* a file could not be read */
+  POURSIM_EPARSE = -3, /* a file could not be parsed */
+  POURSIM_ESTATE = -4  /* call out of order (e.g. step after the episode ended) */
+} poursim_status_t;
+
+/* The whole configuration. poursim_default_config() documents each default (docs/simulator.md). */
+typedef struct {
+  /* time */
+  double dt;              /* physics step [s], 0.001 (the 1 kHz control tick) */
+  int substeps;           /* Box2D sub-steps per step, 1..16 */
+  double episode_s;       /* episode length [s] */
+  double settle_s;        /* liquid settles this long, bucket held upright, before t = 0 [s] */
+  /* geometry (both buckets are the same U of three boxes) */
+  double bucket_inner_width; /* [m] */
+  double bucket_height;      /* outer height [m] */
+  double bucket_wall;        /* wall and bottom thickness [m] */
+  double pivot_height;       /* rotating bucket's centre (pivot) above the ground [m] */
+  double target_dx;          /* target bucket's centre x minus pivot x [m] (> 0: the pouring side) */
+  /* masses and liquid */
+  double bucket_mass;     /* rotating bucket (steel) [kg] */
+  double liquid_mass;     /* all the liquid [kg] */
+  int n_particles;        /* circles, 1..POURSIM_MAX_PARTICLES */
+  double radius_min;      /* radii evenly spread over [radius_min, radius_max] [m] */
+  double radius_max;
+  /* contact model */
+  double restitution_liquid; /* circle–circle */
+  double restitution_wall;   /* circle–wall (mixed with min, so it wins) */
+  double friction;
+  double restitution_threshold; /* collisions slower than this do not bounce [m/s] */
+  double contact_hertz;         /* contact stiffness [Hz] */
+  /* actuation */
+  double tau_max;         /* torque of action level 1.0 [N·m] */
+  double theta_min;       /* lower hard stop [rad] */
+  double theta_max;       /* upper hard stop [rad] */
+  /* observation normalisation (must match the policy's weights.h) */
+  double obs_theta_min;   /* [rad] */
+  double obs_theta_max;   /* [rad] */
+  double obs_omega_max;   /* [rad/s] */
+  /* reward */
+  double k_target;
+  double k_spill;
+  double gamma;           /* per-step discount of the return */
+  uint32_t seed;          /* default seed of reset() and the CLI */
+} poursim_config_t;
+
+/* Everything measured after a step (or at reset). */
+typedef struct {
+  uint32_t step;        /* steps since t = 0 */
+  double t;             /* [s] */
+  double theta;         /* [rad] */
+  double omega;         /* [rad/s] */
+  double v_rotating;    /* fraction of circles inside the rotating bucket (its frame) */
+  double v_target;      /* fraction inside the target bucket */
+  double v_spill;       /* fraction outside both and below the target's rim, or on the ground */
+  double v_flight;      /* fraction in none of those (in the air) */
+  double obs[5];        /* normalised θ, θ̇, V_rot, V_tgt, V_spill, each in [0, 1] */
+  double reward;        /* K_target·V_target − K_spill·V_spill of this state */
+  double torque;        /* torque applied in the step that led here [N·m] */
+  int done;             /* 1 once t reaches episode_s */
+} poursim_obs_t;
+
+typedef struct poursim_world poursim_world_t;
+
+/* Defaults of the paper's scene (docs/simulator.md). */
+poursim_config_t poursim_default_config(void);
+
+/* Checks every field; on error writes a message naming the field into err (may be NULL). */
+int poursim_config_validate(const poursim_config_t *config, char *err, size_t err_len);
+
+/* Reads "key = value" lines (# comments) over the values already in *config, then validates. */
+int poursim_config_load(const char *path, poursim_config_t *config, char *err, size_t err_len);
+
+/* Sets one field by name from text (the same keys as the config file). */
+int poursim_config_set(poursim_config_t *config, const char *key, const char *value, char *err,
+                       size_t err_len);
+
+/* Writes the config as a loadable file. */
+int poursim_config_write(const poursim_config_t *config, const char *path, char *err, size_t err_len);
+
+/* Creates a world (validates the config) and resets it with config->seed. NULL on error. */
+poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len);
+
+/* Rebuilds the scene: new liquid arrangement from seed, settled, bucket upright at rest, t = 0. */
+int poursim_reset(poursim_world_t *world, uint32_t seed);
+
+/* One dt step with torque a·tau_max, a in [-1, 1] (clamped); fills *out (may be NULL). */
+int poursim_step(poursim_world_t *world, double action, poursim_obs_t *out);
+
+/* The state after the last step (or reset). */
+void poursim_observe(const poursim_world_t *world, poursim_obs_t *out);
+
+void poursim_destroy(poursim_world_t *world);
+
+const poursim_config_t *poursim_world_config(const poursim_world_t *world);
+
+/* Number of circles. */
+int poursim_particle_count(const poursim_world_t *world);
+
+/* Copies circle centres (x, y interleaved [m]) and radii [m]; either array may be NULL. Returns count. */
+int poursim_particles(const poursim_world_t *world, float *xy, float *radius, int capacity);
+
+/* Where each circle is: 0 rotating, 1 target, 2 spilled, 3 in flight. Returns count. */
+int poursim_particle_regions(const poursim_world_t *world, uint8_t *region, int capacity);
+
+/* Deepest circle–circle or circle–wall overlap right now [m] (contact quality). */
+double poursim_max_overlap(const poursim_world_t *world);
+
+/* Deepest excursion of any circle through a wall of the rotating bucket seen since reset [m]
+ * (0 if none: a circle that tunnels shows up here). */
+double poursim_max_wall_penetration(const poursim_world_t *world);
+
+/* Rotating bucket's moment of inertia about its pivot, bucket only (liquid comes from contacts) [kg·m²]. */
+double poursim_bucket_inertia(const poursim_world_t *world);
+
+/* Running FNV-1a 64 over the bits of every observation and circle position so far (determinism). */
+uint64_t poursim_trajectory_hash(const poursim_world_t *world);
+
+/* ---- Whole-episode rollout with a float softmax-linear policy (the trainer's model). ---- */
+
+/* A policy as weights.h describes it, in float: logits = x·W, x = [θn, ωn, Vr, Vt, Vs, 1]. */
+typedef struct {
+  int n_actions;              /* 2..POURSIM_MAX_ACTIONS */
+  int decision_period;        /* steps between decisions, >= 1 */
+  const double *w;            /* [POURSIM_N_FEATURES][n_actions], row-major */
+  const double *levels;       /* [n_actions] torque fraction of tau_max, in [-1, 1] */
+  double theta_min, theta_max; /* normalisation [rad] */
+  double omega_max;            /* [rad/s] */
+  int greedy;                 /* 1: argmax (ties to lowest index); 0: sample with the seed */
+} poursim_policy_t;
+
+/* Caller-provided arrays; any pointer may be NULL. Capacities: decisions = ceil(steps / period). */
+typedef struct {
+  int capacity;         /* decisions the arrays hold */
+  double *features;     /* [capacity][POURSIM_N_FEATURES] */
+  int32_t *actions;     /* [capacity] */
+  double *rewards;      /* [capacity] reward summed over the decision's steps */
+  double *probs;        /* [capacity][n_actions] */
+  int step_capacity;    /* steps the per-step arrays hold */
+  double *step_rewards; /* [step_capacity] */
+  double *step_theta;   /* [step_capacity] θ after each step [rad] */
+} poursim_rollout_buffers_t;
+
+/* Metrics of one episode. */
+typedef struct {
+  int n_steps;
+  int n_decisions;
+  double poured;       /* final V_target */
+  double spilled;      /* final V_spill */
+  double remaining;    /* final V_rotating */
+  double finish_time;  /* first t at which V_target + V_spill reached 99 % of its final value [s];
+                          -1 if it ends below 1 % (nothing poured) */
+  double ret;          /* Σ γ^t r_t */
+  double reward_sum;   /* Σ r_t */
+  double max_theta;    /* [rad] */
+} poursim_episode_t;
+
+/* Resets the world with seed, runs one full episode: at steps 0, P, 2P, … the policy picks an action
+ * from the observation at that step; the torque goes through the firmware's safety envelope
+ * (pour_safety_apply with its default config) before each step. */
+int poursim_rollout(poursim_world_t *world, const poursim_policy_t *policy, uint32_t seed,
+                    const poursim_rollout_buffers_t *buffers, poursim_episode_t *episode);
+
+/* n rollouts with seeds[i], on n_threads threads (each with its own world). bufs and episodes are
+ * arrays of n (bufs may be NULL). */
+int poursim_rollout_batch(const poursim_config_t *config, const poursim_policy_t *policy,
+                          const uint32_t *seeds, int n, int n_threads,
+                          const poursim_rollout_buffers_t *bufs, poursim_episode_t *episodes,
+                          char *err, size_t err_len);
+
+/* Library version string. */
+const char *poursim_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* POURSIM_POURSIM_H */

@@ -1,0 +1,258 @@
+// SPDX-License-Identifier: MIT
+// The simulator's configuration: defaults, one table of fields (name, range), file I/O.
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "poursim/poursim.h"
+#include "poursim_internal.hpp"
+
+namespace {
+
+enum class Kind { Double, Int, U32 };
+
+struct Field {
+  const char *name;
+  size_t offset;
+  Kind kind;
+  double min, max; // inclusive range
+};
+
+#define F(name, kind, lo, hi) {#name, offsetof(poursim_config_t, name), Kind::kind, lo, hi}
+// Ranges: wide enough for experiments, narrow enough that the physics stays meaningful.
+const Field kFields[] = {
+    F(dt, Double, 1e-4, 0.01),
+    F(substeps, Int, 1, 16),
+    F(episode_s, Double, 0.01, 600.0),
+    F(settle_s, Double, 0.0, 10.0),
+    F(bucket_inner_width, Double, 0.05, 1.0),
+    F(bucket_height, Double, 0.05, 1.0),
+    F(bucket_wall, Double, 0.001, 0.05),
+    F(pivot_height, Double, 0.1, 5.0),
+    F(target_dx, Double, -2.0, 2.0),
+    F(bucket_mass, Double, 0.01, 100.0),
+    F(liquid_mass, Double, 0.01, 100.0),
+    F(n_particles, Int, 1, POURSIM_MAX_PARTICLES),
+    F(radius_min, Double, 0.001, 0.05),
+    F(radius_max, Double, 0.001, 0.05),
+    F(restitution_liquid, Double, 0.0, 1.0),
+    F(restitution_wall, Double, 0.0, 1.0),
+    F(friction, Double, 0.0, 2.0),
+    F(restitution_threshold, Double, 0.0, 100.0),
+    F(contact_hertz, Double, 1.0, 10000.0),
+    F(tau_max, Double, 0.01, 1000.0),
+    F(theta_min, Double, -1.0, 0.0),
+    F(theta_max, Double, 0.1, 3.1),
+    F(obs_theta_min, Double, -3.2, 3.2),
+    F(obs_theta_max, Double, -3.2, 3.2),
+    F(obs_omega_max, Double, 1e-3, 1000.0),
+    F(k_target, Double, 0.0, 1e6),
+    F(k_spill, Double, 0.0, 1e6),
+    F(gamma, Double, 0.0, 1.0),
+    F(seed, U32, 0, 4294967295.0),
+};
+#undef F
+
+const Field *find_field(const char *name) {
+  for (const Field &f : kFields) {
+    if (std::strcmp(f.name, name) == 0) return &f;
+  }
+  return nullptr;
+}
+
+double get_value(const poursim_config_t *c, const Field &f) {
+  const char *base = reinterpret_cast<const char *>(c) + f.offset;
+  switch (f.kind) {
+    case Kind::Double: return *reinterpret_cast<const double *>(base);
+    case Kind::Int: return *reinterpret_cast<const int *>(base);
+    case Kind::U32: return *reinterpret_cast<const uint32_t *>(base);
+  }
+  return 0.0;
+}
+
+std::string trim(const std::string &s) {
+  size_t a = s.find_first_not_of(" \t\r\n");
+  if (a == std::string::npos) return "";
+  size_t b = s.find_last_not_of(" \t\r\n");
+  return s.substr(a, b - a + 1);
+}
+
+} // namespace
+
+namespace poursim {
+
+int set_error(char *err, size_t err_len, int status, const char *fmt, ...) {
+  if (err != nullptr && err_len > 0) {
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(err, err_len, fmt, ap);
+    va_end(ap);
+  }
+  return status;
+}
+
+} // namespace poursim
+
+using poursim::set_error;
+
+extern "C" poursim_config_t poursim_default_config(void) {
+  poursim_config_t c;
+  std::memset(&c, 0, sizeof c);
+  c.dt = 0.001;
+  c.substeps = 2;
+  c.episode_s = 10.0;
+  c.settle_s = 0.6;
+  c.bucket_inner_width = 0.24;
+  c.bucket_height = 0.33;
+  c.bucket_wall = 0.005;
+  c.pivot_height = 0.56;
+  c.target_dx = 0.20;
+  c.bucket_mass = 2.0;
+  c.liquid_mass = 10.0;
+  c.n_particles = 150;
+  c.radius_min = 0.0075;
+  c.radius_max = 0.0115;
+  c.restitution_liquid = 0.5;
+  c.restitution_wall = 0.1;
+  c.friction = 0.1;
+  c.restitution_threshold = 1.0;
+  c.contact_hertz = 240.0;
+  c.tau_max = 20.0;
+  c.theta_min = -0.0872664626; // -5°
+  c.theta_max = 2.35619449;    // 135°
+  c.obs_theta_min = 0.0;
+  c.obs_theta_max = 2.356194;
+  c.obs_omega_max = 4.0;
+  c.k_target = 1.0;
+  c.k_spill = 5.0;
+  c.gamma = 0.9995;
+  c.seed = 1;
+  return c;
+}
+
+extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, size_t err_len) {
+  if (c == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "config is NULL");
+  for (const Field &f : kFields) {
+    double v = get_value(c, f);
+    if (!std::isfinite(v) || v < f.min || v > f.max) {
+      return set_error(err, err_len, POURSIM_EINVAL, "config %s = %g is out of range [%g, %g]", f.name, v,
+                       f.min, f.max);
+    }
+  }
+  if (c->radius_min > c->radius_max)
+    return set_error(err, err_len, POURSIM_EINVAL, "config radius_min (%g) > radius_max (%g)", c->radius_min,
+                     c->radius_max);
+  if (2.0 * c->radius_max >= c->bucket_inner_width)
+    return set_error(err, err_len, POURSIM_EINVAL, "config radius_max %g does not fit the bucket width %g",
+                     c->radius_max, c->bucket_inner_width);
+  if (c->obs_theta_max <= c->obs_theta_min)
+    return set_error(err, err_len, POURSIM_EINVAL, "config obs_theta_max must be > obs_theta_min");
+  if (c->bucket_height <= 2.0 * c->bucket_wall)
+    return set_error(err, err_len, POURSIM_EINVAL, "config bucket_height must exceed twice bucket_wall");
+  // The rotating bucket must swing clear of the ground.
+  double hw = 0.5 * c->bucket_inner_width + c->bucket_wall, hh = 0.5 * c->bucket_height;
+  double sweep = std::sqrt(hw * hw + hh * hh);
+  if (c->pivot_height < sweep + 0.01)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config pivot_height %g: the rotating bucket (corner radius %.3f m) would hit the ground",
+                     c->pivot_height, sweep);
+  // ... and of the target bucket (the target's top corners must lie outside the swept circle).
+  double tx0 = c->target_dx - hw, tx1 = c->target_dx + hw, ty = c->bucket_height - c->pivot_height;
+  double nx = std::fmax(tx0, std::fmin(0.0, tx1)); // nearest x of the target's top edge to the pivot
+  if (ty > -sweep && std::sqrt(nx * nx + ty * ty) < sweep + 0.005)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config target_dx %g / pivot_height %g: the rotating bucket would hit the target bucket",
+                     c->target_dx, c->pivot_height);
+  // The liquid must fit: total circle area below ~90 % of the bucket's inner area.
+  double n = c->n_particles, r2 = 0.0;
+  for (int i = 0; i < c->n_particles; ++i) {
+    double r = poursim::particle_radius(c, i);
+    r2 += r * r;
+  }
+  double inner = c->bucket_inner_width * (c->bucket_height - c->bucket_wall);
+  if (M_PI * r2 / 0.80 > inner)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config: %g circles of radius %g..%g m do not fit in the bucket", n, c->radius_min,
+                     c->radius_max);
+  return POURSIM_OK;
+}
+
+extern "C" int poursim_config_set(poursim_config_t *c, const char *key, const char *value, char *err,
+                                  size_t err_len) {
+  if (c == nullptr || key == nullptr || value == nullptr)
+    return set_error(err, err_len, POURSIM_EINVAL, "config_set: NULL argument");
+  const Field *f = find_field(key);
+  if (f == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "unknown config key '%s'", key);
+  errno = 0;
+  char *end = nullptr;
+  double v = std::strtod(value, &end);
+  if (end == value || *end != '\0' || errno != 0 || !std::isfinite(v))
+    return set_error(err, err_len, POURSIM_EPARSE, "config %s: '%s' is not a number", key, value);
+  if (v < f->min || v > f->max)
+    return set_error(err, err_len, POURSIM_EINVAL, "config %s = %s is out of range [%g, %g]", key, value, f->min,
+                     f->max);
+  char *base = reinterpret_cast<char *>(c) + f->offset;
+  switch (f->kind) {
+    case Kind::Double: *reinterpret_cast<double *>(base) = v; break;
+    case Kind::Int:
+    case Kind::U32:
+      if (v != std::floor(v))
+        return set_error(err, err_len, POURSIM_EPARSE, "config %s: '%s' is not an integer", key, value);
+      if (f->kind == Kind::Int)
+        *reinterpret_cast<int *>(base) = static_cast<int>(v);
+      else
+        *reinterpret_cast<uint32_t *>(base) = static_cast<uint32_t>(v);
+      break;
+  }
+  return POURSIM_OK;
+}
+
+extern "C" int poursim_config_load(const char *path, poursim_config_t *c, char *err, size_t err_len) {
+  if (path == nullptr || c == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "config_load: NULL argument");
+  std::ifstream in(path);
+  if (!in) return set_error(err, err_len, POURSIM_EIO, "cannot read config file '%s': %s", path, std::strerror(errno));
+  std::string line;
+  int lineno = 0;
+  char sub[POURSIM_ERR_LEN];
+  while (std::getline(in, line)) {
+    ++lineno;
+    size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    line = trim(line);
+    if (line.empty()) continue;
+    size_t eq = line.find('=');
+    if (eq == std::string::npos)
+      return set_error(err, err_len, POURSIM_EPARSE, "%s:%d: expected 'key = value', got '%s'", path, lineno,
+                       line.c_str());
+    std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+    int rc = poursim_config_set(c, key.c_str(), value.c_str(), sub, sizeof sub);
+    if (rc != POURSIM_OK) return set_error(err, err_len, rc, "%s:%d: %s", path, lineno, sub);
+  }
+  if (in.bad()) return set_error(err, err_len, POURSIM_EIO, "error reading config file '%s'", path);
+  int rc = poursim_config_validate(c, sub, sizeof sub);
+  if (rc != POURSIM_OK) return set_error(err, err_len, rc, "%s: %s", path, sub);
+  return POURSIM_OK;
+}
+
+extern "C" int poursim_config_write(const poursim_config_t *c, const char *path, char *err, size_t err_len) {
+  std::ofstream out(path);
+  if (!out) return set_error(err, err_len, POURSIM_EIO, "cannot write config file '%s'", path);
+  out << "# poursim config (docs/simulator.md describes every key)\n";
+  for (const Field &f : kFields) {
+    char buf[64];
+    double v = get_value(c, f);
+    if (f.kind == Kind::Double)
+      std::snprintf(buf, sizeof buf, "%.17g", v);
+    else
+      std::snprintf(buf, sizeof buf, "%.0f", v);
+    out << f.name << " = " << buf << "\n";
+  }
+  return out ? POURSIM_OK : set_error(err, err_len, POURSIM_EIO, "error writing '%s'", path);
+}

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: MIT
+// What commands the bucket in host_sim: one interface, several implementations (the firmware core
+// in-process, baselines; a controller across LCM plugs in the same way).
+#ifndef POURSIM_CONTROLLERS_HPP
+#define POURSIM_CONTROLLERS_HPP
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+extern "C" {
+#include "pour/control.h"
+#include "pour/safety.h"
+}
+#include "poursim/poursim.h"
+#include "poursim/weights_file.h"
+
+namespace poursim {
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  virtual std::string name() const = 0;
+  // Called before every episode.
+  virtual void reset(uint32_t seed) = 0;
+  // The torque for the coming step as a fraction of tau_max, from the state s_t measured after the
+  // last step. Called once per 1 ms tick.
+  virtual double command(const poursim_obs_t &obs) = 0;
+  // Index of the action in force (policies), -1 for baselines.
+  virtual int action() const { return -1; }
+};
+
+// The firmware core (pour_control_step) with a weights.h loaded at run time. The state crosses as it
+// would over the wire: θ, θ̇ in µrad(/s) by lround, volumes Q15 rounded and saturated.
+std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &weights, bool sampled);
+
+// Baselines, all through the firmware's safety envelope (pour_safety_apply, default config).
+// Tilt at a constant rate [rad/s] to the stop, tracked by a PD loop (the paper's best binary policy).
+std::unique_ptr<Controller> make_rate_controller(double rate, const poursim_config_t &config);
+// +tau_max from start to end.
+std::unique_ptr<Controller> make_full_torque_controller();
+// A hand-written good pour: quickly to just before the onset angle, then slowly on to the stop.
+std::unique_ptr<Controller> make_hand_controller(const poursim_config_t &config);
+
+// State as the firmware receives it (rounding rules of the wire).
+pour_state_t to_firmware_state(const poursim_obs_t &obs, uint32_t seq);
+
+} // namespace poursim
+
+#endif // POURSIM_CONTROLLERS_HPP

@@ -1,0 +1,533 @@
+// SPDX-License-Identifier: MIT
+// host_sim: runs pours in the Box2D world with the firmware core in-process (or a baseline), prints
+// results, writes trajectories and renders them. `host_sim --help` explains the flags.
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "controllers.hpp"
+#include "poursim/poursim.h"
+#include "poursim/weights_file.h"
+
+extern char **environ;
+
+namespace {
+
+const char *kUsage =
+    "usage: host_sim (--policy WEIGHTS_H | --baseline NAME | --bench) [options]\n"
+    "\n"
+    "Pours a bucket of simulated liquid (150 circles, Box2D) into a second bucket and reports how\n"
+    "much landed in the target, how much was spilled, how long the pour took and the return.\n"
+    "\n"
+    "What drives the bucket (one of):\n"
+    "  --policy FILE       a weights.h (as exported by the trainer): parsed and checked at run time,\n"
+    "                      run by the firmware core in-process (the same C code that is flashed)\n"
+    "  --baseline NAME     rate  : tilt at a constant rate to the stop (--rate, default 1.5 rad/s)\n"
+    "                      full  : full torque all the way\n"
+    "                      hand  : hand-written good pour (fast to the lip, then slowly)\n"
+    "  --bench             measure speed, contact quality, episodes/s and the pour onset angle\n"
+    "\n"
+    "Options:\n"
+    "  --episodes N        episodes to run (default 1), seeds S, S+1, ...\n"
+    "  --seed S            first seed (default: the config's seed, 1)\n"
+    "  --config FILE       simulator config, 'key = value' lines (configs/sim/default.cfg)\n"
+    "  --set KEY=VALUE     override one config value (repeatable)\n"
+    "  --sampled           sample the policy's actions (seeded) instead of greedy argmax\n"
+    "  --rate R            rate of the 'rate' baseline [rad/s]\n"
+    "  --json              print the summary as one JSON object (per-episode lines go to stderr)\n"
+    "  --csv FILE          write every step of every episode as CSV\n"
+    "  --render FILE       animate the first episode: FILE.gif or FILE.mp4, plus FILE's .png snapshot\n"
+    "  --quiet             only the summary\n"
+    "  --help              this text\n"
+    "\n"
+    "Examples:\n"
+    "  host_sim --policy policy/weights.h --render pour.gif\n"
+    "  host_sim --baseline rate --episodes 5 --json\n"
+    "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n";
+
+struct Options {
+  std::string policy, baseline, config_path, csv, render;
+  bool bench = false, sampled = false, json = false, quiet = false;
+  int episodes = 1;
+  long long seed = -1;
+  double rate = 1.5;
+  std::vector<std::string> sets;
+};
+
+int usage_error(const char *fmt, const char *arg) {
+  std::fprintf(stderr, "host_sim: ");
+  std::fprintf(stderr, fmt, arg);
+  std::fprintf(stderr, "\n(run host_sim --help for usage)\n");
+  return 2;
+}
+
+bool parse_long(const char *s, long long lo, long long hi, long long &out) {
+  char *end = nullptr;
+  errno = 0;
+  long long v = std::strtoll(s, &end, 10);
+  if (end == s || *end != '\0' || errno != 0 || v < lo || v > hi) return false;
+  out = v;
+  return true;
+}
+
+// Returns -1 to continue, else the exit code.
+int parse_args(int argc, char **argv, Options &o) {
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&](const char *flag) -> const char * {
+      if (i + 1 >= argc) return nullptr;
+      (void)flag;
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--policy" || a == "--baseline" || a == "--config" || a == "--csv" || a == "--render" ||
+               a == "--episodes" || a == "--seed" || a == "--set" || a == "--rate") {
+      const char *v = value(a.c_str());
+      if (v == nullptr) return usage_error("%s needs a value", a.c_str());
+      long long n = 0;
+      if (a == "--policy") o.policy = v;
+      else if (a == "--baseline") o.baseline = v;
+      else if (a == "--config") o.config_path = v;
+      else if (a == "--csv") o.csv = v;
+      else if (a == "--render") o.render = v;
+      else if (a == "--set") o.sets.push_back(v);
+      else if (a == "--episodes") {
+        if (!parse_long(v, 1, 100000, n)) return usage_error("--episodes wants an integer 1..100000, got '%s'", v);
+        o.episodes = static_cast<int>(n);
+      } else if (a == "--seed") {
+        if (!parse_long(v, 0, 4294967295LL, n)) return usage_error("--seed wants an integer 0..4294967295, got '%s'", v);
+        o.seed = n;
+      } else if (a == "--rate") {
+        char *end = nullptr;
+        o.rate = std::strtod(v, &end);
+        if (end == v || *end != '\0' || !(o.rate > 0.0 && o.rate < 100.0))
+          return usage_error("--rate wants a rate in (0, 100) rad/s, got '%s'", v);
+      }
+    } else if (a == "--bench") o.bench = true;
+    else if (a == "--sampled") o.sampled = true;
+    else if (a == "--json") o.json = true;
+    else if (a == "--quiet") o.quiet = true;
+    else return usage_error("unknown option '%s'", a.c_str());
+  }
+  int modes = (o.policy.empty() ? 0 : 1) + (o.baseline.empty() ? 0 : 1) + (o.bench ? 1 : 0);
+  if (modes != 1) return usage_error("%s", "choose exactly one of --policy FILE, --baseline NAME, --bench");
+  if (!o.baseline.empty() && o.baseline != "rate" && o.baseline != "full" && o.baseline != "hand")
+    return usage_error("unknown baseline '%s' (rate, full or hand)", o.baseline.c_str());
+  return -1;
+}
+
+struct Episode {
+  uint32_t seed = 0;
+  double poured = 0, spilled = 0, remaining = 0, finish = -1, ret = 0, wall = 0;
+  double max_overlap_end = 0;
+};
+
+// One step of history for CSV and rendering.
+struct Sample {
+  poursim_obs_t obs;
+  int action;
+};
+
+struct Recorder {
+  bool steps = false;          // keep every step (CSV, render plots)
+  int frame_every = 0;         // keep circle positions every this many steps (render), 0 = never
+  std::vector<Sample> samples;
+  std::vector<std::vector<float>> frames;
+  std::vector<double> frame_theta, frame_t;
+  std::vector<float> radius; // of this episode's circles (the order is shuffled per seed)
+};
+
+Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t seed, Recorder *rec) {
+  Episode e;
+  e.seed = seed;
+  poursim_reset(world, seed);
+  ctl.reset(seed);
+  const poursim_config_t *cfg = poursim_world_config(world);
+  int n = poursim_particle_count(world);
+  poursim_obs_t o;
+  poursim_observe(world, &o);
+  std::vector<double> settled;
+  double disc = 1.0;
+  auto t0 = std::chrono::steady_clock::now();
+  auto keep_frame = [&](const poursim_obs_t &ob) {
+    std::vector<float> xy(static_cast<size_t>(2 * n));
+    poursim_particles(world, xy.data(), nullptr, n);
+    rec->frames.push_back(std::move(xy));
+    rec->frame_theta.push_back(ob.theta);
+    rec->frame_t.push_back(ob.t);
+  };
+  if (rec != nullptr && rec->frame_every > 0) {
+    rec->radius.assign(static_cast<size_t>(n), 0.0f);
+    poursim_particles(world, nullptr, rec->radius.data(), n);
+    keep_frame(o);
+  }
+  while (!o.done) {
+    double a = ctl.command(o);
+    poursim_step(world, a, &o);
+    e.ret += disc * o.reward;
+    disc *= cfg->gamma;
+    settled.push_back(o.v_target + o.v_spill);
+    if (rec != nullptr) {
+      if (rec->steps) rec->samples.push_back({o, ctl.action()});
+      if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
+    }
+  }
+  e.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  e.poured = o.v_target;
+  e.spilled = o.v_spill;
+  e.remaining = o.v_rotating;
+  double fin = settled.empty() ? 0.0 : settled.back();
+  if (fin >= 0.01) {
+    for (size_t t = 0; t < settled.size(); ++t)
+      if (settled[t] >= 0.99 * fin) {
+        e.finish = static_cast<double>(t + 1) * cfg->dt;
+        break;
+      }
+  }
+  e.max_overlap_end = poursim_max_overlap(world);
+  return e;
+}
+
+bool write_csv(const std::string &path, const std::vector<std::pair<uint32_t, std::vector<Sample>>> &runs,
+               double tau_max) {
+  std::FILE *f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return false;
+  std::fprintf(f, "episode,seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,action,"
+                  "torque_nm,torque_frac,reward\n");
+  for (size_t k = 0; k < runs.size(); ++k)
+    for (const Sample &s : runs[k].second)
+      std::fprintf(f, "%zu,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", k + 1, runs[k].first,
+                   s.obs.step, s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill,
+                   s.obs.v_flight, s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
+  return std::fclose(f) == 0;
+}
+
+// The trajectory as JSON for tools/pour/render.py.
+bool write_render_json(const std::string &path, const poursim_world_t *world, const Recorder &rec,
+                       const std::string &title, const Episode &e) {
+  std::FILE *f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return false;
+  const poursim_config_t *c = poursim_world_config(world);
+  const std::vector<float> &radius = rec.radius;
+  int n = static_cast<int>(radius.size());
+  std::fprintf(f, "{\"title\": \"%s\", \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", title.c_str(),
+               e.poured, e.spilled, e.finish);
+  std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
+                  "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
+               c->bucket_inner_width, c->bucket_height, c->bucket_wall, c->pivot_height, c->target_dx, c->theta_max);
+  std::fprintf(f, "\"radius\": [");
+  for (int i = 0; i < n; ++i) std::fprintf(f, "%s%.5f", i ? "," : "", static_cast<double>(radius[static_cast<size_t>(i)]));
+  std::fprintf(f, "],\n\"series\": {\"t\": [");
+  // Plots at 100 Hz are plenty.
+  std::vector<const Sample *> pick;
+  for (size_t i = 0; i < rec.samples.size(); i += 10) pick.push_back(&rec.samples[i]);
+  const char *keys[] = {"t", "theta", "v_rotating", "v_target", "v_spill", "torque"};
+  for (int k = 0; k < 6; ++k) {
+    if (k > 0) std::fprintf(f, "], \"%s\": [", keys[k]);
+    for (size_t i = 0; i < pick.size(); ++i) {
+      const poursim_obs_t &o = pick[i]->obs;
+      double v = k == 0 ? o.t : k == 1 ? o.theta : k == 2 ? o.v_rotating : k == 3 ? o.v_target : k == 4 ? o.v_spill : o.torque;
+      std::fprintf(f, "%s%.5g", i ? "," : "", v);
+    }
+  }
+  std::fprintf(f, "]},\n\"frames\": [");
+  for (size_t k = 0; k < rec.frames.size(); ++k) {
+    std::fprintf(f, "%s\n{\"t\": %.3f, \"theta\": %.5f, \"xy\": [", k ? "," : "", rec.frame_t[k], rec.frame_theta[k]);
+    const std::vector<float> &xy = rec.frames[k];
+    for (size_t i = 0; i < xy.size(); ++i) std::fprintf(f, "%s%.4f", i ? "," : "", static_cast<double>(xy[i]));
+    std::fprintf(f, "]}");
+  }
+  std::fprintf(f, "]}\n");
+  return std::fclose(f) == 0;
+}
+
+int run_render(const std::string &json_path, const std::string &out) {
+  const char *py = std::getenv("POUR_PYTHON");
+  std::string python = py != nullptr ? py : POURSIM_PYTHON;
+  std::string script = POURSIM_RENDER_PY;
+  std::vector<std::string> args = {python, script, json_path, out};
+  std::vector<char *> argv;
+  for (std::string &s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid;
+  if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
+    std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", python.c_str(), std::strerror(errno));
+    return 1;
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::fprintf(stderr, "host_sim: the renderer (%s %s) failed\n", python.c_str(), script.c_str());
+    return 1;
+  }
+  return 0;
+}
+
+double mean(const std::vector<double> &v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+}
+double stdev(const std::vector<double> &v) {
+  if (v.size() < 2) return 0.0;
+  double m = mean(v), s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+// Ideal liquid in a rectangle (2D), fill height h in depth H, width w: the free surface stays level
+// and pivots about the centre of the liquid column; it reaches the lip when tan θ = 2(H − h)/w while
+// it still covers the bottom (h ≥ H/2), else when tan θ = H²/(2 w h) (triangle).
+double ideal_onset(double h, double H, double w) {
+  return h >= 0.5 * H ? std::atan(2.0 * (H - h) / w) : std::atan(H * H / (2.0 * w * h));
+}
+
+int run_bench(const Options &o, const poursim_config_t &cfg) {
+  char err[POURSIM_ERR_LEN];
+  double load[3] = {0, 0, 0};
+  if (std::FILE *f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
+    std::fclose(f);
+  }
+  std::printf("host_sim bench: %d circles, dt %.4f s, %d substeps, contact %.0f Hz; load average %.2f %.2f %.2f\n",
+              cfg.n_particles, cfg.dt, cfg.substeps, cfg.contact_hertz, load[0], load[1], load[2]);
+  poursim_world_t *w = poursim_create(&cfg, err, sizeof err);
+  if (w == nullptr) {
+    std::fprintf(stderr, "host_sim: %s\n", err);
+    return 1;
+  }
+  // 1. One episode on one core, hand-written pour (the liquid moves all episode long).
+  auto hand = poursim::make_hand_controller(cfg);
+  std::vector<double> rtf, overlap_rest, overlap_end;
+  int n = std::max(3, std::min(o.episodes, 10));
+  for (int k = 0; k < n; ++k) {
+    uint32_t seed = static_cast<uint32_t>(k + 1);
+    poursim_reset(w, seed);
+    overlap_rest.push_back(poursim_max_overlap(w));
+    Episode e = run_episode(w, *hand, seed, nullptr);
+    rtf.push_back(cfg.episode_s / e.wall);
+    overlap_end.push_back(e.max_overlap_end);
+  }
+  std::printf("real-time factor, one core: %.1fx (min %.1fx over %d episodes of %.0f s)\n", mean(rtf),
+              *std::min_element(rtf.begin(), rtf.end()), n, cfg.episode_s);
+  std::printf("max resting overlap: %.3f mm settled in the bucket, %.3f mm at episode end (worst of %d)\n",
+              1e3 * *std::max_element(overlap_rest.begin(), overlap_rest.end()),
+              1e3 * *std::max_element(overlap_end.begin(), overlap_end.end()), n);
+  // 2. Episodes per second with the C rollout (float policy), 1 and 2 threads.
+  std::vector<double> wbuf(POURSIM_N_FEATURES * POURSIM_MAX_ACTIONS), lbuf(POURSIM_MAX_ACTIONS);
+  poursim_policy_t pol{};
+  poursim_weights_file_t wf;
+  if (!o.policy.empty()) {
+    if (poursim_weights_load(o.policy.c_str(), &wf, err, sizeof err) != POURSIM_OK) {
+      std::fprintf(stderr, "host_sim: %s\n", err);
+      poursim_destroy(w);
+      return 1;
+    }
+    poursim_weights_float_policy(&wf, wbuf.data(), lbuf.data(), &pol);
+    pol.greedy = 0;
+  } else {
+    // Uniform random policy over 11 levels: sampled actions, as in training.
+    pol.n_actions = 11;
+    pol.decision_period = 10;
+    for (int i = 0; i < 11; ++i) lbuf[static_cast<size_t>(i)] = -1.0 + 2.0 * i / 10.0;
+    pol.w = wbuf.data();
+    pol.levels = lbuf.data();
+    pol.theta_min = cfg.obs_theta_min;
+    pol.theta_max = cfg.obs_theta_max;
+    pol.omega_max = cfg.obs_omega_max;
+    pol.greedy = 0;
+  }
+  const int batch = 8;
+  std::vector<uint32_t> seeds(batch);
+  for (int i = 0; i < batch; ++i) seeds[static_cast<size_t>(i)] = static_cast<uint32_t>(100 + i);
+  std::vector<poursim_episode_t> eps(batch);
+  for (int threads = 1; threads <= 2; ++threads) {
+    auto t0 = std::chrono::steady_clock::now();
+    int rc = poursim_rollout_batch(&cfg, &pol, seeds.data(), batch, threads, nullptr, eps.data(), err, sizeof err);
+    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (rc != POURSIM_OK) {
+      std::fprintf(stderr, "host_sim: %s\n", err);
+      poursim_destroy(w);
+      return 1;
+    }
+    std::printf("rollouts (C, %s policy): %d episodes on %d thread%s in %.2f s = %.2f episodes/s\n",
+                o.policy.empty() ? "random" : "given", batch, threads, threads > 1 ? "s" : "", s, batch / s);
+  }
+  // 3. Pour onset: tilt slowly (0.2 rad/s); the first circle out of the bucket gives the angle.
+  auto slow = poursim::make_rate_controller(0.2, cfg);
+  std::vector<double> onset, ideal;
+  for (int k = 0; k < 3; ++k) {
+    uint32_t seed = static_cast<uint32_t>(k + 1);
+    poursim_reset(w, seed);
+    slow->reset(seed);
+    int np = poursim_particle_count(w);
+    std::vector<float> xy(static_cast<size_t>(2 * np)), r(static_cast<size_t>(np));
+    poursim_particles(w, xy.data(), r.data(), np);
+    // Fill height: the liquid's area spread over the width, at the packing the pile actually has
+    // (judged from the top of the pile: mean of its 10 highest circle tops).
+    std::vector<double> tops;
+    for (int i = 0; i < np; ++i) tops.push_back(xy[static_cast<size_t>(2 * i + 1)] + r[static_cast<size_t>(i)]);
+    std::sort(tops.rbegin(), tops.rend());
+    double top = 0;
+    for (int i = 0; i < 10 && i < np; ++i) top += tops[static_cast<size_t>(i)] / std::min(10, np);
+    double bottom = cfg.pivot_height - 0.5 * cfg.bucket_height + cfg.bucket_wall;
+    double depth = cfg.bucket_height - cfg.bucket_wall;
+    ideal.push_back(ideal_onset(top - bottom, depth, cfg.bucket_inner_width));
+    poursim_obs_t ob;
+    poursim_observe(w, &ob);
+    double first = -1;
+    while (!ob.done && first < 0) {
+      poursim_step(w, slow->command(ob), &ob);
+      if (ob.v_rotating < 1.0) first = ob.theta;
+    }
+    onset.push_back(first);
+  }
+  const double deg = 180.0 / M_PI;
+  std::printf("pour onset: %.1f deg (seeds 1-3: %.1f %.1f %.1f) vs ideal liquid %.1f deg for the same fill\n",
+              mean(onset) * deg, onset[0] * deg, onset[1] * deg, onset[2] * deg, mean(ideal) * deg);
+  poursim_destroy(w);
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  Options o;
+  int rc = parse_args(argc, argv, o);
+  if (rc >= 0) return rc;
+  char err[POURSIM_ERR_LEN];
+  poursim_config_t cfg = poursim_default_config();
+
+  // The policy first: the simulator runs at the tau_max the policy was trained with.
+  poursim_weights_file_t weights;
+  if (!o.policy.empty()) {
+    if (poursim_weights_load(o.policy.c_str(), &weights, err, sizeof err) != POURSIM_OK) {
+      std::fprintf(stderr, "host_sim: bad policy: %s\n", err);
+      return 1;
+    }
+    cfg.tau_max = weights.tau_max_mnm * 1e-3;
+  }
+  const double tau_policy = cfg.tau_max;
+  if (!o.config_path.empty() && poursim_config_load(o.config_path.c_str(), &cfg, err, sizeof err) != POURSIM_OK) {
+    std::fprintf(stderr, "host_sim: bad config: %s\n", err);
+    return 1;
+  }
+  for (const std::string &s : o.sets) {
+    size_t eq = s.find('=');
+    if (eq == std::string::npos) return usage_error("--set wants KEY=VALUE, got '%s'", s.c_str());
+    if (poursim_config_set(&cfg, s.substr(0, eq).c_str(), s.substr(eq + 1).c_str(), err, sizeof err) != POURSIM_OK) {
+      std::fprintf(stderr, "host_sim: bad --set: %s\n", err);
+      return 1;
+    }
+  }
+  if (poursim_config_validate(&cfg, err, sizeof err) != POURSIM_OK) {
+    std::fprintf(stderr, "host_sim: bad config: %s\n", err);
+    return 1;
+  }
+  if (!o.policy.empty() && std::fabs(cfg.tau_max - tau_policy) > 1e-9) {
+    std::fprintf(stderr,
+                 "host_sim: mismatch: %s was trained with tau_max %.3f N·m (POUR_WEIGHTS_TAU_MAX_MNM) but the config "
+                 "sets tau_max = %.3f\n",
+                 o.policy.c_str(), tau_policy, cfg.tau_max);
+    return 1;
+  }
+  if (o.bench) return run_bench(o, cfg);
+
+  std::unique_ptr<poursim::Controller> ctl;
+  if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled);
+  else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, cfg);
+  else if (o.baseline == "full") ctl = poursim::make_full_torque_controller();
+  else ctl = poursim::make_hand_controller(cfg);
+
+  std::string render_base, render_json;
+  if (!o.render.empty()) {
+    std::string ext = o.render.size() > 4 ? o.render.substr(o.render.size() - 4) : "";
+    if (ext != ".gif" && ext != ".mp4") return usage_error("--render wants a .gif or .mp4 file name, got '%s'", o.render.c_str());
+    render_base = o.render.substr(0, o.render.size() - 4);
+    render_json = render_base + ".json";
+  }
+  poursim_world_t *world = poursim_create(&cfg, err, sizeof err);
+  if (world == nullptr) {
+    std::fprintf(stderr, "host_sim: %s\n", err);
+    return 1;
+  }
+  uint32_t seed0 = o.seed >= 0 ? static_cast<uint32_t>(o.seed) : cfg.seed;
+  std::FILE *per = o.json ? stderr : stdout;
+  if (!o.quiet)
+    std::fprintf(per, "host_sim: %s, %d episode%s of %.1f s, tau_max %.1f N·m, seed %u\n", ctl->name().c_str(),
+                 o.episodes, o.episodes > 1 ? "s" : "", cfg.episode_s, cfg.tau_max, seed0);
+  std::vector<Episode> eps;
+  std::vector<std::pair<uint32_t, std::vector<Sample>>> csv_runs;
+  Recorder first;
+  for (int k = 0; k < o.episodes; ++k) {
+    uint32_t seed = seed0 + static_cast<uint32_t>(k);
+    Recorder rec;
+    rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
+    rec.frame_every = (k == 0 && !o.render.empty()) ? 40 : 0;
+    Episode e = run_episode(world, *ctl, seed, &rec);
+    eps.push_back(e);
+    if (!o.quiet)
+      std::fprintf(per, "episode %d seed %u: poured %5.1f %%  spilled %4.1f %%  left %4.1f %%  finish %s  return %.1f\n",
+                   k + 1, seed, 100 * e.poured, 100 * e.spilled, 100 * e.remaining,
+                   e.finish < 0 ? "  -   " : (std::to_string(e.finish).substr(0, 5) + " s").c_str(), e.ret);
+    if (k == 0 && !o.render.empty()) first = rec;
+    if (!o.csv.empty()) csv_runs.emplace_back(seed, std::move(rec.samples));
+  }
+  std::vector<double> poured, spilled, finish, ret;
+  int unfinished = 0;
+  for (const Episode &e : eps) {
+    poured.push_back(100 * e.poured);
+    spilled.push_back(100 * e.spilled);
+    ret.push_back(e.ret);
+    if (e.finish >= 0) finish.push_back(e.finish);
+    else ++unfinished;
+  }
+  if (o.json) {
+    std::printf("{\"controller\": \"%s\", \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
+                "\"poured_pct\": %.3f, \"poured_pct_std\": %.3f, \"spilled_pct\": %.3f, \"spilled_pct_std\": %.3f, "
+                "\"finish_s\": %.4f, \"unfinished\": %d, \"return\": %.4f, \"return_std\": %.4f, \"per_episode\": [",
+                ctl->name().c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
+                stdev(spilled), finish.empty() ? -1.0 : mean(finish), unfinished, mean(ret), stdev(ret));
+    for (size_t k = 0; k < eps.size(); ++k)
+      std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"finish_s\": %.4f, \"return\": %.4f}",
+                  k ? ", " : "", eps[k].seed, 100 * eps[k].poured, 100 * eps[k].spilled, eps[k].finish, eps[k].ret);
+    std::printf("]}\n");
+  } else {
+    std::printf("summary (%d episode%s): poured %.1f %% (sd %.1f)  spilled %.1f %% (sd %.1f)  finish %s  return %.1f\n",
+                o.episodes, o.episodes > 1 ? "s" : "", mean(poured), stdev(poured), mean(spilled), stdev(spilled),
+                finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(), mean(ret));
+  }
+  int status = 0;
+  if (!o.csv.empty()) {
+    if (!write_csv(o.csv, csv_runs, cfg.tau_max)) {
+      std::fprintf(stderr, "host_sim: cannot write CSV '%s'\n", o.csv.c_str());
+      status = 1;
+    } else if (!o.quiet) {
+      std::fprintf(per, "trajectory: %s\n", o.csv.c_str());
+    }
+  }
+  if (!o.render.empty()) {
+    if (!write_render_json(render_json, world, first, ctl->name(), eps[0])) {
+      std::fprintf(stderr, "host_sim: cannot write '%s'\n", render_json.c_str());
+      status = 1;
+    } else if (run_render(render_json, o.render) != 0) {
+      status = 1;
+    } else if (!o.quiet) {
+      std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render_base.c_str(),
+                   render_json.c_str());
+    }
+  }
+  poursim_destroy(world);
+  return status;
+}

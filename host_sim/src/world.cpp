@@ -1,0 +1,378 @@
+// SPDX-License-Identifier: MIT
+// The pouring world: a rotating bucket on a revolute joint, a target bucket on the ground, circles of
+// liquid. Box2D angles are counter-clockwise; θ is clockwise (toward the target on the right), so the
+// sign flips at every crossing between the two.
+#include <box2d/box2d.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <new>
+#include <vector>
+
+#include "poursim/poursim.h"
+#include "poursim_internal.hpp"
+#include "world.hpp"
+
+namespace {
+
+std::once_flag g_units_once;
+// Box2D keeps its worlds in one global table; creating and destroying them is not thread-safe.
+std::mutex g_world_table;
+
+// Walls bounce at 0.1 and circles at 0.5 only if the pair takes the smaller of the two.
+float restitution_min(float a, int, float b, int) { return a < b ? a : b; }
+
+constexpr double kWorldHalfWidth = 1.5; // the floor's extent; side walls stop anything rolling off
+constexpr double kWorldHeight = 3.0;
+
+double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
+
+// Signed distance from p to an axis-aligned box (negative inside).
+double box_sdf(const Eigen::Vector2d &p, const Eigen::Vector2d &lo, const Eigen::Vector2d &hi) {
+  Eigen::Vector2d c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
+  Eigen::Vector2d d = (p - c).cwiseAbs() - h;
+  return d.cwiseMax(0.0).norm() + std::min(std::max(d.x(), d.y()), 0.0);
+}
+
+inline uint64_t fnv_mix(uint64_t h, const void *data, size_t n) {
+  const unsigned char *p = static_cast<const unsigned char *>(data);
+  for (size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+} // namespace
+
+namespace poursim {
+
+// The three boxes of a bucket in its own frame (origin at the bucket's centre).
+void bucket_walls(const poursim_config_t &c, Eigen::Vector2d lo[3], Eigen::Vector2d hi[3]) {
+  double wi = 0.5 * c.bucket_inner_width, w = c.bucket_wall, hh = 0.5 * c.bucket_height;
+  lo[0] = {-wi - w, -hh}, hi[0] = {wi + w, -hh + w}; // bottom
+  lo[1] = {-wi - w, -hh}, hi[1] = {-wi, hh};         // left wall
+  lo[2] = {wi, -hh}, hi[2] = {wi + w, hh};           // right wall
+}
+
+} // namespace poursim
+
+using poursim::set_error;
+
+static void build_scene(poursim_world_t *w, uint32_t seed) {
+  const poursim_config_t &c = w->cfg;
+  b2WorldDef wd = b2DefaultWorldDef();
+  wd.gravity = {0.0f, -9.81f};
+  wd.restitutionThreshold = static_cast<float>(c.restitution_threshold);
+  wd.contactHertz = static_cast<float>(c.contact_hertz);
+  wd.restitutionCallback = restitution_min;
+  wd.enableSleep = true;
+  {
+    std::lock_guard<std::mutex> lock(g_world_table);
+    w->world = b2CreateWorld(&wd);
+  }
+  w->has_world = true;
+
+  b2SurfaceMaterial wall_mat = b2DefaultSurfaceMaterial();
+  wall_mat.friction = static_cast<float>(c.friction);
+  wall_mat.restitution = static_cast<float>(c.restitution_wall);
+
+  // Ground, the target bucket standing on it, and walls that close the world.
+  b2BodyDef gd = b2DefaultBodyDef();
+  w->ground = b2CreateBody(w->world, &gd);
+  b2ShapeDef sd = b2DefaultShapeDef();
+  sd.material = wall_mat;
+  const float W = static_cast<float>(kWorldHalfWidth), Hw = static_cast<float>(kWorldHeight);
+  b2Polygon floor = b2MakeOffsetBox(W + 0.1f, 0.1f, {0.0f, -0.1f}, b2Rot_identity);
+  b2CreatePolygonShape(w->ground, &sd, &floor);
+  b2Polygon left = b2MakeOffsetBox(0.1f, 0.5f * Hw, {-W - 0.1f, 0.5f * Hw}, b2Rot_identity);
+  b2Polygon right = b2MakeOffsetBox(0.1f, 0.5f * Hw, {W + 0.1f, 0.5f * Hw}, b2Rot_identity);
+  b2Polygon roof = b2MakeOffsetBox(W + 0.1f, 0.1f, {0.0f, Hw + 0.1f}, b2Rot_identity);
+  b2CreatePolygonShape(w->ground, &sd, &left);
+  b2CreatePolygonShape(w->ground, &sd, &right);
+  b2CreatePolygonShape(w->ground, &sd, &roof);
+  Eigen::Vector2d lo[3], hi[3];
+  poursim::bucket_walls(c, lo, hi);
+  Eigen::Vector2d target_centre(c.target_dx, 0.5 * c.bucket_height);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector2d mid = 0.5 * (lo[i] + hi[i]) + target_centre, half = 0.5 * (hi[i] - lo[i]);
+    b2Polygon box = b2MakeOffsetBox(static_cast<float>(half.x()), static_cast<float>(half.y()),
+                                    {static_cast<float>(mid.x()), static_cast<float>(mid.y())}, b2Rot_identity);
+    b2CreatePolygonShape(w->ground, &sd, &box);
+  }
+
+  // The rotating bucket: a dynamic body whose origin is the pivot (the bucket's centre).
+  b2BodyDef bd = b2DefaultBodyDef();
+  bd.type = b2_dynamicBody;
+  bd.position = {0.0f, static_cast<float>(c.pivot_height)};
+  w->bucket = b2CreateBody(w->world, &bd);
+  double wall_area = 0.0;
+  for (int i = 0; i < 3; ++i) wall_area += (hi[i] - lo[i]).prod();
+  b2ShapeDef bsd = b2DefaultShapeDef();
+  bsd.material = wall_mat;
+  bsd.density = static_cast<float>(c.bucket_mass / wall_area);
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector2d mid = 0.5 * (lo[i] + hi[i]), half = 0.5 * (hi[i] - lo[i]);
+    b2Polygon box = b2MakeOffsetBox(static_cast<float>(half.x()), static_cast<float>(half.y()),
+                                    {static_cast<float>(mid.x()), static_cast<float>(mid.y())}, b2Rot_identity);
+    b2CreatePolygonShape(w->bucket, &bsd, &box);
+  }
+  b2RevoluteJointDef jd = b2DefaultRevoluteJointDef();
+  jd.bodyIdA = w->ground;
+  jd.bodyIdB = w->bucket;
+  jd.localAnchorA = {0.0f, static_cast<float>(c.pivot_height)};
+  jd.localAnchorB = {0.0f, 0.0f};
+  jd.enableLimit = true;
+  jd.lowerAngle = static_cast<float>(-c.theta_max);
+  jd.upperAngle = static_cast<float>(-c.theta_min);
+  jd.enableMotor = true; // holds the bucket upright while the liquid settles
+  jd.motorSpeed = 0.0f;
+  jd.maxMotorTorque = 1e4f;
+  w->joint = b2CreateRevoluteJoint(w->world, &jd);
+
+  // Liquid: the same radii every seed (so the fill is the same), placed in a shuffled jittered grid.
+  int n = c.n_particles;
+  poursim::Rng rng(0x5eedULL ^ (static_cast<unsigned long long>(seed) << 20));
+  std::vector<int> order(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
+  for (int i = n - 1; i > 0; --i) {
+    int j = static_cast<int>(rng.next() % static_cast<unsigned long long>(i + 1));
+    std::swap(order[static_cast<size_t>(i)], order[static_cast<size_t>(j)]);
+  }
+  double area = 0.0;
+  for (int i = 0; i < n; ++i) area += M_PI * poursim::particle_radius(&c, i) * poursim::particle_radius(&c, i);
+  double density = c.liquid_mass / area;
+  double cell = 2.0 * c.radius_max + 0.001;
+  int per_row = std::max(1, static_cast<int>(std::floor(c.bucket_inner_width / cell)));
+  double x0 = -0.5 * per_row * cell + 0.5 * cell;
+  double y0 = -0.5 * c.bucket_height + c.bucket_wall + 0.5 * cell;
+  double slack = 0.5 * (cell - 2.0 * c.radius_max);
+  b2SurfaceMaterial liquid_mat = b2DefaultSurfaceMaterial();
+  liquid_mat.friction = static_cast<float>(c.friction);
+  liquid_mat.restitution = static_cast<float>(c.restitution_liquid);
+  w->circles.assign(static_cast<size_t>(n), b2BodyId{});
+  w->radii.assign(static_cast<size_t>(n), 0.0f);
+  for (int k = 0; k < n; ++k) {
+    int i = order[static_cast<size_t>(k)];
+    double r = poursim::particle_radius(&c, i);
+    double jx = (rng.uniform() - 0.5) * 2.0 * slack, jy = (rng.uniform() - 0.5) * 2.0 * slack;
+    b2BodyDef cd = b2DefaultBodyDef();
+    cd.type = b2_dynamicBody;
+    cd.position = {static_cast<float>(x0 + (k % per_row) * cell + jx),
+                   static_cast<float>(c.pivot_height + y0 + (k / per_row) * cell + jy)};
+    b2BodyId body = b2CreateBody(w->world, &cd);
+    b2ShapeDef csd = b2DefaultShapeDef();
+    csd.material = liquid_mat;
+    csd.density = static_cast<float>(density);
+    b2Circle circle = {{0.0f, 0.0f}, static_cast<float>(r)};
+    b2CreateCircleShape(body, &csd, &circle);
+    w->circles[static_cast<size_t>(k)] = body;
+    w->radii[static_cast<size_t>(k)] = static_cast<float>(r);
+  }
+  w->bucket_inertia = b2Body_GetRotationalInertia(w->bucket);
+}
+
+static void destroy_scene(poursim_world_t *w) {
+  if (!w->has_world) return;
+  std::lock_guard<std::mutex> lock(g_world_table);
+  b2DestroyWorld(w->world);
+  w->has_world = false;
+}
+
+// Positions, regions, volumes, normalised observation, reward; updates the hash and wall penetration.
+static void measure(poursim_world_t *w) {
+  const poursim_config_t &c = w->cfg;
+  poursim_obs_t &o = w->obs;
+  size_t n = w->circles.size();
+  b2Transform xf = b2Body_GetTransform(w->bucket);
+  Eigen::Vector2d pivot(xf.p.x, xf.p.y);
+  // World → bucket frame: undo the bucket's counter-clockwise rotation.
+  Eigen::Rotation2Dd to_bucket(-static_cast<double>(b2Rot_GetAngle(xf.q)));
+  double wi = 0.5 * c.bucket_inner_width, hh = 0.5 * c.bucket_height;
+  double tx0 = c.target_dx - wi, tx1 = c.target_dx + wi, rim = c.bucket_height;
+  Eigen::Vector2d lo[3], hi[3];
+  poursim::bucket_walls(c, lo, hi);
+  int counts[4] = {0, 0, 0, 0};
+  uint64_t h = w->hash;
+  for (size_t i = 0; i < n; ++i) {
+    b2Vec2 p = b2Body_GetPosition(w->circles[i]);
+    w->pos[2 * i] = p.x;
+    w->pos[2 * i + 1] = p.y;
+    h = fnv_mix(h, &p, sizeof p);
+    const double px = p.x, py = p.y;
+    Eigen::Vector2d local = to_bucket * (Eigen::Vector2d(px, py) - pivot);
+    uint8_t region;
+    if (std::fabs(local.x()) <= wi && local.y() >= -hh + c.bucket_wall && local.y() <= hh)
+      region = 0;
+    else if (px >= tx0 && px <= tx1 && py >= c.bucket_wall && py <= rim)
+      region = 1;
+    else if (py < rim)
+      region = 2;
+    else
+      region = 3;
+    w->region[i] = region;
+    counts[region]++;
+    if (local.norm() < hh + wi + 0.05) {
+      for (int k = 0; k < 3; ++k) {
+        double pen = static_cast<double>(w->radii[i]) - box_sdf(local, lo[k], hi[k]);
+        if (pen > w->max_wall_pen) w->max_wall_pen = pen;
+      }
+    }
+  }
+  double inv = n > 0 ? 1.0 / static_cast<double>(n) : 0.0;
+  o.step = w->step;
+  o.t = w->step * c.dt;
+  o.theta = -static_cast<double>(b2RevoluteJoint_GetAngle(w->joint));
+  o.omega = -static_cast<double>(b2Body_GetAngularVelocity(w->bucket));
+  o.v_rotating = counts[0] * inv;
+  o.v_target = counts[1] * inv;
+  o.v_spill = counts[2] * inv;
+  o.v_flight = counts[3] * inv;
+  o.obs[0] = clamp01((o.theta - c.obs_theta_min) / (c.obs_theta_max - c.obs_theta_min));
+  o.obs[1] = clamp01((o.omega + c.obs_omega_max) / (2.0 * c.obs_omega_max));
+  o.obs[2] = clamp01(o.v_rotating);
+  o.obs[3] = clamp01(o.v_target);
+  o.obs[4] = clamp01(o.v_spill);
+  o.reward = c.k_target * o.v_target - c.k_spill * o.v_spill;
+  o.done = (o.t >= c.episode_s - 0.5 * c.dt) ? 1 : 0;
+  double scalars[8] = {o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight, o.reward, o.torque};
+  w->hash = fnv_mix(h, scalars, sizeof scalars);
+}
+
+extern "C" {
+
+poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
+  if (poursim_config_validate(config, err, err_len) != POURSIM_OK) return nullptr;
+  // Box2D's length unit is global: 0.1 (decimetre-scale tolerances) suits circles of ~1 cm.
+  std::call_once(g_units_once, [] { b2SetLengthUnitsPerMeter(0.1f); });
+  poursim_world_t *w = new (std::nothrow) poursim_world_t();
+  if (w == nullptr) {
+    set_error(err, err_len, POURSIM_EINVAL, "out of memory");
+    return nullptr;
+  }
+  w->cfg = *config;
+  int rc = poursim_reset(w, config->seed);
+  if (rc != POURSIM_OK) {
+    set_error(err, err_len, rc, "reset failed");
+    poursim_destroy(w);
+    return nullptr;
+  }
+  return w;
+}
+
+int poursim_reset(poursim_world_t *w, uint32_t seed) {
+  if (w == nullptr) return POURSIM_EINVAL;
+  destroy_scene(w);
+  build_scene(w, seed);
+  const poursim_config_t &c = w->cfg;
+  size_t n = w->circles.size();
+  w->pos.assign(2 * n, 0.0f);
+  w->region.assign(n, 0);
+  // Settle with the bucket held by the joint motor, then release it at rest.
+  int settle_steps = static_cast<int>(std::lround(c.settle_s / c.dt));
+  float dt = static_cast<float>(c.dt);
+  for (int i = 0; i < settle_steps; ++i) b2World_Step(w->world, dt, c.substeps);
+  b2RevoluteJoint_EnableMotor(w->joint, false);
+  b2Body_SetAngularVelocity(w->bucket, 0.0f);
+  w->step = 0;
+  w->hash = 14695981039346656037ULL;
+  w->max_wall_pen = 0.0;
+  std::memset(&w->obs, 0, sizeof w->obs);
+  measure(w);
+  w->max_wall_pen = 0.0; // count excursions from t = 0 on
+  return POURSIM_OK;
+}
+
+int poursim_step(poursim_world_t *w, double action, poursim_obs_t *out) {
+  if (w == nullptr || !w->has_world) return POURSIM_EINVAL;
+  if (!std::isfinite(action)) return POURSIM_EINVAL;
+  double a = std::max(-1.0, std::min(1.0, action));
+  double tau = a * w->cfg.tau_max;
+  b2Body_ApplyTorque(w->bucket, static_cast<float>(-tau), true);
+  b2World_Step(w->world, static_cast<float>(w->cfg.dt), w->cfg.substeps);
+  w->step++;
+  w->obs.torque = tau;
+  measure(w);
+  if (out != nullptr) *out = w->obs;
+  return POURSIM_OK;
+}
+
+void poursim_observe(const poursim_world_t *w, poursim_obs_t *out) {
+  if (w != nullptr && out != nullptr) *out = w->obs;
+}
+
+void poursim_destroy(poursim_world_t *w) {
+  if (w == nullptr) return;
+  destroy_scene(w);
+  delete w;
+}
+
+const poursim_config_t *poursim_world_config(const poursim_world_t *w) { return w ? &w->cfg : nullptr; }
+
+int poursim_particle_count(const poursim_world_t *w) { return w ? static_cast<int>(w->circles.size()) : 0; }
+
+int poursim_particles(const poursim_world_t *w, float *xy, float *radius, int capacity) {
+  if (w == nullptr || capacity < 0) return 0;
+  int n = std::min(capacity, static_cast<int>(w->circles.size()));
+  for (int i = 0; i < n; ++i) {
+    size_t k = static_cast<size_t>(i);
+    if (xy != nullptr) {
+      xy[2 * k] = w->pos[2 * k];
+      xy[2 * k + 1] = w->pos[2 * k + 1];
+    }
+    if (radius != nullptr) radius[k] = w->radii[k];
+  }
+  return n;
+}
+
+int poursim_particle_regions(const poursim_world_t *w, uint8_t *region, int capacity) {
+  if (w == nullptr || region == nullptr || capacity < 0) return 0;
+  int n = std::min(capacity, static_cast<int>(w->circles.size()));
+  for (int i = 0; i < n; ++i) region[i] = w->region[static_cast<size_t>(i)];
+  return n;
+}
+
+double poursim_max_overlap(const poursim_world_t *w) {
+  if (w == nullptr) return 0.0;
+  const poursim_config_t &c = w->cfg;
+  size_t n = w->circles.size();
+  double worst = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d pi(w->pos[2 * i], w->pos[2 * i + 1]);
+    for (size_t j = i + 1; j < n; ++j) {
+      Eigen::Vector2d pj(w->pos[2 * j], w->pos[2 * j + 1]);
+      double ov = static_cast<double>(w->radii[i] + w->radii[j]) - (pi - pj).norm();
+      worst = std::max(worst, ov);
+    }
+  }
+  b2Transform xf = b2Body_GetTransform(w->bucket);
+  Eigen::Vector2d pivot(xf.p.x, xf.p.y), target_centre(c.target_dx, 0.5 * c.bucket_height);
+  Eigen::Rotation2Dd to_bucket(-static_cast<double>(b2Rot_GetAngle(xf.q)));
+  Eigen::Vector2d lo[3], hi[3];
+  poursim::bucket_walls(c, lo, hi);
+  for (size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d p(w->pos[2 * i], w->pos[2 * i + 1]);
+    Eigen::Vector2d local = to_bucket * (p - pivot), in_target = p - target_centre;
+    double r = w->radii[i];
+    for (int k = 0; k < 3; ++k) {
+      worst = std::max(worst, r - box_sdf(local, lo[k], hi[k]));
+      worst = std::max(worst, r - box_sdf(in_target, lo[k], hi[k]));
+    }
+    worst = std::max(worst, r - p.y()); // the floor
+  }
+  return worst;
+}
+
+double poursim_max_wall_penetration(const poursim_world_t *w) { return w ? w->max_wall_pen : 0.0; }
+
+double poursim_bucket_inertia(const poursim_world_t *w) { return w ? w->bucket_inertia : 0.0; }
+
+uint64_t poursim_trajectory_hash(const poursim_world_t *w) { return w ? w->hash : 0; }
+
+const char *poursim_version(void) { return "poursim 0.1.0 (Box2D 3.1)"; }
+
+} // extern "C"
