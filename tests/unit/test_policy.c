@@ -1,10 +1,293 @@
 /* SPDX-License-Identifier: MIT */
+#include <string.h>
+
+#include "pour/policy.h"
+#include "pour/weights_compiled.h"
 #include "unity.h"
-void setUp(void) {}
+
+static int16_t w[POUR_POLICY_N_FEATURES * POUR_POLICY_MAX_ACTIONS];
+static q15_t levels[POUR_POLICY_MAX_ACTIONS];
+static pour_policy_weights_t weights;
+static pour_obs_t obs;
+static pour_policy_t policy;
+static pour_policy_eval_t ev;
+
+/* A valid policy of n actions with all weights set to value; the hash is recomputed. */
+static void make_weights(unsigned n, uint8_t frac_bits, int16_t value) {
+  for (unsigned i = 0; i < POUR_POLICY_N_FEATURES * n; ++i) {
+    w[i] = value;
+  }
+  for (unsigned a = 0; a < n; ++a) {
+    levels[a] = (q15_t)(-32768 + (int32_t)((65535u * a) / (n - 1u)));
+  }
+  weights.n_actions = (uint8_t)n;
+  weights.w_frac_bits = frac_bits;
+  weights.decision_period_ms = 10u;
+  weights.w = w;
+  weights.action_levels = levels;
+  weights.norm.theta_min_urad = 0;
+  weights.norm.theta_max_urad = 2356194;
+  weights.norm.omega_max_urad_s = 4000000;
+  weights.tau_max_mnm = 40000;
+  weights.content_hash = pour_policy_weights_hash(&weights);
+}
+
+static void set_obs(q15_t v) {
+  for (unsigned k = 0; k < POUR_OBS_N; ++k) {
+    obs.x[k] = v;
+  }
+}
+
+static int32_t sum_probs(const q15_t *p, unsigned n) {
+  int32_t s = 0;
+  for (unsigned a = 0; a < n; ++a) {
+    s += p[a];
+  }
+  return s;
+}
+
+void setUp(void) {
+  make_weights(11, 11, 0);
+  set_obs(0);
+  memset(&ev, 0xA5, sizeof ev);
+}
+
 void tearDown(void) {}
-static void test_placeholder_Runs(void) { TEST_ASSERT_EQUAL_INT(1, 1); }
+
+static void test_policy_logits_AllMaxInputsWithMinWeightsSaturateLow(void) {
+  make_weights(2, 0, INT16_MIN);
+  set_obs(POUR_Q15_MAX);
+  int32_t logits[2];
+  pour_policy_logits(&weights, &obs, logits); /* -32768 * (5 * 32767 + 32768) ~ -6.4e9 < INT32_MIN */
+  TEST_ASSERT_EQUAL_INT32(INT32_MIN, logits[0]);
+  TEST_ASSERT_EQUAL_INT32(INT32_MIN, logits[1]);
+}
+
+static void test_policy_logits_AllMaxInputsWithMaxWeightsSaturateHigh(void) {
+  make_weights(2, 0, INT16_MAX);
+  set_obs(POUR_Q15_MAX);
+  int32_t logits[2];
+  pour_policy_logits(&weights, &obs, logits);
+  TEST_ASSERT_EQUAL_INT32(INT32_MAX, logits[0]);
+}
+
+static void test_policy_logits_AccumulatorHoldsTheExtremeExactly(void) {
+  /* With 15 fraction bits the extreme sum fits int32 after the shift: it must come out exact, which
+   * only an int64 accumulator achieves (the sum itself is ~ -6.4e9). */
+  make_weights(2, 15, INT16_MIN);
+  set_obs(POUR_Q15_MAX);
+  int32_t logits[2];
+  pour_policy_logits(&weights, &obs, logits);
+  TEST_ASSERT_EQUAL_INT32(-(5 * 32767 + 32768), logits[0]);
+  make_weights(2, 15, INT16_MAX);
+  pour_policy_logits(&weights, &obs, logits);
+  /* 32767 * (5 * 32767 + 32768) / 32768 = 196603 - 5.99997 -> 196597 */
+  TEST_ASSERT_EQUAL_INT32(196597, logits[1]);
+}
+
+static void test_policy_logits_BiasRowIsExactlyOne(void) {
+  make_weights(2, 11, 0);
+  w[5 * 2 + 0] = 2048; /* bias weight 1.0 in Q4.11 */
+  w[5 * 2 + 1] = -1024; /* -0.5 */
+  weights.content_hash = pour_policy_weights_hash(&weights);
+  int32_t logits[2];
+  pour_policy_logits(&weights, &obs, logits);
+  TEST_ASSERT_EQUAL_INT32(32768, logits[0]);
+  TEST_ASSERT_EQUAL_INT32(-16384, logits[1]);
+}
+
+static void test_policy_logits_RoundsHalfUp(void) {
+  make_weights(2, 1, 0);
+  obs.x[0] = 1;
+  w[0] = 1;  /* 1 * 1 / 2 = 0.5 -> 1 */
+  w[1] = -1; /* -0.5 -> 0 (half up) */
+  int32_t logits[2];
+  pour_policy_logits(&weights, &obs, logits);
+  TEST_ASSERT_EQUAL_INT32(1, logits[0]);
+  TEST_ASSERT_EQUAL_INT32(0, logits[1]);
+  obs.x[0] = 3; /* 1.5 -> 2, -1.5 -> -1 */
+  pour_policy_logits(&weights, &obs, logits);
+  TEST_ASSERT_EQUAL_INT32(2, logits[0]);
+  TEST_ASSERT_EQUAL_INT32(-1, logits[1]);
+}
+
+static void test_policy_softmax_EqualLogitsShareEvenly(void) {
+  const int32_t logits[16] = {0};
+  q15_t p[16];
+  pour_policy_softmax_q15(logits, 2, p);
+  TEST_ASSERT_EQUAL_INT16(16384, p[0]);
+  TEST_ASSERT_EQUAL_INT16(16384, p[1]);
+  pour_policy_softmax_q15(logits, 11, p);
+  for (unsigned a = 0; a < 11; ++a) {
+    TEST_ASSERT_EQUAL_INT16(2979, p[a]); /* 32768 / 11 = 2978.9 */
+  }
+  pour_policy_softmax_q15(logits, 16, p);
+  TEST_ASSERT_EQUAL_INT16(2048, p[15]);
+}
+
+static void test_policy_softmax_OneDominantActionSaturatesToMax(void) {
+  const int32_t logits[3] = {INT32_MIN, INT32_MAX, INT32_MIN};
+  q15_t p[3];
+  pour_policy_softmax_q15(logits, 3, p);
+  TEST_ASSERT_EQUAL_INT16(0, p[0]);
+  TEST_ASSERT_EQUAL_INT16(32767, p[1]);
+  TEST_ASSERT_EQUAL_INT16(0, p[2]);
+}
+
+static void test_policy_softmax_KnownRatio(void) {
+  /* logits 0 and -ln 2 (Q16.15: 22713): p = 2/3, 1/3 -> 21845, 10923 within the table's accuracy */
+  const int32_t logits[2] = {0, -22713};
+  q15_t p[2];
+  pour_policy_softmax_q15(logits, 2, p);
+  TEST_ASSERT_INT_WITHIN(2, 21845, p[0]);
+  TEST_ASSERT_INT_WITHIN(2, 10923, p[1]);
+  TEST_ASSERT_GREATER_THAN_INT16(p[1], p[0]);
+}
+
+static void test_policy_softmax_SumWithinHalfLsbPerAction(void) {
+  /* Stated bound: |sum p - 32768| <= n/2 LSB. Random logits over several scales, every n. */
+  uint32_t rng = 12345u;
+  for (unsigned n = POUR_POLICY_MIN_ACTIONS; n <= POUR_POLICY_MAX_ACTIONS; ++n) {
+    for (unsigned trial = 0; trial < 300u; ++trial) {
+      int32_t logits[POUR_POLICY_MAX_ACTIONS];
+      const unsigned scale = trial % 4u; /* spreads of ~1, ~16, ~256, full int32 */
+      for (unsigned a = 0; a < n; ++a) {
+        const uint32_t r = pour_policy_xorshift32(&rng);
+        logits[a] = scale == 3u ? (int32_t)r : (int32_t)(r >> (16u - 4u * scale)) - (int32_t)(1u << (15u + 4u * scale));
+      }
+      q15_t p[POUR_POLICY_MAX_ACTIONS];
+      pour_policy_softmax_q15(logits, n, p);
+      const int32_t err = sum_probs(p, n) - 32768;
+      TEST_ASSERT_TRUE_MESSAGE(2 * (err < 0 ? -err : err) <= (int32_t)n, "|sum p - 1| > n/2 LSB");
+      for (unsigned a = 0; a < n; ++a) {
+        TEST_ASSERT_TRUE(p[a] >= 0);
+      }
+    }
+  }
+}
+
+static void test_policy_softmax_LargerLogitNeverGetsLessMass(void) {
+  const int32_t logits[4] = {100000, 50000, 50001, -7};
+  q15_t p[4];
+  pour_policy_softmax_q15(logits, 4, p);
+  TEST_ASSERT_TRUE(p[0] >= p[2]);
+  TEST_ASSERT_TRUE(p[2] >= p[1]);
+  TEST_ASSERT_TRUE(p[1] >= p[3]);
+}
+
+static void test_policy_argmax_PicksIndexZeroWhenItIsTheMax(void) {
+  const int32_t logits[5] = {10, 9, -3, 9, 0};
+  TEST_ASSERT_EQUAL_UINT(0u, pour_policy_argmax(logits, 5));
+}
+
+static void test_policy_argmax_PicksLowestIndexOnTie(void) {
+  const int32_t logits[5] = {1, 7, 3, 7, 7};
+  TEST_ASSERT_EQUAL_UINT(1u, pour_policy_argmax(logits, 5));
+  const int32_t flat[3] = {INT32_MIN, INT32_MIN, INT32_MIN};
+  TEST_ASSERT_EQUAL_UINT(0u, pour_policy_argmax(flat, 3));
+}
+
+static void test_policy_argmax_PicksTheLastIndex(void) {
+  const int32_t logits[16] = {[15] = 1};
+  TEST_ASSERT_EQUAL_UINT(15u, pour_policy_argmax(logits, 16));
+}
+
+static void test_policy_xorshift32_MatchesReferenceSequence(void) {
+  uint32_t s = 1u;
+  TEST_ASSERT_EQUAL_HEX32(0x00042021u, pour_policy_xorshift32(&s));
+  TEST_ASSERT_EQUAL_HEX32(0x04080601u, pour_policy_xorshift32(&s));
+  s = 2463534242u;
+  TEST_ASSERT_EQUAL_HEX32(723471715u, pour_policy_xorshift32(&s));
+}
+
+static void test_policy_sample_NeverPicksZeroProbability(void) {
+  const q15_t p[4] = {0, 20000, 0, 12768};
+  uint32_t rng = 99u;
+  unsigned counts[4] = {0};
+  for (unsigned i = 0; i < 2000u; ++i) {
+    counts[pour_policy_sample(p, 4, &rng)]++;
+  }
+  TEST_ASSERT_EQUAL_UINT(0u, counts[0]);
+  TEST_ASSERT_EQUAL_UINT(0u, counts[2]);
+  /* 20000/32768 = 0.61: 1221 expected of 2000; 5 sigma ~ 110 */
+  TEST_ASSERT_UINT_WITHIN(110u, 1221u, counts[1]);
+}
+
+static void test_policy_init_RefusesBadArguments(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_policy_init(NULL, &weights, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_policy_init(&policy, NULL, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_policy_init(&policy, &weights, (pour_policy_mode_t)7, 1u));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_SAMPLED, 0u));
+  TEST_ASSERT_NOT_EQUAL(0u, policy.rng); /* seed 0 replaced: xorshift32 would stick at 0 */
+}
+
+static void test_policy_eval_GreedyFollowsArgmaxAndClearsUnusedSlots(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
+  set_obs(0);
+  obs.x[1] = 16384; /* upright, still, full rotating bucket: the example policy tilts forward */
+  obs.x[2] = 32767;
+  pour_policy_eval(&policy, &obs, &ev);
+  const unsigned n = pour_weights_compiled.n_actions;
+  TEST_ASSERT_EQUAL_UINT8(pour_policy_argmax(ev.logits, n), ev.action);
+  TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[ev.action] > 0);
+  for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    TEST_ASSERT_EQUAL_INT32(0, ev.logits[a]);
+    TEST_ASSERT_EQUAL_INT16(0, ev.probs[a]);
+  }
+}
+
+static void test_policy_eval_ExampleBacksOffWhenNearlyEmpty(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
+  set_obs(0);
+  obs.x[0] = 19000; /* tilted ~78 deg, still, almost empty */
+  obs.x[1] = 16384;
+  obs.x[2] = 1000;
+  obs.x[3] = 30000;
+  pour_policy_eval(&policy, &obs, &ev);
+  TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[ev.action] < 0);
+}
+
+static void test_policy_eval_SampledIsReproducibleFromTheSeed(void) {
+  pour_policy_t a;
+  pour_policy_t b;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&a, &pour_weights_compiled, POUR_POLICY_SAMPLED, 42u));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&b, &pour_weights_compiled, POUR_POLICY_SAMPLED, 42u));
+  set_obs(8000);
+  pour_policy_eval_t eb;
+  unsigned differs = 0;
+  uint8_t first = 0;
+  for (unsigned i = 0; i < 200u; ++i) {
+    pour_policy_eval(&a, &obs, &ev);
+    pour_policy_eval(&b, &obs, &eb);
+    TEST_ASSERT_EQUAL_UINT8(ev.action, eb.action);
+    if (i == 0u) {
+      first = ev.action;
+    }
+    differs += ev.action != first;
+  }
+  TEST_ASSERT_TRUE_MESSAGE(differs > 0u, "sampled mode always picked the same action");
+}
+
 int main(void) {
   UNITY_BEGIN();
-  RUN_TEST(test_placeholder_Runs);
+  RUN_TEST(test_policy_logits_AllMaxInputsWithMinWeightsSaturateLow);
+  RUN_TEST(test_policy_logits_AllMaxInputsWithMaxWeightsSaturateHigh);
+  RUN_TEST(test_policy_logits_AccumulatorHoldsTheExtremeExactly);
+  RUN_TEST(test_policy_logits_BiasRowIsExactlyOne);
+  RUN_TEST(test_policy_logits_RoundsHalfUp);
+  RUN_TEST(test_policy_softmax_EqualLogitsShareEvenly);
+  RUN_TEST(test_policy_softmax_OneDominantActionSaturatesToMax);
+  RUN_TEST(test_policy_softmax_KnownRatio);
+  RUN_TEST(test_policy_softmax_SumWithinHalfLsbPerAction);
+  RUN_TEST(test_policy_softmax_LargerLogitNeverGetsLessMass);
+  RUN_TEST(test_policy_argmax_PicksIndexZeroWhenItIsTheMax);
+  RUN_TEST(test_policy_argmax_PicksLowestIndexOnTie);
+  RUN_TEST(test_policy_argmax_PicksTheLastIndex);
+  RUN_TEST(test_policy_xorshift32_MatchesReferenceSequence);
+  RUN_TEST(test_policy_sample_NeverPicksZeroProbability);
+  RUN_TEST(test_policy_init_RefusesBadArguments);
+  RUN_TEST(test_policy_eval_GreedyFollowsArgmaxAndClearsUnusedSlots);
+  RUN_TEST(test_policy_eval_ExampleBacksOffWhenNearlyEmpty);
+  RUN_TEST(test_policy_eval_SampledIsReproducibleFromTheSeed);
   return UNITY_END();
 }
