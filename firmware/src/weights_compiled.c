@@ -8,6 +8,10 @@
 #endif
 #include POUR_WEIGHTS_HEADER
 
+/* Before C11, glibc's and newlib's <sys/cdefs.h> turn _Static_assert into a bit-field trick that loses
+ * the message; GCC and Clang accept the keyword itself in C99 mode, message included. */
+#undef _Static_assert
+
 #ifndef POUR_WEIGHTS_FORMAT
 #error "weights.h: missing POUR_WEIGHTS_FORMAT"
 #endif
