@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <sys/select.h>
 
@@ -55,6 +56,7 @@ struct LcmLink::Impl {
   int64_t waiting_seq = -1;   // the state whose answer the current tick waits for
   bool got_waited = false;
   int16_t answer_q15 = 0;     // torque of the latest accepted answer
+  int answer_action = -1;     // its action index
   int64_t answer_ns = 0;      // when it arrived (real time: age check)
   bool have_answer = false;
   int64_t t0_ns = 0;          // real time: slot of tick 0
@@ -93,6 +95,7 @@ struct LcmLink::Impl {
     // Real time uses the newest answer, whichever state it answers; lockstep only the awaited one.
     if (!def.lockstep || msg.seq == waiting_seq) {
       answer_q15 = msg.torque_q15;
+      answer_action = msg.action;
       answer_ns = now;
       have_answer = true;
     }
@@ -177,6 +180,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
     s.sent_ns.fill(0);
     s.have_answer = false;
     s.answer_q15 = 0;
+    s.answer_action = -1;
     s.next_particles_step = 0;
     if (!s.def.lockstep && seq == 0) {
       s.t0_ns = 0;
@@ -296,6 +300,8 @@ void LcmLink::drain(int wait_ms) {
   s.pump_until(mono_ns() + static_cast<int64_t>(wait_ms) * 1000000LL);
 }
 
+int LcmLink::last_action() const { return impl_->answer_action; }
+
 const LcmLinkStats &LcmLink::stats() const { return impl_->stats; }
 const LcmLinkDef &LcmLink::def() const { return impl_->def; }
 
@@ -331,6 +337,38 @@ std::string LcmLink::summary() const {
                 static_cast<long long>(st.safe_ticks), static_cast<long long>(st.overruns),
                 static_cast<long long>(st.late_max_us), static_cast<long long>(st.particles_sent), med, p99);
   return buf;
+}
+
+std::unique_ptr<LcmController> LcmController::open(const LcmLinkDef &def, std::string *err) {
+  std::unique_ptr<LcmLink> link = LcmLink::open(def, err);
+  if (!link) {
+    return nullptr;
+  }
+  return std::unique_ptr<LcmController>(new LcmController(std::move(link)));
+}
+
+std::string LcmController::name() const {
+  const LcmLinkDef &d = link_->def();
+  return std::string("pour_controller over LCM (") + (d.lockstep ? "lockstep" : "real time") + ", " +
+         (d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url) + ")";
+}
+
+void LcmController::reset(uint32_t /*seed*/) { episode_++; }
+
+double LcmController::command(const poursim_obs_t &obs) {
+  int16_t q15 = 0;
+  std::string err;
+  if (!link_->exchange(episode_, obs, &q15, &err)) {
+    std::fprintf(stderr, "host_sim: %s\n", err.c_str());
+    std::fprintf(stderr, "host_sim: %s\n", link_->summary().c_str());
+    std::fflush(nullptr);
+    std::exit(3);
+  }
+  if (world_ != nullptr) {
+    link_->maybe_publish_particles(world_, obs);
+  }
+  // Exactly as the in-process firmware controller turns its output into an action.
+  return q15 / 32768.0;
 }
 
 } // namespace poursim

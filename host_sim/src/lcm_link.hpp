@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "controllers.hpp"
 #include "poursim/poursim.h"
 
 namespace poursim {
@@ -59,6 +60,9 @@ class LcmLink {
   // Reads whatever answers are still in flight (for a final count); waits at most wait_ms.
   void drain(int wait_ms);
 
+  // Policy action index of the answer in use (-1 before the first answer of an episode).
+  int last_action() const;
+
   const LcmLinkStats &stats() const;
   const LcmLinkDef &def() const;
 
@@ -73,6 +77,27 @@ class LcmLink {
  private:
   explicit LcmLink(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
+};
+
+// host_sim's controller across LCM: each command() is one exchange with pour_controller. A lockstep
+// timeout prints the error naming the channel and ends the process with exit status 3 (the pour cannot
+// go on without its controller).
+class LcmController : public Controller {
+ public:
+  static std::unique_ptr<LcmController> open(const LcmLinkDef &def, std::string *err);
+  std::string name() const override;
+  void reset(uint32_t seed) override;
+  double command(const poursim_obs_t &obs) override;
+  int action() const override { return link_->last_action(); }
+  // Particles are published from this world at the link's viewing rate (nullptr: none).
+  void set_world(const poursim_world_t *world) { world_ = world; }
+  LcmLink &link() { return *link_; }
+
+ private:
+  explicit LcmController(std::unique_ptr<LcmLink> link) : link_(std::move(link)) {}
+  std::unique_ptr<LcmLink> link_;
+  const poursim_world_t *world_ = nullptr;
+  int episode_ = -1;
 };
 
 } // namespace poursim

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "controllers.hpp"
+#include "lcm_link.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
 
@@ -36,6 +37,9 @@ const char *kUsage =
     "                      full  : full torque all the way\n"
     "                      hand  : hand-written good pour (fast to the lip, then slowly)\n"
     "  --bench             measure speed, contact quality, episodes/s and the pour onset angle\n"
+    "  --lcm [URL]         pour_controller, a separate process, over LCM (POUR_STATE out, POUR_TORQUE in,\n"
+    "                      POUR_PARTICLES for viewers); lockstep unless --realtime. With --policy, the\n"
+    "                      file only sets tau_max. Exit status 3 if the controller does not answer.\n"
     "\n"
     "Options:\n"
     "  --episodes N        episodes to run (default 1), seeds S, S+1, ...\n"
@@ -48,12 +52,16 @@ const char *kUsage =
     "  --csv FILE          write every step of every episode as CSV\n"
     "  --render FILE       animate the first episode: FILE.gif or FILE.mp4, plus FILE's .png snapshot\n"
     "  --quiet             only the summary\n"
+    "  --realtime          with --lcm: pace at 1 kHz wall clock, use the latest torque, count misses\n"
+    "  --lcm-timeout-ms T  with --lcm in lockstep: give up after T ms without an answer (default 2000)\n"
     "  --help              this text\n"
     "\n"
     "Examples:\n"
     "  host_sim --policy policy/weights.h --render pour.gif\n"
     "  host_sim --baseline rate --episodes 5 --json\n"
     "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n";
+
+constexpr int kFrameEveryMs = 80; // 12.5 frames/s: smooth enough, and a GIF of 10 s renders in seconds
 
 struct Options {
   std::string policy, baseline, config_path, csv, render;
@@ -62,6 +70,9 @@ struct Options {
   long long seed = -1;
   double rate = 1.5;
   std::vector<std::string> sets;
+  bool lcm = false, realtime = false;
+  std::string lcm_url;
+  int lcm_timeout_ms = 2000;
 };
 
 int usage_error(const char *fmt, const char *arg) {
@@ -115,6 +126,16 @@ int parse_args(int argc, char **argv, Options &o) {
         if (end == v || *end != '\0' || !(o.rate > 0.0 && o.rate < 100.0))
           return usage_error("--rate wants a rate in (0, 100) rad/s, got '%s'", v);
       }
+    } else if (a == "--lcm") {
+      o.lcm = true;
+      if (i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0) o.lcm_url = argv[++i];
+    } else if (a == "--realtime") o.realtime = true;
+    else if (a == "--lcm-timeout-ms") {
+      long long n = 0;
+      if (i + 1 >= argc || !parse_long(argv[i + 1], 1, 3600000, n))
+        return usage_error("--lcm-timeout-ms wants an integer 1..3600000, got '%s'", i + 1 < argc ? argv[i + 1] : "");
+      o.lcm_timeout_ms = static_cast<int>(n);
+      ++i;
     } else if (a == "--bench") o.bench = true;
     else if (a == "--sampled") o.sampled = true;
     else if (a == "--json") o.json = true;
@@ -122,6 +143,9 @@ int parse_args(int argc, char **argv, Options &o) {
     else return usage_error("unknown option '%s'", a.c_str());
   }
   int modes = (o.policy.empty() ? 0 : 1) + (o.baseline.empty() ? 0 : 1) + (o.bench ? 1 : 0);
+  if (o.lcm && (o.bench || !o.baseline.empty())) return usage_error("%s", "--lcm goes with --policy FILE or alone");
+  if (o.realtime && !o.lcm) return usage_error("%s", "--realtime needs --lcm");
+  if (o.lcm && modes == 0) modes = 1;
   if (modes != 1) return usage_error("%s", "choose exactly one of --policy FILE, --baseline NAME, --bench");
   if (!o.baseline.empty() && o.baseline != "rate" && o.baseline != "full" && o.baseline != "hand")
     return usage_error("unknown baseline '%s' (rate, full or hand)", o.baseline.c_str());
@@ -222,7 +246,7 @@ bool write_render_json(const std::string &path, const poursim_world_t *world, co
   const poursim_config_t *c = poursim_world_config(world);
   const std::vector<float> &radius = rec.radius;
   int n = static_cast<int>(radius.size());
-  std::fprintf(f, "{\"title\": \"%s\", \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", title.c_str(),
+  std::fprintf(f, "{\"fps\": %.3f, \"title\": \"%s\", \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs, title.c_str(),
                e.poured, e.spilled, e.finish);
   std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
                   "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
@@ -261,6 +285,8 @@ int run_render(const std::string &json_path, const std::string &out) {
   std::vector<char *> argv;
   for (std::string &s : args) argv.push_back(s.data());
   argv.push_back(nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
   pid_t pid;
   if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
     std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", python.c_str(), std::strerror(errno));
@@ -445,7 +471,21 @@ int main(int argc, char **argv) {
   if (o.bench) return run_bench(o, cfg);
 
   std::unique_ptr<poursim::Controller> ctl;
-  if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled);
+  poursim::LcmController *lcm_ctl = nullptr;
+  if (o.lcm) {
+    poursim::LcmLinkDef def;
+    def.url = o.lcm_url;
+    def.lockstep = !o.realtime;
+    def.answer_timeout_ms = o.lcm_timeout_ms;
+    std::string lerr;
+    std::unique_ptr<poursim::LcmController> lc = poursim::LcmController::open(def, &lerr);
+    if (!lc) {
+      std::fprintf(stderr, "host_sim: %s\n", lerr.c_str());
+      return 1;
+    }
+    lcm_ctl = lc.get();
+    ctl = std::move(lc);
+  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled);
   else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, cfg);
   else if (o.baseline == "full") ctl = poursim::make_full_torque_controller();
   else ctl = poursim::make_hand_controller(cfg);
@@ -462,6 +502,7 @@ int main(int argc, char **argv) {
     std::fprintf(stderr, "host_sim: %s\n", err);
     return 1;
   }
+  if (lcm_ctl != nullptr) lcm_ctl->set_world(world);
   uint32_t seed0 = o.seed >= 0 ? static_cast<uint32_t>(o.seed) : cfg.seed;
   std::FILE *per = o.json ? stderr : stdout;
   if (!o.quiet)
@@ -474,7 +515,7 @@ int main(int argc, char **argv) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
     Recorder rec;
     rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
-    rec.frame_every = (k == 0 && !o.render.empty()) ? 40 : 0;
+    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
     Episode e = run_episode(world, *ctl, seed, &rec);
     eps.push_back(e);
     if (!o.quiet)
@@ -507,6 +548,10 @@ int main(int argc, char **argv) {
     std::printf("summary (%d episode%s): poured %.1f %% (sd %.1f)  spilled %.1f %% (sd %.1f)  finish %s  return %.1f\n",
                 o.episodes, o.episodes > 1 ? "s" : "", mean(poured), stdev(poured), mean(spilled), stdev(spilled),
                 finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(), mean(ret));
+  }
+  if (lcm_ctl != nullptr) {
+    lcm_ctl->link().drain(50);
+    std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());
   }
   int status = 0;
   if (!o.csv.empty()) {

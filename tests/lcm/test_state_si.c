@@ -28,12 +28,14 @@ static void test_state_si_UradSaturatesAndNanIsOutOfRange(void) {
 
 static void test_state_si_Q15EdgeValues(void) {
   TEST_ASSERT_EQUAL_INT16(32767, pour_si_to_q15(1.0));
-  TEST_ASSERT_EQUAL_INT16(-32768, pour_si_to_q15(-1.0));
-  TEST_ASSERT_EQUAL_INT16(-32768, pour_si_to_q15(-2.0));
+  TEST_ASSERT_EQUAL_INT16(32767, pour_si_to_q15(2.0));
+  TEST_ASSERT_EQUAL_INT16(0, pour_si_to_q15(-1.0)); /* a volume is never negative */
   TEST_ASSERT_EQUAL_INT16(0, pour_si_to_q15(0.0));
-  TEST_ASSERT_EQUAL_INT16(1, pour_si_to_q15(0.5 / 32768.0));   /* half an LSB rounds up */
-  TEST_ASSERT_EQUAL_INT16(-1, pour_si_to_q15(-0.5 / 32768.0)); /* and away from zero below */
+  TEST_ASSERT_EQUAL_INT16(0, pour_si_to_q15(0.5 / 32768.0)); /* half an LSB: ties to even */
+  TEST_ASSERT_EQUAL_INT16(2, pour_si_to_q15(1.5 / 32768.0));
+  TEST_ASSERT_EQUAL_INT16(1, pour_si_to_q15(0.6 / 32768.0));
   TEST_ASSERT_EQUAL_INT16(16384, pour_si_to_q15(0.5));
+  TEST_ASSERT_EQUAL_INT16(32766, pour_si_to_q15(32766.5 / 32768.0)); /* tie to even, inside */
   TEST_ASSERT_EQUAL_INT16(-32768, pour_si_to_q15(NAN));
 }
 

@@ -22,10 +22,10 @@ q15_t pour_si_to_q15(double fraction) {
   if (q >= 32767.0) {
     return POUR_Q15_MAX;
   }
-  if (q <= -32768.0) {
-    return POUR_Q15_MIN;
+  if (q <= 0.0) {
+    return 0;
   }
-  return (q15_t)lround(q);
+  return (q15_t)nearbyint(q);
 }
 
 void pour_state_from_si(pour_state_t *state, int64_t seq, double theta, double omega, double v_rotating,

@@ -9,11 +9,11 @@
 
 #include "pour/obs.h"
 
-/* θ [rad] → [µrad]: lround(θ·1e6), saturated to int32; NaN becomes INT32_MAX (out of any range). */
+/* θ [rad] → [µrad]: θ·1e6 rounded half away from zero, saturated to int32; NaN becomes INT32_MAX. */
 int32_t pour_si_to_urad(double rad);
 
-/* Fraction [1] → Q15: round(v·32768) (half away from zero), saturated to [-32768, 32767];
- * NaN becomes -32768 (out of the volume range). */
+/* Volume fraction [1] → Q15: v·32768 rounded to nearest (ties to even, as host_sim's in-process
+ * controller does), saturated to [0, 32767]; NaN becomes -32768 so that the core flags BAD_INPUT. */
 q15_t pour_si_to_q15(double fraction);
 
 /* Fills *state from SI values: θ [rad], ω [rad/s], volume fractions [1]; seq is the low 32 bits. */
