@@ -124,3 +124,58 @@ def test_driver_rejects_bad_arguments(tools, argv, needle):
     _, driver = tools
     r = run([driver, *argv])
     assert r.returncode != 0 and needle in r.stderr
+
+
+# ---- host_sim itself: the README's pour, as two processes ----
+
+def host_sim_args(source_dir, *extra):
+    return ["--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=3", "--episodes", "2",
+            "--seed", "4", *extra]
+
+
+def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, source_dir, tmp_path):
+    host_sim = binary(build_dir, "host_sim")
+    controller = binary(build_dir, "pour_controller")
+    ref = run([host_sim, *host_sim_args(source_dir, "--csv", tmp_path / "inproc.csv")])
+    assert ref.returncode == 0, ref.stderr
+    u = url(16)
+    with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]) as c:
+        r = run([host_sim, *host_sim_args(source_dir, "--lcm", u, "--csv", tmp_path / "lcm.csv")])
+        assert c.stop() == 0
+    assert r.returncode == 0, r.stderr
+    inproc, lcm_csv = (tmp_path / "inproc.csv").read_text(), (tmp_path / "lcm.csv").read_text()
+    assert len(inproc.splitlines()) == 1 + 2 * 3000
+    assert lcm_csv == inproc  # every step: state, action, torque, reward
+    assert "lcm lockstep: states 6000 answers 6000 on_time 6000" in r.stdout
+    summary = [x for x in r.stdout.splitlines() if x.startswith("summary")]
+    assert summary == [x for x in ref.stdout.splitlines() if x.startswith("summary")]
+    assert "answers 6000" in c.out and "episodes 2" in c.out
+
+
+def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_dir, source_dir):
+    host_sim = binary(build_dir, "host_sim")
+    r = run([host_sim, *host_sim_args(source_dir, "--lcm", url(17), "--lcm-timeout-ms", "300")])
+    assert r.returncode == 3
+    assert "no answer on POUR_TORQUE to POUR_STATE seq 0" in r.stderr
+
+
+def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build_dir, source_dir):
+    host_sim = binary(build_dir, "host_sim")
+    r = run([host_sim, "--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=0.3",
+             "--lcm", url(18), "--realtime"])
+    assert r.returncode == 0, r.stderr
+    line = [x for x in r.stdout.splitlines() if x.startswith("lcm realtime")][0]
+    assert "states 300 answers 0" in line and "missing 300" in line and "safe_ticks 300" in line
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--baseline", "hand", "--lcm"], "--lcm goes with --policy FILE or alone"),
+    (["--bench", "--lcm"], "--lcm goes with --policy FILE or alone"),
+    (["--baseline", "hand", "--realtime"], "--realtime needs --lcm"),
+    (["--lcm", "--lcm-timeout-ms", "0"], "--lcm-timeout-ms wants an integer"),
+    (["--lcm", "--lcm-timeout-ms"], "--lcm-timeout-ms wants an integer"),
+    (["--lcm", "nosuchprovider://x"], "cannot open LCM"),
+])
+def test_host_sim_rejects_bad_lcm_arguments(build_dir, argv, needle):
+    r = run([binary(build_dir, "host_sim"), *argv])
+    assert r.returncode != 0 and needle in r.stderr
