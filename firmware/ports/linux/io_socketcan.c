@@ -145,6 +145,7 @@ static int can_wait(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in) {
   socketcan_t *s = io->ctx;
   const int64_t deadline = mono_ms() + (timeout_us + 999) / 1000;
   for (;;) {
+    housekeeping(s); /* time passed while polling counts before a frame that arrived feeds the watchdog */
     const int r = drain(s, in);
     housekeeping(s);
     if (r != 0) {

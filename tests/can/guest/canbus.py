@@ -1,0 +1,103 @@
+# SPDX-License-Identifier: MIT
+"""The bench side of the pour CAN protocol for the guest tests: raw AF_CAN sockets (Python's own), frames
+encoded and decoded with cantools from can/pour.dbc, so the C codec is checked against the DBC here too."""
+from __future__ import annotations
+
+import os
+import select
+import signal
+import socket
+import struct
+import subprocess
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import cantools
+
+SOURCE_DIR = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[3]))
+BUILD_DIR = Path(os.environ.get("POUR_BUILD_DIR", SOURCE_DIR / "build" / "host"))
+DBC = SOURCE_DIR / "can" / "pour.dbc"
+IFACE = "vcan0"
+FRAME = struct.Struct("=IB3x8s")
+
+
+@dataclass
+class Frame:
+    t: float
+    id: int
+    data: bytes
+
+
+class Bus:
+    def __init__(self, iface: str = IFACE) -> None:
+        self.db = cantools.database.load_file(str(DBC))
+        self.sock = socket.socket(socket.PF_CAN, socket.SOCK_RAW, socket.CAN_RAW)
+        self.sock.bind((iface,))
+        self.log: list[Frame] = []
+
+    def close(self) -> None:
+        self.sock.close()
+
+    def send_raw(self, frame_id: int, data: bytes) -> None:
+        self.sock.send(FRAME.pack(frame_id, len(data), data.ljust(8, b"\0")))
+
+    def send(self, name: str, node: int = 0, **signals) -> None:
+        m = self.db.get_message_by_name(name)
+        self.send_raw((node << 5) | m.frame_id, m.encode(signals, scaling=False))
+
+    def send_state(self, seq: int, theta_urad: int = 0, omega_urad_s: int = 0, vr: int = 32767, vt: int = 0,
+                   vs: int = 0, node: int = 0) -> None:
+        self.send("StateA", node, Theta=theta_urad, Omega=omega_urad_s, SeqLow=seq & 0xFF)
+        self.send("StateB", node, Seq=seq & 0xFFFF, VRotating=vr, VTarget=vt, VSpill=vs)
+
+    def recv(self, timeout: float) -> Frame | None:
+        """The next frame, or None if none arrives within timeout."""
+        r, _, _ = select.select([self.sock], [], [], max(0.0, timeout))
+        if not r:
+            return None
+        can_id, dlc, data = FRAME.unpack(self.sock.recv(16))
+        f = Frame(time.monotonic(), can_id, data[:dlc])
+        self.log.append(f)
+        return f
+
+    def poll(self, timeout: float) -> list[Frame]:
+        """All frames that arrive within timeout."""
+        got = []
+        end = time.monotonic() + timeout
+        while (f := self.recv(end - time.monotonic())) is not None:
+            got.append(f)
+        return got
+
+    def wait_for(self, name: str, pred=lambda d: True, timeout: float = 2.0, node: int = 0) -> dict:
+        """Waits for the first frame of message name whose raw signals satisfy pred."""
+        m = self.db.get_message_by_name(name)
+        end = time.monotonic() + timeout
+        while (f := self.recv(end - time.monotonic())) is not None:
+            if f.id == (node << 5) | m.frame_id:
+                d = m.decode(f.data, scaling=False, decode_choices=False)
+                if pred(d):
+                    return d
+        raise AssertionError(f"no {name} frame matching the condition within {timeout} s")
+
+    def decode(self, f: Frame) -> tuple[str, dict]:
+        m = self.db.get_message_by_frame_id(f.id & 0x1F)
+        return m.name, m.decode(f.data, scaling=False, decode_choices=False)
+
+
+class Controller:
+    """pour_controller --io can:vcan0,... as a child process."""
+
+    def __init__(self, *args: str, io: str = f"can:{IFACE},heartbeat-ms=10") -> None:
+        exe = BUILD_DIR / "bin" / "pour_controller"
+        if not exe.exists():
+            raise FileNotFoundError(f"{exe} not built")
+        self.proc = subprocess.Popen([str(exe), "--io", io, *args], stdout=subprocess.PIPE,
+                                     stderr=subprocess.PIPE, text=True)
+
+    def stop(self) -> str:
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+        out, err = self.proc.communicate(timeout=20)
+        assert self.proc.returncode == 0, f"controller exit {self.proc.returncode}: {err}"
+        return out + err

@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: MIT
+"""The controller's Linux port on real SocketCAN (vcan0 in a user-mode Linux guest; tests/can/uml_run.py).
+Run inside the guest only: the host kernel has no CAN."""
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import time
+
+import pytest
+
+from canbus import DBC, Bus, Controller
+
+MODE = {"IDLE": 0, "RUN": 1, "FAULT": 2, "ESTOP": 3}
+
+
+@pytest.fixture
+def bus():
+    b = Bus()
+    yield b
+    b.close()
+
+
+def start(bus: Bus, *args: str, io: str = "can:vcan0,heartbeat-ms=10", node: int = 0) -> Controller:
+    c = Controller(*args, io=io)
+    bus.wait_for("Heartbeat", timeout=10.0, node=node)
+    return c
+
+
+def run_states(bus: Bus, first: int, n: int, period: float = 0.001, **state) -> list[dict]:
+    """Sends n states and collects the Torque frames that answer them."""
+    answers = []
+    for seq in range(first, first + n):
+        bus.send_state(seq, **state)
+        answers.append(bus.wait_for("Torque", lambda d, s=seq: d["Seq"] == s & 0xFFFF, timeout=2.0))
+        time.sleep(period)
+    return answers
+
+
+def test_candump_capture_decodes_with_units(bus, tmp_path):
+    cap = tmp_path / "candump.log"
+    with open(cap, "w") as f:
+        dump = subprocess.Popen(["candump", "-L", "vcan0"], stdout=f)
+    try:
+        time.sleep(0.2)
+        ctl = start(bus, "--lockstep")
+        run_states(bus, 0, 30, theta_urad=100000, omega_urad_s=-200000, vr=30000, vt=1000, vs=10)
+        bus.send("Estop", Assert=1)
+        bus.send("Estop", Assert=0)
+        bus.send("ClearErrors")
+        bus.wait_for("Heartbeat", timeout=2.0)
+        ctl.stop()
+        time.sleep(0.2)
+    finally:
+        dump.send_signal(2)
+        dump.wait(timeout=10)
+    lines = cap.read_text().splitlines()
+    assert len(lines) >= 30 * 3
+    out = subprocess.run([sys.executable, "-m", "cantools", "decode", "--single-line", str(DBC)],
+                         input="\n".join(lines) + "\n", capture_output=True, text=True, timeout=120, check=True)
+    decoded = out.stdout.splitlines()
+    assert len(decoded) == len(lines)
+    assert not [d for d in decoded if "Unknown frame id" in d or "::" not in d]
+    text = out.stdout
+    for name in ("StateA(", "StateB(", "Torque(", "Heartbeat(", "Estop(", "ClearErrors("):
+        assert name in text, name
+    # Physical values with their units, as scaled by the DBC.
+    assert pytest.approx(0.1) == float(re.search(r"Theta: ([-0-9.e]+) rad,", text).group(1))
+    assert pytest.approx(-0.2) == float(re.search(r"Omega: ([-0-9.e]+) rad/s,", text).group(1))
+    assert "VTarget: 3.0517578125 %" in text
+    assert " %" in [d for d in decoded if "Torque(" in d][0]
+    assert "Mode: RUN" in text
+
+
+def test_silent_bus_trips_the_watchdog(bus):
+    # Real time, 1 kHz. Margins for a loaded emulated guest: the CAN watchdog (100 ms) trips before the
+    # core's own input timeout (150 ms); states come every ~2 ms.
+    ctl = start(bus, "--input-timeout-ms", "150", io="can:vcan0,heartbeat-ms=10,watchdog-ms=100")
+    try:
+        run_states(bus, 0, 40)
+        hb = bus.wait_for("Heartbeat", timeout=1.0)
+        assert hb["Mode"] == MODE["RUN"] and hb["Fault_CanWatchdog"] == 0, hb
+        t_silent = time.monotonic()
+        hb = bus.wait_for("Heartbeat", lambda d: d["Fault_CanWatchdog"] == 1, timeout=3.0)
+        silence = time.monotonic() - t_silent
+        assert silence >= 0.095, silence
+        assert hb["Mode"] == MODE["FAULT"]
+        hb = bus.wait_for("Heartbeat", lambda d: d["Fault_StaleInput"] == 1, timeout=3.0)  # the core's, later
+        assert hb["Fault_CanWatchdog"] == 1 and hb["Mode"] == MODE["FAULT"]
+        # Latched: a state now gets safe torque, not the policy's.
+        answer = run_states(bus, 40, 3)[-1]
+        assert answer["Torque"] == 0 and answer["Mode"] == MODE["FAULT"]
+        # ClearErrors clears it; fresh states bring the controller back to RUN.
+        bus.send("ClearErrors")
+        answers = run_states(bus, 43, 20)
+        assert answers[-1]["Mode"] == MODE["RUN"]
+        hb = bus.wait_for("Heartbeat", timeout=1.0)
+        assert hb["Fault_CanWatchdog"] == 0
+    finally:
+        ctl.stop()
+
+
+def test_malformed_frames_are_dropped_and_counted(bus):
+    ctl = start(bus, "--lockstep")
+    try:
+        before = run_states(bus, 0, 10)
+        hb0 = bus.wait_for("Heartbeat", timeout=1.0)
+        assert hb0["RxDropped"] == 0
+        good_a = bus.db.get_message_by_name("StateA").encode({"Theta": 0, "Omega": 0, "SeqLow": 10}, scaling=False)
+        bus.send_raw(0x010, good_a[:7])                    # StateA, wrong DLC
+        bus.send_raw(0x01F, bytes(8))                      # unknown cmd id of our node
+        bus.send_raw(0x010, bytes([0x00, 0x00, 0x40]) + good_a[3:])  # theta = 4.19 rad: out of range
+        bus.send_raw(0x002, bytes([2]))                    # Estop 2: out of range
+        bus.send_raw(0x011, bytes([10, 0, 0xFF, 0x7F, 0, 0, 0, 0]))  # StateB without its StateA
+        bus.send_raw(0x018, bytes([1]))                    # ClearErrors with a payload: wrong DLC
+        hb = bus.wait_for("Heartbeat", lambda d: d["RxDropped"] >= 6, timeout=2.0)
+        assert hb["RxDropped"] == 6
+        assert hb["Mode"] == MODE["RUN"] and hb["Fault_EStop"] == 0 and hb["Fault_BadInput"] == 0
+        # None of them produced an answer or reached the policy: the next state answers as before.
+        got = bus.poll(0.05)
+        assert not [f for f in got if bus.decode(f)[0] == "Torque"]
+        after = run_states(bus, 10, 5)
+        assert all(a["Mode"] == MODE["RUN"] for a in after)
+        assert abs(after[0]["Torque"] - before[-1]["Torque"]) <= 32768 // 10
+    finally:
+        out = ctl.stop()
+    assert "dropped 6" in out
+
+
+def test_estop_frame_gives_zero_torque_within_one_tick(bus):
+    ctl = start(bus, "--lockstep")
+    try:
+        answers = run_states(bus, 0, 40)
+        assert answers[-1]["Torque"] != 0, "the policy should command torque on a full bucket"
+        bus.send("Estop", Assert=1)
+        answer = run_states(bus, 40, 1)[0]  # the very next tick
+        assert answer["Torque"] == 0 and answer["Mode"] == MODE["ESTOP"]
+        bus.send("Estop", Assert=0)
+        bus.send("ClearErrors")
+        answers = run_states(bus, 41, 40)
+        assert answers[-1]["Mode"] == MODE["RUN"] and answers[-1]["Torque"] != 0
+    finally:
+        ctl.stop()
+
+
+def test_other_nodes_frames_are_not_ours(bus):
+    ctl = start(bus, "--lockstep", io="can:vcan0,node=5,heartbeat-ms=10", node=5)
+    try:
+        bus.send_state(0, node=0)  # addressed to node 0: filtered out, not counted
+        assert not [f for f in bus.poll(0.1) if f.id == (5 << 5) | 0x12]
+        ans = run_states_node(bus, 5)
+        assert ans["Seq"] == 1
+        hb = bus.wait_for("Heartbeat", node=5, timeout=1.0)
+        assert hb["RxDropped"] == 0
+    finally:
+        ctl.stop()
+
+
+def run_states_node(bus: Bus, node: int) -> dict:
+    bus.send_state(1, node=node)
+    return bus.wait_for("Torque", lambda d: d["Seq"] == 1, node=node, timeout=2.0)
