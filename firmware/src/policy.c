@@ -99,41 +99,74 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
 void pour_policy_logits(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
   const unsigned n = weights->n_actions;
   const unsigned f = weights->w_frac_bits;
-  const int64_t half = f > 0u ? ((int64_t)1 << (f - 1u)) : 0;
+  const int16_t *w = weights->w;
+  /* x is Q15 in [0, 32767] (never negative), w is int16 Q(15-f).f, the bias input is 32768 (1.0), so
+   * |x w| <= 32767 * 32768 and the exact sum has |acc| <= 6 * 2^30 < 2^33 (Q(15+f)): an int64
+   * accumulator. It is formed from three pair sums that are each exact in int32: two observation
+   * terms stay within 2 * 32767 * 32768 < 2^31, and x4 w4 + 32768 w5 lies in
+   * [-32768 * 65535, 32767 * 65535]. The pairs are computed row by row (few live registers on the
+   * Cortex-M4, 32-bit multiply-accumulates). */
+  int32_t s01[POUR_POLICY_MAX_ACTIONS];
+  int32_t s23[POUR_POLICY_MAX_ACTIONS];
+  const int32_t x0 = obs->x[0], x1 = obs->x[1];
   for (unsigned a = 0; a < n; ++a) {
-    /* Q15 x (>= 0, <= 32767) times Q(15-f).f w (|w| <= 32768): each product fits int32 (< 2^30), the
-     * bias term is 32768 * w; |acc| <= 6 * 2^30 < 2^33, so int64 never overflows. acc is Q(15+f). */
-    int64_t acc = (int64_t)POUR_Q15_ONE_INT * weights->w[POUR_OBS_N * n + a];
-    for (unsigned k = 0; k < POUR_OBS_N; ++k) {
-      acc += (int32_t)obs->x[k] * (int32_t)weights->w[k * n + a];
+    s01[a] = x0 * w[a] + x1 * w[n + a];
+  }
+  const int32_t x2 = obs->x[2], x3 = obs->x[3];
+  for (unsigned a = 0; a < n; ++a) {
+    s23[a] = x2 * w[2u * n + a] + x3 * w[3u * n + a];
+  }
+  const int32_t x4 = obs->x[4];
+  const int16_t *w4 = w + 4u * n;
+  const int16_t *w5 = w + 5u * n;
+  if (f >= 2u) {
+    /* round(acc / 2^f) without 64-bit arithmetic: floor((s + t + u + half) / 2^f) equals
+     * (s >> f) + (t >> f) + (u >> f) + (((s & m) + (t & m) + (u & m) + half) >> f), m = 2^f - 1.
+     * With f >= 2 the result, |acc| / 4 < 2^31, never needs saturating. */
+    const int32_t m = (int32_t)((1u << f) - 1u);
+    const int32_t half = (int32_t)(1u << (f - 1u));
+    for (unsigned a = 0; a < n; ++a) {
+      const int32_t u = x4 * w4[a] + POUR_Q15_ONE_INT * w5[a];
+      const int32_t s = s01[a];
+      const int32_t t = s23[a];
+      logits[a] = (s >> f) + (t >> f) + (u >> f) + (((s & m) + (t & m) + (u & m) + half) >> f);
     }
-    logits[a] = pour_sat_i32((acc + half) >> f);
+  } else {
+    const int64_t half = f > 0u ? 1 : 0;
+    for (unsigned a = 0; a < n; ++a) {
+      const int64_t acc = (int64_t)s01[a] + s23[a] + (x4 * w4[a] + POUR_Q15_ONE_INT * w5[a]);
+      logits[a] = pour_sat_i32((acc + half) >> f);
+    }
   }
 }
 
 /* exp(-d) for d = max - logit >= 0 (Q16.15 difference, as uint32), in Q16 (1.0 = 65536).
- * exp(-d) = 2^-y with y = d * log2(e), y in Q15 (log2(e) in Q16 = 94548, rounded). y = k + r:
- * 2^-r from the 65-entry Q24 table with linear interpolation over 9 fraction bits (error < 1 LSB of
- * Q16), then >> (8 + k) rounded. k > 16 gives 0 (below half a Q16 LSB). */
+ * exp(-d) = 2^-y with y = round(d * log2(e)) in Q15, log2(e) in Q16 = 94548 = 65536 + 4 * 7253, so
+ * y = (d * 94548 + 32768) >> 16 = d + ((d * 7253 + 8192) >> 14) exactly, in 32 bits for the d that
+ * matter. y = k + r: 2^-r from the 65-entry Q24 table with linear interpolation over 9 fraction bits
+ * (error < 1 LSB of Q16), then >> (8 + k) rounded. k > 16 (d >= 386124) gives 0, below half a Q16 LSB. */
+#define EXP_D_CUTOFF 386124u
 static uint32_t exp_neg_q16(uint32_t d) {
-  const uint64_t y = ((uint64_t)d * 94548u + 32768u) >> 16;
-  const uint64_t k = y >> 15;
-  if (k > 16u) {
+  if (d >= EXP_D_CUTOFF) {
     return 0u;
   }
-  const uint32_t r = (uint32_t)y & 0x7FFFu;
+  const uint32_t y = d + ((d * 7253u + 8192u) >> 14); /* d * 7253 < 2^32 below the cutoff */
+  const uint32_t k = y >> 15;
+  const uint32_t r = y & 0x7FFFu;
   const uint32_t j = r >> 9;
   const uint32_t frac = r & 0x1FFu;
   const uint32_t step = exp2_neg_q24[j] - exp2_neg_q24[j + 1u]; /* < 2^18: step * 511 fits */
   const uint32_t v = exp2_neg_q24[j] - ((step * frac + 256u) >> 9);
-  const uint32_t shift = 8u + (uint32_t)k;
+  const uint32_t shift = 8u + k;
   return (v + (1u << (shift - 1u))) >> shift;
 }
 
 void pour_policy_softmax_q15(const int32_t *logits, unsigned n, q15_t *probs) {
   int32_t max = logits[0];
   for (unsigned a = 1; a < n; ++a) {
-    max = logits[a] > max ? logits[a] : max;
+    if (logits[a] > max) {
+      max = logits[a];
+    }
   }
   uint32_t e[POUR_POLICY_MAX_ACTIONS];
   uint32_t sum = 0u; /* >= 65536 (the max's term), <= 16 * 65536 */

@@ -21,6 +21,15 @@ def test_log2e_constant_is_rounded_log2e():
     assert fp.LOG2E_Q16 == int(np.floor(np.log2(np.e) * 65536 + 0.5))
 
 
+def test_exp_cutoff_and_the_c_32_bit_form_match_the_definition():
+    d = np.arange(0, fp.EXP_D_CUTOFF + 64, dtype=np.int64)
+    y = (d * fp.LOG2E_Q16 + 32768) >> 16
+    assert np.array_equal(y[: fp.EXP_D_CUTOFF], (d + ((d * 7253 + 8192) >> 14))[: fp.EXP_D_CUTOFF])
+    assert int((y >> 15)[fp.EXP_D_CUTOFF - 1]) == 16 and np.all((y >> 15)[fp.EXP_D_CUTOFF:] > 16)
+    assert fp.EXP_D_CUTOFF * 7253 < 2**32
+    assert fp.exp_neg_q16(0) == 65536 and fp.exp_neg_q16(fp.EXP_D_CUTOFF) == 0
+
+
 def test_committed_golden_files_equal_a_fresh_generation(source_dir):
     assert golden.main(["--check", "--source-dir", str(source_dir)]) == 0
 

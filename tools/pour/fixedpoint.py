@@ -120,12 +120,15 @@ def logits_q15(w_q: np.ndarray, frac_bits: int, obs_q15: Sequence[int]) -> list[
     return out
 
 
+EXP_D_CUTOFF = 386124  # smallest d whose y = (d * LOG2E_Q16 + 32768) >> 16 has y >> 15 > 16
+
+
 def exp_neg_q16(d: int) -> int:
     """exp(-d / 32768) in Q16 for 0 <= d < 2^32 (policy.c exp_neg_q16)."""
-    y = (d * LOG2E_Q16 + 32768) >> 16
-    k = y >> 15
-    if k > 16:
+    if d >= EXP_D_CUTOFF:
         return 0
+    y = (d * LOG2E_Q16 + 32768) >> 16  # the C code's d + ((d * 7253 + 8192) >> 14), the same value
+    k = y >> 15
     r = y & 0x7FFF
     j, frac = r >> 9, r & 0x1FF
     step = EXP2_TABLE_Q24[j] - EXP2_TABLE_Q24[j + 1]

@@ -62,10 +62,13 @@ def _quant_cases(rng: np.random.Generator) -> list[tuple]:
     """(norm, state, expected obs) cases: edges, half LSBs, extremes, then random."""
     i32min, i32max = fp.INT32_MIN, fp.INT32_MAX
     norms = [NORM, fp.ObsNorm(-87266, 2356194, 4000000), fp.ObsNorm(0, 65536, 1), fp.ObsNorm(i32min, i32max, i32max),
-             fp.ObsNorm(-5, 3 * 32768 - 5, 3)]
+             fp.ObsNorm(-5, 3 * 32768 - 5, 3),
+             # either side of obs.c's switch from two 32-bit divides to one 64-bit divide (span 2^24)
+             fp.ObsNorm(0, (1 << 24) - 1, (1 << 23) - 1), fp.ObsNorm(0, 1 << 24, 1 << 23)]
     states = [(0, 0, 0, 0, 0), (2356194, 4000000, 32767, 32767, 32767), (i32min, i32min, -32768, -1, -32768),
               (i32max, i32max, 32767, 0, 1), (1, 1, 1, 1, 1), (3, -3, 2, 3, 4), (1178097, -2000000, 16384, 8192, 100),
-              (65535, 2, 0, 0, 0), (-1, -1, -1, -1, -1)]
+              (65535, 2, 0, 0, 0), (-1, -1, -1, -1, -1), ((1 << 24) - 2, (1 << 23) - 2, 5, 5, 5),
+              (8388607, -8388607, 0, 0, 0), (16777215, 0, 0, 0, 0), (12345678, 7654321, 0, 0, 0)]
     cases = [(n, s) for n in norms for s in states]
     for _ in range(60):
         n = norms[int(rng.integers(len(norms)))]
@@ -80,7 +83,8 @@ def _softmax_cases(rng: np.random.Generator) -> list[tuple[list[int], list[int],
     i32min, i32max = fp.INT32_MIN, fp.INT32_MAX
     fixed = [[0, 0], [i32max, i32min], [i32min, i32max, i32min], [0, -22713], [5, 5, 5, 4],
              [i32min] * 16, [i32max] * 3 + [i32min] * 13, list(range(0, 16 * 40000, 40000)),
-             [100000, 50000, 50001, -7], [-12, 0, -12], [0] * 11]
+             [100000, 50000, 50001, -7], [-12, 0, -12], [0] * 11,
+             [0, -(fp.EXP_D_CUTOFF - 1), -fp.EXP_D_CUTOFF, -(fp.EXP_D_CUTOFF + 1)]]
     out = [list(v) for v in fixed]
     while len(out) < N_SOFTMAX:
         n = int(rng.integers(2, 17))

@@ -1,0 +1,127 @@
+/* SPDX-License-Identifier: MIT */
+/* Instructions per control step on QEMU mps2-an386 under -icount shift=0 (one instruction per virtual
+ * ns). SysTick runs from the core clock; a calibration loop of known length converts its ticks to
+ * instructions. Prints figures; never fails on them. */
+#include <stdint.h>
+#include <stdio.h>
+
+#include "pour/control.h"
+#include "pour/weights_compiled.h"
+
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define N_STEPS 2000u
+#define CAL_ITERATIONS 200000u
+
+static uint32_t now(void) { return SYST_CVR; } /* counts down */
+
+static uint32_t elapsed(uint32_t start, uint32_t end) { return (start - end) & 0x00FFFFFFu; }
+
+/* 3 instructions per iteration (subs, nop, bne), in assembly so the count does not depend on flags. */
+static void spin(uint32_t n) {
+  __asm volatile("1: subs %0, %0, #1\n nop\n bne 1b\n" : "+r"(n) : : "cc");
+}
+
+static pour_control_t ctl;
+static pour_control_input_t inputs[64];
+
+static void make_inputs(void) {
+  for (unsigned i = 0; i < 64u; ++i) {
+    inputs[i].state_fresh = true;
+    inputs[i].estop = false;
+    inputs[i].clear_faults = false;
+    inputs[i].state.seq = i;
+    inputs[i].state.theta_urad = (int32_t)(i * 30000u);
+    inputs[i].state.omega_urad_s = (int32_t)(i * 20000u) - 600000;
+    inputs[i].state.v_rotating = (q15_t)(32767 - (int32_t)i * 500);
+    inputs[i].state.v_target = (q15_t)(i * 480u);
+    inputs[i].state.v_spill = (q15_t)(i * 10u);
+  }
+}
+
+/* Average SysTick ticks (x1000) per step for N_STEPS steps, minus the loop's own cost. */
+static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
+  const pour_control_config_t config = pour_control_default_config();
+  if (pour_control_init(&ctl, &config, w) != POUR_OK) {
+    return 0u;
+  }
+  pour_control_output_t out;
+  const uint32_t t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    if (do_step) {
+      pour_control_step(&ctl, &inputs[i & 63u], &out);
+    } else {
+      __asm volatile("" : : "r"(&inputs[i & 63u]) : "memory");
+    }
+  }
+  return elapsed(t0, now());
+}
+
+static void report(const char *name, const pour_policy_weights_t *w, uint32_t insn_per_kilotick) {
+  const uint32_t loop = time_steps(w, 0);
+  const uint32_t run = time_steps(w, 1);
+  const uint32_t per_step = (uint32_t)(((uint64_t)(run - loop) * insn_per_kilotick) / (1000u * N_STEPS));
+  printf("%-34s %5u instructions/step (n_actions %u, decision every %u ms)\n", name, (unsigned)per_step,
+          (unsigned)w->n_actions, (unsigned)w->decision_period_ms);
+}
+
+/* Instructions per call of the two kernels a decision tick adds to a hold tick. */
+static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kilotick) {
+  pour_policy_t policy;
+  pour_policy_eval_t ev;
+  pour_obs_t obs[64];
+  if (pour_policy_init(&policy, w, POUR_POLICY_GREEDY, 1u) != POUR_OK) {
+    return;
+  }
+  uint32_t t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    pour_obs_quantize(&w->norm, &inputs[i & 63u].state, &obs[i & 63u]);
+  }
+  const uint32_t quant = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    pour_policy_eval(&policy, &obs[i & 63u], &ev);
+  }
+  const uint32_t eval = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    pour_policy_logits(w, &obs[i & 63u], ev.logits);
+  }
+  const uint32_t logits = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    ev.logits[0] = (int32_t)i;
+    pour_policy_softmax_q15(ev.logits, w->n_actions, ev.probs);
+  }
+  const uint32_t softmax = elapsed(t0, now());
+  const uint64_t scale = 1000ull * N_STEPS;
+  printf("  per call (loop included): pour_obs_quantize %u, pour_policy_eval %u = logits %u + softmax %u + argmax\n",
+         (unsigned)((quant * (uint64_t)insn_per_kilotick) / scale), (unsigned)((eval * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((logits * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale));
+}
+
+int main(void) {
+  SYST_CSR = 0u;
+  SYST_RVR = 0x00FFFFFFu;
+  SYST_CVR = 0u;
+  SYST_CSR = 0x5u; /* enable, core clock, no interrupt */
+  make_inputs();
+
+  const uint32_t t0 = now();
+  spin(CAL_ITERATIONS);
+  const uint32_t cal = elapsed(t0, now());
+  const uint32_t insn_per_kilotick = (uint32_t)((3000ull * CAL_ITERATIONS) / cal);
+  printf("calibration: %u SysTick ticks for %u instructions (%u.%03u instructions/tick)\n", (unsigned)cal,
+          (unsigned)(3u * CAL_ITERATIONS), (unsigned)(insn_per_kilotick / 1000u), (unsigned)(insn_per_kilotick % 1000u));
+
+  /* The compiled policy as shipped, then the worst case: a decision on every tick. */
+  pour_policy_weights_t every_tick = pour_weights_compiled;
+  every_tick.decision_period_ms = 1u;
+  every_tick.content_hash = pour_policy_weights_hash(&every_tick);
+  report("control step, average:", &pour_weights_compiled, insn_per_kilotick);
+  report("control step, decision tick:", &every_tick, insn_per_kilotick);
+  report_kernels(&pour_weights_compiled, insn_per_kilotick);
+  return 0;
+}
