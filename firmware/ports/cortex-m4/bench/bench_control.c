@@ -123,5 +123,7 @@ int main(void) {
   report("control step, average:", &pour_weights_compiled, insn_per_kilotick);
   report("control step, decision tick:", &every_tick, insn_per_kilotick);
   report_kernels(&pour_weights_compiled, insn_per_kilotick);
+  printf("controller state: sizeof(pour_control_t) = %u B (the core has no static data)\n",
+         (unsigned)sizeof(pour_control_t));
   return 0;
 }

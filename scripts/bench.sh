@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Benchmarks: measure and print; never fail on the figures (only on a build that does not work).
+#   scripts/bench.sh              all sections
+#   scripts/bench.sh core         only the named sections (see SECTIONS below)
+set -uo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ROOT"
+
+# --- section: core — the firmware core on an emulated Cortex-M4 -----------------------------------
+# Instructions per control step under qemu-system-arm -icount shift=0 (one instruction per virtual ns,
+# so the guest's SysTick turns into an instruction count: deterministic), for the hand-made 11-action
+# and 2-action policies; flash and RAM of the core and of the STM32G431 image (arm-none-eabi-size).
+# Bars: <= 1,500 instructions/step; core <= 4 KB flash and <= 512 B RAM.
+bench_core() {
+  local build=build/cortex-m4 log
+  log=$(mktemp)
+  echo "== core: Cortex-M4 (STM32G431 image; QEMU mps2-an386, -icount shift=0) =="
+  if ! { cmake --preset cortex-m4 && cmake --build --preset cortex-m4 -j2; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the cortex-m4 build failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  local port=$build/firmware/ports/cortex-m4 n elf out
+  for n in 11 2; do
+    elf=$port/pour_bench_control_$n.elf
+    echo "-- policy with $n actions:"
+    if ! out=$(timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+                 -semihosting-config enable=on,target=native -icount shift=0 -kernel "$elf" 2>&1); then
+      echo "$out"
+      echo "error: $elf did not run to completion under QEMU" >&2
+      return 1
+    fi
+    echo "$out" | sed 's/^/   /'
+    if [ "$n" = 11 ]; then
+      worst=$(sed -nE 's/.*decision tick: *([0-9]+) instructions.*/\1/p' <<<"$out")
+      avg=$(sed -nE 's/.*average: *([0-9]+) instructions.*/\1/p' <<<"$out")
+      state=$(sed -nE 's/.*sizeof\(pour_control_t\) = ([0-9]+) B.*/\1/p' <<<"$out")
+    fi
+  done
+
+  echo "-- sizes (arm-none-eabi-size, MinSizeRel):"
+  local objdir=$build/firmware/CMakeFiles/pour_core.dir/src core_text=0 core_ram=0 all_text=0 o t d b
+  for o in "$objdir"/*.obj; do
+    read -r t d b < <(arm-none-eabi-size "$o" | awk 'NR == 2 {print $1, $2, $3}')
+    all_text=$((all_text + t + d))
+    case "$(basename "$o")" in
+      fixed.c.obj|obs.c.obj|policy.c.obj|safety.c.obj|control.c.obj)
+        core_text=$((core_text + t + d)); core_ram=$((core_ram + d + b))
+        printf '   %-18s %5d B flash\n' "$(basename "$o" .c.obj).c" $((t + d)) ;;
+    esac
+  done
+  printf '   control core (fixed, obs, policy, safety, control): %d B flash, %d B static RAM;\n' \
+    "$core_text" "$core_ram"
+  printf '   one controller instance (pour_control_t): %s B RAM\n' "${state:-?}"
+  printf '   whole pour_core library (with the CAN codec and node): %d B flash\n' "$all_text"
+  read -r t d b < <(arm-none-eabi-size "$port/pour_firmware.elf" | awk 'NR == 2 {print $1, $2, $3}')
+  printf '   image pour_firmware.elf: %d B flash (text+data), %d B RAM (data+bss) + 2048 B stack reserve\n' \
+    $((t + d)) $((d + b))
+
+  echo "-- against the bars:"
+  verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
+  printf '   instructions/step, worst case (decision tick, 11 actions): %s (bar 1500: %s)\n' \
+    "$worst" "$(verdict "$worst" 1500)"
+  printf '   instructions/step, average (decision every 10 ms, 11 actions): %s\n' "$avg"
+  printf '   core flash: %d B (bar 4096: %s); core RAM: %d B static + %s B per controller (bar 512: %s)\n' \
+    "$core_text" "$(verdict "$core_text" 4096)" "$core_ram" "${state:-?}" \
+    "$(verdict $((core_ram + ${state:-0})) 512)"
+}
+
+SECTIONS=(core)
+wanted=("$@")
+[ ${#wanted[@]} -gt 0 ] || wanted=("${SECTIONS[@]}")
+status=0
+for s in "${wanted[@]}"; do
+  if [[ " ${SECTIONS[*]} " != *" $s "* ]]; then
+    echo "error: unknown section '$s' (sections: ${SECTIONS[*]})" >&2
+    exit 2
+  fi
+  "bench_$s" || status=1
+  echo
+done
+exit "$status"
