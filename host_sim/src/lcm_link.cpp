@@ -281,6 +281,7 @@ void LcmLink::maybe_publish_particles(const poursim_world_t *world, const poursi
   m.bucket_inner_width = static_cast<float>(c->bucket_inner_width);
   m.bucket_height = static_cast<float>(c->bucket_height);
   m.bucket_wall = static_cast<float>(c->bucket_wall);
+  m.theta_max = c->theta_max;
   m.n = got;
   m.x.resize(static_cast<size_t>(got));
   m.y.resize(static_cast<size_t>(got));

@@ -119,10 +119,10 @@ bool parse_float(const std::string &tok, double &v) {
 }
 
 // Finds "<name>[d0][d1] = {...};" (or "[d0]") and returns its rows of tokens.
-int read_array(const Ctx &c, const std::string &t, const char *name, int rows, int cols,
+int read_array(const Ctx &c, const std::string &t, const char *type, const char *name, int rows, int cols,
                const std::map<std::string, long long> &macros, std::vector<Node> &values, bool required,
                bool *found) {
-  std::regex decl(std::string("\\b") + name + "\\s*((\\[[^\\]]*\\]\\s*)+)=");
+  std::regex decl(std::string("(\\w+)\\s+") + name + "\\s*((\\[[^\\]]*\\]\\s*)+)=");
   std::smatch m;
   *found = false;
   if (!std::regex_search(t, m, decl)) {
@@ -133,7 +133,10 @@ int read_array(const Ctx &c, const std::string &t, const char *name, int rows, i
   size_t at = static_cast<size_t>(m.position(0));
   int line = c.line_of(at);
   // Declared dimensions must agree with the macros (a number or the macro's name).
-  std::string dims = m[1].str();
+  if (m[1].str() != type)
+    return set_error(c.err, c.err_len, POURSIM_EPARSE, "%s:%d: %s is declared %s, expected %s", c.name, line, name,
+                     m[1].str().c_str(), type);
+  std::string dims = m[2].str();
   std::regex dim_re("\\[\\s*([^\\]\\s]*)\\s*\\]");
   std::vector<long long> declared;
   for (auto it = std::sregex_iterator(dims.begin(), dims.end(), dim_re); it != std::sregex_iterator(); ++it) {
@@ -280,7 +283,7 @@ extern "C" int poursim_weights_parse(const char *text, size_t len, const char *n
 
   std::vector<Node> vals;
   bool found = false;
-  int rc = read_array(c, t, "pour_weights_w", nf, n, macros, vals, true, &found);
+  int rc = read_array(c, t, "int16_t", "pour_weights_w", nf, n, macros, vals, true, &found);
   if (rc != POURSIM_OK) return rc;
   for (size_t i = 0; i < vals.size(); ++i) {
     long long v;
@@ -290,7 +293,7 @@ extern "C" int poursim_weights_parse(const char *text, size_t len, const char *n
                        vals[i].token.c_str());
     out->w[i] = static_cast<int16_t>(v);
   }
-  rc = read_array(c, t, "pour_weights_action_levels_q15", 0, n, macros, vals, true, &found);
+  rc = read_array(c, t, "int16_t", "pour_weights_action_levels_q15", 0, n, macros, vals, true, &found);
   if (rc != POURSIM_OK) return rc;
   for (size_t i = 0; i < vals.size(); ++i) {
     long long v;
@@ -303,7 +306,7 @@ extern "C" int poursim_weights_parse(const char *text, size_t len, const char *n
                        "%s:%d: pour_weights_action_levels_q15 must be strictly increasing (index %zu)", name,
                        c.line_of(vals[i].offset), i);
   }
-  rc = read_array(c, t, "pour_weights_w_float", nf, n, macros, vals, false, &found);
+  rc = read_array(c, t, "float", "pour_weights_w_float", nf, n, macros, vals, false, &found);
   if (rc != POURSIM_OK) return rc;
   out->has_float_reference = found ? 1 : 0;
   for (size_t i = 0; found && i < vals.size(); ++i) {

@@ -1,0 +1,170 @@
+/* SPDX-License-Identifier: MIT */
+/* host_sim's run-time weights.h loader: accepts the shipped headers, refuses each kind of bad one with
+ * a message naming the field. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "poursim/weights_file.h"
+#include "unity.h"
+
+static poursim_weights_file_t wf;
+static char err[POURSIM_ERR_LEN];
+static char good[16384];
+static size_t good_len;
+
+static size_t read_text(const char *path, char *buf, size_t cap) {
+  FILE *f = fopen(path, "rb");
+  TEST_ASSERT_NOT_NULL_MESSAGE(f, path);
+  size_t n = fread(buf, 1, cap - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return n;
+}
+
+void setUp(void) {
+  err[0] = '\0';
+  good_len = read_text(POUR_SOURCE_DIR "/policy/example_weights.h", good, sizeof good);
+}
+
+void tearDown(void) {}
+
+/* good with the first occurrence of from replaced by to, then parsed; returns the status. */
+static int parse_edited(const char *from, const char *to) {
+  static char text[20000];
+  const char *at = strstr(good, from);
+  TEST_ASSERT_NOT_NULL_MESSAGE(at, from);
+  size_t head = (size_t)(at - good);
+  snprintf(text, sizeof text, "%.*s%s%s", (int)head, good, to, at + strlen(from));
+  return poursim_weights_parse(text, strlen(text), "edited.h", &wf, err, sizeof err);
+}
+
+/* The first value of the 2-D array called name in good. */
+static const char *first_value(const char *name) {
+  const char *p = strstr(good, name);
+  TEST_ASSERT_NOT_NULL_MESSAGE(p, name);
+  p = strchr(strchr(strchr(p, '=') + 1, '{') + 1, '{') + 1;
+  while (*p == ' ' || *p == '\n') ++p;
+  return p;
+}
+
+static void expect_error_naming(int rc, const char *field) {
+  TEST_ASSERT_TRUE_MESSAGE(rc < 0, "a bad header was accepted");
+  TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, field), err);
+}
+
+static void test_weights_file_AcceptsShippedHeadersAndMatchesCoreHash(void) {
+  const char *paths[] = {POUR_SOURCE_DIR "/policy/example_weights.h", POUR_SOURCE_DIR "/policy/weights.h",
+                         POUR_SOURCE_DIR "/tests/golden/example_weights_2.h"};
+  for (size_t i = 0; i < sizeof paths / sizeof paths[0]; ++i) {
+    TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, poursim_weights_load(paths[i], &wf, err, sizeof err), err);
+    pour_policy_weights_t view;
+    poursim_weights_view(&wf, &view);
+    TEST_ASSERT_EQUAL_UINT32(wf.content_hash, pour_policy_weights_hash(&view));
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_weights_validate(&view));
+  }
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_weights_load(POUR_SOURCE_DIR "/policy/example_weights.h", &wf, err, sizeof err));
+  TEST_ASSERT_EQUAL_INT(11, wf.n_actions);
+  TEST_ASSERT_EQUAL_INT(-32768, wf.levels[0]);
+  TEST_ASSERT_EQUAL_INT(32767, wf.levels[10]);
+  TEST_ASSERT_EQUAL_INT(1, wf.has_float_reference);
+  /* The float policy for rollouts: W / 2^f, levels / 32768. */
+  double w[POURSIM_N_FEATURES * 16], lv[16];
+  poursim_policy_t p;
+  poursim_weights_float_policy(&wf, w, lv, &p);
+  TEST_ASSERT_EQUAL_DOUBLE(wf.w[0] / 2048.0, w[0]);
+  TEST_ASSERT_EQUAL_DOUBLE(-1.0, lv[0]);
+  TEST_ASSERT_EQUAL_INT(wf.decision_period_ms, p.decision_period);
+}
+
+/* The firmware's bad headers (tests/unit/bad_weights) are refused at run time too, naming the field. */
+static void test_weights_file_RefusesEveryFirmwareBadHeader(void) {
+  static const char *cases[][2] = {
+      {"bad_format.h", "POUR_WEIGHTS_FORMAT"},
+      {"wrong_features.h", "POUR_WEIGHTS_N_FEATURES"},
+      {"too_many_actions.h", "POUR_WEIGHTS_N_ACTIONS"},
+      {"frac_bits_out_of_range.h", "POUR_WEIGHTS_W_FRAC_BITS"},
+      {"zero_period.h", "POUR_WEIGHTS_DECISION_PERIOD_MS"},
+      {"inverted_theta.h", "POUR_WEIGHTS_THETA_MAX_URAD"},
+      {"missing_tau_max.h", "POUR_WEIGHTS_TAU_MAX_MNM"},
+      {"missing_hash.h", "POUR_WEIGHTS_CONTENT_HASH"},
+      {"missing_levels.h", "pour_weights_action_levels_q15"},
+      {"wrong_shape.h", "pour_weights_w"},
+      {"truncated_rows.h", "pour_weights_w"},
+      {"truncated_levels.h", "pour_weights_action_levels_q15"},
+      {"wrong_level_type.h", "pour_weights_action_levels_q15"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char path[512];
+    snprintf(path, sizeof path, "%s/tests/unit/bad_weights/%s", POUR_SOURCE_DIR, cases[i][0]);
+    int rc = poursim_weights_load(path, &wf, err, sizeof err);
+    printf("%-26s -> %s\n", cases[i][0], err);
+    expect_error_naming(rc, cases[i][1]);
+  }
+}
+
+static void test_weights_file_RefusesWrongActionCount(void) {
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_N_ACTIONS 11", "#define POUR_WEIGHTS_N_ACTIONS 10"),
+                      "pour_weights_w");
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_N_ACTIONS 11", "#define POUR_WEIGHTS_N_ACTIONS 17"),
+                      "POUR_WEIGHTS_N_ACTIONS");
+}
+
+static void test_weights_file_RefusesBadQFormat(void) {
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS 16"),
+                      "POUR_WEIGHTS_W_FRAC_BITS");
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS eleven"),
+                      "POUR_WEIGHTS_W_FRAC_BITS");
+  /* Another f changes the hash: an edited Q format without re-export is caught. */
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS 12"),
+                      "POUR_WEIGHTS_CONTENT_HASH");
+}
+
+static void test_weights_file_RefusesTruncatedFile(void) {
+  const char *levels = strstr(good, "pour_weights_action_levels_q15[");
+  TEST_ASSERT_NOT_NULL(levels);
+  size_t cut = (size_t)(levels - good) + 80; /* in the middle of the levels */
+  expect_error_naming(poursim_weights_parse(good, cut, "cut.h", &wf, err, sizeof err), "pour_weights_action_levels_q15");
+  const char *w = strstr(good, "pour_weights_w[");
+  cut = (size_t)(w - good) + 150; /* in the middle of W */
+  expect_error_naming(poursim_weights_parse(good, cut, "cut.h", &wf, err, sizeof err), "pour_weights_w");
+  expect_error_naming(poursim_weights_parse(good, 200, "cut.h", &wf, err, sizeof err), "missing");
+}
+
+static void test_weights_file_RefusesNaNInFloatReference(void) {
+  const char *first = first_value("pour_weights_w_float[");
+  const char *comma = strchr(first, ',');
+  static char text[20000];
+  snprintf(text, sizeof text, "%.*sNAN%s", (int)(first - good), good, comma);
+  expect_error_naming(poursim_weights_parse(text, strlen(text), "nan.h", &wf, err, sizeof err), "pour_weights_w_float[0][0]");
+  snprintf(text, sizeof text, "%.*s1e999f%s", (int)(first - good), good, comma);
+  expect_error_naming(poursim_weights_parse(text, strlen(text), "inf.h", &wf, err, sizeof err), "pour_weights_w_float[0][0]");
+}
+
+static void test_weights_file_RefusesEditedWeightsAndBadValues(void) {
+  /* One weight edited by hand: the content hash no longer matches. */
+  const char *first = first_value("pour_weights_w[");
+  const char *comma = strchr(first, ',');
+  static char text[20000];
+  snprintf(text, sizeof text, "%.*s123%s", (int)(first - good), good, comma);
+  expect_error_naming(poursim_weights_parse(text, strlen(text), "edited.h", &wf, err, sizeof err), "POUR_WEIGHTS_CONTENT_HASH");
+  snprintf(text, sizeof text, "%.*s40000%s", (int)(first - good), good, comma);
+  expect_error_naming(poursim_weights_parse(text, strlen(text), "big.h", &wf, err, sizeof err), "pour_weights_w[0][0]");
+  expect_error_naming(parse_edited("{-32768, -26214", "{-26214, -32768"), "strictly increasing");
+  expect_error_naming(parse_edited("#define POUR_WEIGHTS_TAU_MAX_MNM", "#define POUR_WEIGHTS_TAU_MAX_MNM 5\n#define POUR_WEIGHTS_TAU_MAX_MNM"),
+                      "defined twice");
+  TEST_ASSERT_EQUAL_INT(POURSIM_EIO, poursim_weights_load("/nonexistent/weights.h", &wf, err, sizeof err));
+  TEST_ASSERT_NOT_NULL(strstr(err, "/nonexistent/weights.h"));
+}
+
+int main(void) {
+  UNITY_BEGIN();
+  RUN_TEST(test_weights_file_AcceptsShippedHeadersAndMatchesCoreHash);
+  RUN_TEST(test_weights_file_RefusesEveryFirmwareBadHeader);
+  RUN_TEST(test_weights_file_RefusesWrongActionCount);
+  RUN_TEST(test_weights_file_RefusesBadQFormat);
+  RUN_TEST(test_weights_file_RefusesTruncatedFile);
+  RUN_TEST(test_weights_file_RefusesNaNInFloatReference);
+  RUN_TEST(test_weights_file_RefusesEditedWeightsAndBadValues);
+  return UNITY_END();
+}
