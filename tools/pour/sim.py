@@ -88,10 +88,10 @@ _lib: C.CDLL | None = None
 
 
 def library_candidates() -> list[Path]:
-    """Where load_library() looks, in order."""
-    out: list[Path] = []
+    """Where load_library() looks, in order ($POUR_SIM_LIB alone when it is set)."""
     if os.environ.get("POUR_SIM_LIB"):
-        out.append(Path(os.environ["POUR_SIM_LIB"]))
+        return [Path(os.environ["POUR_SIM_LIB"])]
+    out: list[Path] = []
     if os.environ.get("POUR_BUILD_DIR"):
         out.append(Path(os.environ["POUR_BUILD_DIR"]) / "lib" / "libpoursim.so")
     out.append(Path(__file__).resolve().parents[2] / "build" / "host" / "lib" / "libpoursim.so")

@@ -1,0 +1,104 @@
+# SPDX-License-Identifier: MIT
+"""tools/pour/sim.py: the ctypes binding of libpoursim."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pour import sim
+
+
+@pytest.fixture(autouse=True)
+def _lib(build_dir, monkeypatch):
+    monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
+
+
+def small_policy(greedy=False):
+    lv = sim.uniform_levels(5)
+    w = np.zeros((6, 5))
+    w[0], w[2], w[5] = -3 * lv, 2 * lv, lv  # tilt while full and upright
+    return sim.Policy(w=w, levels=lv, decision_period=10, greedy=greedy)
+
+
+def test_default_config_has_the_documented_scene():
+    c = sim.default_config()
+    assert set(c) == set(sim.CONFIG_KEYS)
+    assert c["n_particles"] == 150 and c["bucket_inner_width"] == 0.24 and c["bucket_height"] == 0.33
+    assert c["bucket_wall"] == 0.005 and c["dt"] == 0.001 and c["episode_s"] == 10.0
+    assert c["restitution_liquid"] == 0.5 and c["restitution_wall"] == 0.1
+
+
+def test_bad_config_key_or_value_raises_naming_it():
+    with pytest.raises(sim.SimError, match="no_such_key"):
+        sim.make_config({"no_such_key": 1})
+    with pytest.raises(sim.SimError, match="gamma"):
+        sim.make_config({"gamma": 2.0})
+    with pytest.raises(sim.SimError, match="cannot read config file"):
+        sim.make_config(path="/nonexistent/sim.cfg")
+
+
+def test_world_steps_and_accounts_for_every_circle():
+    with sim.World(seed=2) as w:
+        o0 = w.observe()
+        assert o0.step == 0 and o0.v_rotating == 1.0
+        for _ in range(300):
+            o = w.step(1.0)
+        assert o.step == 300 and o.theta > 0.3
+        xy, r = w.particles()
+        assert xy.shape == (150, 2) and r.shape == (150,)
+        reg = w.regions()
+        assert np.bincount(reg, minlength=4).sum() == 150
+        assert o.v_rotating == pytest.approx(np.mean(reg == 0))
+        with pytest.raises(sim.SimError, match="finite"):
+            w.step(float("nan"))
+
+
+def test_rollout_arrays_and_determinism():
+    pol = small_policy()
+    with sim.World({"episode_s": 2.0}) as w:
+        a = w.rollout(pol, seed=4, record_steps=True)
+        b = w.rollout(pol, seed=4)
+    assert a.features.shape == (200, 6) and a.actions.shape == (200,) and a.probs.shape == (200, 5)
+    assert a.step_rewards.shape == (2000,)
+    assert np.all(a.features[:, 5] == 1.0)
+    assert np.all((a.features >= 0) & (a.features <= 1))
+    assert np.allclose(a.probs.sum(axis=1), 1.0)
+    assert a.rewards.sum() == pytest.approx(a.reward_sum) == pytest.approx(a.step_rewards.sum())
+    assert np.array_equal(a.actions, b.actions) and a.ret == b.ret
+
+
+def test_batch_on_two_threads_equals_sequential():
+    pol = small_policy()
+    cfg = {"episode_s": 1.5}
+    batch = sim.rollout_batch(cfg, pol, seeds=[7, 8, 9], n_threads=2)
+    with sim.World(cfg) as w:
+        seq = [w.rollout(pol, seed=s) for s in (7, 8, 9)]
+    for x, y in zip(batch, seq):
+        assert x.seed == y.seed and x.ret == y.ret and np.array_equal(x.actions, y.actions)
+
+
+def test_bad_policy_shape_raises():
+    with pytest.raises(sim.SimError, match="shape"):
+        sim.Policy(w=np.zeros((5, 11)), levels=sim.uniform_levels(11))._struct()
+    with pytest.raises(sim.SimError):
+        sim.rollout_batch({"episode_s": 0.1}, sim.Policy(w=np.zeros((6, 3)), levels=np.array([-2.0, 0, 1])), [1])
+
+
+def _load_in_subprocess(lib_path):
+    code = "from pour import sim\ntry:\n    sim.load_library()\nexcept sim.SimError as e:\n    print('SimError:', e)\n"
+    env = dict(os.environ, POUR_SIM_LIB=str(lib_path))
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+
+
+def test_missing_library_gives_a_clear_error(tmp_path):
+    r = _load_in_subprocess(tmp_path / "nope.so")
+    assert r.returncode == 0 and "SimError: libpoursim.so not found" in r.stdout
+
+
+def test_library_that_fails_to_load_gives_a_clear_error(tmp_path):
+    bad = tmp_path / "libpoursim.so"
+    bad.write_text("not a shared library")
+    r = _load_in_subprocess(bad)
+    assert r.returncode == 0 and "failed to load" in r.stdout
