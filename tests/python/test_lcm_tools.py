@@ -1,0 +1,85 @@
+# SPDX-License-Identifier: MIT
+"""pour-live-view (headless) and pour-lcm-cmd against live traffic; their bad inputs."""
+import random
+import subprocess
+import sys
+import threading
+
+import numpy as np
+from PIL import Image
+
+from lcm_helpers import Bus, Proc, binary, url
+from pour import channels
+
+
+def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_dir, tmp_path):
+    u = url(41)
+    png = tmp_path / "live.png"
+    bus = Bus(u)
+    stop = threading.Event()
+
+    def spam() -> None:
+        rng = random.Random(4)
+        while not stop.is_set():
+            bus.lc.publish(channels.PARTICLES, bytes(rng.randrange(256) for _ in range(64)))
+            stop.wait(0.01)
+
+    t = threading.Thread(target=spam)
+    with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
+         Proc([binary(build_dir, "host_sim"), "--policy", source_dir / "policy" / "weights.h", "--lcm", u,
+               "--realtime", "--set", "episode_s=6"]):
+        t.start()
+        try:
+            r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", u, "--save", png, "--frames", "10"],
+                               capture_output=True, text=True, timeout=120)
+        finally:
+            stop.set()
+            t.join()
+    assert r.returncode == 0, r.stderr
+    img = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    # Liquid is drawn in cream (0.96, 0.88, 0.70) or blue/red: plenty of such pixels.
+    cream = (abs(img[:, :, 0] - 245) < 12) & (abs(img[:, :, 1] - 224) < 12) & (abs(img[:, :, 2] - 178) < 12)
+    assert cream.sum() > 500
+
+
+def test_live_view_without_traffic_fails_clearly():
+    r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", url(42), "--save", "x.png", "--timeout",
+                        "0.5"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "no POUR_PARTICLES" in r.stderr
+
+
+def test_live_view_rejects_bad_arguments():
+    r = subprocess.run([sys.executable, "-m", "pour.live_view", "--save", "x.png", "--frames", "0"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "--frames must be >= 1" in r.stderr
+
+
+def test_lcm_cmd_estop_and_clear_reach_the_controller(build_dir):
+    u = url(43)
+    bus = Bus(u)
+    with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]) as c:
+        bus.ask(0, theta=0.3)
+
+        def cmd(*flags: str) -> None:
+            r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--url", u, *flags], capture_output=True,
+                               text=True, timeout=60)
+            assert r.returncode == 0, r.stderr
+            bus.pump(0.05)
+
+        cmd("--estop")
+        assert bus.ask(1, theta=0.3).mode == 3
+        cmd("--release")
+        assert bus.ask(2, theta=0.3).mode == 2
+        cmd("--clear")
+        bus.ask(3, theta=0.3)
+        assert bus.ask(4, theta=0.3).mode == 1
+        c.stop()
+
+
+def test_lcm_cmd_bad_inputs():
+    r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--url", "nosuchprovider://x", "--clear"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "cannot open LCM" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--clear", "--estop"], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2 and "not allowed with" in r.stderr
