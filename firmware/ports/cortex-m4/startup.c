@@ -36,10 +36,30 @@ void Reset_Handler(void) {
   }
 }
 
-/* Cortex-M4 core exceptions; device interrupts (FDCAN, timers) follow from entry 16 when a driver needs
- * them. Unused entries stop in Default_Handler. */
+#ifndef POUR_SEMIHOSTED
+/* STM32G431 device interrupts (RM0440): IRQ 0..101 follow the 16 core entries. A driver provides a
+ * handler by defining its name (the FDCAN driver: FDCAN1_IT0_IRQHandler, FDCAN1_IT1_IRQHandler); every
+ * other interrupt stops in Default_Handler. */
+void FDCAN1_IT0_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+void FDCAN1_IT1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+#define D1 Default_Handler
+#define D4 D1, D1, D1, D1
+#define D20 D4, D4, D4, D4, D4
+#define POUR_DEVICE_VECTORS                                                                    \
+  D20, D1,                           /* IRQ 0..20 */                                           \
+      FDCAN1_IT0_IRQHandler,         /* IRQ 21 */                                              \
+      FDCAN1_IT1_IRQHandler,         /* IRQ 22 */                                              \
+      D20, D20, D20, D4, D4, D4, D1, D1, D1 /* IRQ 23..101 */
+#define POUR_N_DEVICE_VECTORS 102
+#else
+/* QEMU mps2-an386 images (tests, benchmark) use no device interrupt. */
+#define POUR_DEVICE_VECTORS
+#define POUR_N_DEVICE_VECTORS 0
+#endif
+
+/* Cortex-M4 core exceptions, then the device's. Unused entries stop in Default_Handler. */
 typedef void (*pour_vector_t)(void);
-__attribute__((section(".isr_vector"), used)) static const pour_vector_t vectors[16] = {
+__attribute__((section(".isr_vector"), used)) static const pour_vector_t vectors[16 + POUR_N_DEVICE_VECTORS] = {
     (pour_vector_t)(uintptr_t)&__StackTop,
     Reset_Handler,
     Default_Handler, /* NMI */
@@ -53,4 +73,5 @@ __attribute__((section(".isr_vector"), used)) static const pour_vector_t vectors
     0,
     Default_Handler, /* PendSV */
     pour_hal_timer_isr, /* SysTick */
+    POUR_DEVICE_VECTORS
 };
