@@ -174,3 +174,12 @@ def test_safety_envelope_mirrors_the_c_rules():
     assert env.apply(-32768, -87266) == 0 and env.active & fp.LIMIT_ANGLE_MIN
     clamp = fp.SafetyEnvelope(fp.SafetyConfig(tau_limit=1000, slew_per_tick=32767))
     assert clamp.apply(20000, 0) == 1000 and clamp.active & fp.LIMIT_CLAMP
+
+
+def test_python_safety_defaults_match_the_c_defaults(source_dir):
+    text = (source_dir / "firmware/src/safety.c").read_text()
+    c = {m.group(1): int(m.group(2)) for m in re.finditer(r"#define DEFAULT_(\w+) \(?(-?\d+)\)?", text)}
+    py = fp.SafetyConfig()
+    assert (py.slew_per_tick, py.theta_min_urad, py.theta_max_urad) == \
+        (c["SLEW_PER_TICK"], c["THETA_MIN_URAD"], c["THETA_MAX_URAD"])
+    assert py.tau_limit == fp.Q15_MAX
