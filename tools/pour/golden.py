@@ -52,6 +52,7 @@ N_SOFTMAX = 120
 N_POLICY = 120
 N_SAMPLED = 4
 SAMPLED_LEN = 32
+SAFETY_LEN = 100
 
 
 def _c_array(values) -> str:
@@ -146,7 +147,27 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
         sp = fp.FixedPolicy(ex.w_q, ex.w_frac_bits, sampled=True, seed=seed_i)
         acts = [sp.eval(ob).action for _ in range(SAMPLED_LEN)]
         lines.append(f"    {{{seed_i}u, {_c_array(ob)}, {_c_array(acts)}}},")
-    lines += ["};", f"#define POUR_GOLDEN_N_SAMPLED {N_SAMPLED}", f"#define POUR_GOLDEN_SAMPLED_LEN {SAMPLED_LEN}",
+    lines += ["};", f"#define POUR_GOLDEN_N_SAMPLED {N_SAMPLED}", f"#define POUR_GOLDEN_SAMPLED_LEN {SAMPLED_LEN}", ""]
+    configs = [fp.SafetyConfig(), fp.SafetyConfig(tau_limit=20000, slew_per_tick=3000, theta_min_urad=-1000,
+                                                  theta_max_urad=2000000)]
+    lines += ["/* pour_safety_apply: config (tau_limit, slew_per_tick, theta_min, theta_max), then per tick",
+              " * requested torque and θ -> command and active limits */",
+              f"typedef struct {{ int32_t config[4]; int32_t requested[{SAFETY_LEN}]; int32_t theta[{SAFETY_LEN}]; "
+              f"int16_t torque[{SAFETY_LEN}]; uint8_t active[{SAFETY_LEN}]; }} pour_golden_safety_t;",
+              "static const pour_golden_safety_t pour_golden_safety[] = {"]
+    for cfg in configs:
+        env = fp.SafetyEnvelope(cfg)
+        req, th, tq, act = [], [], [], []
+        for t in range(SAFETY_LEN):
+            r = int(rng.choice([-32768, 32767, 0, int(rng.integers(-32768, 32768))]))
+            theta = int(rng.choice([cfg.theta_min_urad, cfg.theta_max_urad, int(rng.integers(-200000, 2500000))]))
+            req.append(r)
+            th.append(theta)
+            tq.append(env.apply(r, theta))
+            act.append(env.active)
+        lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad])}, "
+                     f"{_c_array(req)}, {_c_array(th)}, {_c_array(tq)}, {_c_array(act)}}},")
+    lines += ["};", f"#define POUR_GOLDEN_N_SAFETY {len(configs)}", f"#define POUR_GOLDEN_SAFETY_LEN {SAFETY_LEN}",
               "", "#endif", ""]
     return "\n".join(lines)
 
