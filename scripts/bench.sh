@@ -70,7 +70,66 @@ bench_core() {
     "$(verdict $((core_ram + ${state:-0})) 512)"
 }
 
-SECTIONS=(core)
+# --- section: lcm — host_sim and pour_controller as two processes over LCM (udpm, loopback) ------------
+# Lockstep: loop rate and round trip POUR_STATE -> POUR_TORQUE (median, p99) over 20,000 exchanges with
+# synthetic states (the transport and the controller alone), then a 10 s pour (10,000 steps, Box2D
+# included) next to the same pour in-process. Real time: a 60 s pour at 1 kHz wall clock against the
+# controller's own 1 kHz loop: late and missing answers, safe-torque ticks and overruns on both sides.
+# Wall-clock figures on a shared machine are noisy: they are printed, never judged.
+bench_lcm() {
+  local build=build/host log bin hs u ctl
+  log=$(mktemp)
+  echo "== lcm: host_sim <-> pour_controller over LCM (loopback) =="
+  if ! { cmake --preset host && cmake --build --preset host -j2; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the host build failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  bin=$build/bin
+  hs=$(ls -t "$build/bin/host_sim" "$build/host_sim/host_sim" 2>/dev/null | head -n 1)
+  u="udpm://239.255.76.67:$((20000 + $$ % 20000))?ttl=0"
+  echo "-- lockstep, transport + controller only (20,000 synthetic states):"
+  "$bin/pour_controller" --io "lcm:$u" --lockstep 2>/dev/null >/dev/null &
+  ctl=$!
+  "$bin/lcm_loop_driver" --mode lcm --url "$u" --no-sim --steps 20000 | grep -E '^(steps|lcm)' | sed 's/^/   /'
+  echo "-- lockstep, a 10 s pour (10,000 steps, Box2D included), then the same pour in-process:"
+  local TIMEFORMAT='wall %R s'
+  { time "$hs" --policy policy/weights.h --lcm "$u" --quiet; } 2>&1 | sed 's/^/   over LCM:   /'
+  { time "$hs" --policy policy/weights.h --quiet; } 2>&1 | sed 's/^/   in-process: /'
+  kill -INT "$ctl"; wait "$ctl"
+  echo "-- real time, 60 s at 1 kHz (controller on its own 1 kHz clock):"
+  "$bin/pour_controller" --io "lcm:$u" --duration 70 2>/dev/null >"$log" &
+  ctl=$!
+  sleep 0.5
+  "$hs" --policy policy/weights.h --lcm "$u" --realtime --set episode_s=60 --quiet | sed 's/^/   host: /'
+  kill -INT "$ctl"; wait "$ctl"
+  sed 's/^/   /' "$log"
+  rm -f "$log"
+}
+
+# --- section: sim — the Box2D pouring world (libpoursim, host_sim --bench) --------------------------
+# Real-time factor of one 10 s episode on one core (hand-written pour; by thread CPU time, which the
+# other processes on a shared machine do not distort, and by wall time), the deepest resting overlap
+# (contact quality), C rollouts per second on 1 and 2 threads with the shipped policy, and the pour
+# onset angle against an ideal liquid of the same fill. Bars: >= 15x real time, <= 1 mm overlap.
+bench_sim() {
+  local log
+  log=$(mktemp)
+  echo "== sim: libpoursim (Box2D 3.1, 150 circles, 1 ms steps) =="
+  if ! { cmake --preset host && cmake --build --preset host -j2 --target host_sim; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the host build of host_sim failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  echo "   machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) (other jobs slow the wall-time figures)"
+  ./build/host/host_sim/host_sim --bench --policy policy/weights.h | sed 's/^/   /'
+}
+
+SECTIONS=(core lcm sim)
 wanted=("$@")
 [ ${#wanted[@]} -gt 0 ] || wanted=("${SECTIONS[@]}")
 status=0
