@@ -1,0 +1,132 @@
+/* SPDX-License-Identifier: MIT */
+#include "bridge.h"
+
+#include <stddef.h>
+#include <string.h>
+
+#include "pour/control.h"
+#include "state_si.h"
+
+pour_bridge_config_t pour_bridge_default_config(void) {
+  pour_bridge_config_t c;
+  c.node_id = 0;
+  c.tau_max_mnm = 40000;
+  c.n_actions = 11;
+  return c;
+}
+
+pour_status_t pour_bridge_init(pour_bridge_t *b, const pour_bridge_config_t *config) {
+  if (b == NULL || config == NULL || config->node_id > POUR_CAN_NODE_ID_MAX || config->tau_max_mnm <= 0 ||
+      config->n_actions < 2u || config->n_actions > 16u) {
+    return POUR_EINVAL;
+  }
+  memset(b, 0, sizeof *b);
+  b->config = *config;
+  return POUR_OK;
+}
+
+int pour_bridge_from_state(pour_bridge_t *b, const pour_plant_state_t *msg, pour_can_frame_t frames[2]) {
+  /* The very conversion the in-process simulator and the LCM controller use: same bits reach the core. */
+  pour_state_t s;
+  pour_state_from_si(&s, msg->seq, msg->theta, msg->omega, msg->v_rotating, msg->v_target, msg->v_spill);
+  const uint16_t seq16 = (uint16_t)((uint64_t)msg->seq & 0xFFFFu);
+  const pour_can_state_a_t a = {s.theta_urad, s.omega_urad_s, (uint8_t)(seq16 & 0xFFu)};
+  const pour_can_state_b_t sb = {seq16, s.v_rotating, s.v_target, s.v_spill};
+  if (pour_can_pack_state_a(b->config.node_id, &a, &frames[0]) != POUR_OK ||
+      pour_can_pack_state_b(b->config.node_id, &sb, &frames[1]) != POUR_OK) {
+    b->counters.states_refused++;
+    return 0;
+  }
+  pour_bridge_sent_t *slot = &b->sent[seq16 % POUR_BRIDGE_RING];
+  slot->seq = msg->seq;
+  slot->utime = msg->utime;
+  slot->episode = msg->episode;
+  slot->used = true;
+  b->counters.states_sent++;
+  return 2;
+}
+
+int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[2]) {
+  const pour_can_estop_t e = {(uint8_t)(msg->estop ? 1u : 0u)};
+  int n = 0;
+  if (pour_can_pack_estop(b->config.node_id, &e, &frames[n]) == POUR_OK) {
+    n++;
+  }
+  if (msg->clear_faults && pour_can_pack_clear_errors(b->config.node_id, &frames[n]) == POUR_OK) {
+    n++;
+  }
+  b->counters.commands++;
+  return n;
+}
+
+static pour_bridge_out_t torque_of(pour_bridge_t *b, const pour_can_frame_t *frame, int64_t utime,
+                                   pour_torque_t *out) {
+  pour_can_torque_t t;
+  if (pour_can_unpack_torque(frame, &t) != POUR_CAN_RX_OK) {
+    b->counters.frames_dropped++;
+    return POUR_BRIDGE_DROPPED;
+  }
+  const pour_bridge_sent_t *slot = &b->sent[t.seq % POUR_BRIDGE_RING];
+  if (!slot->used || (uint16_t)((uint64_t)slot->seq & 0xFFFFu) != t.seq) {
+    b->counters.torques_unmatched++;
+    return POUR_BRIDGE_DROPPED;
+  }
+  memset(out, 0, sizeof *out);
+  out->utime = utime;
+  out->seq = slot->seq;
+  out->episode = slot->episode;
+  out->state_utime = slot->utime;
+  out->torque_q15 = t.torque;
+  out->torque = (double)t.torque / 32768.0 * (double)b->config.tau_max_mnm * 1e-3;
+  out->action = (int8_t)t.action;
+  out->mode = (int8_t)t.mode;
+  out->faults = (int16_t)b->faults; /* the torque frame has no fault bits: the latest heartbeat's */
+  out->n_actions = (int8_t)b->config.n_actions;
+  b->mode = t.mode;
+  b->counters.torques++;
+  return POUR_BRIDGE_TORQUE;
+}
+
+static pour_bridge_out_t status_of(pour_bridge_t *b, const pour_can_frame_t *frame, int64_t utime,
+                                   pour_controller_status_t *out) {
+  pour_can_heartbeat_t hb;
+  if (pour_can_unpack_heartbeat(frame, &hb) != POUR_CAN_RX_OK) {
+    b->counters.frames_dropped++;
+    return POUR_BRIDGE_DROPPED;
+  }
+  b->mode = hb.mode;
+  b->faults = hb.faults;
+  b->heartbeat_count++;
+  b->counters.heartbeats++;
+  memset(out, 0, sizeof *out);
+  out->utime = utime;
+  out->tick = b->heartbeat_count;
+  out->mode = (int8_t)hb.mode;
+  /* POUR_STATUS names the core's bits; the CAN watchdog's (0x100) rides along above them. */
+  out->faults = (int16_t)hb.faults;
+  out->overruns = hb.overruns;
+  out->messages_dropped = hb.rx_dropped;
+  out->step_time_ns = -1; /* not carried over CAN */
+  out->step_time_max_ns = -1;
+  out->late_max_us = -1;
+  out->states_received = b->counters.states_sent;
+  return POUR_BRIDGE_STATUS;
+}
+
+pour_bridge_out_t pour_bridge_from_frame(pour_bridge_t *b, const pour_can_frame_t *frame, int64_t utime,
+                                         pour_torque_t *torque, pour_controller_status_t *status) {
+  const uint32_t accept = (1u << POUR_CAN_CMD_TORQUE) | (1u << POUR_CAN_CMD_HEARTBEAT);
+  uint8_t cmd = 0;
+  const pour_can_rx_t rc = pour_can_classify(frame, b->config.node_id, accept, &cmd);
+  if (rc == POUR_CAN_RX_OTHER_NODE) {
+    return POUR_BRIDGE_NONE;
+  }
+  if (rc == POUR_CAN_RX_BAD_ID && pour_can_dlc_of(cmd) >= 0) {
+    return POUR_BRIDGE_NONE; /* a host-to-controller frame (ours, or another host's) */
+  }
+  if (rc != POUR_CAN_RX_OK) {
+    b->counters.frames_dropped++;
+    return POUR_BRIDGE_DROPPED;
+  }
+  return cmd == POUR_CAN_CMD_TORQUE ? torque_of(b, frame, utime, torque) : status_of(b, frame, utime, status);
+}
