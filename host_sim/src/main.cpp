@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -516,6 +517,16 @@ int main(int argc, char **argv) {
     if (ext != ".gif" && ext != ".mp4") return usage_error("--render wants a .gif or .mp4 file name, got '%s'", o.render.c_str());
     render_base = o.render.substr(0, o.render.size() - 4);
     render_json = render_base + ".json";
+  }
+  // Fail before a long run, not after it, if an output cannot be written.
+  for (const std::string &path : {o.csv, render_json}) {
+    if (path.empty()) continue;
+    std::FILE *probe = std::fopen(path.c_str(), "a");
+    if (probe == nullptr) {
+      std::fprintf(stderr, "host_sim: cannot write '%s': %s\n", path.c_str(), std::strerror(errno));
+      return 1;
+    }
+    std::fclose(probe);
   }
   poursim_world_t *world = poursim_create(&cfg, err, sizeof err);
   if (world == nullptr) {

@@ -87,6 +87,13 @@ def test_bad_config_is_refused(host_sim, tmp_path, text, message):
     assert r.returncode == 1 and "bad config" in r.stderr and message in r.stderr, r.stderr
 
 
+@pytest.mark.parametrize("flag, name", [("--csv", "run.csv"), ("--render", "pour.gif")])
+def test_unwritable_output_is_refused_before_running(host_sim, tmp_path, flag, name):
+    r = host_sim("--baseline", "rate", flag, tmp_path / "no_such_dir" / name, timeout=30)
+    assert r.returncode == 1 and "cannot write" in r.stderr and "No such file or directory" in r.stderr
+    assert "episode 1" not in r.stdout
+
+
 def test_out_of_range_set_is_refused(host_sim):
     r = host_sim("--baseline", "rate", "--set", "n_particles=5000")
     assert r.returncode == 1 and "n_particles" in r.stderr
