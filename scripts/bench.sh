@@ -94,6 +94,10 @@ bench_lcm() {
   "$bin/pour_controller" --io "lcm:$u" --lockstep 2>/dev/null >/dev/null &
   ctl=$!
   "$bin/lcm_loop_driver" --mode lcm --url "$u" --no-sim --steps 20000 | grep -E '^(steps|lcm)' | sed 's/^/   /'
+  # The silence after a run latches the controller's stale-input fault: a fresh controller per run.
+  kill -INT "$ctl"; wait "$ctl"
+  "$bin/pour_controller" --io "lcm:$u" --lockstep 2>/dev/null >/dev/null &
+  ctl=$!
   echo "-- lockstep, a 10 s pour (10,000 steps, Box2D included), then the same pour in-process:"
   local TIMEFORMAT='wall %R s'
   { time "$hs" --policy policy/weights.h --lcm "$u" --quiet; } 2>&1 | sed 's/^/   over LCM:   /'

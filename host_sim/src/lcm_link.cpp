@@ -95,6 +95,11 @@ struct LcmLink::Impl {
     // Real time uses the newest answer, whichever state it answers; lockstep only the awaited one.
     if (!def.lockstep || msg.seq == waiting_seq) {
       answer_q15 = msg.torque_q15;
+      stats.last_mode = msg.mode;
+      stats.last_faults = msg.faults;
+      if (msg.mode >= 2) {
+        stats.fault_answers++;
+      }
       answer_action = msg.action;
       answer_ns = now;
       have_answer = true;
@@ -330,13 +335,14 @@ std::string LcmLink::summary() const {
   std::snprintf(buf, sizeof buf,
                 "lcm %s: states %lld answers %lld on_time %lld late %lld missing %lld resends %lld "
                 "dropped %lld stale_answers %lld safe_ticks %lld overruns %lld late_max_us %lld particles %lld "
-                "rtt_median_us %.0f rtt_p99_us %.0f",
+                "rtt_median_us %.0f rtt_p99_us %.0f fault_answers %lld controller_faults 0x%04x",
                 impl_->def.lockstep ? "lockstep" : "realtime", static_cast<long long>(st.states_sent),
                 static_cast<long long>(st.answers), static_cast<long long>(st.on_time), static_cast<long long>(st.late),
                 static_cast<long long>(st.states_sent - st.on_time - st.late), static_cast<long long>(st.resends),
                 static_cast<long long>(st.dropped), static_cast<long long>(st.stale_answers),
                 static_cast<long long>(st.safe_ticks), static_cast<long long>(st.overruns),
-                static_cast<long long>(st.late_max_us), static_cast<long long>(st.particles_sent), med, p99);
+                static_cast<long long>(st.late_max_us), static_cast<long long>(st.particles_sent), med, p99,
+                static_cast<long long>(st.fault_answers), static_cast<unsigned>(st.last_faults & 0xffff));
   return buf;
 }
 
@@ -367,6 +373,15 @@ double LcmController::command(const poursim_obs_t &obs) {
   }
   if (world_ != nullptr) {
     link_->maybe_publish_particles(world_, obs);
+  }
+  const LcmLinkStats &st = link_->stats();
+  if (st.last_mode >= 2 && !warned_) {
+    // Latched faults need an operator's clear: say so instead of pouring silently with safe torque.
+    std::fprintf(stderr,
+                 "host_sim: warning: pour_controller answers in %s (faults 0x%04x): it commands safe torque until "
+                 "its faults are cleared (pour-lcm-cmd --clear)\n",
+                 st.last_mode == 3 ? "E-STOP" : "FAULT", static_cast<unsigned>(st.last_faults & 0xffff));
+    warned_ = true;
   }
   // Exactly as the in-process firmware controller turns its output into an action.
   return q15 / 32768.0;

@@ -37,6 +37,9 @@ struct LcmLinkStats {
   int64_t overruns = 0;      // real time: ticks that started more than one period late
   int64_t late_max_us = 0;   // real time: worst tick-start lateness [µs]
   int64_t particles_sent = 0;
+  int64_t fault_answers = 0; // answers given in FAULT or E-STOP mode (safe or zero torque)
+  int last_mode = -1;        // controller mode of the latest answer (pour_mode_t), -1 before any
+  int last_faults = 0;       // its latched fault bits
   std::vector<int32_t> rtt_us; // round trip per on-time or late answer [µs], state publish → answer
 };
 
@@ -98,6 +101,7 @@ class LcmController : public Controller {
   std::unique_ptr<LcmLink> link_;
   const poursim_world_t *world_ = nullptr;
   int episode_ = -1;
+  bool warned_ = false;
 };
 
 } // namespace poursim

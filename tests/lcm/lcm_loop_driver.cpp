@@ -3,6 +3,7 @@
 // in-process or through pour_controller over LCM (host_sim's lcm_link), and prints the trajectory hash,
 // so that the two can be compared bit for bit.
 #include <cerrno>
+#include <chrono>
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
@@ -24,7 +25,8 @@ namespace {
 void usage(FILE *f) {
   std::fprintf(f,
                "usage: lcm_loop_driver --mode inproc|lcm [--url URL] [--realtime] [--steps N] [--episodes E]\n"
-               "                       [--seed S] [--answer-timeout-ms T] [--particles-ms P] [--trace FILE]\n");
+               "                       [--seed S] [--answer-timeout-ms T] [--particles-ms P] [--trace FILE] [--no-sim]\n"
+               "  --no-sim   synthetic states instead of the Box2D world: the loop's own rate (benchmark)\n");
 }
 
 bool parse_long(const char *opt, const char *s, long lo, long hi, long *out) {
@@ -48,6 +50,7 @@ int main(int argc, char **argv) {
   def.particles_period_ms = 0;
   long steps = 2000, episodes = 1, seed = 1, v = 0;
   const char *trace_path = nullptr;
+  bool no_sim = false;
   for (int i = 1; i < argc; i++) {
     const std::string a = argv[i];
     const char *val = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -79,6 +82,8 @@ int main(int argc, char **argv) {
     } else if (a == "--trace" && val != nullptr) {
       trace_path = val;
       i++;
+    } else if (a == "--no-sim") {
+      no_sim = true;
     } else if (a == "--help") {
       usage(stdout);
       return 0;
@@ -118,6 +123,7 @@ int main(int argc, char **argv) {
   const pour_control_config_t ccfg = pour_control_default_config();
   pour_control_t ctl;
   poursim_obs_t obs{};
+  const auto t_start = std::chrono::steady_clock::now();
   int rc = 0;
   for (long ep = 0; ep < episodes && rc == 0; ep++) {
     poursim_reset(world, static_cast<uint32_t>(seed + ep));
@@ -148,11 +154,20 @@ int main(int argc, char **argv) {
       if (trace != nullptr) {
         std::fprintf(trace, "%ld %u %.17g %.17g %d\n", ep, obs.step, obs.theta, obs.omega, q15);
       }
-      if (poursim_step(world, static_cast<double>(q15) / 32768.0, &obs) != POURSIM_OK) {
+      if (no_sim) {
+        // A plausible state that changes every tick, at no physics cost.
+        obs.step = static_cast<uint32_t>(k + 1);
+        obs.t = static_cast<double>(k + 1) * 1e-3;
+        obs.theta = 1e-4 * static_cast<double>(k % 20000);
+        obs.omega = static_cast<double>(q15) / 32768.0;
+      } else if (poursim_step(world, static_cast<double>(q15) / 32768.0, &obs) != POURSIM_OK) {
         break;
       }
     }
   }
+  const auto wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+  std::printf("steps %ld wall_s %.3f steps_per_s %.0f\n", steps * episodes, wall_s,
+              static_cast<double>(steps * episodes) / wall_s);
   if (link) {
     link->drain(50);
     std::printf("%s\n", link->summary().c_str());

@@ -143,9 +143,15 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   ci.clear_faults = l->clear_pending;
   l->clear_pending = false;
 
+  const uint16_t faults_before = l->out.faults;
   const int64_t t0 = mono_ns();
   pour_control_step(&l->ctl, &ci, &l->out);
   const int64_t dt = mono_ns() - t0;
+  if ((l->out.faults & ~faults_before) != 0u) {
+    fprintf(stderr, "pour_controller: fault 0x%04x latched at tick %lu (0x1 stale input, 0x2 e-stop, 0x4 bad input); "
+            "safe torque until cleared (POUR_COMMAND clear_faults, e.g. pour-lcm-cmd --clear)\n",
+            (unsigned)l->out.faults, (unsigned long)l->out.tick);
+  }
 
   pour_linux_stats_t *st = l->stats;
   st->ticks++;
