@@ -32,7 +32,7 @@ def hash_of(stdout: str) -> str:
 def stats_of(stdout: str) -> dict:
     line = [x for x in stdout.splitlines() if x.startswith("lcm ")][-1]
     words = line.split()[2:]
-    return {k: float(v) for k, v in zip(words[0::2], words[1::2])}
+    return {k: float(int(v, 16) if v.startswith("0x") else v) for k, v in zip(words[0::2], words[1::2])}
 
 
 def test_lockstep_loop_is_bit_identical_to_in_process(tools, tmp_path):
