@@ -1,0 +1,90 @@
+# SPDX-License-Identifier: MIT
+"""Bus load of the pour CAN protocol: frame lengths, the worst-case stuffing bound (checked against real
+bit streams with CRC-15 and stuffing), the total at 1 kHz under the 50 % bar, and bad input."""
+from __future__ import annotations
+
+import random
+import subprocess
+import sys
+
+import pytest
+
+from pour import can_bus_load as bl
+
+
+def crc15(bits: list[int]) -> int:
+    crc = 0
+    for b in bits:
+        nxt = b ^ ((crc >> 14) & 1)
+        crc = (crc << 1) & 0x7FFF
+        if nxt:
+            crc ^= 0x4599
+    return crc
+
+
+def stuffed_length(frame_id: int, data: bytes) -> int:
+    """Bits on the wire of a real classic base frame (stuffing counted), with the interframe space."""
+    bits = [0] + [(frame_id >> (10 - i)) & 1 for i in range(11)] + [0, 0, 0]
+    bits += [(len(data) >> (3 - i)) & 1 for i in range(4)]
+    for byte in data:
+        bits += [(byte >> (7 - i)) & 1 for i in range(8)]
+    crc = crc15(bits)
+    bits += [(crc >> (14 - i)) & 1 for i in range(15)]
+    stuffed, run, last = 0, 0, None
+    out = []
+    for b in bits:
+        out.append(b)
+        run = run + 1 if b == last else 1
+        last = b
+        if run == 5:
+            out.append(1 - b)
+            stuffed += 1
+            last, run = 1 - b, 1
+    return len(out) + 13
+
+
+def test_frame_bits_of_known_lengths():
+    assert bl.frame_bits(8) == 135 and bl.frame_bits(8, stuffing=False) == 111
+    assert bl.frame_bits(7) == 125 and bl.frame_bits(0) == 55 and bl.frame_bits(0, stuffing=False) == 47
+    with pytest.raises(ValueError):
+        bl.frame_bits(9)
+
+
+def test_real_frames_never_exceed_the_worst_case_bound():
+    rng = random.Random(6)
+    worst_seen = {}
+    for _ in range(3000):
+        n = rng.randint(0, 8)
+        data = bytes(rng.choice([0x00, 0xFF, rng.getrandbits(8)]) for _ in range(n))
+        frame_id = rng.choice([0x000, 0x7FF, rng.getrandbits(11)])
+        length = stuffed_length(frame_id, data)
+        assert bl.frame_bits(n, stuffing=False) <= length <= bl.frame_bits(n)
+        worst_seen[n] = max(worst_seen.get(n, 0), length)
+    assert worst_seen[8] > bl.frame_bits(8, stuffing=False)  # stuffing does happen
+
+
+def test_protocol_load_at_1khz_is_under_half_the_bus():
+    rows = {r.name: r for r in bl.cyclic_messages()}
+    assert set(rows) == {"StateA", "StateB", "Torque", "Heartbeat"}
+    assert rows["StateA"].rate_hz == rows["Torque"].rate_hz == 1000.0
+    assert rows["Heartbeat"].rate_hz == 10.0
+    total = sum(r.load for r in rows.values())
+    assert total == pytest.approx(((135 + 135 + 125) * 1000 + 135 * 10) / 1e6)
+    assert total < 0.5
+    assert "39.6 % worst case" in bl.report(list(rows.values()))
+
+
+def test_cli_reports_and_rejects_bad_input(tmp_path):
+    run = lambda *a: subprocess.run([sys.executable, "-m", "pour.can_bus_load", *a], capture_output=True,
+                                    text=True, timeout=60)
+    ok = run()
+    assert ok.returncode == 0 and "bar 50 %: ok" in ok.stdout
+    fast = run("--heartbeat-ms", "1")
+    assert fast.returncode == 0 and "OVER" in fast.stdout
+    for args in (["--heartbeat-ms", "0"], ["--dbc", str(tmp_path / "missing.dbc")]):
+        r = run(*args)
+        assert r.returncode == 2 and "pour-can-bus-load: error:" in r.stderr
+    bad = tmp_path / "bad.dbc"
+    bad.write_text("garbage\n")
+    r = run("--dbc", str(bad))
+    assert r.returncode == 2 and "cannot read" in r.stderr
