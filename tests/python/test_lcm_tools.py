@@ -83,3 +83,21 @@ def test_lcm_cmd_bad_inputs():
     r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--clear", "--estop"], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "not allowed with" in r.stderr
+
+
+def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
+    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--",
+                        "--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=0.5"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "lcm lockstep: states 500 answers 500 on_time 500" in r.stdout
+    assert "pour_controller: ticks" in r.stdout and "answers 500" in r.stdout
+
+
+def test_lcm_run_passes_on_host_sim_failures_and_refuses_doubled_flags(build_dir):
+    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--", "--policy",
+                        "/nonexistent/weights.h"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and "bad policy" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--", "--lcm", "x"], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2 and "not to host_sim" in r.stderr
