@@ -16,7 +16,7 @@ APT_PACKAGES=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
   can-utils user-mode-linux iproute2 kmod
   default-jdk-headless default-jre fonts-dejavu-core xvfb xauth x11-apps
-  python3 python3-venv python3-dev libglib2.0-0
+  python3 python3-venv python3-dev python3-tk libglib2.0-0
   ca-certificates xz-utils
 )
 
