@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* host_sim's run-time weights.h loader: accepts the shipped headers, refuses each kind of bad one with
  * a message naming the field. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +40,19 @@ static int parse_edited(const char *from, const char *to) {
   return poursim_weights_parse(text, strlen(text), "edited.h", &wf, err, sizeof err);
 }
 
+/* good with macro name's value replaced by value, then parsed; returns the status. */
+static int parse_with_macro(const char *name, const char *value) {
+  static char text[20000];
+  char key[96];
+  snprintf(key, sizeof key, "#define %s ", name);
+  const char *at = strstr(good, key);
+  TEST_ASSERT_NOT_NULL_MESSAGE(at, key);
+  const char *rest = at + strlen(key);
+  while (*rest && *rest != ' ' && *rest != '\n') ++rest; /* skip the old value */
+  snprintf(text, sizeof text, "%.*s%s%s", (int)(at + strlen(key) - good), good, value, rest);
+  return poursim_weights_parse(text, strlen(text), "edited.h", &wf, err, sizeof err);
+}
+
 /* The first value of the 2-D array called name in good. */
 static const char *first_value(const char *name) {
   const char *p = strstr(good, name);
@@ -72,7 +86,7 @@ static void test_weights_file_AcceptsShippedHeadersAndMatchesCoreHash(void) {
   double w[POURSIM_N_FEATURES * 16], lv[16];
   poursim_policy_t p;
   poursim_weights_float_policy(&wf, w, lv, &p);
-  TEST_ASSERT_EQUAL_DOUBLE(wf.w[0] / 2048.0, w[0]);
+  TEST_ASSERT_EQUAL_DOUBLE(ldexp(wf.w[0], -wf.w_frac_bits), w[0]);
   TEST_ASSERT_EQUAL_DOUBLE(-1.0, lv[0]);
   TEST_ASSERT_EQUAL_INT(wf.decision_period_ms, p.decision_period);
 }
@@ -104,20 +118,21 @@ static void test_weights_file_RefusesEveryFirmwareBadHeader(void) {
 }
 
 static void test_weights_file_RefusesWrongActionCount(void) {
-  expect_error_naming(parse_edited("#define POUR_WEIGHTS_N_ACTIONS 11", "#define POUR_WEIGHTS_N_ACTIONS 10"),
-                      "pour_weights_w");
-  expect_error_naming(parse_edited("#define POUR_WEIGHTS_N_ACTIONS 11", "#define POUR_WEIGHTS_N_ACTIONS 17"),
-                      "POUR_WEIGHTS_N_ACTIONS");
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_weights_parse(good, good_len, "good.h", &wf, err, sizeof err));
+  char fewer[16];
+  snprintf(fewer, sizeof fewer, "%d", wf.n_actions - 1);
+  expect_error_naming(parse_with_macro("POUR_WEIGHTS_N_ACTIONS", fewer), "pour_weights_w");
+  expect_error_naming(parse_with_macro("POUR_WEIGHTS_N_ACTIONS", "17"), "POUR_WEIGHTS_N_ACTIONS");
 }
 
 static void test_weights_file_RefusesBadQFormat(void) {
-  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS 16"),
-                      "POUR_WEIGHTS_W_FRAC_BITS");
-  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS eleven"),
-                      "POUR_WEIGHTS_W_FRAC_BITS");
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_weights_parse(good, good_len, "good.h", &wf, err, sizeof err));
+  char other[16];
+  snprintf(other, sizeof other, "%d", (wf.w_frac_bits + 1) % 16);
+  expect_error_naming(parse_with_macro("POUR_WEIGHTS_W_FRAC_BITS", "16"), "POUR_WEIGHTS_W_FRAC_BITS");
+  expect_error_naming(parse_with_macro("POUR_WEIGHTS_W_FRAC_BITS", "eleven"), "POUR_WEIGHTS_W_FRAC_BITS");
   /* Another f changes the hash: an edited Q format without re-export is caught. */
-  expect_error_naming(parse_edited("#define POUR_WEIGHTS_W_FRAC_BITS 11", "#define POUR_WEIGHTS_W_FRAC_BITS 12"),
-                      "POUR_WEIGHTS_CONTENT_HASH");
+  expect_error_naming(parse_with_macro("POUR_WEIGHTS_W_FRAC_BITS", other), "POUR_WEIGHTS_CONTENT_HASH");
 }
 
 static void test_weights_file_RefusesTruncatedFile(void) {
@@ -150,7 +165,14 @@ static void test_weights_file_RefusesEditedWeightsAndBadValues(void) {
   expect_error_naming(poursim_weights_parse(text, strlen(text), "edited.h", &wf, err, sizeof err), "POUR_WEIGHTS_CONTENT_HASH");
   snprintf(text, sizeof text, "%.*s40000%s", (int)(first - good), good, comma);
   expect_error_naming(poursim_weights_parse(text, strlen(text), "big.h", &wf, err, sizeof err), "pour_weights_w[0][0]");
-  expect_error_naming(parse_edited("{-32768, -26214", "{-26214, -32768"), "strictly increasing");
+  {
+    /* The second level made equal to the first. */
+    const char *lv = strchr(strchr(strstr(good, "pour_weights_action_levels_q15["), '=') + 1, '{') + 1;
+    const char *c1 = strchr(lv, ','), *c2 = strchr(c1 + 1, ',');
+    snprintf(text, sizeof text, "%.*s, %.*s%s", (int)(c1 - good), good, (int)(c1 - lv), lv, c2);
+    expect_error_naming(poursim_weights_parse(text, strlen(text), "levels.h", &wf, err, sizeof err),
+                        "strictly increasing");
+  }
   expect_error_naming(parse_edited("#define POUR_WEIGHTS_TAU_MAX_MNM", "#define POUR_WEIGHTS_TAU_MAX_MNM 5\n#define POUR_WEIGHTS_TAU_MAX_MNM"),
                       "defined twice");
   TEST_ASSERT_EQUAL_INT(POURSIM_EIO, poursim_weights_load("/nonexistent/weights.h", &wf, err, sizeof err));
