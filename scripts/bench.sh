@@ -133,7 +133,55 @@ bench_sim() {
   ./build/host/host_sim/host_sim --bench --policy policy/weights.h | sed 's/^/   /'
 }
 
-SECTIONS=(core lcm sim)
+# --- section: can — the pour CAN protocol: bus load, and the full loop on real SocketCAN ------------------
+# Bus load at 1 kHz from the DBC (frame bits with and without worst-case stuffing; bar 50 % of 1 Mbit/s).
+# Then, in a user-mode Linux guest (tests/can/uml_run.py) on vcan0: a 10 s pour in lockstep through
+# host_sim -> LCM -> can_bridge -> vcan0 -> pour_controller, its rate (steps/s, emulated kernel: every
+# syscall is expensive there, so this is a floor, not the bench's rate), and the bus load measured from
+# the candump capture of that pour with exact bit stuffing.
+bench_can() {
+  local build=build/host log guest
+  log=$(mktemp)
+  echo "== can: pour.dbc bus load, full loop over vcan0 in a user-mode Linux guest =="
+  if ! { cmake --preset host && cmake --build --preset host -j2; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the host build failed" >&2
+    return 1
+  fi
+  echo "-- computed from can/pour.dbc:"
+  .venv/bin/python -m pour.can_bus_load | sed 's/^/   /'
+  guest=$(mktemp -d)
+  cat >"$guest/loop.sh" <<EOS
+B=$ROOT/$build; U="udpm://239.255.76.67:7699?ttl=0"
+candump -L vcan0 > $guest/candump.log &
+dump=\$!
+\$B/bin/pour_controller --io can:vcan0 --lockstep --stall-ms 5000 > $guest/ctl.txt 2>&1 &
+ctl=\$!
+\$B/bin/can_bridge --iface vcan0 --lcm \$U > $guest/bridge.txt 2>&1 &
+br=\$!
+sleep 0.5
+t0=\$(date +%s.%N)
+\$B/host_sim/host_sim --policy $ROOT/policy/weights.h --lcm \$U --quiet > $guest/host.txt 2>&1
+t1=\$(date +%s.%N)
+kill -INT \$br \$ctl \$dump; wait \$br \$ctl \$dump
+echo "\$t0 \$t1" > $guest/times.txt
+EOS
+  if .venv/bin/python tests/can/uml_run.py --timeout 600 -- sh "$guest/loop.sh" >"$log" 2>&1; then
+    read -r t0 t1 <"$guest/times.txt"
+    echo "-- lockstep 10 s pour over CAN in the guest:"
+    grep -E '^lcm lockstep' "$guest/host.txt" | sed 's/^/   /'
+    awk -v a="$t0" -v b="$t1" 'BEGIN { printf "   10,000 steps in %.1f s wall: %.0f steps/s\n", b - a, 10000 / (b - a) }'
+    sed 's/^/   /' "$guest/bridge.txt"
+    .venv/bin/python -m pour.can_bus_load --candump "$guest/candump.log" | tail -n 1 | sed 's/^/   /'
+  else
+    cat "$log"
+    echo "error: the guest run failed" >&2
+  fi
+  rm -rf "$guest" "$log"
+}
+
+SECTIONS=(core lcm sim can)
 wanted=("$@")
 [ ${#wanted[@]} -gt 0 ] || wanted=("${SECTIONS[@]}")
 status=0

@@ -12,42 +12,18 @@ import pytest
 from pour import can_bus_load as bl
 
 
-def crc15(bits: list[int]) -> int:
-    crc = 0
-    for b in bits:
-        nxt = b ^ ((crc >> 14) & 1)
-        crc = (crc << 1) & 0x7FFF
-        if nxt:
-            crc ^= 0x4599
-    return crc
-
-
-def stuffed_length(frame_id: int, data: bytes) -> int:
-    """Bits on the wire of a real classic base frame (stuffing counted), with the interframe space."""
-    bits = [0] + [(frame_id >> (10 - i)) & 1 for i in range(11)] + [0, 0, 0]
-    bits += [(len(data) >> (3 - i)) & 1 for i in range(4)]
-    for byte in data:
-        bits += [(byte >> (7 - i)) & 1 for i in range(8)]
-    crc = crc15(bits)
-    bits += [(crc >> (14 - i)) & 1 for i in range(15)]
-    stuffed, run, last = 0, 0, None
-    out = []
-    for b in bits:
-        out.append(b)
-        run = run + 1 if b == last else 1
-        last = b
-        if run == 5:
-            out.append(1 - b)
-            stuffed += 1
-            last, run = 1 - b, 1
-    return len(out) + 13
-
-
 def test_frame_bits_of_known_lengths():
     assert bl.frame_bits(8) == 135 and bl.frame_bits(8, stuffing=False) == 111
     assert bl.frame_bits(7) == 125 and bl.frame_bits(0) == 55 and bl.frame_bits(0, stuffing=False) == 47
     with pytest.raises(ValueError):
         bl.frame_bits(9)
+
+
+def test_wire_bits_of_an_all_zero_frame():
+    # id 0, 8 zero bytes: long runs of dominant bits, stuffed every 5
+    assert bl.wire_bits(0, bytes(8)) > bl.frame_bits(8, stuffing=False) + 15
+    with pytest.raises(ValueError):
+        bl.wire_bits(0x800, b"")
 
 
 def test_real_frames_never_exceed_the_worst_case_bound():
@@ -57,7 +33,7 @@ def test_real_frames_never_exceed_the_worst_case_bound():
         n = rng.randint(0, 8)
         data = bytes(rng.choice([0x00, 0xFF, rng.getrandbits(8)]) for _ in range(n))
         frame_id = rng.choice([0x000, 0x7FF, rng.getrandbits(11)])
-        length = stuffed_length(frame_id, data)
+        length = bl.wire_bits(frame_id, data)
         assert bl.frame_bits(n, stuffing=False) <= length <= bl.frame_bits(n)
         worst_seen[n] = max(worst_seen.get(n, 0), length)
     assert worst_seen[8] > bl.frame_bits(8, stuffing=False)  # stuffing does happen
@@ -84,6 +60,17 @@ def test_cli_reports_and_rejects_bad_input(tmp_path):
     for args in (["--heartbeat-ms", "0"], ["--dbc", str(tmp_path / "missing.dbc")]):
         r = run(*args)
         assert r.returncode == 2 and "pour-can-bus-load: error:" in r.stderr
+    dump = tmp_path / "dump.log"
+    dump.write_text("(1.0) vcan0 010#0000000000000000\n(1.0) vcan0 011#0000FF7F00000000\n"
+                    "(1.0) vcan0 012#00000000050100\n")
+    r = run("--candump", str(dump))
+    assert r.returncode == 0 and "3 frames over 1 ticks" in r.stdout
+    dump.write_text("(1.0) vcan0 010#0000000000000000\n")
+    r = run("--candump", str(dump))
+    assert r.returncode == 2 and "no Torque frame" in r.stderr
+    dump.write_text("(1.0) vcan0 910#00\n")
+    r = run("--candump", str(dump))
+    assert r.returncode == 2 and "not a classic 11-bit frame" in r.stderr
     bad = tmp_path / "bad.dbc"
     bad.write_text("garbage\n")
     r = run("--dbc", str(bad))

@@ -30,6 +30,53 @@ def frame_bits(n_bytes: int, stuffing: bool = True) -> int:
     return bits + ((34 + 8 * n_bytes - 1) // 4 if stuffing else 0)
 
 
+def _crc15(bits: list[int]) -> int:
+    crc = 0
+    for b in bits:
+        nxt = b ^ ((crc >> 14) & 1)
+        crc = (crc << 1) & 0x7FFF
+        if nxt:
+            crc ^= 0x4599  # CAN's CRC-15 polynomial
+    return crc
+
+
+def wire_bits(frame_id: int, data: bytes) -> int:
+    """Exact bits on the wire of one classic base data frame: its real bit stream (CRC-15 included) with
+    stuffing, plus the fixed tail and the interframe space."""
+    if not 0 <= frame_id <= 0x7FF or len(data) > 8:
+        raise ValueError(f"not a classic 11-bit frame: id 0x{frame_id:x}, {len(data)} bytes")
+    bits = [0] + [(frame_id >> (10 - i)) & 1 for i in range(11)] + [0, 0, 0]
+    bits += [(len(data) >> (3 - i)) & 1 for i in range(4)]
+    for byte in data:
+        bits += [(byte >> (7 - i)) & 1 for i in range(8)]
+    crc = _crc15(bits)
+    bits += [(crc >> (14 - i)) & 1 for i in range(15)]
+    stuffed, run, last = 0, 0, -1
+    for b in bits:
+        run = run + 1 if b == last else 1
+        last = b
+        if run == 5:  # a stuff bit of the opposite level, which starts the next run
+            stuffed += 1
+            last, run = 1 - b, 1
+    return len(bits) + stuffed + 13
+
+
+def measured(candump_log: Path, dbc: Path = DBC_PATH) -> tuple[int, int, int]:
+    """From a `candump -L` capture: (frames, exact bits on the wire, control ticks = Torque frames)."""
+    torque_cmd = cantools.database.load_file(str(dbc)).get_message_by_name("Torque").frame_id
+    frames = bits = ticks = 0
+    for line in candump_log.read_text().splitlines():
+        parts = line.split()
+        if len(parts) < 3 or "#" not in parts[2]:
+            continue
+        ident, payload = parts[2].split("#", 1)
+        frame_id = int(ident, 16)
+        frames += 1
+        bits += wire_bits(frame_id, bytes.fromhex(payload))
+        ticks += (frame_id & 0x1F) == torque_cmd
+    return frames, bits, ticks
+
+
 @dataclass
 class Row:
     name: str
@@ -73,6 +120,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="pour-can-bus-load", description=__doc__.splitlines()[0])
     ap.add_argument("--dbc", default=str(DBC_PATH), help="DBC file (default can/pour.dbc)")
     ap.add_argument("--heartbeat-ms", type=float, default=None, help="heartbeat period instead of the DBC's [ms]")
+    ap.add_argument("--candump", help="also measure a `candump -L` capture: exact bits per control tick")
     args = ap.parse_args(argv)
     if args.heartbeat_ms is not None and not args.heartbeat_ms > 0:
         print(f"pour-can-bus-load: error: --heartbeat-ms must be positive, got {args.heartbeat_ms}", file=sys.stderr)
@@ -83,6 +131,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pour-can-bus-load: error: cannot read {args.dbc}: {e}", file=sys.stderr)
         return 2
     print(report(rows))
+    if args.candump:
+        try:
+            frames, bits, ticks = measured(Path(args.candump), Path(args.dbc))
+        except (OSError, ValueError) as e:
+            print(f"pour-can-bus-load: error: cannot read {args.candump}: {e}", file=sys.stderr)
+            return 2
+        if ticks == 0:
+            print(f"pour-can-bus-load: error: {args.candump} has no Torque frame", file=sys.stderr)
+            return 2
+        print(f"measured ({args.candump}): {frames} frames over {ticks} ticks, {bits / ticks:.1f} bits per 1 ms "
+              f"tick with exact stuffing = {100 * bits / ticks * 1000 / BITRATE:.1f} % of 1 Mbit/s at 1 kHz")
     return 0
 
 
