@@ -127,3 +127,29 @@ def test_overflowing_weights_give_a_clear_gradient_error():
                       {"v_target": 0, "v_spill": 0, "finish_s": 0})
     with pytest.raises(reinforce.GradientError, match="non-finite"):
         train.update(cfg, np.zeros((6, 11)), [ep], None, 0)
+
+
+def test_feedback_parameterisation_gradient_matches_finite_differences():
+    rng = np.random.default_rng(11)
+    n_act, c = 7, 3.0
+    beta = rng.normal(0, 0.5, 6)
+    x = rng.uniform(0, 1, (9, 6))
+    x[:, -1] = 1.0
+    acts = rng.integers(0, n_act, 9)
+    wts = rng.normal(0, 1, 9)
+
+    def obj(b):
+        return reinforce.surrogate(reinforce.w_from_params("feedback", b, n_act, c), x, acts, wts, 0.2)
+
+    g_w = reinforce.grad_surrogate(reinforce.w_from_params("feedback", beta, n_act, c), x, acts, wts, 0.2)
+    g = reinforce.grad_params("feedback", g_w, n_act, c)
+    num = np.array([(obj(beta + h) - obj(beta - h)) / 2e-6 for h in np.eye(6) * 1e-6])
+    np.testing.assert_allclose(g, num, rtol=1e-6, atol=1e-8)
+
+
+def test_feedback_policy_peaks_at_the_level_nearest_u():
+    beta = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.33])  # u(x) = 0.33 everywhere
+    w = reinforce.w_from_params("feedback", beta, 11, 4.0)
+    x = np.array([[0.3, 0.5, 1.0, 0.0, 0.0, 1.0]])
+    assert int(np.argmax(x @ w)) == 7  # levels are -1, -0.8, ..., 0.4 at index 7 is nearest 0.33
+    assert reinforce.w_from_params("full", np.arange(12.0), 2, 1.0).shape == (6, 2)

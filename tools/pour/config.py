@@ -24,7 +24,10 @@ class ConfigError(ValueError):
 class PolicyConfig:
     n_actions: int = 11            # torque levels evenly spaced in [-1, 1] x tau_max, 2..16
     decision_period_ms: int = 10   # a new action every this many 1 ms ticks
-    init: str = "zeros"            # "zeros": uniform random start, as the paper
+    init: str = "zeros"            # "zeros": every parameter 0 (param "full": uniform random actions, as the paper)
+    init_beta: list = field(default_factory=list)  # param "feedback", init "beta": the 6 initial beta values
+    param: str = "full"            # "full": W itself; "feedback": W from a linear feedback u(x) (reinforce.py)
+    sharpness: float = 4.0         # "feedback": c in logit_a = -c (L_a - u(x))^2
 
 
 @dataclass(frozen=True)
@@ -101,6 +104,10 @@ def _typed(section: str, key: str, value: Any, want: Any) -> Any:
         if not isinstance(value, str):
             raise ConfigError(f"{name} = {value!r}: expected a string")
         return value
+    if isinstance(want, list):
+        if not isinstance(value, list):
+            raise ConfigError(f"{name} = {value!r}: expected an array")
+        return list(value)
     if isinstance(want, dict):
         if not isinstance(value, dict):
             raise ConfigError(f"{name} = {value!r}: expected a table")
@@ -132,8 +139,24 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(2 <= p.n_actions <= 16, f"policy.n_actions = {p.n_actions}: expected 2..16")
     _check(1 <= p.decision_period_ms <= 1000,
            f"policy.decision_period_ms = {p.decision_period_ms}: expected 1..1000")
-    _check(p.init in ("zeros",), f"policy.init = {p.init!r}: expected 'zeros'")
+    _check(p.init in ("zeros", "beta"), f"policy.init = {p.init!r}: expected 'zeros' or 'beta'")
+    if p.init == "beta":
+        _check(p.param == "feedback", "policy.init = 'beta' needs policy.param = 'feedback'")
+        _check(len(p.init_beta) == 6 and all(isinstance(b, (int, float)) and not isinstance(b, bool)
+                                             and math.isfinite(b) for b in p.init_beta),
+               f"policy.init_beta = {p.init_beta!r}: expected 6 finite numbers (theta, omega, V_rot, V_tgt, "
+               "V_spill, bias)")
+    _check(p.param in ("full", "feedback"), f"policy.param = {p.param!r}: expected 'full' or 'feedback'")
+    _check(0.0 < p.sharpness <= 1000.0, f"policy.sharpness = {p.sharpness}: expected 0 < c <= 1000")
     _check(a.kind in ("vanilla", "pg"), f"algo.kind = {a.kind!r}: expected 'vanilla' or 'pg'")
+    if a.kind == "vanilla":
+        paper = {"reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
+                 "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0}
+        for k, want in paper.items():
+            _check(getattr(a, k) == want, f"algo.kind = 'vanilla' is the paper's update: algo.{k} must be {want!r} "
+                                       f"(got {getattr(a, k)!r}); use algo.kind = 'pg' to change it")
+        _check(p.param == "full", f"algo.kind = 'vanilla' is the paper's update: policy.param must be 'full' "
+                                  f"(got {p.param!r})")
     _check(1 <= a.batch_episodes <= 4096, f"algo.batch_episodes = {a.batch_episodes}: expected 1..4096")
     _check(0.0 < a.gamma <= 1.0, f"algo.gamma = {a.gamma}: expected 0 < gamma <= 1")
     _check(0.0 < a.lr <= 10.0, f"algo.lr = {a.lr}: expected 0 < lr <= 10")

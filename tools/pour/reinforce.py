@@ -179,3 +179,37 @@ def clip_norm(g: np.ndarray, max_norm: float) -> tuple[np.ndarray, float]:
     if max_norm > 0 and norm > max_norm:
         g = g * (max_norm / norm)
     return g, norm
+
+
+# --- parameterisations of W ---------------------------------------------------------------------------
+# "full": W itself (6 x n_actions), the paper's policy.
+# "feedback": W = c (2 beta (x) L - e_bias (x) L^2), so logit_a = -c (L_a - u(x))^2 + const with
+#   u(x) = beta . x: the softmax peaks at the torque level nearest a linear state feedback u(x), and c
+#   (the sharpness) sets how widely it explores around it. Still a softmax-linear policy over the same
+#   features (W has rank 2), exported and run by the firmware unchanged; REINFORCE's gradient reaches
+#   beta through the chain rule. Exploring around a feedback law rather than with white-noise torque
+#   is what lets the gradient find pours that do not spill.
+
+def params_shape(param: str, n_actions: int) -> tuple:
+    return (6, n_actions) if param == "full" else (6,)
+
+
+def w_from_params(param: str, p: np.ndarray, n_actions: int, sharpness: float) -> np.ndarray:
+    """The policy's W [6][n_actions] for a parameter vector."""
+    if param == "full":
+        return np.asarray(p, dtype=np.float64).reshape(6, n_actions)
+    if param == "feedback":
+        lv = action_levels(n_actions)
+        w = 2.0 * sharpness * np.outer(p, lv)
+        w[5] -= sharpness * lv ** 2
+        return w
+    raise ValueError(f"unknown parameterisation {param!r}")
+
+
+def grad_params(param: str, g_w: np.ndarray, n_actions: int, sharpness: float) -> np.ndarray:
+    """Chain rule: the gradient in the parameters from the gradient in W."""
+    if param == "full":
+        return np.asarray(g_w)
+    if param == "feedback":
+        return 2.0 * sharpness * (np.asarray(g_w) @ action_levels(n_actions))
+    raise ValueError(f"unknown parameterisation {param!r}")

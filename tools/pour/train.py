@@ -181,9 +181,16 @@ def _entropy_coef(cfg: cfgmod.TrainConfig, it: int) -> float:
     return a.entropy_coef + (a.entropy_coef_final - a.entropy_coef) * frac
 
 
+def weights(cfg: cfgmod.TrainConfig, params: np.ndarray) -> np.ndarray:
+    """The policy's W for the run's parameter vector."""
+    return reinforce.w_from_params(cfg.policy.param, params, cfg.policy.n_actions, cfg.policy.sharpness)
+
+
 def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
            it: int) -> tuple[np.ndarray, float]:
-    """One policy-gradient step on a batch of episodes; returns (new weights, gradient norm)."""
+    """One policy-gradient step on a batch of episodes; returns (new parameters, gradient norm).
+
+    w is the parameter vector (for policy.param 'full' it is W itself)."""
     with np.errstate(over="ignore", invalid="ignore"):  # non-finite results are caught below, by name
         return _update(cfg, w, eps, opt, it)
 
@@ -195,7 +202,8 @@ def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode],
     batch = reinforce.Batch(np.stack([e.x for e in eps]), np.stack([e.actions for e in eps]),
                             np.stack([e.rewards for e in eps]) * a.reward_scale)
     adv = reinforce.advantages(batch, gamma_d, a.reward_to_go, a.baseline, a.normalize_advantages)
-    g = reinforce.batch_gradient(w, batch, adv, _entropy_coef(cfg, it))
+    g_w = reinforce.batch_gradient(weights(cfg, w), batch, adv, _entropy_coef(cfg, it))
+    g = reinforce.grad_params(cfg.policy.param, g_w, cfg.policy.n_actions, cfg.policy.sharpness)
     reinforce.check_finite("gradient", g, it)
     g, norm = reinforce.clip_norm(g, a.grad_clip)
     step = opt.step(g) if opt is not None else a.lr * g
@@ -214,9 +222,12 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     n_feat, n_act = envs.N_FEATURES, cfg.policy.n_actions
     steps = int(round(cfg.env.episode_s * 1000))
 
-    w = np.zeros((n_feat, n_act))
+    params = np.zeros(reinforce.params_shape(cfg.policy.param, n_act))
+    if cfg.policy.init == "beta":
+        params = np.array(cfg.policy.init_beta, dtype=np.float64)
+    w = weights(cfg, params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
-    opt = reinforce.Adam(w.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
+    opt = reinforce.Adam(params.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
     best_ep: dict[str, np.ndarray] = {}
     rows: list[dict[str, Any]] = []
     if ckpt_path.exists() and resume:
@@ -225,7 +236,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             raise TrainError(f"{run_dir}: checkpoint was made with a different config "
                              f"(digest {str(st['config_digest'])[:12]} vs {digest[:12]}); "
                              "use a new run directory or --fresh")
-        w, best_w, best_score = st["w"], st["best_w"], float(st["best_score"])
+        params, best_w, best_score = st["params"], st["best_w"], float(st["best_score"])
+        w = weights(cfg, params)
         start, wall_prev = int(st["iteration"]), float(st["wall_s"])
         if opt is not None:
             opt.load_state_dict(st)
@@ -256,7 +268,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                 e = eps[ib]
                 best_ep = {"best_ep_x": e.x, "best_ep_actions": e.actions, "best_ep_rewards": e.rewards,
                            "best_ep_return": np.array(rets[ib]), "best_ep_iteration": np.array(it)}
-            w, gnorm = update(cfg, w, eps, opt, it)
+            params, gnorm = update(cfg, params, eps, opt, it)
+            w = weights(cfg, params)
             ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
             last = it == cfg.iterations - 1
             if cfg.eval.episodes and ((it + 1) % cfg.eval.every == 0 or last):
@@ -278,7 +291,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                    "finish_s_mean": np.mean([e.metrics["finish_s"] for e in eps]),
                    "entropy_mean": ent, "grad_norm": gnorm, **ev, "best_score": best_score}
             rows.append({k: _fmt(v) for k, v in row.items()})
-            state = {"w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
+            state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
                      "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep}
             # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
             write_log(log_path, rows)
