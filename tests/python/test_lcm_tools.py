@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: MIT
 """pour-live-view (headless) and pour-lcm-cmd against live traffic; their bad inputs."""
+import os
 import random
 import subprocess
 import sys
 import threading
+import time
 
 import numpy as np
 from PIL import Image
@@ -101,3 +103,31 @@ def test_lcm_run_passes_on_host_sim_failures_and_refuses_doubled_flags(build_dir
     r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--", "--lcm", "x"], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "not to host_sim" in r.stderr
+
+
+def test_live_view_window_under_xvfb(build_dir, source_dir, tmp_path):
+    from pour import lcm_spy
+
+    u = url(44)
+    xvfb, display = lcm_spy.start_xvfb("800x600x24")
+    try:
+        env = dict(os.environ, DISPLAY=display, MPLBACKEND="TkAgg")
+        with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
+             Proc([binary(build_dir, "host_sim"), "--policy", source_dir / "policy" / "weights.h", "--lcm", u,
+                   "--realtime", "--set", "episode_s=8"]):
+            p = subprocess.Popen([sys.executable, "-m", "pour.live_view", "--url", u, "--seconds", "6"], env=env,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            white = 0
+            for _ in range(40):  # the window appears once Python, matplotlib and Tk have started
+                time.sleep(0.25)
+                rgb = lcm_spy.screenshot(display, tmp_path / "window.png")
+                white = int((rgb.sum(axis=2) > 600).sum())
+                if white > 50000 or p.poll() is not None:
+                    break
+            out, err = p.communicate(timeout=60)
+    finally:
+        lcm_spy.stop(xvfb)
+    assert p.returncode == 0, err
+    frames = int(out.split("pour-live-view: ")[1].split()[0])
+    assert frames > 10
+    assert white > 50000  # a white figure covers much of the black root window

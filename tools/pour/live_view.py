@@ -85,17 +85,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--save", type=Path, help="headless: save the --frames-th frame as a PNG and exit")
     ap.add_argument("--frames", type=int, default=30, help="with --save: frames to wait for (default 30)")
     ap.add_argument("--timeout", type=float, default=10.0, help="give up after this long without a frame [s]")
+    ap.add_argument("--seconds", type=float, help="window: close it after this long [s] (default: when closed)")
     a = ap.parse_args(argv)
-    if a.frames < 1 or not a.timeout > 0:
-        ap.error("--frames must be >= 1 and --timeout positive")
+    if a.frames < 1 or not a.timeout > 0 or (a.seconds is not None and not a.seconds > 0):
+        ap.error("--frames must be >= 1, --timeout and --seconds positive")
     if a.save is None and not os.environ.get("DISPLAY"):
         print("pour-live-view: error: no DISPLAY; use --save FILE.png for a headless snapshot", file=sys.stderr)
         return 2
     if a.save is not None:
         matplotlib.use("Agg")
+    backend = matplotlib.get_backend()  # resolved now: render.py selects Agg when it is imported
     import matplotlib.pyplot as plt
 
     from pour import render
+
+    if a.save is None:
+        if backend.lower() in ("agg", "pdf", "svg", "ps", "cairo"):
+            print(f"pour-live-view: error: matplotlib has no window backend here ({backend}); "
+                  "install python3-tk (scripts/setup.sh does), or use --save FILE.png", file=sys.stderr)
+            return 2
+        plt.switch_backend(backend)
 
     view = LiveView(a.url)
     deadline = time.monotonic() + a.timeout
@@ -136,10 +145,12 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     plt.ion()
     plt.show()
-    while plt.fignum_exists(fig.number):
+    end = None if a.seconds is None else time.monotonic() + a.seconds
+    while plt.fignum_exists(fig.number) and (end is None or time.monotonic() < end):
         view.pump(0.02)
         draw()
         plt.pause(0.001)
+    print(f"pour-live-view: {view.frames} frames shown, {view.dropped} undecodable dropped")
     return 0
 
 
