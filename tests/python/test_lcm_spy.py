@@ -45,7 +45,7 @@ def test_lcm_spy_decodes_our_types_under_xvfb(build_dir, source_dir, tmp_path):
     u = url(21)
     png, log = tmp_path / "spy.png", tmp_path / "spy.log"
     with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]), \
-         Proc([driver, "--mode", "lcm", "--url", u, "--realtime", "--steps", "15000", "--particles-ms", "33"]):
+         Proc([driver, "--mode", "lcm", "--url", u, "--realtime", "--steps", "45000", "--particles-ms", "33"]):
         r = subprocess.run([sys.executable, "-m", "pour.lcm_spy", "--url", u, "--build-dir", build_dir,
                             "--screenshot", png, "--seconds", "6", "--log", log],
                            capture_output=True, text=True, timeout=120)

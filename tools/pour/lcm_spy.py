@@ -151,6 +151,15 @@ def main(argv: list[str] | None = None) -> int:
             print(f"error: lcm-spy exited early with status {spy.returncode}", file=sys.stderr)
             return 1
         rgb = screenshot(display, a.screenshot)
+        # A loaded machine may take longer to bring the JVM's window up: wait (bounded) for it.
+        give_up, waited = time.monotonic() + 30.0, False
+        while rgb.mean() < 10.0 and time.monotonic() < give_up and spy.poll() is None:
+            waited = True
+            time.sleep(0.5)
+            rgb = screenshot(display, a.screenshot)
+        if waited and rgb.mean() >= 10.0:
+            time.sleep(2.0)  # a moment of traffic in the window that came late
+            rgb = screenshot(display, a.screenshot)
     finally:
         stop(spy)
         stop(xvfb)
