@@ -194,6 +194,7 @@ static void measure(poursim_world_t *w) {
   Eigen::Rotation2Dd to_bucket(-static_cast<double>(b2Rot_GetAngle(xf.q)));
   double wi = 0.5 * c.bucket_inner_width, hh = 0.5 * c.bucket_height;
   double tx0 = c.target_dx - wi, tx1 = c.target_dx + wi, rim = c.bucket_height;
+  const Eigen::Vector2d target_centre(c.target_dx, 0.5 * c.bucket_height);
   Eigen::Vector2d lo[3], hi[3];
   poursim::bucket_walls(c, lo, hi);
   int counts[4] = {0, 0, 0, 0};
@@ -216,9 +217,12 @@ static void measure(poursim_world_t *w) {
       region = 3;
     w->region[i] = region;
     counts[region]++;
-    if (local.norm() < hh + wi + 0.05) {
+    // How deep any circle sinks into a wall of either bucket (more than its radius = passed through).
+    const Eigen::Vector2d in_target = Eigen::Vector2d(px, py) - target_centre;
+    for (const Eigen::Vector2d &q : {local, in_target}) {
+      if (q.norm() > hh + wi + 0.05) continue;
       for (int k = 0; k < 3; ++k) {
-        double pen = static_cast<double>(w->radii[i]) - box_sdf(local, lo[k], hi[k]);
+        double pen = static_cast<double>(w->radii[i]) - box_sdf(q, lo[k], hi[k]);
         if (pen > w->max_wall_pen) w->max_wall_pen = pen;
       }
     }

@@ -129,8 +129,8 @@ int poursim_particle_regions(const poursim_world_t *world, uint8_t *region, int 
 /* Deepest circle–circle or circle–wall overlap right now [m] (contact quality). */
 double poursim_max_overlap(const poursim_world_t *world);
 
-/* Deepest excursion of any circle through a wall of the rotating bucket seen since reset [m]
- * (0 if none: a circle that tunnels shows up here). */
+/* Deepest any circle sank into a wall of either bucket since reset [m]: a contact sinks a fraction of a
+ * millimetre; a circle that tunnels through a wall shows up as more than its radius. */
 double poursim_max_wall_penetration(const poursim_world_t *world);
 
 /* Rotating bucket's moment of inertia about its pivot, bucket only (liquid comes from contacts) [kg·m²]. */
