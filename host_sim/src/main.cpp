@@ -237,18 +237,17 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   return e;
 }
 
-bool write_csv(const std::string &path, const std::vector<std::pair<uint32_t, std::vector<Sample>>> &runs,
-               double tau_max) {
-  std::FILE *f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return false;
+// Every step of every episode, written as each episode ends (memory stays one episode's worth).
+void write_csv_header(std::FILE *f) {
   std::fprintf(f, "episode,seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,action,"
                   "torque_nm,torque_frac,reward\n");
-  for (size_t k = 0; k < runs.size(); ++k)
-    for (const Sample &s : runs[k].second)
-      std::fprintf(f, "%zu,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", k + 1, runs[k].first,
-                   s.obs.step, s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill,
-                   s.obs.v_flight, s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
-  return std::fclose(f) == 0;
+}
+
+void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vector<Sample> &samples, double tau_max) {
+  for (const Sample &s : samples)
+    std::fprintf(f, "%d,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", episode, seed, s.obs.step,
+                 s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill, s.obs.v_flight,
+                 s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
 }
 
 // The trajectory as JSON for tools/pour/render.py.
@@ -540,7 +539,16 @@ int main(int argc, char **argv) {
     std::fprintf(per, "host_sim: %s, %d episode%s of %.1f s, tau_max %.1f N·m, seed %u\n", ctl->name().c_str(),
                  o.episodes, o.episodes > 1 ? "s" : "", cfg.episode_s, cfg.tau_max, seed0);
   std::vector<Episode> eps;
-  std::vector<std::pair<uint32_t, std::vector<Sample>>> csv_runs;
+  std::FILE *csv = nullptr;
+  if (!o.csv.empty()) {
+    csv = std::fopen(o.csv.c_str(), "w");
+    if (csv == nullptr) {
+      std::fprintf(stderr, "host_sim: cannot write '%s': %s\n", o.csv.c_str(), std::strerror(errno));
+      poursim_destroy(world);
+      return 1;
+    }
+    write_csv_header(csv);
+  }
   Recorder first;
   for (int k = 0; k < o.episodes; ++k) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
@@ -554,7 +562,7 @@ int main(int argc, char **argv) {
                    k + 1, seed, 100 * e.poured, 100 * e.spilled, 100 * e.remaining,
                    e.finish < 0 ? "  -   " : (std::to_string(e.finish).substr(0, 5) + " s").c_str(), e.ret);
     if (k == 0 && !o.render.empty()) first = rec;
-    if (!o.csv.empty()) csv_runs.emplace_back(seed, std::move(rec.samples));
+    if (csv != nullptr) write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
   std::vector<double> poured, spilled, finish, ret;
   int unfinished = 0;
@@ -585,9 +593,9 @@ int main(int argc, char **argv) {
     std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());
   }
   int status = 0;
-  if (!o.csv.empty()) {
-    if (!write_csv(o.csv, csv_runs, cfg.tau_max)) {
-      std::fprintf(stderr, "host_sim: cannot write CSV '%s'\n", o.csv.c_str());
+  if (csv != nullptr) {
+    if (std::ferror(csv) != 0 || std::fclose(csv) != 0) {
+      std::fprintf(stderr, "host_sim: error writing CSV '%s'\n", o.csv.c_str());
       status = 1;
     } else if (!o.quiet) {
       std::fprintf(per, "trajectory: %s\n", o.csv.c_str());
