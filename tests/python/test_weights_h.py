@@ -150,11 +150,13 @@ def test_committed_policies_parse(source_dir):
 
 
 def test_hand_made_policy_behaves_sensibly():
-    """Full, upright, still: tilt forward. Tilted and nearly empty: pull back. Full but far over: ease off."""
+    """Full, upright, still: tilt forward hard. Poured (target full, tilted): turn back. Eases off as θ
+    grows and as the rotating bucket empties; damps a fast tilt."""
     w = golden.hand_made_weights(11)
     levels = np.linspace(-1, 1, 11)
     act = lambda x: levels[int(np.argmax(fp.float_policy_probs(w, np.array(x))))]  # noqa: E731
     assert act([0.0, 0.5, 1.0, 0.0, 0.0]) > 0.5
-    assert act([0.6, 0.5, 0.05, 0.9, 0.0]) < 0
+    assert act([0.85, 0.5, 0.0, 1.0, 0.0]) < 0
     assert act([0.9, 0.5, 0.6, 0.3, 0.0]) < act([0.3, 0.5, 0.6, 0.3, 0.0])
-    assert act([0.3, 0.9, 0.6, 0.3, 0.0]) < act([0.3, 0.5, 0.6, 0.3, 0.0])  # damps a fast tilt
+    assert act([0.5, 0.5, 0.2, 0.7, 0.0]) < act([0.5, 0.5, 0.9, 0.0, 0.0])
+    assert act([0.3, 0.9, 0.6, 0.3, 0.0]) < act([0.3, 0.5, 0.6, 0.3, 0.0])

@@ -83,11 +83,11 @@ static void test_control_step_DecidesEveryPeriodAndHoldsBetween(void) {
   const unsigned period = pour_weights_compiled.decision_period_ms;
   step(true);
   const uint8_t first = out.action;
-  /* From now on the state says "nearly empty, tilted": the policy wants to pull back, but only the
-   * next decision tick may change the action. */
-  in.state.theta_urad = 1800000;
+  /* From now on the state says "poured, tilted": the policy wants to pull back, but only the next
+   * decision tick may change the action. */
+  in.state.theta_urad = 2000000;
   in.state.v_rotating = 500;
-  in.state.v_target = 30000;
+  in.state.v_target = 32000;
   for (unsigned k = 1; k < period; ++k) {
     step(true);
     TEST_ASSERT_EQUAL_UINT8(first, out.action);

@@ -236,13 +236,13 @@ static void test_policy_eval_GreedyFollowsArgmaxAndClearsUnusedSlots(void) {
   }
 }
 
-static void test_policy_eval_ExampleBacksOffWhenNearlyEmpty(void) {
+static void test_policy_eval_ExampleTurnsBackOncePoured(void) {
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
   set_obs(0);
-  obs.x[0] = 19000; /* tilted ~78 deg, still, almost empty */
+  obs.x[0] = 27853; /* tilted ~115 deg, still, poured: the target holds the liquid */
   obs.x[1] = 16384;
-  obs.x[2] = 1000;
-  obs.x[3] = 30000;
+  obs.x[2] = 0;
+  obs.x[3] = 32767;
   pour_policy_eval(&policy, &obs, &ev);
   TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[ev.action] < 0);
 }
@@ -287,7 +287,7 @@ int main(void) {
   RUN_TEST(test_policy_sample_NeverPicksZeroProbability);
   RUN_TEST(test_policy_init_RefusesBadArguments);
   RUN_TEST(test_policy_eval_GreedyFollowsArgmaxAndClearsUnusedSlots);
-  RUN_TEST(test_policy_eval_ExampleBacksOffWhenNearlyEmpty);
+  RUN_TEST(test_policy_eval_ExampleTurnsBackOncePoured);
   RUN_TEST(test_policy_eval_SampledIsReproducibleFromTheSeed);
   return UNITY_END();
 }

@@ -99,7 +99,7 @@ static void test_weights_compiled_CarriesTheHeaderFields(void) {
   TEST_ASSERT_EQUAL_INT16(0, pour_weights_compiled.action_levels[5]);
   TEST_ASSERT_EQUAL_INT16(32767, pour_weights_compiled.action_levels[10]);
   TEST_ASSERT_EQUAL_INT32(2356194, pour_weights_compiled.norm.theta_max_urad);
-  TEST_ASSERT_EQUAL_INT32(40000, pour_weights_compiled.tau_max_mnm);
+  TEST_ASSERT_EQUAL_INT32(20000, pour_weights_compiled.tau_max_mnm);
 }
 
 int main(void) {
