@@ -37,13 +37,27 @@ def hand_made_weights(n_actions: int, sharpness: float = 4.0) -> np.ndarray:
     return w
 
 
+HAND_MADE = (("policy/example_weights.h", 11, "pour.golden.hand_made_weights(11), kept for tests"),
+             ("tests/golden/example_weights_2.h", 2, "pour.golden.hand_made_weights(2), benchmarks"),
+             ("policy/weights.h", 11, "pour.golden.hand_made_weights(11), until a trained export"))
+
+
+def _is_hand_made(path: Path) -> bool:
+    try:
+        first = path.read_text(encoding="utf-8").split("\n", 1)[0]
+    except OSError:
+        return True  # absent: ours to write
+    return "Hand-made" in first
+
+
 def write_policies(source_dir: Path = SOURCE_DIR) -> list[Path]:
-    """The hand-made policies: shipped (weights.h), tests (example_weights.h), benchmarks (2 actions)."""
+    """The hand-made policies: tests (example_weights.h), benchmarks (2 actions) and the shipped
+    policy/weights.h — the last only while it is hand-made (a trained export is never overwritten)."""
     out = []
-    for rel, n, what in (("policy/example_weights.h", 11, "pour.golden.hand_made_weights(11), kept for tests"),
-                         ("policy/weights.h", 11, "pour.golden.hand_made_weights(11), until a trained export"),
-                         ("tests/golden/example_weights_2.h", 2, "pour.golden.hand_made_weights(2), benchmarks")):
+    for rel, n, what in HAND_MADE:
         path = source_dir / rel
+        if rel == "policy/weights.h" and not _is_hand_made(path):
+            continue
         path.parent.mkdir(parents=True, exist_ok=True)
         weights_h.write_weights_h(path, hand_made_weights(n), decision_period_ms=10, norm=NORM, tau_max_mnm=20000,
                                   banner_inputs=what)
@@ -184,11 +198,15 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if args.check:
         import tempfile
+        stale = []
         with tempfile.TemporaryDirectory() as tmp:
             fresh = Path(tmp)
             write_policies(fresh)
-            stale = [rel for rel in ("policy/example_weights.h", "policy/weights.h", "tests/golden/example_weights_2.h")
-                     if (fresh / rel).read_text() != _read(args.source_dir / rel)]
+            for rel, _, _ in HAND_MADE:
+                if rel == "policy/weights.h" and not _is_hand_made(args.source_dir / rel):
+                    continue  # a trained export: not ours to compare
+                if (fresh / rel).read_text() != _read(args.source_dir / rel):
+                    stale.append(rel)
         if golden_vectors_text(args.source_dir) != _read(args.source_dir / GOLDEN_REL):
             stale.append(GOLDEN_REL)
         for rel in stale:
