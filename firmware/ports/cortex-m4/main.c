@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* Cortex-M4 firmware: the 1 kHz loop around the control step. Inputs come from the CAN port (see
- * poll_input); until it is wired, no state ever arrives and the controller stays in IDLE at safe torque.
+/* Cortex-M4 firmware: the 1 kHz loop around the control step. Inputs come from FDCAN1 through the core's
+ * CAN node (can/pour.dbc: states, e-stop, clear-errors); torque and heartbeat frames go back the same way.
  * Built with POUR_SMOKE_TICKS (QEMU, semihosted), the same loop runs that many ticks on a scripted
  * input and checks what the controller did: the on-target smoke test of SysTick and the loop. */
 #include <stdbool.h>
@@ -29,12 +29,31 @@ static void poll_input(pour_control_input_t *in, uint32_t tick) {
   in->clear_faults = false;
 }
 #else
-/* Fills one tick's inputs. The FDCAN driver and the CAN node (POUR_CM4_CAN_SOURCES) plug in here. */
+#include "fdcan.h"
+#include "pour/can_node.h"
+
+static pour_can_node_t can_node;
+static pour_fdcan_t fdcan;
+
+/* Fills one tick's inputs from the frames received since the last tick (the latest state wins). */
 static void poll_input(pour_control_input_t *in, uint32_t tick) {
   (void)tick;
-  in->state_fresh = false;
-  in->estop = false;
-  in->clear_faults = false;
+  pour_can_frame_t f;
+  (void)pour_fdcan_poll(&fdcan);
+  while (pour_fdcan_receive(&fdcan, &f) == 1) {
+    (void)pour_can_node_receive(&can_node, &f);
+  }
+  pour_can_node_begin_tick(&can_node, in);
+}
+
+/* CAN up: pins and clocks, the peripheral, the node. If it fails no state arrives: IDLE, safe torque. */
+static void can_init(void) {
+  pour_fdcan_stm32g4_board_init();
+  pour_fdcan_config_t fc = pour_fdcan_default_config();
+  fc.kernel_clock_hz = POUR_CORE_CLOCK_HZ;
+  (void)pour_fdcan_init(&fdcan, pour_fdcan_stm32g4_fdcan1(), &fc);
+  const pour_can_node_config_t nc = pour_can_node_default_config();
+  (void)pour_can_node_init(&can_node, &nc);
 }
 #endif
 
@@ -67,11 +86,18 @@ int main(void) {
          (unsigned)out.faults, (int)pour_hal_motor_torque(), ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
 #else
+  can_init();
+  uint32_t overruns = 0u;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   for (uint32_t tick = 0;; ++tick) {
-    (void)pour_hal_timer_wait_tick();
+    overruns += pour_hal_timer_wait_tick();
     poll_input(&in, tick);
     pour_control_step(&controller, &in, &out);
+    const uint8_t n_tx = pour_can_node_end_tick(&can_node, &out, overruns, tx); /* the watchdog may cut torque */
     pour_hal_motor_set_torque(out.torque);
+    for (uint8_t i = 0; i < n_tx; ++i) {
+      (void)pour_fdcan_transmit(&fdcan, &tx[i]);
+    }
   }
 #endif
 }
