@@ -193,3 +193,30 @@ def test_python_safety_defaults_match_the_c_defaults(source_dir):
     assert (py.slew_per_tick, py.theta_min_urad, py.theta_max_urad) == \
         (c["SLEW_PER_TICK"], c["THETA_MIN_URAD"], c["THETA_MAX_URAD"])
     assert py.tau_limit == fp.Q15_MAX
+
+
+def test_controller_decides_at_steps_0_p_2p(source_dir):
+    """The decision schedule the trainer's rollouts follow: decide from the observation of steps 0, P,
+    2P, ... (the first RUN tick is step 0), hold the action in between."""
+    ex = weights_h.parse_weights_h(source_dir / "policy/example_weights.h")
+    ctl = fp.Controller(ex.w_q, ex.w_frac_bits, ex.levels_q15, ex.decision_period_ms, ex.norm)
+    calls = []
+    real_eval = ctl.policy.eval
+    ctl.policy.eval = lambda obs: calls.append(ctl.tick) or real_eval(obs)
+    for _ in range(5):
+        ctl.step(None)  # IDLE: no state yet
+    for _ in range(3 * ex.decision_period_ms + 1):
+        ctl.step((0, 0, 32767, 0, 0))
+    first = 6
+    assert calls == [first + k * ex.decision_period_ms for k in range(4)]
+
+
+def test_controller_timeout_and_estop():
+    ctl = fp.Controller(np.zeros((6, 2), dtype=np.int16), 11, [-32768, 32767], 10, fp.ObsNorm(0, 2356194, 4000000))
+    assert ctl.step(None).mode == fp.MODE_IDLE
+    assert ctl.step((0, 0, 32767, 0, 0)).mode == fp.MODE_RUN
+    outs = [ctl.step(None) for _ in range(21)]
+    assert outs[19].mode == fp.MODE_RUN and outs[20].mode == fp.MODE_FAULT
+    assert outs[20].faults == fp.FAULT_STALE_INPUT
+    o = ctl.step((0, 0, 32767, 0, 0), estop=True)
+    assert (o.mode, o.torque) == (fp.MODE_ESTOP, 0) and o.faults & fp.FAULT_ESTOP

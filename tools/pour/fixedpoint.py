@@ -261,3 +261,113 @@ class SafetyEnvelope:
     def force(self, torque: int) -> None:
         self.torque = int(torque)
         self.active = 0
+
+
+# Control step (control.c): modes, faults and the decision schedule, for bit-exact replays in Python.
+MODE_IDLE, MODE_RUN, MODE_FAULT, MODE_ESTOP = 0, 1, 2, 3
+FAULT_STALE_INPUT, FAULT_ESTOP, FAULT_BAD_INPUT = 0x0001, 0x0002, 0x0004
+
+
+@dataclass
+class ControlConfig:
+    safety: SafetyConfig | None = None
+    input_timeout_ms: int = 20
+    safe_torque: int = 0
+    sampled: bool = False
+    seed: int = 1
+    plausible_theta_urad: int = 3141593
+    plausible_omega_urad_s: int = 50000000
+    plausible_volume_sum: int = 32896
+
+
+@dataclass
+class ControlOutput:
+    torque: int
+    action: int
+    probs: list[int]
+    mode: int
+    faults: int
+    limits: int
+    tick: int
+
+
+class Controller:
+    """pour_control_t: one call of step() is one 1 ms tick of pour_control_step().
+
+    state is (theta_urad, omega_urad_s, v_rotating, v_target, v_spill) with volumes in Q15.
+    """
+
+    def __init__(self, w_q: np.ndarray, frac_bits: int, levels_q15: Sequence[int], decision_period_ms: int,
+                 norm: ObsNorm, config: ControlConfig | None = None):
+        self.config = config or ControlConfig()
+        self.safety = SafetyEnvelope(self.config.safety or SafetyConfig())
+        self.policy = FixedPolicy(w_q, frac_bits, sampled=self.config.sampled, seed=self.config.seed)
+        self.levels = [int(v) for v in levels_q15]
+        self.period = int(decision_period_ms)
+        self.norm = norm
+        self.mode, self.faults, self.tick = MODE_IDLE, 0, 0
+        self.ms_since_fresh, self.ms_to_decision = 0, 0
+        self.state = (0, 0, 0, 0, 0)
+        self.action, self.probs = 0, [0] * MAX_ACTIONS
+
+    def _plausible(self, s: Sequence[int]) -> bool:
+        c = self.config
+        theta, omega, vr, vt, vs = (int(v) for v in s)
+        if abs(theta) > c.plausible_theta_urad or abs(omega) > c.plausible_omega_urad_s:
+            return False
+        if vr < 0 or vt < 0 or vs < 0:
+            return False
+        return vr + vt + vs <= c.plausible_volume_sum
+
+    def _force_safe(self) -> int:
+        sc = self.safety.config
+        theta = self.state[0]
+        torque = self.config.safe_torque
+        if (torque > 0 and theta >= sc.theta_max_urad) or (torque < 0 and theta <= sc.theta_min_urad):
+            torque = 0
+        self.safety.force(torque)
+        return torque
+
+    def _out(self, torque: int) -> ControlOutput:
+        return ControlOutput(torque, self.action, list(self.probs), self.mode, self.faults, self.safety.active,
+                             self.tick)
+
+    def step(self, state: Sequence[int] | None, estop: bool = False, clear_faults: bool = False) -> ControlOutput:
+        """state None means no fresh state this tick."""
+        self.tick = (self.tick + 1) & 0xFFFFFFFF
+        if estop:
+            self.mode = MODE_ESTOP
+            self.faults |= FAULT_ESTOP
+            self.safety.force(0)
+            return self._out(0)
+        if self.mode == MODE_ESTOP:
+            self.mode = MODE_FAULT
+        if clear_faults and self.mode == MODE_FAULT:
+            self.faults, self.mode, self.ms_since_fresh = 0, MODE_IDLE, 0
+        fresh = False
+        if state is not None:
+            if self._plausible(state):
+                self.state = tuple(int(v) for v in state)
+                self.ms_since_fresh = 0
+                fresh = True
+            else:
+                self.faults |= FAULT_BAD_INPUT
+                self.mode = MODE_FAULT
+        elif self.mode == MODE_RUN:
+            self.ms_since_fresh += 1
+            if self.ms_since_fresh > self.config.input_timeout_ms:
+                self.faults |= FAULT_STALE_INPUT
+                self.mode = MODE_FAULT
+        if self.mode == MODE_IDLE and fresh:
+            self.mode, self.ms_to_decision = MODE_RUN, 0
+        if self.mode == MODE_RUN:
+            if self.ms_to_decision == 0:
+                e = self.policy.eval(quantize_obs(self.norm, *self.state))
+                self.action = e.action
+                self.probs = e.probs + [0] * (MAX_ACTIONS - len(e.probs))
+                self.ms_to_decision = self.period
+            self.ms_to_decision -= 1
+            torque = self.safety.apply(self.levels[self.action], self.state[0])
+        else:
+            torque = self._force_safe()
+        return self._out(torque)

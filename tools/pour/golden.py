@@ -113,6 +113,71 @@ def _softmax_cases(rng: np.random.Generator) -> list[tuple[list[int], list[int],
     return [(lg, fp.softmax_q15(lg), fp.argmax(lg)) for lg in out]
 
 
+def _control_script(rng: np.random.Generator) -> list[tuple[bool, tuple, bool, bool]]:
+    """Ticks of (fresh, state, estop, clear): idle, a pour with short gaps, a timeout, clear, e-stop,
+    clear, an impossible state, clear, run."""
+    ticks: list[tuple[bool, tuple, bool, bool]] = []
+    theta, omega, vr, vt = 0, 0, 32767, 0
+
+    def state() -> tuple:
+        return (theta, omega, vr, vt, 0)
+
+    def run(n: int, gaps: bool = True) -> None:
+        nonlocal theta, omega, vr, vt
+        for _ in range(n):
+            omega = int(np.clip(omega + rng.integers(-60000, 90000), -3000000, 3000000))
+            theta = int(np.clip(theta + omega // 1000, -50000, 2300000))
+            moved = int(rng.integers(0, 200)) if theta > 1200000 else 0
+            moved = min(moved, vr)
+            vr, vt = vr - moved, vt + moved
+            fresh = not (gaps and rng.random() < 0.1)
+            ticks.append((fresh, state(), False, False))
+
+    ticks += [(False, state(), False, False)] * 15
+    run(160)
+    ticks += [(False, state(), False, False)] * 25          # stale input: fault
+    run(20, gaps=False)                                     # latched: still FAULT
+    ticks.append((True, state(), False, True))              # clear, and this state restarts RUN
+    run(60)
+    ticks += [(True, state(), True, False)] * 4             # e-stop held
+    ticks.append((True, state(), True, True))               # clear ignored while held
+    ticks.append((True, state(), False, False))             # released: FAULT
+    ticks.append((True, state(), False, True))              # clear
+    run(40)
+    ticks.append((True, (theta, omega, -5, vt, 0), False, False))  # impossible: negative volume
+    run(5, gaps=False)
+    ticks.append((False, state(), False, True))
+    run(60)
+    return ticks
+
+
+def _control_lines(ex: weights_h.WeightsH, rng: np.random.Generator) -> list[str]:
+    configs = [("greedy, default config", fp.ControlConfig()),
+               ("sampled (seed 7), tighter envelope, 10 ms timeout",
+                fp.ControlConfig(safety=fp.SafetyConfig(tau_limit=24000, slew_per_tick=2000, theta_min_urad=-20000,
+                                                        theta_max_urad=1900000),
+                                 input_timeout_ms=10, safe_torque=-1000, sampled=True, seed=7))]
+    lines = ["/* pour_control_step on example_weights.h: per tick the inputs (flags: 1 fresh, 2 e-stop, 4 clear;",
+             " * state θ, θ̇, V_rot, V_tgt, V_spill) and the outputs (torque, action, mode, faults, limits). */",
+             "typedef struct { uint8_t flags; int32_t state[5]; int16_t torque; uint8_t action; uint8_t mode; "
+             "uint16_t faults; uint8_t limits; } pour_golden_tick_t;"]
+    script = _control_script(rng)
+    for i, (what, cfg) in enumerate(configs):
+        ctl = fp.Controller(ex.w_q, ex.w_frac_bits, ex.levels_q15, ex.decision_period_ms, ex.norm, cfg)
+        sc = cfg.safety or fp.SafetyConfig()
+        lines += [f"/* {what} */",
+                  f"static const int32_t pour_golden_control_config_{i}[10] = "
+                  f"{_c_array([sc.tau_limit, sc.slew_per_tick, sc.theta_min_urad, sc.theta_max_urad, cfg.input_timeout_ms, cfg.safe_torque, int(cfg.sampled), cfg.seed, 0, 0])};",
+                  f"static const pour_golden_tick_t pour_golden_control_{i}[] = {{"]
+        for fresh, st, estop, clear in script:
+            o = ctl.step(st if fresh else None, estop=estop, clear_faults=clear)
+            flags = int(fresh) | 2 * int(estop) | 4 * int(clear)
+            lines.append(f"    {{{flags}, {_c_array(st)}, {o.torque}, {o.action}, {o.mode}, {o.faults}, {o.limits}}},")
+        lines.append("};")
+    lines += [f"#define POUR_GOLDEN_CONTROL_LEN {len(script)}", ""]
+    return lines
+
+
 def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> str:
     """The text of tests/golden/golden_vectors.h, from the Python reference and example_weights.h."""
     rng = np.random.default_rng(seed)
@@ -186,8 +251,8 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
             act.append(env.active)
         lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad])}, "
                      f"{_c_array(req)}, {_c_array(th)}, {_c_array(tq)}, {_c_array(act)}}},")
-    lines += ["};", f"#define POUR_GOLDEN_N_SAFETY {len(configs)}", f"#define POUR_GOLDEN_SAFETY_LEN {SAFETY_LEN}",
-              "", "#endif", ""]
+    lines += ["};", f"#define POUR_GOLDEN_N_SAFETY {len(configs)}", f"#define POUR_GOLDEN_SAFETY_LEN {SAFETY_LEN}", ""]
+    lines += _control_lines(ex, rng) + ["#endif", ""]
     return "\n".join(lines)
 
 
