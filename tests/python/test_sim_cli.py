@@ -170,3 +170,20 @@ def test_render_writes_gif_and_png(host_sim, tmp_path):
         assert im.n_frames >= 10
     with Image.open(png) as im:
         assert im.size[0] >= 600 and im.size[1] >= 300
+
+
+@pytest.mark.parametrize("content, out, message", [
+    (None, "x.gif", "cannot read trajectory"),
+    ("{not json", "x.gif", "cannot read trajectory"),
+    ('{"scene": {}, "radius": [], "series": {}}', "x.gif", "has no 'frames'"),
+    ('{"scene": {}, "radius": [], "series": {}, "frames": []}', "x.gif", "has no frames"),
+    ('{"scene": {}, "radius": [], "series": {}, "frames": [{}]}', "x.png", "must end in .gif or .mp4"),
+])
+def test_renderer_refuses_bad_input(tmp_path, content, out, message):
+    import sys
+    traj = tmp_path / "t.json"
+    if content is not None:
+        traj.write_text(content)
+    r = subprocess.run([sys.executable, "-m", "pour.render", str(traj), str(tmp_path / out)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1 and message in r.stderr, r.stderr
