@@ -216,7 +216,7 @@ unsigned pour_policy_sample(const q15_t *probs, unsigned n, uint32_t *rng) {
       return a;
     }
   }
-  return n - 1u; /* unreachable: cum reaches total > u */
+  return n - 1u; /* only when every probability is 0 (never after pour_policy_softmax_q15) */
 }
 
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
