@@ -8,7 +8,7 @@
 #define DEFAULT_SEED 1u
 #define DEFAULT_PLAUSIBLE_THETA_URAD 3141593   /* π: the tilt cannot pass half a turn */
 #define DEFAULT_PLAUSIBLE_OMEGA_URAD_S 50000000 /* 50 rad/s, ~8 turns/s */
-#define DEFAULT_PLAUSIBLE_VOLUME_SUM 32896      /* 1.0 + 128 LSB for the three roundings */
+#define DEFAULT_PLAUSIBLE_VOLUME_SUM 32896      /* 1.0 + 128 LSB (0.4 %) of slack for rounding */
 
 pour_control_config_t pour_control_default_config(void) {
   pour_control_config_t config;
