@@ -220,3 +220,12 @@ def test_controller_timeout_and_estop():
     assert outs[20].faults == fp.FAULT_STALE_INPUT
     o = ctl.step((0, 0, 32767, 0, 0), estop=True)
     assert (o.mode, o.torque) == (fp.MODE_ESTOP, 0) and o.faults & fp.FAULT_ESTOP
+
+
+def test_python_control_defaults_match_the_c_defaults(source_dir):
+    text = (source_dir / "firmware/src/control.c").read_text()
+    c = {m.group(1): int(m.group(2)) for m in re.finditer(r"#define DEFAULT_(\w+) (\d+)u?", text)}
+    py = fp.ControlConfig()
+    assert (py.input_timeout_ms, py.seed, py.plausible_theta_urad, py.plausible_omega_urad_s,
+            py.plausible_volume_sum) == (c["INPUT_TIMEOUT_MS"], c["SEED"], c["PLAUSIBLE_THETA_URAD"],
+                                         c["PLAUSIBLE_OMEGA_URAD_S"], c["PLAUSIBLE_VOLUME_SUM"])
