@@ -187,3 +187,13 @@ def test_renderer_refuses_bad_input(tmp_path, content, out, message):
     r = subprocess.run([sys.executable, "-m", "pour.render", str(traj), str(tmp_path / out)],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 1 and message in r.stderr, r.stderr
+
+
+def test_firmware_pour_is_bit_identical_across_runs(host_sim, tmp_path, source_dir):
+    outs = []
+    for k in range(2):
+        out = tmp_path / f"run{k}.csv"
+        r = host_sim("--policy", source_dir / "policy" / "weights.h", "--sampled", "--seed", 3, "--csv", out, *SHORT)
+        assert r.returncode == 0, r.stderr
+        outs.append(out.read_bytes())
+    assert outs[0] == outs[1] and len(outs[0]) > 100_000
