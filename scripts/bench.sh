@@ -55,6 +55,14 @@ bench_core() {
   printf '   control core (fixed, obs, policy, safety, control): %d B flash, %d B static RAM;\n' \
     "$core_text" "$core_ram"
   printf '   one controller instance (pour_control_t): %s B RAM\n' "${state:-?}"
+  # Deepest stack of one step: pour_control_step -> pour_policy_eval -> its deepest kernel (gcc -fstack-usage).
+  stack=$(cat "$objdir"/*.su 2>/dev/null | awk -F'\t' '
+    { split($1, a, ":"); f[a[4]] = $2 }
+    END { k = f["pour_policy_logits"]; if (f["pour_policy_softmax_q15"] > k) k = f["pour_policy_softmax_q15"];
+          if (f["pour_policy_sample"] > k) k = f["pour_policy_sample"];
+          print f["pour_control_step"] + f["pour_policy_eval"] + k }')
+  printf '   deepest stack of a control step: %s B (pour_control_step + pour_policy_eval + deepest kernel)\n' \
+    "${stack:-?}"
   printf '   whole pour_core library (with the CAN codec and node): %d B flash\n' "$all_text"
   read -r t d b < <(arm-none-eabi-size "$port/pour_firmware.elf" | awk 'NR == 2 {print $1, $2, $3}')
   printf '   image pour_firmware.elf: %d B flash (text+data), %d B RAM (data+bss) + 2048 B stack reserve\n' \
@@ -65,9 +73,10 @@ bench_core() {
   printf '   instructions/step, worst case (decision tick, 11 actions): %s (bar 1500: %s)\n' \
     "$worst" "$(verdict "$worst" 1500)"
   printf '   instructions/step, average (decision every 10 ms, 11 actions): %s\n' "$avg"
-  printf '   core flash: %d B (bar 4096: %s); core RAM: %d B static + %s B per controller (bar 512: %s)\n' \
+  printf '   core flash: %d B (bar 4096: %s); core RAM: %d B static + %s B per controller (bar 512: %s);\n' \
     "$core_text" "$(verdict "$core_text" 4096)" "$core_ram" "${state:-?}" \
     "$(verdict $((core_ram + ${state:-0})) 512)"
+  printf '   with the deepest stack of a step: %d B\n' $((core_ram + ${state:-0} + ${stack:-0}))
 }
 
 # --- section: lcm — host_sim and pour_controller as two processes over LCM (udpm, loopback) ------------
