@@ -39,6 +39,15 @@ def reward_curve(groups: dict[str, Sequence[Path]], out: Path, column: str = "re
         n = min(len(lg[column]) for lg in logs)
         y = np.stack([lg[column][:n] for lg in logs])
         x = logs[0]["episodes"][:n]
+        per_it = int(x[0]) if n else 1
+        win = max(1, 16 // max(per_it, 1))
+        if win > 1 and n >= win:
+            # One episode per iteration: a running mean over 16 episodes, so that both methods' curves
+            # average the same number of episodes per point.
+            k = np.ones(win) / win
+            y = np.stack([np.convolve(row, k, mode="valid") for row in y])
+            x = x[win - 1:]
+            label = f"{label}, running mean of {win}"
         m, s = y.mean(0), y.std(0)
         (line,) = ax.plot(x, m, label=f"{label} (n={len(dirs)} seeds)")
         ax.fill_between(x, m - s, m + s, color=line.get_color(), alpha=0.2)
