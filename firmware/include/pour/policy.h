@@ -53,13 +53,14 @@ pour_status_t pour_policy_weights_validate(const pour_policy_weights_t *weights)
 pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_t *weights,
                                pour_policy_mode_t mode, uint32_t seed);
 
-/* Evaluates the policy on one observation. Never fails on an initialised policy. */
+/* Evaluates the policy on one observation (elements in [0, 32767], as pour_obs_quantize makes them).
+ * Never fails on an initialised policy. */
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
 
 /* The kernels pour_policy_eval is made of, exposed for tests and the benchmark. */
 
-/* logits[a] = round((x·W)[a] / 2^f), x = [obs Q15, 1.0], W Q(15-f).f, int64 accumulator; Q16.15,
- * rounded half up, saturated to int32. logits has weights->n_actions entries. */
+/* logits[a] = round((x·W)[a] / 2^f), x = [obs Q15 in [0, 32767], 1.0], W Q(15-f).f, int64 accumulator;
+ * Q16.15, rounded half up, saturated to int32. logits has weights->n_actions entries. */
 void pour_policy_logits(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits);
 
 /* Softmax of n (1..16) Q16.15 logits into Q15 probabilities: max subtracted, exp in Q16 by table and
