@@ -10,7 +10,7 @@
 #include <ctime>
 #include <sys/select.h>
 
-#include <lcm/lcm-cpp.hpp>
+#include <lcm/lcm.h>
 
 #include "pour/particles_t.hpp"
 #include "pour/plant_state_t.hpp"
@@ -42,13 +42,22 @@ void sleep_until_ns(int64_t t_ns) {
 }
 
 constexpr int64_t kPeriodNs = 1000000;
+
+// Encodes a generated C++ message and publishes it with the C API. (LCM's C++ wrapper is avoided: its
+// subscription casts trip UBSan's vptr check.)
+template <typename Msg>
+int publish(lcm_t *lcm, const char *channel, const Msg &msg) {
+  std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
+  const int n = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return n < 0 ? n : lcm_publish(lcm, channel, buf.data(), static_cast<unsigned>(n));
+}
 constexpr size_t kRing = 4096; // send times of recent states, by seq modulo the ring size
 
 } // namespace
 
 struct LcmLink::Impl {
   LcmLinkDef def;
-  lcm::LCM lcm;
+  lcm_t *lcm = nullptr;
   LcmLinkStats stats;
   std::array<int64_t, kRing> sent_ns{};  // publish time of seq % kRing
   std::array<int64_t, kRing> sent_seq{}; // which seq the slot holds
@@ -63,9 +72,20 @@ struct LcmLink::Impl {
   int64_t next_particles_step = 0;
   pour::plant_state_t last_state{};
 
-  explicit Impl(const LcmLinkDef &d) : def(d), lcm(d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url) {}
+  explicit Impl(const LcmLinkDef &d) : def(d), lcm(lcm_create(d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url.c_str())) {}
+  ~Impl() {
+    if (lcm != nullptr) {
+      lcm_destroy(lcm);
+    }
+  }
+  Impl(const Impl &) = delete;
+  Impl &operator=(const Impl &) = delete;
 
-  void on_torque(const lcm::ReceiveBuffer *rbuf, const std::string & /*channel*/) {
+  static void on_torque_c(const lcm_recv_buf_t *rbuf, const char * /*channel*/, void *user) {
+    static_cast<Impl *>(user)->on_torque(rbuf);
+  }
+
+  void on_torque(const lcm_recv_buf_t *rbuf) {
     pour::torque_t msg;
     const int n = msg.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size));
     if (n < 0 || static_cast<uint32_t>(n) != rbuf->data_size) {
@@ -108,7 +128,7 @@ struct LcmLink::Impl {
 
   // Handles messages until the awaited answer arrived or deadline_ns passed; returns got_waited.
   bool pump_until(int64_t deadline_ns) {
-    const int fd = lcm.getFileno();
+    const int fd = lcm_get_fileno(lcm);
     while (!got_waited) {
       const int64_t left_ns = deadline_ns - mono_ns();
       if (left_ns <= 0) {
@@ -125,14 +145,14 @@ struct LcmLink::Impl {
         break;
       }
       if (r > 0) {
-        lcm.handle();
+        lcm_handle(lcm);
       }
     }
     return got_waited;
   }
 
   void poll_all() {
-    const int fd = lcm.getFileno();
+    const int fd = lcm_get_fileno(lcm);
     for (int i = 0; i < 10000; i++) {
       fd_set fds;
       FD_ZERO(&fds);
@@ -141,7 +161,7 @@ struct LcmLink::Impl {
       if (select(fd + 1, &fds, nullptr, nullptr, &tv) <= 0) {
         break;
       }
-      lcm.handle();
+      lcm_handle(lcm);
     }
   }
 
@@ -149,7 +169,7 @@ struct LcmLink::Impl {
     const size_t slot = static_cast<size_t>(seq) % kRing;
     sent_seq[slot] = seq;
     sent_ns[slot] = mono_ns();
-    lcm.publish(POUR_LCM_CHANNEL_STATE, &last_state);
+    publish(lcm, POUR_LCM_CHANNEL_STATE, last_state);
   }
 };
 
@@ -158,7 +178,7 @@ LcmLink::~LcmLink() = default;
 
 std::unique_ptr<LcmLink> LcmLink::open(const LcmLinkDef &def, std::string *err) {
   auto impl = std::make_unique<Impl>(def);
-  if (!impl->lcm.good()) {
+  if (impl->lcm == nullptr) {
     if (err != nullptr) {
       *err = "cannot open LCM at '" + (def.url.empty() ? std::string(POUR_LCM_DEFAULT_URL) : def.url) + "'";
     }
@@ -171,7 +191,12 @@ std::unique_ptr<LcmLink> LcmLink::open(const LcmLinkDef &def, std::string *err) 
     }
     return nullptr;
   }
-  impl->lcm.subscribe(POUR_LCM_CHANNEL_TORQUE, &Impl::on_torque, impl.get());
+  if (lcm_subscribe(impl->lcm, POUR_LCM_CHANNEL_TORQUE, &Impl::on_torque_c, impl.get()) == nullptr) {
+    if (err != nullptr) {
+      *err = "cannot subscribe to " POUR_LCM_CHANNEL_TORQUE;
+    }
+    return nullptr;
+  }
   impl->stats.rtt_us.reserve(1 << 16);
   return std::unique_ptr<LcmLink>(new LcmLink(std::move(impl)));
 }
@@ -229,7 +254,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
       s.stats.resends++;
       const size_t slot = static_cast<size_t>(seq) % kRing;
       const int64_t first = s.sent_ns[slot];
-      s.lcm.publish(POUR_LCM_CHANNEL_STATE, &m);
+      publish(s.lcm, POUR_LCM_CHANNEL_STATE, m);
       s.sent_ns[slot] = first; // the round trip counts from the first publish
       resend_at = mono_ns() + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
     }
@@ -295,7 +320,7 @@ void LcmLink::maybe_publish_particles(const poursim_world_t *world, const poursi
     m.x[static_cast<size_t>(i)] = xy[static_cast<size_t>(2 * i)];
     m.y[static_cast<size_t>(i)] = xy[static_cast<size_t>(2 * i + 1)];
   }
-  s.lcm.publish(POUR_LCM_CHANNEL_PARTICLES, &m);
+  publish(s.lcm, POUR_LCM_CHANNEL_PARTICLES, m);
   s.stats.particles_sent++;
 }
 
