@@ -120,7 +120,8 @@ def run(cmd: list[str], timeout: float, mem: str, cwd: str, env: list[str], keep
             return fail(EXIT_NO_VCAN, f"the guest booted but could not load can/can_raw/vcan or bring up vcan0:\n"
                         f"{setup}", console)
         if rc is None:
-            return fail(EXIT_TIMEOUT, f"command did not finish within {timeout:.0f} s: {shlex.join(cmd)}")
+            return fail(EXIT_TIMEOUT, f"command did not finish within {timeout:.0f} s: {shlex.join(cmd)} "
+                        f"(guest {work.name} stopped)")
         status_file = work / "status"
         if not status_file.exists():
             return fail(EXIT_NO_BOOT, f"the guest stopped (kernel exit status {rc}) before the command finished",
