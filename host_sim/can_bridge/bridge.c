@@ -106,9 +106,7 @@ static pour_bridge_out_t status_of(pour_bridge_t *b, const pour_can_frame_t *fra
   out->faults = (int16_t)hb.faults;
   out->overruns = hb.overruns;
   out->messages_dropped = hb.rx_dropped;
-  out->step_time_ns = -1; /* not carried over CAN */
-  out->step_time_max_ns = -1;
-  out->late_max_us = -1;
+  /* Step time and lateness are not carried over CAN: they stay 0 (the fields' documented floor). */
   out->states_received = b->counters.states_sent;
   return POUR_BRIDGE_STATUS;
 }
