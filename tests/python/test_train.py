@@ -97,6 +97,12 @@ def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
     assert not list(run.glob("*.tmp"))
 
 
+def test_learning_rate_decays_linearly_to_lr_final():
+    cfg = _cfg(iterations=5, algo={"lr": 0.1, "lr_final": 0.02})
+    assert [round(train.learning_rate(cfg, i), 12) for i in range(5)] == [0.1, 0.08, 0.06, 0.04, 0.02]
+    assert train.learning_rate(_cfg(), 3) == 0.1
+
+
 def test_resume_with_another_config_is_refused(tmp_path):
     train.train(_cfg(), tmp_path / "r", quiet=True, stop_after=1)
     with pytest.raises(train.TrainError, match="different config"):
@@ -127,6 +133,7 @@ BAD = [
     ({"algo": {"gamma": 1.5}}, "algo.gamma = 1.5"),
     ({"algo": {"gamma": float("nan")}}, "algo.gamma = nan: expected a finite number"),
     ({"algo": {"lr": 0.0}}, "algo.lr = 0.0"),
+    ({"algo": {"lr": 0.1, "lr_final": 0.2}}, "algo.lr_final = 0.2: expected <= algo.lr"),
     ({"algo": {"optimizer": "rmsprop"}}, "algo.optimizer = 'rmsprop'"),
     ({"algo": {"kind": "ppo"}}, "algo.kind = 'ppo'"),
     ({"algo": {"kind": "vanilla", "baseline": "none", "reward_to_go": True}}, "algo.reward_to_go must be False"),

@@ -35,7 +35,8 @@ class AlgoConfig:
     kind: str = "pg"               # "vanilla" (paper eq. 19) or "pg" (the improved update)
     batch_episodes: int = 16       # episodes per update (vanilla: the paper uses 1)
     gamma: float = 0.9995          # discount per 1 ms tick (per decision: gamma ** period)
-    lr: float = 0.05               # learning rate
+    lr: float = 0.05               # learning rate at the first iteration
+    lr_final: float = -1.0         # linearly decayed to this at the last iteration (< 0: constant lr)
     optimizer: str = "adam"        # "adam" or "sgd"
     reward_to_go: bool = True      # weight log pi(a_t) by the return from t on, not R(tau)
     baseline: str = "loo"          # "none", "loo" (time-indexed mean of the others in the batch)
@@ -150,7 +151,7 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(0.0 < p.sharpness <= 1000.0, f"policy.sharpness = {p.sharpness}: expected 0 < c <= 1000")
     _check(a.kind in ("vanilla", "pg"), f"algo.kind = {a.kind!r}: expected 'vanilla' or 'pg'")
     if a.kind == "vanilla":
-        paper = {"reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
+        paper = {"lr_final": -1.0, "reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
                  "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0}
         for k, want in paper.items():
             _check(getattr(a, k) == want, f"algo.kind = 'vanilla' is the paper's update: algo.{k} must be {want!r} "
@@ -160,6 +161,8 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(1 <= a.batch_episodes <= 4096, f"algo.batch_episodes = {a.batch_episodes}: expected 1..4096")
     _check(0.0 < a.gamma <= 1.0, f"algo.gamma = {a.gamma}: expected 0 < gamma <= 1")
     _check(0.0 < a.lr <= 10.0, f"algo.lr = {a.lr}: expected 0 < lr <= 10")
+    _check(a.lr_final < 0 or a.lr_final <= a.lr,
+           f"algo.lr_final = {a.lr_final}: expected <= algo.lr ({a.lr}), or negative for a constant lr")
     _check(a.optimizer in ("adam", "sgd"), f"algo.optimizer = {a.optimizer!r}: expected 'adam' or 'sgd'")
     _check(a.baseline in ("none", "loo"), f"algo.baseline = {a.baseline!r}: expected 'none' or 'loo'")
     _check(a.baseline == "none" or a.batch_episodes >= 2,

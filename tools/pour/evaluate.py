@@ -84,6 +84,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ag.add_argument("--header", required=True, help="the weights.h exported from that run")
     ag.add_argument("--episodes", type=int, default=20)
     ag.add_argument("--which", default="best", choices=("best", "last"))
+    ag.add_argument("--episode-s", type=float, default=10.0, help="held-out episode length [s]")
     args = ap.parse_args(argv)
     from pour import export
     try:
@@ -94,7 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError(f"{args.header} was not exported from {args.run} ({args.which} weights)")
         cfg = doc["config"]
         env = envs.make_env(cfg["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]),
-                            float(cfg["env"]["episode_s"]), cfg["env"]["options"])
+                            args.episode_s, cfg["env"]["options"])
         xs = np.concatenate([env.rollout(w, s, True).x for s in held_out_seeds(args.episodes)])
         a = agreement(w, hdr, xs)
     except (export.ExportError, weights_h.WeightsHError, envs.EnvError, ValueError) as exc:

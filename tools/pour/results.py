@@ -96,6 +96,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"pour-results: error: {exc}", file=sys.stderr)
         return 2
     args.out.mkdir(parents=True, exist_ok=True)
+    # The shipped policy's first held-out episode, 10 s, decisions of the float reference (Figs. 4, 6).
+    from pour import plots
+    sim = envs.make_env("sim", hdr.n_actions, hdr.decision_period_ms, 10.0)
+    ep = sim.rollout(hdr.w_float if hdr.w_float is not None else hdr.w_dequantized, FIRST_SEED, True)
+    title = f"Shipped policy, held-out seed {FIRST_SEED}"
+    plots.angle({"shipped policy": ep.x}, hdr.decision_period_ms, args.out / "shipped_angle.png", title)
+    plots.volumes(ep.x, hdr.decision_period_ms, args.out / "shipped_volumes.png", title)
     (args.out / "results.json").write_text(json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows},
                                                       indent=1) + "\n")
     (args.out / "results.md").write_text(markdown(rows, n))

@@ -186,6 +186,13 @@ def weights(cfg: cfgmod.TrainConfig, params: np.ndarray) -> np.ndarray:
     return reinforce.w_from_params(cfg.policy.param, params, cfg.policy.n_actions, cfg.policy.sharpness)
 
 
+def learning_rate(cfg: cfgmod.TrainConfig, it: int) -> float:
+    a = cfg.algo
+    if a.lr_final < 0:
+        return a.lr
+    return a.lr + (a.lr_final - a.lr) * it / max(1, cfg.iterations - 1)
+
+
 def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
            it: int) -> tuple[np.ndarray, float]:
     """One policy-gradient step on a batch of episodes; returns (new parameters, gradient norm).
@@ -206,7 +213,12 @@ def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode],
     g = reinforce.grad_params(cfg.policy.param, g_w, cfg.policy.n_actions, cfg.policy.sharpness)
     reinforce.check_finite("gradient", g, it)
     g, norm = reinforce.clip_norm(g, a.grad_clip)
-    step = opt.step(g) if opt is not None else a.lr * g
+    lr = learning_rate(cfg, it)
+    if opt is not None:
+        opt.lr = lr
+        step = opt.step(g)
+    else:
+        step = lr * g
     w_new = w + step
     reinforce.check_finite("weights", w_new, it)
     return w_new, norm
