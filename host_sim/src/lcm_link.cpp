@@ -116,6 +116,7 @@ struct LcmLink::Impl {
     if (!def.lockstep || msg.seq == waiting_seq) {
       answer_q15 = msg.torque_q15;
       stats.last_mode = msg.mode;
+      stats.controller_weights_hash = static_cast<uint32_t>(msg.weights_hash);
       stats.last_faults = msg.faults;
       if (msg.mode >= 2) {
         stats.fault_answers++;
@@ -163,6 +164,23 @@ struct LcmLink::Impl {
       }
       lcm_handle(lcm);
     }
+  }
+
+  // The controller's policy must be the one host_sim was given (else the pour is not the one asked for).
+  bool weights_ok(std::string *err) const {
+    if (def.expected_weights_hash == 0 || stats.controller_weights_hash == def.expected_weights_hash) {
+      return true;
+    }
+    if (err != nullptr) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "pour_controller runs weights with content hash 0x%08x, but the policy given has 0x%08x: "
+                    "rebuild pour_controller with that weights.h (CMake POUR_WEIGHTS)",
+                    static_cast<unsigned>(stats.controller_weights_hash),
+                    static_cast<unsigned>(def.expected_weights_hash));
+      *err = buf;
+    }
+    return false;
   }
 
   void publish_state(int64_t seq) {
@@ -259,7 +277,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
       resend_at = mono_ns() + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
     }
     *torque_q15 = s.answer_q15;
-    return true;
+    return s.weights_ok(err);
   }
 
   // Real time: tick k owns the wall-clock slot [t0 + k ms, t0 + (k+1) ms).
@@ -287,7 +305,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
     *torque_q15 = 0;
     s.stats.safe_ticks++;
   }
-  return true;
+  return s.have_answer ? s.weights_ok(err) : true;
 }
 
 void LcmLink::maybe_publish_particles(const poursim_world_t *world, const poursim_obs_t &obs) {
@@ -391,10 +409,11 @@ double LcmController::command(const poursim_obs_t &obs) {
   int16_t q15 = 0;
   std::string err;
   if (!link_->exchange(episode_, obs, &q15, &err)) {
+    const bool answered = link_->stats().answers > 0 && link_->stats().controller_weights_hash != 0;
     std::fprintf(stderr, "host_sim: %s\n", err.c_str());
     std::fprintf(stderr, "host_sim: %s\n", link_->summary().c_str());
     std::fflush(nullptr);
-    std::exit(3);
+    std::exit(answered && link_->def().expected_weights_hash != link_->stats().controller_weights_hash ? 4 : 3);
   }
   if (world_ != nullptr) {
     link_->maybe_publish_particles(world_, obs);

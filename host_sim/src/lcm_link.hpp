@@ -23,6 +23,7 @@ struct LcmLinkDef {
   int rt_budget_us = 800;        // real time: how long a tick waits for the answer to its own state
   int rt_safe_after_ms = 20;     // real time: no answer for this long → safe (zero) torque
   int particles_period_ms = 33;  // POUR_PARTICLES period in simulated time [ms]; 0: none
+  uint32_t expected_weights_hash = 0; // content hash the controller's policy must have; 0: any
 };
 
 struct LcmLinkStats {
@@ -40,6 +41,7 @@ struct LcmLinkStats {
   int64_t fault_answers = 0; // answers given in FAULT or E-STOP mode (safe or zero torque)
   int last_mode = -1;        // controller mode of the latest answer (pour_mode_t), -1 before any
   int last_faults = 0;       // its latched fault bits
+  uint32_t controller_weights_hash = 0; // weights.h content hash the controller reports
   std::vector<int32_t> rtt_us; // round trip per on-time or late answer [µs], state publish → answer
 };
 
@@ -54,7 +56,7 @@ class LcmLink {
   // Publishes the state in obs (seq = obs.step) and gives the torque command to apply now, as a
   // fraction of tau_max in Q15 (the controller's pour_control_output_t.torque). Lockstep: blocks for
   // the answer; false with *err naming the channel after answer_timeout_ms. Real time: sleeps to the
-  // tick's slot first; always true.
+  // tick's slot first. Both: false with *err if the controller runs other weights than expected.
   bool exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q15, std::string *err);
 
   // Publishes POUR_PARTICLES if particles_period_ms of simulated time passed since the last one.

@@ -42,7 +42,8 @@ const char *kUsage =
     "                      (with --policy: the rollouts run that policy, else a uniform random one)\n"
     "  --lcm [URL]         pour_controller, a separate process, over LCM (POUR_STATE out, POUR_TORQUE in,\n"
     "                      POUR_PARTICLES for viewers); lockstep unless --realtime. With --policy, the\n"
-    "                      file only sets tau_max. Exit status 3 if the controller does not answer.\n"
+    "                      file sets tau_max and the controller must run that policy. Exit status 3\n"
+    "                      if the controller does not answer, 4 if it runs other weights.\n"
     "\n"
     "Options:\n"
     "  --episodes N        episodes to run (default 1), seeds S, S+1, ...\n"
@@ -506,6 +507,7 @@ int main(int argc, char **argv) {
     def.url = o.lcm_url;
     def.lockstep = !o.realtime;
     def.answer_timeout_ms = o.lcm_timeout_ms;
+    if (!o.policy.empty()) def.expected_weights_hash = weights.content_hash;
     std::string lerr;
     std::unique_ptr<poursim::LcmController> lc = poursim::LcmController::open(def, &lerr);
     if (!lc) {

@@ -32,6 +32,15 @@ def binary(build_dir: Path, name: str) -> Path:
     return max(found, key=lambda p: p.stat().st_mtime)
 
 
+def compiled_weights(build_dir: Path) -> Path:
+    """The weights.h pour_controller was built with (CMake's POUR_WEIGHTS): host_sim must pour with it."""
+    cache = (build_dir / "CMakeCache.txt").read_text()
+    for line in cache.splitlines():
+        if line.startswith("POUR_WEIGHTS:"):
+            return Path(line.split("=", 1)[1])
+    raise AssertionError(f"POUR_WEIGHTS not in {build_dir / 'CMakeCache.txt'}")
+
+
 class Proc:
     """A child process that is always stopped (SIGINT, then SIGKILL) when the block ends."""
 

@@ -7,7 +7,7 @@ import threading
 
 import pytest
 
-from lcm_helpers import Bus, Proc, binary, url
+from lcm_helpers import Bus, Proc, binary, compiled_weights, url
 from pour import channels
 
 STEPS = "1500"
@@ -128,19 +128,19 @@ def test_driver_rejects_bad_arguments(tools, argv, needle):
 
 # ---- host_sim itself: the README's pour, as two processes ----
 
-def host_sim_args(source_dir, *extra):
-    return ["--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=3", "--episodes", "2",
+def host_sim_args(build_dir, *extra):
+    return ["--policy", compiled_weights(build_dir), "--set", "episode_s=3", "--episodes", "2",
             "--seed", "4", *extra]
 
 
 def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, source_dir, tmp_path):
     host_sim = binary(build_dir, "host_sim")
     controller = binary(build_dir, "pour_controller")
-    ref = run([host_sim, *host_sim_args(source_dir, "--csv", tmp_path / "inproc.csv")])
+    ref = run([host_sim, *host_sim_args(build_dir, "--csv", tmp_path / "inproc.csv")])
     assert ref.returncode == 0, ref.stderr
     u = url(16)
     with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]) as c:
-        r = run([host_sim, *host_sim_args(source_dir, "--lcm", u, "--csv", tmp_path / "lcm.csv")])
+        r = run([host_sim, *host_sim_args(build_dir, "--lcm", u, "--csv", tmp_path / "lcm.csv")])
         assert c.stop() == 0
     assert r.returncode == 0, r.stderr
     inproc, lcm_csv = (tmp_path / "inproc.csv").read_text(), (tmp_path / "lcm.csv").read_text()
@@ -154,14 +154,14 @@ def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, so
 
 def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_dir, source_dir):
     host_sim = binary(build_dir, "host_sim")
-    r = run([host_sim, *host_sim_args(source_dir, "--lcm", url(17), "--lcm-timeout-ms", "300")])
+    r = run([host_sim, *host_sim_args(build_dir, "--lcm", url(17), "--lcm-timeout-ms", "300")])
     assert r.returncode == 3
     assert "no answer on POUR_TORQUE to POUR_STATE seq 0" in r.stderr
 
 
 def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build_dir, source_dir):
     host_sim = binary(build_dir, "host_sim")
-    r = run([host_sim, "--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=0.3",
+    r = run([host_sim, "--policy", compiled_weights(build_dir), "--set", "episode_s=0.3",
              "--lcm", url(18), "--realtime"])
     assert r.returncode == 0, r.stderr
     line = [x for x in r.stdout.splitlines() if x.startswith("lcm realtime")][0]
@@ -179,3 +179,14 @@ def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build
 def test_host_sim_rejects_bad_lcm_arguments(build_dir, argv, needle):
     r = run([binary(build_dir, "host_sim"), *argv])
     assert r.returncode != 0 and needle in r.stderr
+
+
+def test_host_sim_refuses_a_controller_with_other_weights(build_dir, source_dir):
+    """host_sim --policy X must not pour silently with a controller built from other weights."""
+    other = source_dir / "tests" / "golden" / "example_weights_2.h"
+    assert other.read_text() != compiled_weights(build_dir).read_text()
+    u = url(19)
+    with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]):
+        r = run([binary(build_dir, "host_sim"), "--policy", other, "--set", "episode_s=0.2", "--lcm", u])
+    assert r.returncode == 4
+    assert "pour_controller runs weights with content hash" in r.stderr and "POUR_WEIGHTS" in r.stderr

@@ -10,7 +10,7 @@ import time
 import numpy as np
 from PIL import Image
 
-from lcm_helpers import Bus, Proc, binary, url
+from lcm_helpers import Bus, Proc, binary, compiled_weights, url
 from pour import channels
 
 
@@ -28,7 +28,7 @@ def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_di
 
     t = threading.Thread(target=spam)
     with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
-         Proc([binary(build_dir, "host_sim"), "--policy", source_dir / "policy" / "weights.h", "--lcm", u,
+         Proc([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir), "--lcm", u,
                "--realtime", "--set", "episode_s=6"]):
         t.start()
         try:
@@ -89,7 +89,7 @@ def test_lcm_cmd_bad_inputs():
 
 def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
     r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--",
-                        "--policy", source_dir / "policy" / "weights.h", "--set", "episode_s=0.5"],
+                        "--policy", compiled_weights(build_dir), "--set", "episode_s=0.5"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
     assert "lcm lockstep: states 500 answers 500 on_time 500" in r.stdout
@@ -113,7 +113,7 @@ def test_live_view_window_under_xvfb(build_dir, source_dir, tmp_path):
     try:
         env = dict(os.environ, DISPLAY=display, MPLBACKEND="TkAgg")
         with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
-             Proc([binary(build_dir, "host_sim"), "--policy", source_dir / "policy" / "weights.h", "--lcm", u,
+             Proc([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir), "--lcm", u,
                    "--realtime", "--set", "episode_s=8"]):
             p = subprocess.Popen([sys.executable, "-m", "pour.live_view", "--url", u, "--seconds", "6"], env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

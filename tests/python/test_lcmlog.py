@@ -14,7 +14,7 @@ import lcm
 import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
-from lcm_helpers import Bus, Proc, binary, msgs, url
+from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
 from pour import channels, lcmlog
 
 LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
@@ -36,7 +36,7 @@ def recorded(tmp_path_factory):
         with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]) as c:
             bus = Bus(u)
             bus.wait_up()
-            r = subprocess.run([binary(build_dir, "host_sim"), "--policy", source_dir / "policy" / "weights.h",
+            r = subprocess.run([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir),
                                 "--set", "episode_s=2", "--seed", "3", "--lcm", u],
                                capture_output=True, text=True, timeout=120)
             assert r.returncode == 0, r.stderr

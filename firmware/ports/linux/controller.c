@@ -65,6 +65,7 @@ static void send_answer(loop_t *l) {
       .n_actions = l->config->weights->n_actions,
       .obs = &l->ctl.obs,
       .tau_max_mnm = l->config->weights->tau_max_mnm,
+      .weights_hash = l->config->weights->content_hash,
   };
   if (l->io->send_torque(l->io, &a) != 0) {
     l->stats->io_errors++;

@@ -33,6 +33,7 @@ typedef struct {
   uint8_t n_actions;
   const pour_obs_t *obs; /* observation the policy saw */
   int32_t tau_max_mnm;   /* scale of the torque command [mN·m] */
+  uint32_t weights_hash; /* content hash of the policy in use */
 } pour_io_answer_t;
 
 /* Controller health, published at about 10 Hz. */

@@ -116,6 +116,7 @@ static int io_lcm_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
   msg.action = (int8_t)a->out->action;
   msg.mode = (int8_t)a->out->mode;
   msg.faults = (int16_t)a->out->faults;
+  msg.weights_hash = (int32_t)a->weights_hash;
   for (int i = 0; i < POUR_OBS_N; i++) {
     msg.obs_q15[i] = a->obs->x[i];
   }
