@@ -168,7 +168,8 @@ struct LcmLink::Impl {
 
   // The controller's policy must be the one host_sim was given (else the pour is not the one asked for).
   bool weights_ok(std::string *err) const {
-    if (def.expected_weights_hash == 0 || stats.controller_weights_hash == def.expected_weights_hash) {
+    if (def.expected_weights_hash == 0 || stats.controller_weights_hash == 0 ||
+        stats.controller_weights_hash == def.expected_weights_hash) {
       return true;
     }
     if (err != nullptr) {

@@ -24,6 +24,7 @@ struct LcmLinkDef {
   int rt_safe_after_ms = 20;     // real time: no answer for this long → safe (zero) torque
   int particles_period_ms = 33;  // POUR_PARTICLES period in simulated time [ms]; 0: none
   uint32_t expected_weights_hash = 0; // content hash the controller's policy must have; 0: any
+                                      // (answers that report 0, e.g. from a CAN bridge, are not checked)
 };
 
 struct LcmLinkStats {
