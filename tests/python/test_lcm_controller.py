@@ -53,7 +53,9 @@ def test_controller_drops_and_counts_garbage_and_keeps_answering(controller):
         bus.lc.publish(channels.COMMAND, good)  # a state where a command belongs
         assert [bus.ask(k).seq for k in range(1, 6)] == list(range(1, 6))
         n_bad = len(garbage) + 6
-        assert bus.wait_for(lambda: bus.got[channels.STATUS] and bus.last_status().messages_dropped == n_bad, 3.0)
+        # A status at 10 Hz: wait for one that has seen everything sent.
+        assert bus.wait_for(lambda: bus.got[channels.STATUS] and bus.last_status().messages_dropped == n_bad
+                            and bus.last_status().states_received >= 6, 3.0)
         assert c.stop() == 0
     st = bus.last_status()
     assert st.states_received >= 6 and st.faults == 0
