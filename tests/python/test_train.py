@@ -184,3 +184,22 @@ def test_cli_reports_bad_files_and_values_with_exit_code_2(tmp_path):
 def test_unknown_toy_option_is_an_env_error():
     with pytest.raises(envs.EnvError, match="unknown option 'gravty'"):
         envs.make_env("toy", 5, 10, 1.0, {"gravty": 9.8})
+
+
+def test_plots_of_toy_runs(tmp_path):
+    from pour import plots
+    for s in (1, 2):
+        train.train(_cfg(seed=s, iterations=3), tmp_path / f"r{s}", quiet=True)
+    v = cfgmod.from_dict(dict(TOY, iterations=8, algo={"kind": "vanilla", "batch_episodes": 1, "optimizer": "sgd",
+                                                          "baseline": "none", "normalize_advantages": False,
+                                                          "reward_to_go": False, "entropy_coef": 0.0,
+                                                          "lr": 1e-4},
+                              eval={"every": 4, "episodes": 1}))
+    train.train(v, tmp_path / "v", quiet=True)
+    rc = plots.main(["--group", "ours", str(tmp_path / "r1"), str(tmp_path / "r2"), "--group", "vanilla",
+                     str(tmp_path / "v"), "--out", str(tmp_path / "png")])
+    assert rc == 0
+    for name in ("reward_curve.png", "ours_best_angle.png", "ours_best_volumes.png", "vanilla_best_angle.png"):
+        data = (tmp_path / "png" / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
+    assert plots.main(["--group", "lonely", "--out", str(tmp_path / "png")]) == 2

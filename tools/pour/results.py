@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: MIT
 """pour-results: the results table (paper, baselines, vanilla REINFORCE, ours) on held-out seeds.
 
-    pour-results --header policy/weights.h --vanilla RUN... --ours RUN... --out results/
+    pour-results --header policy/weights.h --group "vanilla REINFORCE" RUN... --group ours RUN... --out results/
 
 The shipped policy and the baselines run through host_sim (the firmware core in-process for the
-policy); the training runs' final greedy float policies run through libpoursim's C rollout on the
+policy); the training runs' output float policies run greedy through libpoursim's C rollout on the
 same seeds. Writes results/results.md and results/results.json.
 """
 from __future__ import annotations
@@ -41,11 +41,12 @@ def host_sim_row(name: str, args: Sequence[str], n: int, build_dir: str | None) 
 
 
 def float_rows(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
-    """Greedy final float policies of several runs, n held-out episodes each, pooled."""
+    """The output policies of several runs (policy.json's best_w: the best greedy-validated weights, or
+    the last ones for configs with eval.select_best = false), greedy, n held-out episodes each, pooled."""
     p, s, f, r = [], [], [], []
     for run in runs:
         doc = export.load_policy(run)
-        w = export.weights_of(doc, "last")
+        w = export.weights_of(doc, "best")
         sim = envs.make_env("sim", int(doc["n_actions"]), int(doc["decision_period_ms"]), 10.0)
         for seed in range(FIRST_SEED, FIRST_SEED + n):
             m = sim.rollout(w, seed, True).metrics
@@ -53,7 +54,22 @@ def float_rows(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
             s.append(100 * m["v_spill"])
             f.append(m["finish_s"])
             r.append(m["return"])
-    return _row(name, f"final greedy float policy of {len(runs)} runs (C rollout)", p, s, f, r)
+    return _row(name, f"output float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r)
+
+
+def init_row(config_path: str, n: int) -> dict[str, Any]:
+    """The policy a training config starts from, greedy, on the held-out seeds."""
+    from pour import config, reinforce
+    cfg = config.load(config_path)
+    p = np.zeros(reinforce.params_shape(cfg.policy.param, cfg.policy.n_actions))
+    if cfg.policy.init == "beta":
+        p = np.array(cfg.policy.init_beta, dtype=np.float64)
+    w = reinforce.w_from_params(cfg.policy.param, p, cfg.policy.n_actions, cfg.policy.sharpness)
+    sim = envs.make_env("sim", cfg.policy.n_actions, cfg.policy.decision_period_ms, 10.0)
+    ms = [sim.rollout(w, seed, True).metrics for seed in range(FIRST_SEED, FIRST_SEED + n)]
+    return _row(f"initial policy of {Path(config_path).name}", "greedy float, C rollout",
+                [100 * m["v_target"] for m in ms], [100 * m["v_spill"] for m in ms],
+                [m["finish_s"] for m in ms], [m["return"] for m in ms])
 
 
 def markdown(rows: list[dict[str, Any]], n: int) -> str:
@@ -75,8 +91,9 @@ def markdown(rows: list[dict[str, Any]], n: int) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="pour-results", description=__doc__.split("\n")[0])
     ap.add_argument("--header", default="policy/weights.h")
-    ap.add_argument("--vanilla", nargs="*", default=[], type=Path, help="vanilla REINFORCE run directories")
-    ap.add_argument("--ours", nargs="*", default=[], type=Path, help="improved run directories")
+    ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), default=[],
+                    help="a label and its training runs (their final greedy float policies); repeatable")
+    ap.add_argument("--init", metavar="CONFIG", help="also evaluate the initial policy of this training config")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
     ap.add_argument("--out", default="results", type=Path)
@@ -86,10 +103,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         n = args.episodes
         rows = [host_sim_row("baseline: constant tilt rate", ["--baseline", "rate"], n, args.build_dir),
                 host_sim_row("baseline: full torque", ["--baseline", "full"], n, args.build_dir)]
-        if args.vanilla:
-            rows.append(float_rows("vanilla REINFORCE (paper eq. 19)", args.vanilla, n))
-        if args.ours:
-            rows.append(float_rows("ours, training runs (float)", args.ours, n))
+        rows.append(host_sim_row("baseline: hand-written pour (host_sim)", ["--baseline", "hand"], n, args.build_dir))
+        if args.init:
+            rows.append(init_row(args.init, n))
+        for g in args.group:
+            if len(g) < 2:
+                raise ValueError(f"--group {g[0]} has no run directory")
+            rows.append(float_rows(g[0], [Path(d) for d in g[1:]], n))
         rows.append(host_sim_row(f"ours, shipped {Path(args.header).name} (firmware core, fixed point)",
                                  ["--policy", args.header], n, args.build_dir))
     except (OSError, RuntimeError, ValueError, envs.EnvError, weights_h.WeightsHError, export.ExportError) as exc:
