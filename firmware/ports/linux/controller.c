@@ -31,7 +31,7 @@ pour_linux_config_t pour_linux_default_config(void) {
   pour_linux_config_t c;
   memset(&c, 0, sizeof c);
   c.lockstep = false;
-  c.stall_ms = 200;
+  c.stall_ms = 2000; /* longer than host_sim takes to reset a world between episodes, even on a loaded machine */
   c.control = pour_control_default_config();
   return c;
 }

@@ -39,7 +39,7 @@ typedef struct {
   uint16_t faults;          /* fault bits at exit */
 } pour_linux_stats_t;
 
-/* Defaults: real time, stall 200 ms, run until a signal, control defaults of the core. */
+/* Defaults: real time, stall 2000 ms, run until a signal, control defaults of the core. */
 pour_linux_config_t pour_linux_default_config(void);
 
 /* Runs until *stop becomes non-zero, the duration or the state count is reached.

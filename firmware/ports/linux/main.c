@@ -26,7 +26,7 @@ static void usage(FILE *f) {
           "  --io can:IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n"
           "                         SocketCAN, the protocol of can/pour.dbc (defaults 0, 100, 50)\n"
           "  --lockstep             one tick per received state (deterministic; host_sim --lockstep)\n"
-          "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a state (200)\n"
+          "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a state (2000)\n"
           "  --duration S           stop after S seconds (default: run until SIGINT/SIGTERM)\n"
           "  --max-states N         stop after answering N states\n"
           "  --input-timeout-ms N   the core's input timeout (default from the core)\n"
