@@ -53,7 +53,9 @@ def main(argv: list[str] | None = None) -> int:
     controller, host_sim = find_binary("pour_controller", a.build_dir), find_binary("host_sim", a.build_dir)
     url = a.url or private_url()
     ctl_args = [str(controller), "--io", f"lcm:{url}"] + ([] if a.realtime else ["--lockstep"])
-    ctl = subprocess.Popen(ctl_args, stdout=subprocess.PIPE, text=True)
+    # The controller's own messages matter only if the pour failed: after a good pour its input goes
+    # quiet (host_sim may still be rendering), which it reports as a stale-input fault.
+    ctl = subprocess.Popen(ctl_args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         hs_args = [str(host_sim), *rest, "--lcm", url] + (["--realtime"] if a.realtime else [])
         rc = subprocess.call(hs_args)
@@ -61,11 +63,13 @@ def main(argv: list[str] | None = None) -> int:
         if ctl.poll() is None:
             ctl.send_signal(signal.SIGINT)
         try:
-            out, _ = ctl.communicate(timeout=10)
+            out, err = ctl.communicate(timeout=10)
         except subprocess.TimeoutExpired:
             ctl.kill()
-            out, _ = ctl.communicate()
+            out, err = ctl.communicate()
     sys.stdout.write(out)
+    if rc != 0:
+        sys.stderr.write(err)
     return rc
 
 
