@@ -62,7 +62,8 @@ _Static_assert(POUR_WEIGHTS_OMEGA_MAX_URAD_S > 0 && POUR_WEIGHTS_OMEGA_MAX_URAD_
                "weights.h: POUR_WEIGHTS_OMEGA_MAX_URAD_S must be a positive int32");
 _Static_assert(POUR_WEIGHTS_TAU_MAX_MNM > 0 && POUR_WEIGHTS_TAU_MAX_MNM <= INT32_MAX,
                "weights.h: POUR_WEIGHTS_TAU_MAX_MNM must be a positive int32");
-_Static_assert(POUR_WEIGHTS_CONTENT_HASH >= 0 && POUR_WEIGHTS_CONTENT_HASH <= 0xFFFFFFFFu,
+/* Through unsigned long long: a negative value fails, and no comparison is always true (-Wtype-limits). */
+_Static_assert((unsigned long long)(POUR_WEIGHTS_CONTENT_HASH) <= 0xFFFFFFFFull,
                "weights.h: POUR_WEIGHTS_CONTENT_HASH must fit uint32");
 /* sizeof catches arrays of the wrong shape or element type, and arrays declared with an empty leading
  * dimension ([]) whose initializer is short. A short initializer of an explicitly sized array is
