@@ -29,7 +29,10 @@ def _row(name: str, how: str, poured: Sequence[float], spilled: Sequence[float],
     return {"name": name, "how": how, "episodes": int(poured.size), "poured_pct": float(poured.mean()),
             "poured_pct_min": float(poured.min()), "spilled_pct": float(spilled.mean()),
             "spilled_pct_max": float(spilled.max()),
-            "finish_s": float(np.mean(np.where(finish < 0, 10.0, finish))), "finish_s_max": float(finish.max()),
+            # An episode that never finishes (-1) counts as the full 10 s; -1 stays when none finished.
+            "finish_s": float(np.mean(np.where(finish < 0, 10.0, finish))),
+            "finish_s_max": float(np.max(np.where(finish < 0, 10.0, finish))) if np.any(finish >= 0) else -1.0,
+            "unfinished": int(np.sum(finish < 0)),
             "return": float(np.mean(ret)), "episodes_meeting_all_targets": int(ok.sum())}
 
 
@@ -81,10 +84,10 @@ def markdown(rows: list[dict[str, Any]], n: int) -> str:
              "| paper (REINFORCE, pure-Python sim) | not reported | not reported | not reported | "
              "slight upward trend in 100 episodes (binary); no convergence in 500 (11 actions) | — |"]
     for r in rows:
+        fin = "never (nothing poured)" if r["finish_s_max"] < 0 else f"{r['finish_s']:.2f} / {r['finish_s_max']:.2f}"
         lines.append(f"| {r['name']} | {r['poured_pct']:.1f} / {r['poured_pct_min']:.1f} | "
-                     f"{r['spilled_pct']:.1f} / {r['spilled_pct_max']:.1f} | {r['finish_s']:.2f} / "
-                     f"{r['finish_s_max']:.2f} | {r['return']:.0f} | {r['episodes_meeting_all_targets']}/"
-                     f"{r['episodes']} |")
+                     f"{r['spilled_pct']:.1f} / {r['spilled_pct_max']:.1f} | {fin} | {r['return']:.0f} | "
+                     f"{r['episodes_meeting_all_targets']}/{r['episodes']} |")
     return "\n".join(lines) + "\n"
 
 
