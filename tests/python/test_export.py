@@ -206,3 +206,22 @@ def test_bad_policy_files_give_clear_errors(tmp_path):
     r = subprocess.run([sys.executable, "-m", "pour.export", str(tmp_path / "missing.json"), "--out",
                         str(tmp_path / "o.h")], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and r.stderr.startswith("pour-export: error:") and "Traceback" not in r.stderr
+
+
+def test_pour_eval_agree_on_a_toy_run_and_its_errors(tmp_path, capsys):
+    from pour import evaluate
+    cfg = cfgmod.from_dict({"seed": 4, "iterations": 2, "workers": 1, "policy": {"n_actions": 5},
+                            "algo": {"batch_episodes": 2}, "eval": {"every": 2, "episodes": 1},
+                            "env": {"kind": "toy", "episode_s": 1.0}})
+    train.train(cfg, tmp_path / "run", quiet=True)
+    export.export(tmp_path / "run", tmp_path / "w.h")
+    assert evaluate.main(["agree", str(tmp_path / "run"), "--header", str(tmp_path / "w.h"), "--episodes", "2",
+                          "--episode-s", "1.0"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["states"] == 200 and 0.99 <= out["agreement"] <= 1.0
+    other = _policy_json(tmp_path / "other.json", np.ones((6, 5)))
+    export.export(other, tmp_path / "other.h")
+    assert evaluate.main(["agree", str(tmp_path / "run"), "--header", str(tmp_path / "other.h")]) == 2
+    assert "was not exported from" in capsys.readouterr().err
+    assert evaluate.main(["agree", str(tmp_path / "nowhere"), "--header", str(tmp_path / "w.h")]) == 2
+    assert "pour-eval: error:" in capsys.readouterr().err
