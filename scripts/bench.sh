@@ -97,7 +97,7 @@ bench_lcm() {
   fi
   rm -f "$log"
   bin=$build/bin
-  hs=$(ls -t "$build/bin/host_sim" "$build/host_sim/host_sim" 2>/dev/null | head -n 1)
+  hs=$build/bin/host_sim
   u="udpm://239.255.76.67:$((20000 + $$ % 20000))?ttl=0"
   echo "-- lockstep, transport + controller only (20,000 synthetic states):"
   "$bin/pour_controller" --io "lcm:$u" --lockstep 2>/dev/null >/dev/null &
@@ -139,7 +139,7 @@ bench_sim() {
   fi
   rm -f "$log"
   echo "   machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) (other jobs slow the wall-time figures)"
-  ./build/host/host_sim/host_sim --bench --policy policy/weights.h | sed 's/^/   /'
+  ./build/host/bin/host_sim --bench --policy policy/weights.h | sed 's/^/   /'
 }
 
 # --- section: can — the pour CAN protocol: bus load, and the full loop on real SocketCAN ------------------
@@ -171,7 +171,7 @@ ctl=\$!
 br=\$!
 sleep 0.5
 t0=\$(date +%s.%N)
-\$B/host_sim/host_sim --policy $ROOT/policy/weights.h --lcm \$U --quiet > $guest/host.txt 2>&1
+\$B/bin/host_sim --policy $ROOT/policy/weights.h --lcm \$U --quiet > $guest/host.txt 2>&1
 t1=\$(date +%s.%N)
 kill -INT \$br \$ctl \$dump; wait \$br \$ctl \$dump
 echo "\$t0 \$t1" > $guest/times.txt

@@ -10,6 +10,6 @@ cd "$ROOT"
 cmake --preset host >/dev/null
 cmake --build --preset host --target host_sim
 mkdir -p out
-./build/host/host_sim/host_sim --policy policy/weights.h --seed 1 --render out/pour.gif "$@"
+./build/host/bin/host_sim --policy policy/weights.h --seed 1 --render out/pour.gif "$@"
 echo
 echo "Rendered pour: out/pour.gif (animation) and out/pour.png (snapshot)"

@@ -23,13 +23,10 @@ def url(offset: int) -> str:
 
 
 def binary(build_dir: Path, name: str) -> Path:
-    """An executable of the build tree: bin/NAME or the folder of the target that makes it (newest wins,
-    so that a stale copy left by an older layout is never the one tested)."""
-    places = [build_dir / "bin" / name, build_dir / "host_sim" / name, build_dir / "firmware" / "ports" / "linux" / name,
-              build_dir / "tests" / "lcm" / name]
-    found = [p for p in places if p.is_file()]
-    assert found, f"{name} not built (looked in {', '.join(str(p.parent) for p in places)})"
-    return max(found, key=lambda p: p.stat().st_mtime)
+    """An executable of the build tree (every program lands in bin/)."""
+    p = build_dir / "bin" / name
+    assert p.is_file(), f"{name} not built (looked in {p.parent})"
+    return p
 
 
 def compiled_weights(build_dir: Path) -> Path:

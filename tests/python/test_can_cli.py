@@ -12,9 +12,9 @@ from conftest import BUILD_DIR
 
 
 def exe(name: str) -> Path:
-    for p in (BUILD_DIR / "bin" / name, BUILD_DIR / "host_sim" / "can_bridge" / name):
-        if p.exists():
-            return p
+    p = BUILD_DIR / "bin" / name
+    if p.exists():
+        return p
     raise FileNotFoundError(f"{name} not built in {BUILD_DIR}")
 
 

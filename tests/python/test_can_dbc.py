@@ -56,7 +56,7 @@ class Harness:
 
 @pytest.fixture(scope="module")
 def harness():
-    h = Harness(BUILD_DIR / "tests" / "can" / "can_codec_harness")
+    h = Harness(BUILD_DIR / "bin" / "can_codec_harness")
     yield h
     h.close()
 

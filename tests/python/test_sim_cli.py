@@ -12,7 +12,7 @@ SHORT = ["--set", "episode_s=1.5"]
 
 @pytest.fixture
 def host_sim(build_dir):
-    exe = build_dir / "host_sim" / "host_sim"
+    exe = build_dir / "bin" / "host_sim"
     assert exe.is_file(), f"{exe} not built"
 
     def run(*args, timeout=300):

@@ -59,9 +59,9 @@ def host_sim_binary(build_dir: str | Path | None = None) -> Path:
         cands.append(Path(os.environ["POUR_BUILD_DIR"]))
     cands += [root / "build" / "host"]
     for c in cands:
-        for p in (c / "bin" / "host_sim", c / "host_sim" / "host_sim"):
-            if p.is_file() and os.access(p, os.X_OK):
-                return p
+        p = c / "bin" / "host_sim"
+        if p.is_file() and os.access(p, os.X_OK):
+            return p
     found = shutil.which("host_sim")
     if found:
         return Path(found)

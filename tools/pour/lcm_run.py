@@ -27,10 +27,9 @@ def find_binary(name: str, build_dir: str | None) -> Path:
         dirs.append(Path(os.environ["POUR_BUILD_DIR"]))
     dirs.append(_SOURCE_DIR / "build" / "host")
     for d in dirs:
-        found = [p for p in (d / "bin" / name, d / "host_sim" / name, d / "firmware" / "ports" / "linux" / name)
-                 if p.is_file()]
-        if found:
-            return max(found, key=lambda p: p.stat().st_mtime)
+        p = d / "bin" / name
+        if p.is_file():
+            return p
     raise SystemExit(f"error: {name} not found under {', '.join(map(str, dirs))}; build first "
                      "(cmake --workflow --preset host)")
 

@@ -17,7 +17,7 @@ EPISODES = 2
 
 
 def host_sim(*extra: str) -> subprocess.CompletedProcess:
-    exe = BUILD_DIR / "host_sim" / "host_sim"
+    exe = BUILD_DIR / "bin" / "host_sim"
     argv = [str(exe), "--policy", str(SOURCE_DIR / "policy" / "weights.h"), "--set", f"episode_s={EPISODE_S}",
             "--episodes", str(EPISODES), "--seed", "4", *extra]
     return subprocess.run(argv, capture_output=True, text=True, timeout=600)
