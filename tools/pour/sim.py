@@ -2,7 +2,8 @@
 """Python binding of libpoursim (host_sim/include/poursim/poursim.h) through ctypes.
 
 The library is looked for at $POUR_SIM_LIB, then $POUR_BUILD_DIR/lib/libpoursim.so, then
-<source>/build/host/lib/libpoursim.so. Build it with `cmake --build --preset host`.
+<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so. Build it with
+`cmake --build --preset host`.
 
     from pour import sim
     world = sim.World(sim.default_config(), seed=1)
@@ -17,6 +18,7 @@ GIL during every call, so rollouts also run in parallel from Python threads.
 from __future__ import annotations
 
 import ctypes as C
+import glob
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,7 +33,11 @@ REGIONS = ("rotating", "target", "spilled", "flight")
 
 
 class SimError(RuntimeError):
-    """libpoursim is missing, failed to load, or refused a call."""
+    """libpoursim is missing, failed to load, or refused a call; key names the config key it refused, if any."""
+
+    def __init__(self, message: str, key: str | None = None):
+        super().__init__(message)
+        self.key = key
 
 
 _DP = C.POINTER(C.c_double)
@@ -94,7 +100,9 @@ def library_candidates() -> list[Path]:
     out: list[Path] = []
     if os.environ.get("POUR_BUILD_DIR"):
         out.append(Path(os.environ["POUR_BUILD_DIR"]) / "lib" / "libpoursim.so")
-    out.append(Path(__file__).resolve().parents[2] / "build" / "host" / "lib" / "libpoursim.so")
+    build = Path(__file__).resolve().parents[2] / "build"
+    out.append(build / "host" / "lib" / "libpoursim.so")
+    out += [p for p in map(Path, sorted(glob.glob(str(build / "*" / "lib" / "libpoursim.so")))) if p not in out]
     return out
 
 
@@ -110,7 +118,10 @@ def load_library() -> C.CDLL:
                 lib = C.CDLL(str(path))
             except OSError as e:
                 raise SimError(f"libpoursim at {path} failed to load: {e}") from e
-            _declare(lib)
+            try:
+                _declare(lib)
+            except AttributeError as e:
+                raise SimError(f"libpoursim at {path} is not usable (missing symbol: {e})") from e
             _lib = lib
             return lib
     raise SimError("libpoursim.so not found (looked at: " + ", ".join(map(str, tried)) +
@@ -157,8 +168,12 @@ def default_config() -> dict[str, float]:
     return {k: getattr(s, k) for k in CONFIG_KEYS}
 
 
-def make_config(overrides: Mapping[str, float] | None = None, path: str | os.PathLike | None = None) -> ConfigStruct:
-    """Defaults, then a config file (if any), then overrides; validated. SimError names a bad key."""
+def make_config(overrides: Mapping[str, float | str] | None = None,
+                path: str | os.PathLike | None = None) -> ConfigStruct:
+    """Defaults, then a config file (if any), then overrides (numbers, or text passed as is); validated.
+
+    SimError names a bad key, and carries it in .key when an override was refused.
+    """
     lib = load_library()
     cfg = lib.poursim_default_config()
     e = _err()
@@ -166,10 +181,15 @@ def make_config(overrides: Mapping[str, float] | None = None, path: str | os.Pat
         raise SimError(e.value.decode())
     for key, value in (overrides or {}).items():
         if key not in CONFIG_KEYS:
-            raise SimError(f"unknown config key '{key}'")
-        text = str(int(value)) if isinstance(value, (int, np.integer)) else format(float(value), ".17g")
+            raise SimError(f"unknown config key '{key}'", key)
+        if isinstance(value, str):
+            text = value
+        elif isinstance(value, (int, np.integer)):
+            text = str(int(value))
+        else:
+            text = format(float(value), ".17g")
         if lib.poursim_config_set(C.byref(cfg), key.encode(), text.encode(), e, ERR_LEN) != 0:
-            raise SimError(e.value.decode())
+            raise SimError(e.value.decode(errors="replace"), key)
     if lib.poursim_config_validate(C.byref(cfg), e, ERR_LEN) != 0:
         raise SimError(e.value.decode())
     return cfg
