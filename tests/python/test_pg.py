@@ -153,3 +153,82 @@ def test_feedback_policy_peaks_at_the_level_nearest_u():
     x = np.array([[0.3, 0.5, 1.0, 0.0, 0.0, 1.0]])
     assert int(np.argmax(x @ w)) == 7  # levels are -1, -0.8, ..., 0.4 at index 7 is nearest 0.33
     assert reinforce.w_from_params("full", np.arange(12.0), 2, 1.0).shape == (6, 2)
+
+
+def test_mean_kl_is_zero_for_the_same_policy_and_matches_the_definition():
+    w, x, _, _ = _problem(seed=5)
+    w2 = w + np.random.default_rng(6).normal(0, 0.3, w.shape)
+    assert reinforce.mean_kl(w, w, x) == pytest.approx(0.0, abs=1e-15)
+    p, q = reinforce.probs(w, x), reinforce.probs(w2, x)
+    want = np.mean(np.sum(p * np.log(p / q), axis=1))
+    assert reinforce.mean_kl(w, w2, x) == pytest.approx(want, rel=1e-12)
+    assert reinforce.mean_kl(w, w2, x) > 0
+
+
+def test_trust_region_halves_the_step_until_the_kl_fits():
+    w, x, _, _ = _problem(seed=7)
+    step = np.random.default_rng(8).normal(0, 2.0, w.shape)
+
+    def kl_of(s):
+        return reinforce.mean_kl(w, w + s, x)
+
+    full = kl_of(step)
+    out, kl, scale = reinforce.trust_region(step, kl_of, full / 10)
+    assert scale in (0.5, 0.25, 0.125, 0.0625)
+    np.testing.assert_array_equal(out, step * scale)
+    assert kl == kl_of(out) <= full / 10 < kl_of(out * 2)
+    # A step inside the region is taken whole.
+    out, kl, scale = reinforce.trust_region(step, kl_of, full)
+    assert scale == 1.0 and kl == full
+    np.testing.assert_array_equal(out, step)
+    # No halving fits: the step is dropped rather than taken outside the region.
+    out, kl, scale = reinforce.trust_region(step, lambda s: 1.0 + float(np.sum(s * s)), 0.5, max_halvings=3)
+    assert scale == 0.0 and kl == 0.0 and not np.any(out)
+
+
+def test_update_keeps_the_feedback_policy_inside_the_trust_region():
+    cfg = cfgmod.from_dict({"iterations": 4, "policy": {"n_actions": 11, "param": "feedback", "sharpness": 10.0,
+                                                        "init": "beta", "init_beta": [-4, -4, 0, 0, 0, 4]},
+                            "algo": {"batch_episodes": 4, "lr": 0.25, "max_kl": 0.02}, "env": {"kind": "toy"}})
+    env = envs.make_env("toy", 11, 10, 1.0, {})
+    p0 = np.array(cfg.policy.init_beta, dtype=np.float64)
+    w0 = train.weights(cfg, p0)
+    eps = [env.rollout(w0, s, False) for s in range(4)]
+    p1, st = train.update(cfg, p0, eps, reinforce.Adam(p0.shape, cfg.algo.lr), 0)
+    x = np.concatenate([e.x for e in eps])
+    kl = reinforce.mean_kl(w0, train.weights(cfg, p1), x)
+    assert 0 < kl <= 0.02 and st["kl"] == pytest.approx(kl, rel=1e-12)
+    assert st["step_scale"] < 1.0 and st["lr"] == 0.25
+    # Adam's first step is lr x sign(g) before the trust region scales it down.
+    np.testing.assert_allclose(np.abs(p1 - p0), 0.25 * st["step_scale"], rtol=1e-5)
+
+
+@pytest.mark.parametrize("param", ["feedback", "full"])
+def test_fisher_gives_the_second_order_kl_of_a_step(param):
+    rng = np.random.default_rng(11)
+    x = rng.uniform(0, 1, (300, 6))
+    x[:, 5] = 1.0
+    p = np.array([-4.0, -4.0, 0.0, 0.0, 0.0, 4.0]) if param == "feedback" else rng.normal(0, 0.5, (6, 11))
+    w = reinforce.w_from_params(param, p, 11, 10.0)
+    fim = reinforce.fisher(param, w, x, 10.0)
+    assert fim.shape == (p.size, p.size)
+    np.testing.assert_allclose(fim, fim.T, atol=1e-12)
+    d = rng.normal(0, 1, p.shape)
+    d *= 1e-3 / np.linalg.norm(d)
+    kl = reinforce.mean_kl(w, reinforce.w_from_params(param, p + d, 11, 10.0), x)
+    dv = d.reshape(-1)
+    assert kl == pytest.approx(0.5 * dv @ fim @ dv, rel=1e-2)
+
+
+def test_natural_step_has_the_requested_kl_and_ascends():
+    rng = np.random.default_rng(12)
+    x = rng.uniform(0, 1, (300, 6))
+    x[:, 5] = 1.0
+    p = np.array([-4.0, -4.0, 0.5, 0.0, 0.0, 4.0])
+    w = reinforce.w_from_params("feedback", p, 11, 10.0)
+    g = rng.normal(0, 1, 6)
+    d = reinforce.natural_step(g, reinforce.fisher("feedback", w, x, 10.0), 1e-3)
+    assert g @ d > 0
+    kl = reinforce.mean_kl(w, reinforce.w_from_params("feedback", p + d, 11, 10.0), x)
+    assert kl == pytest.approx(1e-3, rel=5e-2)
+    assert not np.any(reinforce.natural_step(np.zeros(6), reinforce.fisher("feedback", w, x, 10.0), 1e-3))

@@ -52,6 +52,8 @@ def test_same_config_same_run_whatever_the_worker_count(tmp_path):
     np.testing.assert_array_equal(a.best_w, b.best_w)
     assert _rows(tmp_path / "a") == _rows(tmp_path / "b")
     assert len(_rows(tmp_path / "a")) == 6
+    # The exporter's input, hence weights.h, is byte-identical too.
+    assert (tmp_path / "a" / "policy.json").read_bytes() == (tmp_path / "b" / "policy.json").read_bytes()
     c = train.train(_cfg(seed=6), tmp_path / "c", quiet=True)
     assert not np.array_equal(a.w, c.w)
 
@@ -134,11 +136,17 @@ BAD = [
     ({"algo": {"gamma": float("nan")}}, "algo.gamma = nan: expected a finite number"),
     ({"algo": {"lr": 0.0}}, "algo.lr = 0.0"),
     ({"algo": {"lr": 0.1, "lr_final": 0.2}}, "algo.lr_final = 0.2: expected <= algo.lr"),
-    ({"algo": {"optimizer": "rmsprop"}}, "algo.optimizer = 'rmsprop'"),
+    ({"algo": {"optimizer": "rmsprop"}}, "algo.optimizer = 'rmsprop': expected 'adam', 'sgd' or 'natural'"),
     ({"algo": {"kind": "ppo"}}, "algo.kind = 'ppo'"),
     ({"algo": {"kind": "vanilla", "baseline": "none", "reward_to_go": True}}, "algo.reward_to_go must be False"),
     ({"algo": {"baseline": "loo", "batch_episodes": 1}}, "needs algo.batch_episodes >= 2"),
     ({"algo": {"entropy_coef": -0.1}}, "algo.entropy_coef = -0.1"),
+    ({"algo": {"max_kl": -0.01}}, "algo.max_kl = -0.01: expected 0 <= max_kl <= 10"),
+    ({"algo": {"kind": "vanilla", "batch_episodes": 1, "baseline": "none", "reward_to_go": False,
+               "normalize_advantages": False, "entropy_coef": 0.0, "optimizer": "sgd", "max_kl": 0.1}},
+     "algo.max_kl must be 0.0"),
+    ({"algo": {"optimizer": "natural"}}, "algo.optimizer = 'natural' needs algo.max_kl > 0"),
+    ({"algo": {"max_kl": 0.1, "max_kl_final": 0.2}}, "algo.max_kl_final = 0.2: expected 0 < max_kl_final <= algo.max_kl"),
     ({"algo": {"reward_to_go": "yes"}}, "algo.reward_to_go = 'yes': expected true or false"),
     ({"algo": {"learning_rate": 0.1}}, "unknown key(s) learning_rate"),
     ({"env": {"kind": "mujoco"}}, "env.kind = 'mujoco'"),
@@ -203,3 +211,26 @@ def test_plots_of_toy_runs(tmp_path):
         data = (tmp_path / "png" / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
     assert plots.main(["--group", "lonely", "--out", str(tmp_path / "png")]) == 2
+
+
+def test_rollback_undoes_a_step_that_drops_the_return_and_resumes_bit_identically(tmp_path):
+    # A rate far too large for the toy: some steps make the next batch's return drop.
+    algo = {"batch_episodes": 4, "lr": 2.0, "max_kl": 10.0, "rollback": 0.05, "rollback_shrink": 0.1}
+    cfg = _cfg(iterations=12, algo=algo)
+    train.train(cfg, tmp_path / "full", quiet=True)
+    rows = _rows(tmp_path / "full")
+    rolled = [i for i, r in enumerate(rows) if r["rolled_back"] == "1"]
+    assert rolled, "the test needs at least one rolled-back step"
+    best = -np.inf
+    for i, r in enumerate(rows):
+        ret = float(r["return_mean"])
+        if i in rolled:
+            assert ret < best and float(r["step_scale"]) == 0.0 and float(r["kl"]) == 0.0
+        best = max(best, ret) if i not in rolled else best
+    # Each undone step shrinks the trust region by rollback_shrink.
+    first = rolled[0]
+    sched = [train.max_kl(cfg, i) for i in range(12)]
+    assert float(rows[first + 1]["kl_bound"]) == pytest.approx(sched[first + 1] * 0.1, rel=1e-9)
+    train.train(cfg, tmp_path / "part", quiet=True, stop_after=first + 1)
+    train.train(cfg, tmp_path / "part", quiet=True)
+    assert _rows(tmp_path / "full") == _rows(tmp_path / "part")

@@ -37,13 +37,21 @@ class AlgoConfig:
     gamma: float = 0.9995          # discount per 1 ms tick (per decision: gamma ** period)
     lr: float = 0.05               # learning rate at the first iteration
     lr_final: float = -1.0         # linearly decayed to this at the last iteration (< 0: constant lr)
-    optimizer: str = "adam"        # "adam" or "sgd"
+    optimizer: str = "adam"        # "adam", "sgd" or "natural" (a natural-gradient step of KL max_kl)
     reward_to_go: bool = True      # weight log pi(a_t) by the return from t on, not R(tau)
     baseline: str = "loo"          # "none", "loo" (time-indexed mean of the others in the batch)
     normalize_advantages: bool = True
     entropy_coef: float = 0.01     # bonus on the mean policy entropy at the first iteration
     entropy_coef_final: float = 0.0  # linearly annealed to this at the last iteration
     grad_clip: float = 0.0         # clip the gradient's L2 norm to this (0 = off)
+    max_kl: float = 0.0            # trust region: halve the step until the mean KL(old || new) over
+                                   # the batch's states is <= this [nats] (0 = off)
+    max_kl_final: float = -1.0     # decayed geometrically to this at the last iteration (< 0: constant)
+    rollback: float = 0.0          # undo a step when the next batch's mean return falls below the best
+                                   # batch's by more than this fraction (+ 2 standard errors); 0 = off
+    rollback_shrink: float = 0.2   # each undone step multiplies the trust region (max_kl) by this
+    rollback_from: int = 0         # no step is undone before this iteration (the first steps may cross a
+                                   # valley on their way out of the initial policy's basin)
     reward_scale: float = 1.0      # rewards are multiplied by this before anything else
 
 
@@ -152,7 +160,8 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(a.kind in ("vanilla", "pg"), f"algo.kind = {a.kind!r}: expected 'vanilla' or 'pg'")
     if a.kind == "vanilla":
         paper = {"lr_final": -1.0, "reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
-                 "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0}
+                 "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0, "max_kl": 0.0,
+                 "max_kl_final": -1.0, "rollback": 0.0}
         for k, want in paper.items():
             _check(getattr(a, k) == want, f"algo.kind = 'vanilla' is the paper's update: algo.{k} must be {want!r} "
                                        f"(got {getattr(a, k)!r}); use algo.kind = 'pg' to change it")
@@ -163,13 +172,25 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(0.0 < a.lr <= 10.0, f"algo.lr = {a.lr}: expected 0 < lr <= 10")
     _check(a.lr_final < 0 or a.lr_final <= a.lr,
            f"algo.lr_final = {a.lr_final}: expected <= algo.lr ({a.lr}), or negative for a constant lr")
-    _check(a.optimizer in ("adam", "sgd"), f"algo.optimizer = {a.optimizer!r}: expected 'adam' or 'sgd'")
+    _check(a.optimizer in ("adam", "sgd", "natural"),
+           f"algo.optimizer = {a.optimizer!r}: expected 'adam', 'sgd' or 'natural'")
+    _check(a.optimizer != "natural" or a.max_kl > 0,
+           "algo.optimizer = 'natural' needs algo.max_kl > 0 (the KL of each step)")
+    _check(a.max_kl_final < 0 or 0 < a.max_kl_final <= a.max_kl,
+           f"algo.max_kl_final = {a.max_kl_final}: expected 0 < max_kl_final <= algo.max_kl ({a.max_kl}), or "
+           "negative for a "
+           "constant bound")
     _check(a.baseline in ("none", "loo"), f"algo.baseline = {a.baseline!r}: expected 'none' or 'loo'")
     _check(a.baseline == "none" or a.batch_episodes >= 2,
            f"algo.baseline = {a.baseline!r} needs algo.batch_episodes >= 2 (got {a.batch_episodes})")
     _check(a.entropy_coef >= 0.0, f"algo.entropy_coef = {a.entropy_coef}: expected >= 0")
     _check(a.entropy_coef_final >= 0.0, f"algo.entropy_coef_final = {a.entropy_coef_final}: expected >= 0")
     _check(a.grad_clip >= 0.0, f"algo.grad_clip = {a.grad_clip}: expected >= 0 (0 = off)")
+    _check(0.0 <= a.max_kl <= 10.0, f"algo.max_kl = {a.max_kl}: expected 0 <= max_kl <= 10 [nats] (0 = off)")
+    _check(0.0 <= a.rollback <= 1.0, f"algo.rollback = {a.rollback}: expected 0..1 (0 = off)")
+    _check(a.rollback == 0 or a.max_kl > 0, "algo.rollback needs algo.max_kl > 0 (the trust region it shrinks)")
+    _check(a.rollback_from >= 0, f"algo.rollback_from = {a.rollback_from}: expected >= 0")
+    _check(0.0 < a.rollback_shrink <= 1.0, f"algo.rollback_shrink = {a.rollback_shrink}: expected 0 < s <= 1")
     _check(a.reward_scale > 0.0, f"algo.reward_scale = {a.reward_scale}: expected > 0")
     _check(e.every >= 1, f"eval.every = {e.every}: expected >= 1")
     _check(0 <= e.episodes <= 1024, f"eval.episodes = {e.episodes}: expected 0..1024")

@@ -32,7 +32,8 @@ def _log(run_dir: Path) -> dict[str, np.ndarray]:
 
 def reward_curve(groups: dict[str, Sequence[Path]], out: Path, column: str = "return_mean",
                  title: str = "Episode return during training") -> None:
-    """One line per group: mean over its runs, shaded +-1 std over runs, dotted min/max over runs."""
+    """One line per group: mean over its runs, shaded +-1 std over runs, dotted min/max over runs,
+    x on the batches of a run whose preceding step was undone (rollback)."""
     fig, ax = plt.subplots(figsize=(7, 4.2), dpi=120)
     for label, dirs in groups.items():
         logs = [_log(Path(d)) for d in dirs]
@@ -53,6 +54,14 @@ def reward_curve(groups: dict[str, Sequence[Path]], out: Path, column: str = "re
         ax.fill_between(x, m - s, m + s, color=line.get_color(), alpha=0.2)
         ax.plot(x, y.min(0), ":", color=line.get_color(), lw=0.8)
         ax.plot(x, y.max(0), ":", color=line.get_color(), lw=0.8)
+        # Batches whose preceding step the trust region's rollback undid (algo.rollback): each run's own
+        # value, marked, so a dip that was undone reads differently from one the policy stayed in.
+        undone = [(lg["episodes"][i], lg[column][i]) for lg in logs if "rolled_back" in lg
+                  for i in range(min(n, len(lg["rolled_back"]))) if lg["rolled_back"][i] == 1 and win == 1]
+        if undone:
+            ux, uy = zip(*undone)
+            ax.plot(ux, uy, "x", color=line.get_color(), ms=6, mew=1.5, ls="none",
+                    label=f"{label}: step undone (rollback)")
     ax.set_xlabel("training episodes")
     ax.set_ylabel(column.replace("_", " "))
     ax.set_title(title)

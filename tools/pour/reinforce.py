@@ -6,7 +6,8 @@ Two updates are provided:
   * vanilla  -- the paper's eq. 19: every grad log pi(a_t|x_t) of an episode is multiplied by the
                 episode's full discounted return R(tau); plain gradient ascent.
   * pg       -- reward-to-go, a leave-one-out time-indexed baseline over a batch of episodes,
-                normalised advantages, an entropy bonus, Adam and optional gradient-norm clipping.
+                normalised advantages, an entropy bonus, Adam, optional gradient-norm clipping and an
+                optional trust region on the mean KL divergence between the old and the new policy.
 Everything here is pure numpy and deterministic.
 """
 from __future__ import annotations
@@ -171,6 +172,73 @@ class Adam:
         self.m = np.array(d["adam_m"], dtype=np.float64)
         self.v = np.array(d["adam_v"], dtype=np.float64)
         self.t = int(d["adam_t"])
+
+
+def mean_kl(w_old: np.ndarray, w_new: np.ndarray, x: np.ndarray) -> float:
+    """Mean over the rows of x [T][F] of KL(pi_old(.|x) || pi_new(.|x)) [nats]."""
+    def logp(w: np.ndarray) -> np.ndarray:
+        z = x @ w
+        z = z - np.max(z, axis=1, keepdims=True)
+        return z - np.log(np.sum(np.exp(z), axis=1, keepdims=True))
+    lo, ln = logp(w_old), logp(w_new)
+    return float(np.mean(np.sum(np.exp(lo) * (lo - ln), axis=1)))
+
+
+def trust_region(step: np.ndarray, kl_of, max_kl: float, max_halvings: int = 12
+                 ) -> tuple[np.ndarray, float, float]:
+    """Backtracking on the step's length: halves it until kl_of(step) <= max_kl.
+
+    kl_of maps a parameter increment to the mean KL(old || new) over the batch's states. Returns
+    (step, its KL, the scale applied: 1, 1/2, 1/4, ...); after max_halvings the step is dropped
+    (scale 0, KL 0) rather than taken outside the region.
+    """
+    scale = 1.0
+    for _ in range(max_halvings + 1):
+        kl = kl_of(step * scale)
+        if kl <= max_kl:
+            return step * scale, kl, scale
+        scale *= 0.5
+    return np.zeros_like(step), 0.0, 0.0
+
+
+def fisher(param: str, w: np.ndarray, x: np.ndarray, sharpness: float) -> np.ndarray:
+    """The policy's Fisher information in its parameters, averaged over the rows of x [T][F].
+
+    F = mean_x E_a[s s^T], s = grad log pi(a|x) in the parameters; the second-order term of the mean
+    KL(old || new) is 1/2 d^T F d for a parameter step d. "full": d logit_a / d W[f][b] = x_f [a = b],
+    so F[(f,a),(g,b)] = mean x_f x_g (diag(pi) - pi pi^T)[a][b]. "feedback": d logit_a / d beta =
+    2c L_a x, so F = 4c^2 mean Var_pi(L) x x^T.
+    """
+    p = probs(w, x)
+    n, f = x.shape
+    a = p.shape[1]
+    if param == "feedback":
+        lv = action_levels(a)
+        var = p @ (lv * lv) - (p @ lv) ** 2
+        return 4.0 * sharpness ** 2 * (x * var[:, None]).T @ x / n
+    if param == "full":
+        cov = -p[:, :, None] * p[:, None, :]
+        cov[:, np.arange(a), np.arange(a)] += p
+        xx = (x[:, :, None] * x[:, None, :]).reshape(n, f * f)
+        m = (xx.T @ cov.reshape(n, a * a) / n).reshape(f, f, a, a)
+        return m.transpose(0, 2, 1, 3).reshape(f * a, f * a)
+    raise ValueError(f"unknown parameterisation {param!r}")
+
+
+def natural_step(g: np.ndarray, fim: np.ndarray, kl: float, damping: float = 1e-4) -> np.ndarray:
+    """The natural-gradient step whose quadratic KL estimate 1/2 d^T F d equals kl [nats].
+
+    d = sqrt(2 kl / g^T F^-1 g) F^-1 g, with F damped by damping x its mean diagonal so that
+    directions the batch never explores (a feature always 0) stay finite.
+    """
+    shape = g.shape
+    gv = g.reshape(-1)
+    lam = damping * float(np.mean(np.diag(fim))) + 1e-12
+    d = np.linalg.solve(fim + lam * np.eye(gv.size), gv)
+    gd = float(gv @ d)
+    if not gd > 0.0:
+        return np.zeros(shape)
+    return (np.sqrt(2.0 * kl / gd) * d).reshape(shape)
 
 
 def clip_norm(g: np.ndarray, max_norm: float) -> tuple[np.ndarray, float]:

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing as mp
+import os
 import sys
 from pathlib import Path
 from typing import Any, Sequence
@@ -43,21 +45,35 @@ def host_sim_row(name: str, args: Sequence[str], n: int, build_dir: str | None) 
                 [e["finish_s"] for e in per], [e["return"] for e in per])
 
 
-def float_rows(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
-    """The output policies of several runs (policy.json's best_w: the best greedy-validated weights, or
-    the last ones for configs with eval.select_best = false), greedy, n held-out episodes each, pooled."""
-    p, s, f, r = [], [], [], []
+_SIMS: dict[tuple[int, int], Any] = {}
+
+
+def _greedy_metrics(job: tuple) -> dict[str, float]:
+    n_actions, period_ms, w, seed = job
+    if (n_actions, period_ms) not in _SIMS:
+        _SIMS[(n_actions, period_ms)] = envs.make_env("sim", n_actions, period_ms, 10.0)
+    return dict(_SIMS[(n_actions, period_ms)].rollout(w, seed, True).metrics)
+
+
+def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> dict[str, Any]:
+    """The output policies of several runs (which 'best': policy.json's best_w, the best greedy-validated
+    weights, or the last ones for configs with eval.select_best = false; 'last': the final weights),
+    greedy, n held-out episodes each, pooled."""
+    jobs = []
     for run in runs:
         doc = export.load_policy(run)
-        w = export.weights_of(doc, "best")
-        sim = envs.make_env("sim", int(doc["n_actions"]), int(doc["decision_period_ms"]), 10.0)
-        for seed in range(FIRST_SEED, FIRST_SEED + n):
-            m = sim.rollout(w, seed, True).metrics
-            p.append(100 * m["v_target"])
-            s.append(100 * m["v_spill"])
-            f.append(m["finish_s"])
-            r.append(m["return"])
-    return _row(name, f"output float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r)
+        w = export.weights_of(doc, which)
+        jobs += [(int(doc["n_actions"]), int(doc["decision_period_ms"]), w, seed)
+                 for seed in range(FIRST_SEED, FIRST_SEED + n)]
+    # Episodes are independent and seeded: run them on every core, results in job order.
+    with mp.get_context("fork").Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
+        ms = pool.map(_greedy_metrics, jobs, chunksize=1)
+    p = [100 * m["v_target"] for m in ms]
+    s = [100 * m["v_spill"] for m in ms]
+    f = [m["finish_s"] for m in ms]
+    r = [m["return"] for m in ms]
+    what = "output" if which == "best" else "final"
+    return _row(name, f"{what} float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r)
 
 
 def init_row(config_path: str, n: int) -> dict[str, Any]:
@@ -96,6 +112,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--header", default="policy/weights.h")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), default=[],
                     help="a label and its training runs (their final greedy float policies); repeatable")
+    ap.add_argument("--group-last", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), default=[],
+                    help="as --group, but the runs' final weights (not the best validated ones); repeatable")
     ap.add_argument("--init", metavar="CONFIG", help="also evaluate the initial policy of this training config")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
@@ -113,6 +131,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             if len(g) < 2:
                 raise ValueError(f"--group {g[0]} has no run directory")
             rows.append(float_rows(g[0], [Path(d) for d in g[1:]], n))
+        for g in args.group_last:
+            if len(g) < 2:
+                raise ValueError(f"--group-last {g[0]} has no run directory")
+            rows.append(float_rows(g[0], [Path(d) for d in g[1:]], n, "last"))
         rows.append(host_sim_row(f"ours, shipped {Path(args.header).name} (firmware core, fixed point)",
                                  ["--policy", args.header], n, args.build_dir))
     except (OSError, RuntimeError, ValueError, envs.EnvError, weights_h.WeightsHError, export.ExportError) as exc:

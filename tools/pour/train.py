@@ -30,7 +30,7 @@ STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
 
 LOG_FIELDS = ["iteration", "episodes", "wall_s", "return_mean", "return_std", "return_min", "return_max",
               "reward_sum_mean", "v_target_mean", "v_spill_mean", "finish_s_mean", "entropy_mean",
-              "grad_norm", "eval_score", "eval_v_target", "eval_v_spill", "eval_finish_s", "best_score"]
+              "grad_norm", "lr", "kl_bound", "kl", "step_scale", "rolled_back", "eval_score", "eval_v_target", "eval_v_spill", "eval_finish_s", "best_score"]
 
 
 class TrainError(RuntimeError):
@@ -156,8 +156,11 @@ class RunResult:
 
 def write_policy_json(path: Path, cfg: cfgmod.TrainConfig, tau_max_nm: float, iteration: int, w: np.ndarray,
                       best_w: np.ndarray, best_score: float) -> None:
-    """The exporter's input: deterministic bytes (no times), so a re-run exports the same weights.h."""
-    doc = {"format": "pour-policy-1", "config": cfg.to_dict(), "config_digest": cfg.digest(),
+    """The exporter's input: deterministic bytes (no times, and not `workers`, which changes the speed
+    and nothing else), so a re-run exports the same weights.h whatever its worker count."""
+    config = cfg.to_dict()
+    del config["workers"]
+    doc = {"format": "pour-policy-1", "config": config, "config_digest": cfg.digest(),
            "iteration": iteration, "n_actions": cfg.policy.n_actions,
            "decision_period_ms": cfg.policy.decision_period_ms, "tau_max_nm": tau_max_nm,
            "norm": {"theta_min_rad": envs.THETA_MIN_RAD, "theta_max_rad": envs.THETA_MAX_RAD,
@@ -193,17 +196,27 @@ def learning_rate(cfg: cfgmod.TrainConfig, it: int) -> float:
     return a.lr + (a.lr_final - a.lr) * it / max(1, cfg.iterations - 1)
 
 
-def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
-           it: int) -> tuple[np.ndarray, float]:
-    """One policy-gradient step on a batch of episodes; returns (new parameters, gradient norm).
+def max_kl(cfg: cfgmod.TrainConfig, it: int) -> float:
+    """The trust region's bound at iteration it [nats]: max_kl, decayed geometrically to max_kl_final."""
+    a = cfg.algo
+    if a.max_kl_final < 0 or a.max_kl == 0:
+        return a.max_kl
+    return a.max_kl * (a.max_kl_final / a.max_kl) ** (it / max(1, cfg.iterations - 1))
 
-    w is the parameter vector (for policy.param 'full' it is W itself)."""
+
+def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
+           it: int, kl_bound: float | None = None) -> tuple[np.ndarray, dict[str, float]]:
+    """One policy-gradient step on a batch of episodes; returns (new parameters, step statistics).
+
+    w is the parameter vector (for policy.param 'full' it is W itself). The statistics: grad_norm
+    (before clipping), lr, kl (mean KL(old || new) over the batch's states [nats]) and step_scale
+    (the trust region's backtracking factor, 1 when the step was taken whole)."""
     with np.errstate(over="ignore", invalid="ignore"):  # non-finite results are caught below, by name
-        return _update(cfg, w, eps, opt, it)
+        return _update(cfg, w, eps, opt, it, max_kl(cfg, it) if kl_bound is None else kl_bound)
 
 
 def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
-            it: int) -> tuple[np.ndarray, float]:
+            it: int, delta: float) -> tuple[np.ndarray, dict[str, float]]:
     a = cfg.algo
     gamma_d = a.gamma ** cfg.policy.decision_period_ms
     batch = reinforce.Batch(np.stack([e.x for e in eps]), np.stack([e.actions for e in eps]),
@@ -214,14 +227,26 @@ def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode],
     reinforce.check_finite("gradient", g, it)
     g, norm = reinforce.clip_norm(g, a.grad_clip)
     lr = learning_rate(cfg, it)
-    if opt is not None:
+    w_old = weights(cfg, w)
+    x = batch.x.reshape(-1, batch.x.shape[-1])
+    if a.optimizer == "natural":
+        step = reinforce.natural_step(g, reinforce.fisher(cfg.policy.param, w_old, x, cfg.policy.sharpness), delta)
+    elif opt is not None:
         opt.lr = lr
         step = opt.step(g)
     else:
         step = lr * g
+
+    def kl_of(s: np.ndarray) -> float:
+        return reinforce.mean_kl(w_old, weights(cfg, w + s), x)
+
+    if delta > 0:
+        step, kl, scale = reinforce.trust_region(step, kl_of, delta)
+    else:
+        kl, scale = kl_of(step), 1.0
     w_new = w + step
     reinforce.check_finite("weights", w_new, it)
-    return w_new, norm
+    return w_new, {"grad_norm": norm, "lr": lr, "kl_bound": delta, "kl": kl, "step_scale": scale}
 
 
 def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, quiet: bool = False,
@@ -242,6 +267,9 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     opt = reinforce.Adam(params.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
     best_ep: dict[str, np.ndarray] = {}
     rows: list[dict[str, Any]] = []
+    # Rollback (algo.rollback > 0): the parameters of the best batch so far, its mean return and its
+    # standard error, and how many steps were undone (each one shrinks the trust region).
+    anchor_params, anchor_ret, anchor_se, n_rollbacks = params.copy(), -np.inf, 0.0, 0
     if ckpt_path.exists() and resume:
         st = load_checkpoint(ckpt_path)
         if str(st["config_digest"]) != digest:
@@ -254,6 +282,9 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
         if opt is not None:
             opt.load_state_dict(st)
         best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
+        if "anchor_params" in st:
+            anchor_params, anchor_ret = np.array(st["anchor_params"]), float(st["anchor_ret"])
+            anchor_se, n_rollbacks = float(st["anchor_se"]), int(st["n_rollbacks"])
         rows = [r for r in read_log(log_path) if int(r["iteration"]) < start]
         if not quiet:
             print(f"[pour-train] resuming {run_dir} at iteration {start}", file=sys.stderr)
@@ -280,7 +311,27 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                 e = eps[ib]
                 best_ep = {"best_ep_x": e.x, "best_ep_actions": e.actions, "best_ep_rewards": e.rewards,
                            "best_ep_return": np.array(rets[ib]), "best_ep_iteration": np.array(it)}
-            params, gnorm = update(cfg, params, eps, opt, it)
+            rolled = 0
+            if cfg.algo.rollback > 0:
+                r_mean = float(rets.mean())
+                if it >= cfg.algo.rollback_from and \
+                        r_mean < anchor_ret - cfg.algo.rollback * abs(anchor_ret) - 2.0 * anchor_se:
+                    rolled = 1
+                elif r_mean > anchor_ret:
+                    anchor_params, anchor_ret = params.copy(), r_mean
+                    anchor_se = float(rets.std()) / np.sqrt(len(rets))
+            bound = max_kl(cfg, it) * cfg.algo.rollback_shrink ** n_rollbacks
+            if rolled:
+                # The last step made the batch return drop by more than the tolerance: undo it, forget
+                # Adam's momentum (it points over the same edge) and shrink the trust region.
+                n_rollbacks += 1
+                params = anchor_params.copy()
+                if opt is not None:
+                    opt.m[...] = 0.0
+                stats = {"grad_norm": np.nan, "lr": learning_rate(cfg, it), "kl_bound": bound, "kl": 0.0,
+                         "step_scale": 0.0}
+            else:
+                params, stats = update(cfg, params, eps, opt, it, bound)
             w = weights(cfg, params)
             ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
             last = it == cfg.iterations - 1
@@ -301,10 +352,12 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                    "v_target_mean": np.mean([e.metrics["v_target"] for e in eps]),
                    "v_spill_mean": np.mean([e.metrics["v_spill"] for e in eps]),
                    "finish_s_mean": np.mean([e.metrics["finish_s"] for e in eps]),
-                   "entropy_mean": ent, "grad_norm": gnorm, **ev, "best_score": best_score}
+                   "entropy_mean": ent, **stats, "rolled_back": rolled, **ev, "best_score": best_score}
             rows.append({k: _fmt(v) for k, v in row.items()})
             state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
-                     "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep}
+                     "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep,
+                     "anchor_params": anchor_params, "anchor_ret": anchor_ret, "anchor_se": anchor_se,
+                     "n_rollbacks": n_rollbacks}
             # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
             write_log(log_path, rows)
             write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
@@ -313,7 +366,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
-                      f"eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]",
+                      f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]",
                       file=sys.stderr, flush=True)
         runner.close()
     final = load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
