@@ -190,7 +190,50 @@ EOS
   rm -rf "$guest" "$log"
 }
 
-SECTIONS=(core lcm sim can)
+# --- section: weights — parse time of weights.h against its size (host_sim's C++ loader, pour.weights_h) --
+# The worst inputs of the 1 MiB the loaders read: an accepted header made long by one comment or by many
+# comment lines, and one single token. Best of 5 runs (C) or 3 (Python) per size; ns/byte staying flat
+# as the size doubles shows the parse is linear. Bar: < 100 ms for 1 MiB.
+bench_weights() {
+  local log
+  log=$(mktemp)
+  echo "== weights: weights.h parse time (tokenizer, no backtracking; docs/weights-h.md) =="
+  if ! { cmake --preset host && cmake --build --preset host -j2 --target bench_weights_parse; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the host build of bench_weights_parse failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  echo "-- C++ (host_sim, poursim_weights_parse):"
+  ./build/host/bin/bench_weights_parse policy/example_weights.h | sed 's/^/   /'
+  echo "-- Python (pour.weights_h.parse_weights_h_bytes):"
+  .venv/bin/python - <<'EOS' | sed 's/^/   /'
+import time
+from pathlib import Path
+from pour.weights_h import WeightsHError, parse_weights_h_bytes
+good = Path("policy/example_weights.h").read_bytes()
+key = b"#define POUR_WEIGHTS_FORMAT 1"
+for what in ("accepted, one long comment", "one token (refused)"):
+    print(what + ":")
+    size = 1 << 17
+    while size <= 1 << 20:
+        data = (good.replace(key, key + b" /*" + b"x" * (size - len(good) - 6) + b" */") if "comment" in what
+                else b"9" * size)
+        best, verdict = 1e9, "accepted"
+        for _ in range(3):
+            t0 = time.perf_counter()
+            try:
+                parse_weights_h_bytes(data, "bench.h")
+            except WeightsHError:
+                verdict = "refused"
+            best = min(best, time.perf_counter() - t0)
+        print(f"  {len(data):7d} bytes: {1e3 * best:7.2f} ms  {1e9 * best / len(data):6.2f} ns/byte  ({verdict})")
+        size <<= 1
+EOS
+}
+
+SECTIONS=(core lcm sim can weights)
 wanted=("$@")
 [ ${#wanted[@]} -gt 0 ] || wanted=("${SECTIONS[@]}")
 status=0

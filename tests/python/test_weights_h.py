@@ -1,16 +1,21 @@
 # SPDX-License-Identifier: MIT
 """pour.weights_h: writing, parsing and hashing weights.h (docs/weights-h.md)."""
+import ctypes
 import hashlib
+import random
 import re
 import struct
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pour import fixedpoint as fp
 from pour import golden
-from pour.weights_h import (WeightsHError, choose_frac_bits, content_hash, parse_weights_h, quantize_weights,
-                            render_weights_h, write_weights_h)
+from pour import sim
+from pour.weights_h import (WeightsHError, choose_frac_bits, content_hash, parse_weights_h,
+                            parse_weights_h_bytes, quantize_weights, render_weights_h, write_weights_h)
 
 NORM = (0, 2356194, 4000000)
 
@@ -106,17 +111,19 @@ def good_text():
 
 
 @pytest.mark.parametrize("edit, message", [
-    (lambda t: t.replace("#define POUR_WEIGHTS_TAU_MAX_MNM 40000\n", ""), "missing POUR_WEIGHTS_TAU_MAX_MNM"),
+    (lambda t: t.replace("#define POUR_WEIGHTS_TAU_MAX_MNM 40000\n", ""), "POUR_WEIGHTS_TAU_MAX_MNM is missing"),
     (lambda t: t.replace("#define POUR_WEIGHTS_FORMAT 1", "#define POUR_WEIGHTS_FORMAT 2"), "POUR_WEIGHTS_FORMAT"),
     (lambda t: t.replace("#define POUR_WEIGHTS_N_ACTIONS 3", "#define POUR_WEIGHTS_N_ACTIONS 17"), "N_ACTIONS"),
-    (lambda t: re.sub(r"W_FRAC_BITS \d+", "W_FRAC_BITS 16", t), "POUR_WEIGHTS_W_FRAC_BITS is 16"),
+    (lambda t: re.sub(r"W_FRAC_BITS \d+", "W_FRAC_BITS 16", t), "POUR_WEIGHTS_W_FRAC_BITS = '16' is out of range"),
     (lambda t: t.replace("#define POUR_WEIGHTS_DECISION_PERIOD_MS 10", "#define POUR_WEIGHTS_DECISION_PERIOD_MS x"),
-     "DECISION_PERIOD_MS is not an integer"),
+     "DECISION_PERIOD_MS: 'x' is not a plain decimal integer"),
     (lambda t: t.replace("#define POUR_WEIGHTS_THETA_MAX_URAD 2356194", "#define POUR_WEIGHTS_THETA_MAX_URAD -4"),
-     "theta_max_urad"),
+     "THETA_MAX_URAD = -4 must be > POUR_WEIGHTS_THETA_MIN_URAD"),
     (lambda t: t.replace("{-32768, 0, 32767}", "{-32768, 0}"), "pour_weights_action_levels_q15 has 2 values"),
+    (lambda t: t.replace("#define POUR_WEIGHTS_H\n", "#define POUR_WEIGHTS_H\n#define POUR_WEIGHTS_H 1\n"),
+     "POUR_WEIGHTS_H takes no value"),
     (lambda t: t.replace("{-32768, 0, 32767}", "{0, -32768, 32767}"), "strictly increasing"),
-    (lambda t: t.split("static const int16_t pour_weights_w")[0], "missing array pour_weights_w"),
+    (lambda t: t.split("static const int16_t pour_weights_w")[0] + "#endif\n", "pour_weights_w is missing"),
     (lambda t: t[: t.index("pour_weights_w[") + 120], "truncated"),
     (lambda t: t.replace("#define POUR_WEIGHTS_CONTENT_HASH 0x", "#define POUR_WEIGHTS_CONTENT_HASH 0x1"),
      "CONTENT_HASH"),
@@ -160,3 +167,75 @@ def test_hand_made_policy_behaves_sensibly():
     assert act([0.9, 0.5, 0.6, 0.3, 0.0]) < act([0.3, 0.5, 0.6, 0.3, 0.0])
     assert act([0.5, 0.5, 0.2, 0.7, 0.0]) < act([0.5, 0.5, 0.9, 0.0, 0.0])
     assert act([0.3, 0.9, 0.6, 0.3, 0.0]) < act([0.3, 0.5, 0.6, 0.3, 0.0])
+
+
+CASES_DIR = Path(__file__).resolve().parents[1] / "data" / "weights_cases"
+CASES = [line.split("\t") for line in (CASES_DIR / "cases.tsv").read_text().splitlines() if not line.startswith("#")]
+
+
+@pytest.mark.parametrize("name, verdict, message, firmware", CASES, ids=[c[0] for c in CASES])
+def test_shared_case_table(name, verdict, message, firmware):
+    """tests/data/weights_cases: the same verdicts as host_sim's loader (tests/sim/test_weights_file.c)."""
+    path = CASES_DIR / name
+    if verdict == "accept":
+        assert parse_weights_h(path).n_actions == 11
+    else:
+        with pytest.raises(WeightsHError) as exc:
+            parse_weights_h(path)
+        assert message in str(exc.value) and name in str(exc.value)
+
+
+def _c_parse(lib, data: bytes) -> str:
+    out = ctypes.create_string_buffer(8192)  # > sizeof(poursim_weights_file_t)
+    err = ctypes.create_string_buffer(256)
+    rc = lib.poursim_weights_parse(data, len(data), b"case.h", out, err, len(err))
+    return "accepted" if rc == 0 else err.value.decode()
+
+
+def _py_parse(data: bytes) -> str:
+    try:
+        parse_weights_h_bytes(data, "case.h")
+    except WeightsHError as exc:
+        return str(exc)[:255]  # C's message buffer holds 255 characters
+    return "accepted"
+
+
+def _mutations(base: bytes, rng: random.Random, count: int):
+    """Seeded edits of a good header: bytes flipped, deleted, duplicated, and tokens from the grammar inserted."""
+    words = [b"#", b"#define ", b"#endif\n", b"/*", b"*/", b"//", b"\n", b"\r", b"\\\n", b"??/\n", b"{", b"}",
+             b",", b";", b"-", b"-1u", b"0x10u", b"010", b"1e999f", b"NAN", b"[", b"]", b"[]", b"static const ",
+             b"POUR_WEIGHTS_N_ACTIONS", b"POUR_WEIGHTS_H", b"\0", b"\xc3\xa9", b".5f", b"1.e5", b"-.5"]
+    for _ in range(count):
+        data = bytearray(base)
+        for _ in range(rng.randint(1, 3)):
+            at = rng.randrange(len(data) + 1)
+            op = rng.randrange(4)
+            if op == 0 and at < len(data):
+                data[at] = rng.randrange(256)
+            elif op == 1:
+                del data[at:at + rng.randint(1, 40)]
+            elif op == 2:
+                data[at:at] = data[at:at + rng.randint(1, 80)]
+            else:
+                data[at:at] = rng.choice(words)
+        yield bytes(data)
+
+
+def test_c_and_python_parsers_agree_message_for_message(source_dir):
+    """Both parsers, on every shared case and on 3000 seeded mutations of them: the same verdict and the
+    same message (line and field included)."""
+    lib = sim.load_library()
+    lib.poursim_weights_parse.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p, ctypes.c_void_p,
+                                          ctypes.c_char_p, ctypes.c_size_t]
+    lib.poursim_weights_parse.restype = ctypes.c_int
+    rng = random.Random(14)
+    seeds = [(CASES_DIR / c[0]).read_bytes() for c in CASES if len((CASES_DIR / c[0]).read_bytes()) < 8000]
+    checked = accepted = 0
+    for base in seeds:
+        for data in [base, *_mutations(base, rng, 3000 // len(seeds))]:
+            c, py = _c_parse(lib, data), _py_parse(data)
+            assert c == py, data
+            checked += 1
+            accepted += c == "accepted"
+    assert checked > 3000 and 0 < accepted < checked
+

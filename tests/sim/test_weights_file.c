@@ -132,7 +132,52 @@ static void test_weights_file_RefusesTruncatedFile(void) {
   const char *w = strstr(good, "pour_weights_w[");
   cut = (size_t)(w - good) + 150; /* in the middle of W */
   expect_error_naming(poursim_weights_parse(good, cut, "cut.h", &wf, err, sizeof err), "pour_weights_w");
-  expect_error_naming(poursim_weights_parse(good, 200, "cut.h", &wf, err, sizeof err), "missing");
+  const char *hash = strstr(good, "#define POUR_WEIGHTS_CONTENT_HASH");
+  expect_error_naming(poursim_weights_parse(good, (size_t)(hash - good), "cut.h", &wf, err, sizeof err),
+                      "truncated");
+}
+
+/* Every case of tests/data/weights_cases/cases.tsv (shared with tests/python/test_weights_h.py): accepted
+ * or refused as listed, the message containing the listed text and naming the file. */
+static void test_weights_file_AgreesWithTheSharedCaseTable(void) {
+  const char *dir = POUR_SOURCE_DIR "/tests/data/weights_cases";
+  char path[512], line[512];
+  snprintf(path, sizeof path, "%s/cases.tsv", dir);
+  FILE *f = fopen(path, "r");
+  TEST_ASSERT_NOT_NULL_MESSAGE(f, path);
+  int n = 0;
+  while (fgets(line, sizeof line, f) != NULL) {
+    if (line[0] == '#') continue;
+    line[strcspn(line, "\n")] = '\0';
+    char *file = strtok(line, "\t"), *verdict = strtok(NULL, "\t");
+    char *message = verdict != NULL && strcmp(verdict, "refuse") == 0 ? strtok(NULL, "\t") : NULL;
+    TEST_ASSERT_NOT_NULL_MESSAGE(verdict, file);
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    err[0] = '\0';
+    int rc = poursim_weights_load(path, &wf, err, sizeof err);
+    printf("%-34s %s -> %s\n", file, verdict, rc == POURSIM_OK ? "accepted" : err);
+    if (message == NULL) {
+      TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, rc, err);
+    } else {
+      expect_error_naming(rc, message);
+      TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, file), err);
+    }
+    ++n;
+  }
+  fclose(f);
+  TEST_ASSERT_GREATER_THAN_INT(40, n);
+}
+
+/* The largest file the loader reads is refused beyond 1 MiB, before parsing. */
+static void test_weights_file_RefusesFilesOverOneMebibyte(void) {
+  const char *path = "big_weights.h";
+  FILE *f = fopen(path, "wb");
+  TEST_ASSERT_NOT_NULL(f);
+  fputs(good, f);
+  while (ftell(f) <= (1L << 20)) fputs("/* padding */\n", f);
+  fclose(f);
+  expect_error_naming(poursim_weights_load(path, &wf, err, sizeof err), "larger than 1048576 bytes");
+  remove(path);
 }
 
 static void test_weights_file_RefusesNaNInFloatReference(void) {
@@ -177,5 +222,7 @@ int main(void) {
   RUN_TEST(test_weights_file_RefusesTruncatedFile);
   RUN_TEST(test_weights_file_RefusesNaNInFloatReference);
   RUN_TEST(test_weights_file_RefusesEditedWeightsAndBadValues);
+  RUN_TEST(test_weights_file_AgreesWithTheSharedCaseTable);
+  RUN_TEST(test_weights_file_RefusesFilesOverOneMebibyte);
   return UNITY_END();
 }

@@ -1,0 +1,22 @@
+/* example_weights.h — pour policy. Hand-made (pour.golden.hand_made_weights(11), kept for tests). DO NOT EDIT. */
+#ifndef POUR_WEIGHTS_H
+#define POUR_WEIGHTS_H
+#include <stdint.h>
+#define POUR_WEIGHTS_FORMAT 1
+#define POUR_WEIGHTS_N_FEATURES 6 /* theta, omega, v_rotating, v_target, v_spill, bias */
+#define POUR_WEIGHTS_N_ACTIONS 11
+#define POUR_WEIGHTS_W_FRAC_BITS 9 /* int16 weights, Q6.9 */
+#define POUR_WEIGHTS_DECISION_PERIOD_MS 10
+#define POUR_WEIGHTS_THETA_MIN_URAD 0
+#define POUR_WEIGHTS_THETA_MAX_URAD 2356194
+#define POUR_WEIGHTS_OMEGA_MAX_URAD_S 4000000
+#define POUR_WEIGHTS_TAU_MAX_MNM 20000
+#define POUR_WEIGHTS_CONTENT_HASH 0x09b1269bu
+static const int16_t pour_weights_w[POUR_WEIGHTS_N_FEATURES][POUR_WEIGHTS_N_ACTIONS] = {
+    {4096, 3277, 2458, 1638, 819, 0, -819, -1638, -2458, -3277, -4096},
+    {16384, 13107, 9830, 6554, 3277, 0, -3277, -6554, -9830, -13107, -16384},
+    {-3072, -2458, -1843, -1229, -614, 0, 614, 1229, 1843, 2458, 3072},
+    {2048, 1638, 1229, 819, 410, 0, -410, -819, -1229, -1638, -2048},
+    {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+    {-14746, -11469, -8356, -5407, -2621, 0, 2458, 4751, 6881, 8847, 10650}
+}
