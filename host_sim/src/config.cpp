@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The simulator's configuration: defaults, one table of fields (name, range), file I/O.
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -8,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -214,30 +216,78 @@ extern "C" int poursim_config_set(poursim_config_t *c, const char *key, const ch
   return POURSIM_OK;
 }
 
+namespace {
+
+constexpr size_t kMaxConfigBytes = 1 << 20; // the same cap as a weights.h; a config is a few KB
+
+// The line of the first key the file set that a validation message names (0 if it names none): the
+// range checks and cross-field rules name the keys they are about.
+int line_of_named_key(const std::string &msg, const std::map<std::string, int> &lines) {
+  for (size_t i = 0; i < msg.size();) {
+    size_t j = i;
+    while (j < msg.size() && (std::islower(static_cast<unsigned char>(msg[j])) || msg[j] == '_')) ++j;
+    if (j > i) {
+      auto it = lines.find(msg.substr(i, j - i));
+      if (it != lines.end()) return it->second;
+      i = j;
+    } else {
+      ++i;
+    }
+  }
+  return 0;
+}
+
+} // namespace
+
+// Same limits as the weights.h loader: bounded size, text only, every key once, every error with the
+// file and line it comes from.
 extern "C" int poursim_config_load(const char *path, poursim_config_t *c, char *err, size_t err_len) {
   if (path == nullptr || c == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "config_load: NULL argument");
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return set_error(err, err_len, POURSIM_EIO, "cannot read config file '%s': %s", path, std::strerror(errno));
-  std::string line;
-  int lineno = 0;
+  std::string text;
+  char buf[4096];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, static_cast<size_t>(in.gcount()));
+    if (text.size() > kMaxConfigBytes)
+      return set_error(err, err_len, POURSIM_EPARSE, "%s: larger than %zu bytes, not a config file", path,
+                       kMaxConfigBytes);
+  }
+  if (in.bad()) return set_error(err, err_len, POURSIM_EIO, "error reading config file '%s'", path);
+  std::map<std::string, int> key_line;
   char sub[POURSIM_ERR_LEN];
-  while (std::getline(in, line)) {
+  int lineno = 0;
+  for (size_t start = 0; start < text.size();) {
+    size_t stop = text.find('\n', start);
+    if (stop == std::string::npos) stop = text.size();
+    std::string line = text.substr(start, stop - start);
+    start = stop + 1;
     ++lineno;
+    if (line.find('\0') != std::string::npos)
+      return set_error(err, err_len, POURSIM_EPARSE, "%s:%d: contains a NUL byte (not a text file)", path, lineno);
     size_t hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
     line = trim(line);
     if (line.empty()) continue;
     size_t eq = line.find('=');
     if (eq == std::string::npos)
-      return set_error(err, err_len, POURSIM_EPARSE, "%s:%d: expected 'key = value', got '%s'", path, lineno,
+      return set_error(err, err_len, POURSIM_EPARSE, "%s:%d: expected 'key = value', got '%.60s'", path, lineno,
                        line.c_str());
     std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+    auto seen = key_line.find(key);
+    if (seen != key_line.end())
+      return set_error(err, err_len, POURSIM_EPARSE, "%s:%d: %.60s is set twice (first on line %d)", path, lineno,
+                       key.c_str(), seen->second);
     int rc = poursim_config_set(c, key.c_str(), value.c_str(), sub, sizeof sub);
     if (rc != POURSIM_OK) return set_error(err, err_len, rc, "%s:%d: %s", path, lineno, sub);
+    key_line[key] = lineno;
   }
-  if (in.bad()) return set_error(err, err_len, POURSIM_EIO, "error reading config file '%s'", path);
   int rc = poursim_config_validate(c, sub, sizeof sub);
-  if (rc != POURSIM_OK) return set_error(err, err_len, rc, "%s: %s", path, sub);
+  if (rc != POURSIM_OK) {
+    int line = line_of_named_key(sub, key_line);
+    if (line > 0) return set_error(err, err_len, rc, "%s:%d: %s", path, line, sub);
+    return set_error(err, err_len, rc, "%s: %s (with the defaults of the keys it does not set)", path, sub);
+  }
   return POURSIM_OK;
 }
 

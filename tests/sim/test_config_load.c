@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: MIT */
+/* poursim_config_load: the same limits as the weights.h loader (bounded size, text only, each key once)
+ * and every error naming the file and the line. */
+#include <stdio.h>
+#include <string.h>
+
+#include "poursim/poursim.h"
+#include "unity.h"
+
+static poursim_config_t cfg;
+static char err[POURSIM_ERR_LEN];
+
+void setUp(void) {
+  cfg = poursim_default_config();
+  err[0] = '\0';
+}
+
+void tearDown(void) {}
+
+/* Writes len bytes of text to a file in the working directory and loads it. */
+static int load_text(const char *name, const char *text, size_t len) {
+  FILE *f = fopen(name, "wb");
+  TEST_ASSERT_NOT_NULL(f);
+  TEST_ASSERT_EQUAL_size_t(len, fwrite(text, 1, len, f));
+  fclose(f);
+  return poursim_config_load(name, &cfg, err, sizeof err);
+}
+
+static void expect_error(int rc, const char *where, const char *what) {
+  TEST_ASSERT_TRUE_MESSAGE(rc < 0, "a bad config was accepted");
+  TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, where), err);
+  TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, what), err);
+}
+
+static void test_config_load_ReadsTheShippedConfig(void) {
+  TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, poursim_config_load(POUR_SOURCE_DIR "/configs/sim/default.cfg", &cfg, err, sizeof err), err);
+  static const char crlf[] = "# comment\r\nseed = 7\r\n\r\nfriction = 0.1 # why\r\n";
+  TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, load_text("crlf.cfg", crlf, sizeof crlf - 1), err);
+  TEST_ASSERT_EQUAL_UINT32(7, cfg.seed);
+  TEST_ASSERT_EQUAL_DOUBLE(0.1, cfg.friction);
+}
+
+/* /dev/zero: refused at the size cap, not read until memory runs out. */
+static void test_config_load_RefusesAnEndlessFile(void) {
+  expect_error(poursim_config_load("/dev/zero", &cfg, err, sizeof err), "/dev/zero", "larger than 1048576 bytes");
+}
+
+/* "seed = 7\0JUNK" used to read as seed 7. */
+static void test_config_load_RefusesNulBytes(void) {
+  static const char text[] = "friction = 0.1\nseed = 7\0JUNK\n";
+  expect_error(load_text("nul.cfg", text, sizeof text - 1), "nul.cfg:2:", "NUL byte");
+}
+
+/* The last of two settings used to win silently. */
+static void test_config_load_RefusesDuplicateKeys(void) {
+  static const char text[] = "seed = 7\nfriction = 0.1\n  seed=8\n";
+  expect_error(load_text("dup.cfg", text, sizeof text - 1), "dup.cfg:3:", "seed is set twice (first on line 1)");
+}
+
+static void test_config_load_NamesFileAndLineInEveryError(void) {
+  static const char bad_line[] = "seed = 7\n\nno equals sign\n";
+  expect_error(load_text("line.cfg", bad_line, sizeof bad_line - 1), "line.cfg:3:", "expected 'key = value'");
+  static const char bad_key[] = "sead = 7\n";
+  expect_error(load_text("key.cfg", bad_key, sizeof bad_key - 1), "key.cfg:1:", "unknown config key 'sead'");
+  static const char bad_value[] = "# c\nfriction = 1e999\n";
+  expect_error(load_text("value.cfg", bad_value, sizeof bad_value - 1), "value.cfg:2:", "friction");
+  /* A rule across keys: the line of the key the rule names first. */
+  static const char cross[] = "seed = 3\nradius_min = 0.02\n";
+  expect_error(load_text("cross.cfg", cross, sizeof cross - 1), "cross.cfg:2:", "radius_min");
+  expect_error(poursim_config_load("/nonexistent/x.cfg", &cfg, err, sizeof err), "/nonexistent/x.cfg", "cannot read");
+}
+
+int main(void) {
+  UNITY_BEGIN();
+  RUN_TEST(test_config_load_ReadsTheShippedConfig);
+  RUN_TEST(test_config_load_RefusesAnEndlessFile);
+  RUN_TEST(test_config_load_RefusesNulBytes);
+  RUN_TEST(test_config_load_RefusesDuplicateKeys);
+  RUN_TEST(test_config_load_NamesFileAndLineInEveryError);
+  return UNITY_END();
+}
