@@ -197,17 +197,108 @@ def test_bad_policy_files_give_clear_errors(tmp_path):
         with pytest.raises(export.ExportError, match=msg):
             export.export(p, tmp_path / "o.h")
     nan = _policy_json(tmp_path / "nan.json", np.full((6, 3), np.nan))
-    with pytest.raises(export.ExportError, match="NaN or infinity"):
+    with pytest.raises(export.ExportError, match=r"w\[0\]\[0\] is nan, not a finite number"):
         export.export(nan, tmp_path / "o.h")
     shape = _policy_json(tmp_path / "shape.json", np.zeros((5, 3)))
-    with pytest.raises(export.ExportError, match=r"W has shape \(5, 3\), expected \(6, 3\)"):
+    with pytest.raises(export.ExportError, match="w has 5 rows, expected 6 rows of 3"):
         export.export(shape, tmp_path / "o.h")
     huge = _policy_json(tmp_path / "huge.json", np.full((6, 3), 1e6))
     with pytest.raises(export.ExportError, match="does not fit int16"):
         export.export(huge, tmp_path / "o.h")
+    assert not (tmp_path / "o.h").exists()
     r = subprocess.run([sys.executable, "-m", "pour.export", str(tmp_path / "missing.json"), "--out",
                         str(tmp_path / "o.h")], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and r.stderr.startswith("pour-export: error:") and "Traceback" not in r.stderr
+
+
+def _edited(doc_edit):
+    """A good policy document with one edit (a function of the parsed JSON)."""
+    def make(tmp_path):
+        p = _policy_json(tmp_path / "policy.json", np.zeros((6, 3)))
+        doc = json.loads(p.read_text())
+        doc_edit(doc)
+        p.write_text(json.dumps(doc))  # NaN is written as the JSON extension NaN
+        return p
+    return make
+
+
+def _set(path, value):
+    def edit(doc):
+        *head, last = path
+        for k in head:
+            doc = doc[k]
+        if value is KeyError:
+            del doc[last]
+        else:
+            doc[last] = value
+    return edit
+
+
+# Every bad field the issue found (a traceback before), and a few more: one line naming it, exit 2.
+@pytest.mark.parametrize("edit, field", [
+    (_set(("norm", "theta_max_rad"), KeyError), "missing field 'norm.theta_max_rad'"),
+    (_set(("norm", "theta_min_rad"), None), "norm.theta_min_rad is null, not a number"),
+    (_set(("norm",), None), "norm is null, expected an object"),
+    (_set(("norm", "omega_max_rad_s"), float("nan")), "norm.omega_max_rad_s is nan, not a finite number"),
+    (_set(("norm", "omega_max_rad_s"), -1.0), "omega_max_urad_s (-1000000) must be > 0"),
+    (_set(("best_w", 1, 2), "0.5"), 'best_w[1][2] is "0.5", not a number'),
+    (_set(("best_w", 3), [0.0, 0.0]), "best_w row 3 has 2 values, expected 3 values"),
+    (_set(("best_w", 4), 7), "best_w row 4 has 7, expected 3 values"),
+    (_set(("w", 0, 0), True), "w[0][0] is true, not a number"),
+    (_set(("tau_max_nm",), "40"), 'tau_max_nm is "40", not a number'),
+    (_set(("tau_max_nm",), 0), "tau_max_nm is 0.0, expected > 0"),
+    (_set(("tau_max_nm",), 4.0004), "not a whole number of mN"),
+    (_set(("decision_period_ms",), "10"), 'decision_period_ms is "10", not a number'),
+    (_set(("decision_period_ms",), 10.9), "decision_period_ms is 10.9, not an integer in 1..65535"),
+    (_set(("decision_period_ms",), 0), "decision_period_ms is 0, not an integer in 1..65535"),
+    (_set(("n_actions",), 3.5), "n_actions is 3.5, not an integer in 2..16"),
+    (_set(("n_actions",), 4), "w row 0 has 3 values, expected 4 values"),
+])
+def test_each_bad_field_gives_one_line_naming_it_and_exit_2(tmp_path, capsys, edit, field):
+    policy = _edited(edit)(tmp_path)
+    out = tmp_path / "w.h"
+    out.write_text("a good header\n")
+    assert export.main([str(policy), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("pour-export: error: ") and field in err, err
+    assert out.read_text() == "a good header\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["policy.json", "w.h"]
+
+
+def test_integral_floats_are_whole_numbers(tmp_path):
+    policy = _edited(_set(("decision_period_ms",), 10.0))(tmp_path)
+    assert export.export(policy, tmp_path / "w.h").decision_period_ms == 10
+
+
+@pytest.mark.parametrize("out, message", [
+    ("", "--out: the path is empty"),
+    ("{tmp}", "is a directory"),
+    ("{tmp}/sub/", "is a directory"),
+    ("{tmp}/missing/w.h", "folder {tmp}/missing does not exist"),
+])
+def test_bad_out_paths_are_refused_before_any_work(tmp_path, capsys, out, message):
+    policy = _policy_json(tmp_path / "policy.json", np.zeros((6, 3)))
+    (tmp_path / "sub").mkdir()
+    assert export.main([str(policy), "--out", out.format(tmp=tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message.format(tmp=tmp_path) in err, err
+
+
+def test_a_failed_write_leaves_the_previous_header_whole(tmp_path):
+    """The disk filling up mid-write, for real: the file size limit (RLIMIT_FSIZE) makes the kernel refuse
+    the write past 1 KB (EFBIG), as a full disk would (ENOSPC). The good header stays; no temporary stays."""
+    good = export.export(_policy_json(tmp_path / "policy.json", np.zeros((6, 3))), tmp_path / "w.h")
+    before = (tmp_path / "w.h").read_bytes()
+    _policy_json(tmp_path / "policy.json", np.ones((6, 3)))
+    code = ("import resource, signal, sys; signal.signal(signal.SIGXFSZ, signal.SIG_IGN); "
+            "resource.setrlimit(resource.RLIMIT_FSIZE, (1024, 1024)); "
+            "from pour.export import main; sys.exit(main(sys.argv[1:]))")
+    r = subprocess.run([sys.executable, "-c", code, str(tmp_path / "policy.json"), "--out", str(tmp_path / "w.h")],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "cannot write" in r.stderr and "unchanged" in r.stderr
+    assert (tmp_path / "w.h").read_bytes() == before and good.content_hash
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["policy.json", "w.h"]
 
 
 def test_pour_eval_agree_on_a_toy_run_and_its_errors(tmp_path, capsys):

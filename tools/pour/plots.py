@@ -19,8 +19,17 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pour import envs  # noqa: E402
+from pour import atomic, envs  # noqa: E402
 
+
+
+def _save(fig, out: Path) -> None:
+    """Saves and closes fig; the PNG is written beside out and renamed (an old one stays whole on failure)."""
+    try:
+        with atomic.atomic_path(out) as tmp:
+            fig.savefig(tmp)
+    finally:
+        plt.close(fig)
 
 def _log(run_dir: Path) -> dict[str, np.ndarray]:
     with open(run_dir / "log.csv", newline="") as f:
@@ -68,8 +77,7 @@ def reward_curve(groups: dict[str, Sequence[Path]], out: Path, column: str = "re
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right", fontsize=8)
     fig.tight_layout()
-    fig.savefig(out)
-    plt.close(fig)
+    _save(fig, out)
 
 
 def episode_traces(x: np.ndarray, period_ms: int) -> dict[str, np.ndarray]:
@@ -91,8 +99,7 @@ def angle(episodes: dict[str, np.ndarray], period_ms: int, out: Path, title: str
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out)
-    plt.close(fig)
+    _save(fig, out)
 
 
 def volumes(x: np.ndarray, period_ms: int, out: Path, title: str) -> None:
@@ -109,8 +116,7 @@ def volumes(x: np.ndarray, period_ms: int, out: Path, title: str) -> None:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out)
-    plt.close(fig)
+    _save(fig, out)
 
 
 def best_episode(run_dir: Path) -> np.ndarray:

@@ -27,6 +27,8 @@ from matplotlib import animation  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 
+from pour import atomic  # noqa: E402
+
 COLOURS = np.array([[0.96, 0.88, 0.70, 1.0],   # in the rotating bucket
                     [0.96, 0.88, 0.70, 1.0],   # in the target
                     [0.85, 0.15, 0.10, 1.0],   # spilled
@@ -186,7 +188,8 @@ def render(traj: Path, out: Path, fps: float | None = None) -> tuple[Path, Path]
     scene.update(k)
     for c in cursors:
         c.set_xdata([data["frames"][k]["t"]] * 2)
-    fig.savefig(png, dpi=100)
+    with atomic.atomic_path(png) as tmp:
+        fig.savefig(tmp, dpi=100)
 
     def step(i: int):
         for c in cursors:
@@ -195,8 +198,11 @@ def render(traj: Path, out: Path, fps: float | None = None) -> tuple[Path, Path]
 
     anim = animation.FuncAnimation(fig, step, frames=len(data["frames"]), blit=False)
     writer = animation.PillowWriter(fps=fps) if suffix == ".gif" else animation.FFMpegWriter(fps=fps)
-    anim.save(str(out), writer=writer)
-    plt.close(fig)
+    try:
+        with atomic.atomic_path(out) as tmp:
+            anim.save(str(tmp), writer=writer)
+    finally:
+        plt.close(fig)
     return out, png
 
 
@@ -208,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     try:
         out, png = render(args.trajectory, args.out, args.fps)
-    except RenderError as e:
+    except (RenderError, OSError) as e:
         print(f"pour-render: {e}", file=sys.stderr)
         return 1
     print(f"pour-render: wrote {out} and {png}")

@@ -19,7 +19,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import envs, evaluate, export, weights_h
+from pour import atomic, envs, evaluate, export, weights_h
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
 
@@ -148,9 +148,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     title = f"Shipped policy, held-out seed {FIRST_SEED}"
     plots.angle({"shipped policy": ep.x}, hdr.decision_period_ms, args.out / "shipped_angle.png", title)
     plots.volumes(ep.x, hdr.decision_period_ms, args.out / "shipped_volumes.png", title)
-    (args.out / "results.json").write_text(json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows},
-                                                      indent=1) + "\n")
-    (args.out / "results.md").write_text(markdown(rows, n))
+    atomic.write_atomic(args.out / "results.json",
+                        json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows}, indent=1) + "\n")
+    atomic.write_atomic(args.out / "results.md", markdown(rows, n))
     print(markdown(rows, n))
     return 0
 

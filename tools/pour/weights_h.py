@@ -13,6 +13,7 @@ from typing import Mapping, Sequence, Union
 
 import numpy as np
 
+from pour import atomic
 from pour import fixedpoint as fp
 
 FORMAT = 1
@@ -211,7 +212,7 @@ def write_weights_h(path: PathLike, w_float: np.ndarray, levels: Sequence[float]
     path = Path(path)
     text = render_weights_h(w_float, levels, frac_bits, decision_period_ms, norm, tau_max_mnm, banner_inputs,
                             name=path.name, float_reference=float_reference)
-    path.write_text(text, encoding="utf-8")
+    atomic.write_atomic(path, text)
     return parse_weights_h(path)
 
 
