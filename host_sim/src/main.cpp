@@ -3,6 +3,7 @@
 // results, writes trajectories and renders them. `host_sim --help` explains the flags.
 #include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -19,6 +20,7 @@
 
 #include "controllers.hpp"
 #include "lcm_link.hpp"
+#include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
 
@@ -67,7 +69,12 @@ const char *kUsage =
     "  left     % still in the rotating bucket\n"
     "  finish   time until 99 % of what left the bucket had landed (in the target or spilled)\n"
     "  return   sum over 1 ms steps of gamma^t (k_target*V_target - k_spill*V_spill)\n"
-    "Exit status: 0 done, 1 bad file / config / output path, 2 bad command line, 3 (--lcm) no answer.\n"
+    "Outputs (--csv, --render and its .png and .json) are checked before the run: none may name an input\n"
+    "or another output. Each is written beside its target and renamed over it when complete, so a failed\n"
+    "or interrupted run leaves an existing file as it was.\n"
+    "Exit status: 0 done, 1 bad file / config / output path or a failed renderer, 2 bad command line\n"
+    "(an output naming an input or another output included), 3 (--lcm) no answer, 4 (--lcm) the controller\n"
+    "runs other weights.\n"
     "\n"
     "Examples:\n"
     "  host_sim --policy policy/weights.h --render pour.gif\n"
@@ -93,6 +100,20 @@ int usage_error(const char *fmt, const char *arg) {
   std::fprintf(stderr, fmt, arg);
   std::fprintf(stderr, "\n(run host_sim --help for usage)\n");
   return 2;
+}
+
+// Whether an executable called name is on PATH.
+bool on_path(const char *name) {
+  const char *path = std::getenv("PATH");
+  std::string dirs = path != nullptr ? path : "";
+  for (size_t a = 0; a <= dirs.size();) {
+    size_t b = dirs.find(':', a);
+    if (b == std::string::npos) b = dirs.size();
+    std::string file = (b > a ? dirs.substr(a, b - a) : ".") + "/" + name;
+    if (access(file.c_str(), X_OK) == 0) return true;
+    a = b + 1;
+  }
+  return false;
 }
 
 bool parse_long(const char *s, long long lo, long long hi, long long &out) {
@@ -124,6 +145,7 @@ int parse_args(int argc, char **argv, Options &o) {
       if (a == "--policy") o.policy = v;
       else if (a == "--baseline") o.baseline = v;
       else if (a == "--config") o.config_path = v;
+      else if ((a == "--csv" || a == "--render") && *v == '\0') return usage_error("%s: the file name is empty", a.c_str());
       else if (a == "--csv") o.csv = v;
       else if (a == "--render") o.render = v;
       else if (a == "--set") o.sets.push_back(v);
@@ -262,9 +284,10 @@ void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vect
 
 // The trajectory as JSON for tools/pour/render.py.
 bool write_render_json(const std::string &path, const poursim_world_t *world, const Recorder &rec,
-                       const std::string &title, const Episode &e) {
-  std::FILE *f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return false;
+                       const std::string &title, const Episode &e, std::string *why) {
+  poursim::AtomicFile out;
+  if (!out.open(path, why)) return false;
+  std::FILE *f = out.stream();
   const poursim_config_t *c = poursim_world_config(world);
   const std::vector<float> &radius = rec.radius;
   int n = static_cast<int>(radius.size());
@@ -296,7 +319,7 @@ bool write_render_json(const std::string &path, const poursim_world_t *world, co
     std::fprintf(f, "]}");
   }
   std::fprintf(f, "]}\n");
-  return std::fclose(f) == 0;
+  return out.commit(why);
 }
 
 int run_render(const std::string &json_path, const std::string &out) {
@@ -500,6 +523,34 @@ int main(int argc, char **argv) {
   }
   if (o.bench) return run_bench(o, cfg);
 
+  // Every output checked before any work: none may name an input or another output, all must be writable.
+  std::string render_base, render_json;
+  std::vector<poursim::NamedPath> outputs;
+  if (!o.csv.empty()) outputs.push_back({"--csv", o.csv});
+  if (!o.render.empty()) {
+    std::string ext = o.render.size() > 4 ? o.render.substr(o.render.size() - 4) : "";
+    if (ext != ".gif" && ext != ".mp4") return usage_error("--render wants a .gif or .mp4 file name, got '%s'", o.render.c_str());
+    render_base = o.render.substr(0, o.render.size() - 4);
+    if (render_base.empty() || render_base.back() == '/')
+      return usage_error("--render wants a file name before its .gif or .mp4, got '%s'", o.render.c_str());
+    if (ext == ".mp4" && !on_path("ffmpeg")) {
+      std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
+                   o.render.c_str());
+      return 1;
+    }
+    render_json = render_base + ".json";
+    outputs.push_back({"--render", o.render});
+    outputs.push_back({"--render (its .png snapshot)", render_base + ".png"});
+    outputs.push_back({"--render (its .json trajectory)", render_json});
+  }
+  std::string why;
+  int bad_status = 0;
+  if (!poursim::check_outputs(outputs, {{"--policy", o.policy}, {"--config", o.config_path}}, &why, &bad_status)) {
+    if (bad_status == 2) return usage_error("%s", why.c_str());
+    std::fprintf(stderr, "host_sim: %s\n", why.c_str());
+    return bad_status;
+  }
+
   std::unique_ptr<poursim::Controller> ctl;
   poursim::LcmController *lcm_ctl = nullptr;
   if (o.lcm) {
@@ -521,23 +572,6 @@ int main(int argc, char **argv) {
   else if (o.baseline == "full") ctl = poursim::make_full_torque_controller();
   else ctl = poursim::make_hand_controller(cfg);
 
-  std::string render_base, render_json;
-  if (!o.render.empty()) {
-    std::string ext = o.render.size() > 4 ? o.render.substr(o.render.size() - 4) : "";
-    if (ext != ".gif" && ext != ".mp4") return usage_error("--render wants a .gif or .mp4 file name, got '%s'", o.render.c_str());
-    render_base = o.render.substr(0, o.render.size() - 4);
-    render_json = render_base + ".json";
-  }
-  // Fail before a long run, not after it, if an output cannot be written.
-  for (const std::string &path : {o.csv, render_json}) {
-    if (path.empty()) continue;
-    std::FILE *probe = std::fopen(path.c_str(), "a");
-    if (probe == nullptr) {
-      std::fprintf(stderr, "host_sim: cannot write '%s': %s\n", path.c_str(), std::strerror(errno));
-      return 1;
-    }
-    std::fclose(probe);
-  }
   poursim_world_t *world = poursim_create(&cfg, err, sizeof err);
   if (world == nullptr) {
     std::fprintf(stderr, "host_sim: %s\n", err);
@@ -550,14 +584,16 @@ int main(int argc, char **argv) {
     std::fprintf(per, "host_sim: %s, %d episode%s of %.1f s, tau_max %.1f N·m, seed %u\n", ctl->name().c_str(),
                  o.episodes, o.episodes > 1 ? "s" : "", cfg.episode_s, cfg.tau_max, seed0);
   std::vector<Episode> eps;
+  // Written beside the target and renamed at the end: an existing CSV stays whole until the new one is.
+  poursim::AtomicFile csv_file;
   std::FILE *csv = nullptr;
   if (!o.csv.empty()) {
-    csv = std::fopen(o.csv.c_str(), "w");
-    if (csv == nullptr) {
-      std::fprintf(stderr, "host_sim: cannot write '%s': %s\n", o.csv.c_str(), std::strerror(errno));
+    if (!csv_file.open(o.csv, &why)) {
+      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       poursim_destroy(world);
       return 1;
     }
+    csv = csv_file.stream();
     write_csv_header(csv);
   }
   Recorder first;
@@ -605,16 +641,16 @@ int main(int argc, char **argv) {
   }
   int status = 0;
   if (csv != nullptr) {
-    if (std::ferror(csv) != 0 || std::fclose(csv) != 0) {
-      std::fprintf(stderr, "host_sim: error writing CSV '%s'\n", o.csv.c_str());
+    if (!csv_file.commit(&why)) {
+      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
     } else if (!o.quiet) {
       std::fprintf(per, "trajectory: %s\n", o.csv.c_str());
     }
   }
   if (!o.render.empty()) {
-    if (!write_render_json(render_json, world, first, ctl->name(), eps[0])) {
-      std::fprintf(stderr, "host_sim: cannot write '%s'\n", render_json.c_str());
+    if (!write_render_json(render_json, world, first, ctl->name(), eps[0], &why)) {
+      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
     } else if (run_render(render_json, o.render) != 0) {
       status = 1;

@@ -3,6 +3,7 @@
 import csv
 import json
 import re
+import signal
 import subprocess
 
 import pytest
@@ -15,8 +16,8 @@ def host_sim(build_dir):
     exe = build_dir / "bin" / "host_sim"
     assert exe.is_file(), f"{exe} not built"
 
-    def run(*args, timeout=300):
-        return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=timeout)
+    def run(*args, timeout=300, cwd=None):
+        return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=timeout, cwd=cwd)
     return run
 
 
@@ -85,6 +86,8 @@ def test_truncated_policy_is_refused(host_sim, tmp_path, example):
     ("friction = 5\n", "friction = 5 is out of range"),
     ("wobble = 1\n", "unknown config key 'wobble'"),
     ("tau_max 20\n", "expected 'key = value'"),
+    ("friction = 0.1\nseed = 7\0JUNK\n", "sim.cfg:2: contains a NUL byte"),
+    ("seed = 7\nseed = 8\n", "sim.cfg:2: seed is set twice (first on line 1)"),
 ])
 def test_bad_config_is_refused(host_sim, tmp_path, text, message):
     path = tmp_path / "sim.cfg"
@@ -92,6 +95,87 @@ def test_bad_config_is_refused(host_sim, tmp_path, text, message):
         path.write_text(text)
     r = host_sim("--baseline", "rate", "--config", path)
     assert r.returncode == 1 and "bad config" in r.stderr and message in r.stderr, r.stderr
+
+
+def test_endless_config_is_refused_at_the_size_cap(host_sim):
+    r = host_sim("--baseline", "rate", "--config", "/dev/zero", timeout=60)
+    assert r.returncode == 1 and "/dev/zero: larger than 1048576 bytes" in r.stderr, r.stderr
+
+
+def _files(folder):
+    return {p.name: p.read_bytes() if p.is_file() else "dir" for p in folder.iterdir()}
+
+
+@pytest.fixture
+def inputs(tmp_path, source_dir):
+    """A policy, a config, a hard link to the policy and an existing CSV in tmp_path."""
+    (tmp_path / "p.h").write_bytes((source_dir / "policy" / "weights.h").read_bytes())
+    (tmp_path / "c.cfg").write_text("seed = 1\n")
+    (tmp_path / "link.csv").hardlink_to(tmp_path / "p.h")
+    (tmp_path / "old.csv").write_text("a good old CSV\n")
+    return tmp_path
+
+
+# An output that names an input or another output of the same run: refused before any work, nothing touched.
+@pytest.mark.parametrize("args, message", [
+    (("--policy", "p.h", "--csv", "p.h"), "--csv 'p.h' is the input --policy 'p.h'"),
+    (("--policy", "p.h", "--csv", "./sub/../p.h"), "is the input --policy"),
+    (("--policy", "p.h", "--csv", "link.csv"), "--csv 'link.csv' is the input --policy 'p.h'"),
+    (("--baseline", "full", "--config", "c.cfg", "--csv", "c.cfg"), "--csv 'c.cfg' is the input --config"),
+    (("--baseline", "full", "--csv", "out.json", "--render", "out.gif"),
+     "--render (its .json trajectory) 'out.json' is also --csv 'out.json'"),
+    (("--baseline", "full", "--config", "c.cfg", "--render", "c.gif", "--csv", "c.png"),
+     "--render (its .png snapshot) 'c.png' is also --csv 'c.png'"),
+    (("--baseline", "full", "--csv", ""), "--csv: the file name is empty"),
+    (("--baseline", "full", "--render", ""), "--render: the file name is empty"),
+    (("--baseline", "full", "--render", "sub/.gif"), "--render wants a file name before its .gif"),
+])
+def test_outputs_never_overwrite_inputs_or_each_other(host_sim, inputs, args, message):
+    (inputs / "sub").mkdir()
+    before = _files(inputs)
+    r = host_sim(*args, "--set", "episode_s=0.05", cwd=inputs, timeout=30)
+    assert r.returncode == 2 and message in r.stderr and "(run host_sim --help" in r.stderr, r.stderr
+    assert "episode 1" not in r.stdout
+    assert _files(inputs) == before
+
+
+def test_a_failed_output_check_leaves_no_file_behind(host_sim, inputs):
+    """The old write probe created the CSV, then the render's folder was found missing: an empty CSV stayed."""
+    (inputs / "sub").mkdir()
+    before = _files(inputs)
+    r = host_sim("--baseline", "full", "--csv", "new.csv", "--render", "nodir/x.gif", cwd=inputs, timeout=30)
+    assert r.returncode == 1 and "cannot write --render 'nodir/x.gif'" in r.stderr, r.stderr
+    r = host_sim("--baseline", "full", "--csv", "sub", "--render", "x.gif", cwd=inputs, timeout=30)
+    assert r.returncode == 1 and "is a directory" in r.stderr, r.stderr
+    assert _files(inputs) == before
+
+
+@pytest.mark.parametrize("sig", ["TERM", "INT", "KILL"])
+def test_a_killed_run_leaves_the_existing_csv_whole(build_dir, inputs, sig):
+    """The CSV is written to a temporary beside it and renamed at the end: killed half-way, the old CSV is
+    still there, byte for byte. On SIGTERM/SIGINT the temporary is removed too; SIGKILL cannot be caught,
+    so a hidden .old.csv.XXXXXX may stay (never the CSV itself)."""
+    proc = subprocess.Popen([str(build_dir / "bin" / "host_sim"), "--baseline", "full", "--episodes", "100",
+                             "--csv", "old.csv"], cwd=inputs, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    assert proc.stdout.readline().startswith("host_sim:")   # the run has started ...
+    assert proc.stdout.readline().startswith("episode 1")   # ... and written a first episode
+    proc.send_signal(getattr(signal, "SIG" + sig))
+    proc.communicate(timeout=60)
+    assert proc.returncode < 0
+    assert (inputs / "old.csv").read_text() == "a good old CSV\n"
+    left = {p.name for p in inputs.iterdir()} - {"p.h", "c.cfg", "link.csv", "old.csv"}
+    if sig == "KILL":
+        assert all(name.startswith(".old.csv.") for name in left), left
+    else:
+        assert not left, left
+
+
+def test_a_complete_run_replaces_the_csv(host_sim, inputs):
+    r = host_sim("--baseline", "full", "--csv", "old.csv", "--set", "episode_s=0.05", cwd=inputs, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert (inputs / "old.csv").read_text().startswith("episode,seed,step")
+    assert {p.name for p in inputs.iterdir()} == {"p.h", "c.cfg", "link.csv", "old.csv"}
 
 
 @pytest.mark.parametrize("flag, name", [("--csv", "run.csv"), ("--render", "pour.gif")])
