@@ -23,6 +23,25 @@ pour_control_config_t pour_control_default_config(void) {
   return config;
 }
 
+/* The run's state as at power-on: no state seen, zero torque, the decision schedule and the PRNG
+ * from their start (init and an accepted reset; config and weights were validated at init). */
+static void start_afresh(pour_control_t *ctl) {
+  (void)pour_safety_init(&ctl->safety, &ctl->config.safety);
+  (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
+  ctl->ms_since_fresh = 0u;
+  ctl->ms_to_decision = 0u;
+  const pour_state_t zero_state = {0u, 0, 0, 0, 0, 0};
+  ctl->state = zero_state;
+  for (unsigned i = 0; i < POUR_OBS_N; ++i) {
+    ctl->obs.x[i] = 0;
+  }
+  for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    ctl->eval.logits[a] = 0;
+    ctl->eval.probs[a] = 0;
+  }
+  ctl->eval.action = 0u;
+}
+
 pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
                                 const pour_policy_weights_t *weights) {
   if (ctl == NULL || config == NULL) {
@@ -47,18 +66,8 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
   ctl->mode = POUR_MODE_IDLE;
   ctl->faults = 0u;
   ctl->tick = 0u;
-  ctl->ms_since_fresh = 0u;
-  ctl->ms_to_decision = 0u;
-  const pour_state_t zero_state = {0u, 0, 0, 0, 0, 0};
-  ctl->state = zero_state;
-  for (unsigned i = 0; i < POUR_OBS_N; ++i) {
-    ctl->obs.x[i] = 0;
-  }
-  for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
-    ctl->eval.logits[a] = 0;
-    ctl->eval.probs[a] = 0;
-  }
-  ctl->eval.action = 0u;
+  ctl->resets_refused = 0u;
+  start_afresh(ctl);
   return POUR_OK;
 }
 
@@ -111,11 +120,29 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
   if (ctl->mode == POUR_MODE_ESTOP) {
     ctl->mode = POUR_MODE_FAULT;
   }
+  if (in->link_fault) {
+    /* The transport no longer hears its host: the core, not only the bus output, goes to FAULT, so that
+     * nothing keeps ramping behind a substituted output and a later clear cannot release it at once. */
+    ctl->faults |= POUR_FAULT_LINK;
+    ctl->mode = POUR_MODE_FAULT;
+  }
   if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
-    /* Back to IDLE: RUN (and the timeout) start again only with the next fresh state. */
+    /* Back to IDLE: RUN (and the timeout) start again only with the next fresh state, from the safe
+     * torque the envelope holds now, through the slew limit. */
     ctl->faults = 0u;
     ctl->mode = POUR_MODE_IDLE;
     ctl->ms_since_fresh = 0u;
+  }
+  if (in->stop && ctl->mode == POUR_MODE_RUN) {
+    ctl->mode = POUR_MODE_IDLE;
+  }
+  if (in->reset) {
+    /* Re-initialising under a running policy would drop the envelope's torque in one tick: refused. */
+    if (ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) {
+      start_afresh(ctl);
+    } else {
+      ctl->resets_refused++;
+    }
   }
 
   bool fresh = false;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "bridge.h"
 
+#include <math.h>
 #include <stddef.h>
 #include <string.h>
 
@@ -10,13 +11,12 @@
 pour_bridge_config_t pour_bridge_default_config(void) {
   pour_bridge_config_t c;
   c.node_id = 0;
-  c.tau_max_mnm = 40000;
   c.n_actions = 11;
   return c;
 }
 
 pour_status_t pour_bridge_init(pour_bridge_t *b, const pour_bridge_config_t *config) {
-  if (b == NULL || config == NULL || config->node_id > POUR_CAN_NODE_ID_MAX || config->tau_max_mnm <= 0 ||
+  if (b == NULL || config == NULL || config->node_id > POUR_CAN_NODE_ID_MAX ||
       config->n_actions < 2u || config->n_actions > 16u) {
     return POUR_EINVAL;
   }
@@ -46,14 +46,23 @@ int pour_bridge_from_state(pour_bridge_t *b, const pour_plant_state_t *msg, pour
   return 2;
 }
 
-int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[2]) {
+int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[4]) {
   const pour_can_estop_t e = {(uint8_t)(msg->estop ? 1u : 0u)};
   int n = 0;
   if (pour_can_pack_estop(b->config.node_id, &e, &frames[n]) == POUR_OK) {
     n++;
   }
-  if (msg->clear_faults && pour_can_pack_clear_errors(b->config.node_id, &frames[n]) == POUR_OK) {
-    n++;
+  /* The core acts on them in this order within one tick (stop ends the run, then reset may start one). */
+  const struct {
+    int8_t asked;
+    uint8_t cmd;
+  } one_shots[3] = {{msg->stop, POUR_CAN_CMD_STOP},
+                    {msg->clear_faults, POUR_CAN_CMD_CLEAR_ERRORS},
+                    {msg->reset, POUR_CAN_CMD_RESET}};
+  for (unsigned i = 0; i < 3u; ++i) {
+    if (one_shots[i].asked && pour_can_pack_command(b->config.node_id, one_shots[i].cmd, &frames[n]) == POUR_OK) {
+      n++;
+    }
   }
   b->counters.commands++;
   return n;
@@ -77,7 +86,8 @@ static pour_bridge_out_t torque_of(pour_bridge_t *b, const pour_can_frame_t *fra
   out->episode = slot->episode;
   out->state_utime = slot->utime;
   out->torque_q15 = t.torque;
-  out->torque = (double)t.torque / 32768.0 * (double)b->config.tau_max_mnm * 1e-3;
+  out->torque = b->have_identity ? (double)t.torque / 32768.0 * (double)b->identity.tau_max_cnm * 1e-2 : (double)NAN;
+  out->weights_hash = b->have_identity ? (int32_t)b->identity.weights_hash : 0;
   out->action = (int8_t)t.action;
   out->mode = (int8_t)t.mode;
   out->faults = (int16_t)b->faults; /* the torque frame has no fault bits: the latest heartbeat's */
@@ -102,8 +112,8 @@ static pour_bridge_out_t status_of(pour_bridge_t *b, const pour_can_frame_t *fra
   out->utime = utime;
   out->tick = b->heartbeat_count;
   out->mode = (int8_t)hb.mode;
-  /* POUR_STATUS names the core's bits; the CAN watchdog's (0x100) rides along above them. */
   out->faults = (int16_t)hb.faults;
+  out->weights_hash = b->have_identity ? (int32_t)b->identity.weights_hash : 0;
   out->overruns = hb.overruns;
   out->messages_dropped = hb.rx_dropped;
   /* Step time and lateness are not carried over CAN: they stay 0 (the fields' documented floor). */
@@ -111,9 +121,22 @@ static pour_bridge_out_t status_of(pour_bridge_t *b, const pour_can_frame_t *fra
   return POUR_BRIDGE_STATUS;
 }
 
+static pour_bridge_out_t identity_of(pour_bridge_t *b, const pour_can_frame_t *frame) {
+  pour_can_identity_t id;
+  if (pour_can_unpack_identity(frame, &id) != POUR_CAN_RX_OK) {
+    b->counters.frames_dropped++;
+    return POUR_BRIDGE_DROPPED;
+  }
+  b->identity = id;
+  b->have_identity = true;
+  b->counters.identities++;
+  return POUR_BRIDGE_NONE;
+}
+
 pour_bridge_out_t pour_bridge_from_frame(pour_bridge_t *b, const pour_can_frame_t *frame, int64_t utime,
                                          pour_torque_t *torque, pour_controller_status_t *status) {
-  const uint32_t accept = (1u << POUR_CAN_CMD_TORQUE) | (1u << POUR_CAN_CMD_HEARTBEAT);
+  const uint32_t accept =
+      (1u << POUR_CAN_CMD_TORQUE) | (1u << POUR_CAN_CMD_HEARTBEAT) | (1u << POUR_CAN_CMD_IDENTITY);
   uint8_t cmd = 0;
   const pour_can_rx_t rc = pour_can_classify(frame, b->config.node_id, accept, &cmd);
   if (rc == POUR_CAN_RX_OTHER_NODE) {
@@ -125,6 +148,9 @@ pour_bridge_out_t pour_bridge_from_frame(pour_bridge_t *b, const pour_can_frame_
   if (rc != POUR_CAN_RX_OK) {
     b->counters.frames_dropped++;
     return POUR_BRIDGE_DROPPED;
+  }
+  if (cmd == POUR_CAN_CMD_IDENTITY) {
+    return identity_of(b, frame);
   }
   return cmd == POUR_CAN_CMD_TORQUE ? torque_of(b, frame, utime, torque) : status_of(b, frame, utime, status);
 }

@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /* can_bridge's logic, no I/O: LCM messages <-> pour CAN frames (can/pour.dbc).
  *   POUR_STATE (pour_plant_state_t)   -> StateA + StateB  (the SI -> fixed-point conversion of the firmware)
- *   POUR_COMMAND (pour_command_t)     -> Estop (+ ClearErrors)
+ *   POUR_COMMAND (pour_command_t)     -> Estop (+ Stop, ClearErrors, Reset)
  *   Torque frame                      -> POUR_TORQUE (pour_torque_t; seq, episode and utime restored)
  *   Heartbeat frame                   -> POUR_STATUS (pour_controller_status_t)
+ *   Identity frame                    -> the torque scale and the policy hash of the POUR_TORQUE it makes
  * CAN carries 16 bits of seq and no episode or time stamp: the bridge remembers the states it sent, by
- * seq, and answers torque frames only for states it sent. */
+ * seq, and answers torque frames only for states it sent. The torque scale comes from the controller's
+ * Identity frame, never from the bridge's own build or a default. */
 #ifndef POUR_CAN_BRIDGE_H
 #define POUR_CAN_BRIDGE_H
 
@@ -22,8 +24,7 @@
 
 typedef struct {
   uint8_t node_id;     /* controller node id, 0 .. 63 */
-  int32_t tau_max_mnm; /* torque scale for pour_torque_t.torque [mN·m], > 0 */
-  uint8_t n_actions;   /* the controller's policy action count, for pour_torque_t.n_actions, 2 .. 16 */
+  uint8_t n_actions;   /* pour_torque_t.n_actions, 2 .. 16 (CAN carries no probabilities: they stay 0) */
 } pour_bridge_config_t;
 
 typedef struct {
@@ -39,6 +40,7 @@ typedef struct {
   int64_t torques;          /* torque frames turned into POUR_TORQUE */
   int64_t torques_unmatched; /* torque frames answering no state we sent (dropped) */
   int64_t heartbeats;
+  int64_t identities;       /* Identity frames seen */
   int64_t frames_dropped;   /* malformed or unknown frames of the controller's node */
   int64_t commands;
 } pour_bridge_counters_t;
@@ -50,19 +52,21 @@ typedef struct {
   uint8_t mode;            /* from the latest heartbeat or torque frame */
   uint16_t faults;
   int64_t heartbeat_count; /* heartbeats seen, as POUR_STATUS.tick has nothing better over CAN */
+  bool have_identity;      /* an Identity frame arrived: identity is the controller's */
+  pour_can_identity_t identity;
 } pour_bridge_t;
 
-/* Defaults: node 0, tau_max 40 N·m, 11 actions. */
+/* Defaults: node 0, 11 actions. */
 pour_bridge_config_t pour_bridge_default_config(void);
 
-/* POUR_EINVAL for a node id > 63, tau_max <= 0 or n_actions outside 2 .. 16. */
+/* POUR_EINVAL for a node id > 63 or n_actions outside 2 .. 16. */
 pour_status_t pour_bridge_init(pour_bridge_t *b, const pour_bridge_config_t *config);
 
 /* StateA and StateB for one POUR_STATE: returns 2, or 0 if a value is outside its CAN range (counted). */
 int pour_bridge_from_state(pour_bridge_t *b, const pour_plant_state_t *msg, pour_can_frame_t frames[2]);
 
-/* Estop (always, as the level) and ClearErrors (if asked): returns the number of frames, 1 or 2. */
-int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[2]);
+/* Estop (always, as the level), then Stop, ClearErrors and Reset (those asked for): returns the count, 1..4. */
+int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[4]);
 
 typedef enum {
   POUR_BRIDGE_NONE = 0,   /* not the controller's, or a frame the host itself sends: ignored */
@@ -71,7 +75,8 @@ typedef enum {
   POUR_BRIDGE_DROPPED = -1 /* the controller's, but malformed, or a torque that answers no sent state */
 } pour_bridge_out_t;
 
-/* One frame from the bus. utime [µs] stamps the message published. */
+/* One frame from the bus. utime [µs] stamps the message published. Until the controller's Identity frame
+ * has arrived, POUR_TORQUE carries torque NaN [N·m] (scale unknown) and weights_hash 0. */
 pour_bridge_out_t pour_bridge_from_frame(pour_bridge_t *b, const pour_can_frame_t *frame, int64_t utime,
                                          pour_torque_t *torque, pour_controller_status_t *status);
 

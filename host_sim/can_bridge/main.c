@@ -18,7 +18,6 @@
 #include <lcm/lcm.h>
 
 #include "bridge.h"
-#include "pour/weights_compiled.h"
 #include "pour_lcm/channels.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -76,7 +75,7 @@ static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *us
     app->lcm_dropped++;
     return;
   }
-  pour_can_frame_t frames[2];
+  pour_can_frame_t frames[4];
   send_frames(app, frames, pour_bridge_from_command(&app->bridge, &msg, frames));
   pour_command_t_decode_cleanup(&msg);
 }
@@ -138,11 +137,11 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: can_bridge --iface IFACE [--lcm URL] [--node N] [--tau-max-mnm T] [--n-actions A]\n"
-             "                  [--duration S]\n"
-             "  POUR_STATE, POUR_COMMAND (LCM) -> StateA/StateB, Estop, ClearErrors (CAN, can/pour.dbc)\n"
+  fprintf(f, "usage: can_bridge --iface IFACE [--lcm URL] [--node N] [--n-actions A] [--duration S]\n"
+             "  POUR_STATE, POUR_COMMAND (LCM) -> StateA/StateB, Estop, Stop, ClearErrors, Reset (CAN, can/pour.dbc)\n"
              "  Torque, Heartbeat (CAN)        -> POUR_TORQUE, POUR_STATUS (LCM)\n"
-             "  defaults: LCM %s, node 0, tau_max and actions of the compiled-in weights.h\n",
+             "  the torque scale [N.m] and policy hash come from the controller's Identity frame\n"
+             "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n",
           POUR_LCM_DEFAULT_URL);
 }
 
@@ -151,8 +150,6 @@ int main(int argc, char **argv) {
   const char *url = NULL;
   long duration_s = 0;
   pour_bridge_config_t cfg = pour_bridge_default_config();
-  cfg.tau_max_mnm = pour_weights_compiled.tau_max_mnm;
-  cfg.n_actions = pour_weights_compiled.n_actions;
   for (int i = 1; i < argc; ++i) {
     const char *a = argv[i];
     const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -167,9 +164,6 @@ int main(int argc, char **argv) {
     } else if (strcmp(a, "--node") == 0) {
       if (parse_long(a, v, 0, POUR_CAN_NODE_ID_MAX, &n) != 0) return 2;
       cfg.node_id = (uint8_t)n;
-    } else if (strcmp(a, "--tau-max-mnm") == 0) {
-      if (parse_long(a, v, 1, 10000000, &n) != 0) return 2;
-      cfg.tau_max_mnm = (int32_t)n;
     } else if (strcmp(a, "--n-actions") == 0) {
       if (parse_long(a, v, 2, 16, &n) != 0) return 2;
       cfg.n_actions = (uint8_t)n;
@@ -241,10 +235,10 @@ int main(int argc, char **argv) {
     }
   }
   const pour_bridge_counters_t *c = &app.bridge.counters;
-  printf("can_bridge: states %lld refused %lld torques %lld unmatched %lld heartbeats %lld frames_dropped %lld "
-         "commands %lld lcm_dropped %lld can_tx_errors %lld\n",
+  printf("can_bridge: states %lld refused %lld torques %lld unmatched %lld heartbeats %lld identities %lld "
+         "frames_dropped %lld commands %lld lcm_dropped %lld can_tx_errors %lld\n",
          (long long)c->states_sent, (long long)c->states_refused, (long long)c->torques,
-         (long long)c->torques_unmatched, (long long)c->heartbeats, (long long)c->frames_dropped,
+         (long long)c->torques_unmatched, (long long)c->heartbeats, (long long)c->identities, (long long)c->frames_dropped,
          (long long)c->commands, (long long)app.lcm_dropped, (long long)app.can_tx_errors);
   lcm_destroy(app.lcm);
   close(app.fd);

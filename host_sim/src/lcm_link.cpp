@@ -12,6 +12,7 @@
 
 #include <lcm/lcm.h>
 
+#include "pour/command_t.hpp"
 #include "pour/particles_t.hpp"
 #include "pour/plant_state_t.hpp"
 #include "pour/torque_t.hpp"
@@ -350,6 +351,14 @@ void LcmLink::drain(int wait_ms) {
   s.pump_until(mono_ns() + static_cast<int64_t>(wait_ms) * 1000000LL);
 }
 
+void LcmLink::request_new_run() {
+  pour::command_t m{};
+  m.utime = wall_us();
+  m.stop = 1;
+  m.reset = 1;
+  publish(impl_->lcm, POUR_LCM_CHANNEL_COMMAND, m);
+}
+
 int LcmLink::last_action() const { return impl_->answer_action; }
 
 const LcmLinkStats &LcmLink::stats() const { return impl_->stats; }
@@ -404,7 +413,10 @@ std::string LcmController::name() const {
          (d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url) + ")";
 }
 
-void LcmController::reset(uint32_t /*seed*/) { episode_++; }
+void LcmController::reset(uint32_t /*seed*/) {
+  episode_++;
+  link_->request_new_run();
+}
 
 double LcmController::command(const poursim_obs_t &obs) {
   int16_t q15 = 0;

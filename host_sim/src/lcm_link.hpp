@@ -66,6 +66,9 @@ class LcmLink {
   // Reads whatever answers are still in flight (for a final count); waits at most wait_ms.
   void drain(int wait_ms);
 
+  // Asks the controller for a new run (POUR_COMMAND stop + reset): it has no episodes of its own.
+  void request_new_run();
+
   // Policy action index of the answer in use (-1 before the first answer of an episode).
   int last_action() const;
 

@@ -4,7 +4,8 @@
  *   pack <msg> <node> <raw fields...>   -> "ok <id> <dlc> <hex>" | "einval"
  *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
  * msg: state_a (theta omega seq_low), state_b (seq vr vt vs), torque (seq torque action mode limits),
- * heartbeat (mode faults rx_dropped overruns counter), estop (assert), clear_errors (no fields).
+ * heartbeat (mode faults rx_dropped overruns counter), estop (assert), identity (hash tau_max fw init),
+ * clear_errors, stop and reset (no fields).
  * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,6 +45,17 @@ static void print_frame(pour_status_t st, const pour_can_frame_t *f) {
   putchar('\n');
 }
 
+/* The cmd of a message without signals, 0 for any other name. */
+static uint8_t command_of(const char *msg) {
+  if (strcmp(msg, "clear_errors") == 0) {
+    return POUR_CAN_CMD_CLEAR_ERRORS;
+  }
+  if (strcmp(msg, "stop") == 0) {
+    return POUR_CAN_CMD_STOP;
+  }
+  return strcmp(msg, "reset") == 0 ? POUR_CAN_CMD_RESET : 0u;
+}
+
 static void do_pack(const char *msg, long *v, int n) {
   pour_can_frame_t f;
   memset(&f, 0, sizeof f);
@@ -67,8 +79,11 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "estop") == 0 && n == 2) {
     pour_can_estop_t m = {(uint8_t)v[1]};
     print_frame(pour_can_pack_estop(node, &m, &f), &f);
-  } else if (strcmp(msg, "clear_errors") == 0 && n == 1) {
-    print_frame(pour_can_pack_clear_errors(node, &f), &f);
+  } else if (strcmp(msg, "identity") == 0 && n == 5) {
+    pour_can_identity_t m = {(uint32_t)v[1], (uint16_t)v[2], (uint8_t)v[3], (int8_t)v[4]};
+    print_frame(pour_can_pack_identity(node, &m, &f), &f);
+  } else if (command_of(msg) != 0u && n == 1) {
+    print_frame(pour_can_pack_command(node, command_of(msg), &f), &f);
   } else {
     puts("error message or field count");
   }
@@ -134,8 +149,13 @@ static void do_unpack(const char *msg, char *rest) {
     pour_can_estop_t m = {0};
     rc = pour_can_unpack_estop(&f, &m);
     snprintf(out, sizeof out, "%u", (unsigned)m.assert_estop);
-  } else if (strcmp(msg, "clear_errors") == 0) {
-    rc = pour_can_unpack_clear_errors(&f);
+  } else if (strcmp(msg, "identity") == 0) {
+    pour_can_identity_t m = {0};
+    rc = pour_can_unpack_identity(&f, &m);
+    snprintf(out, sizeof out, "%lu %u %u %d", (unsigned long)m.weights_hash, (unsigned)m.tau_max_cnm,
+             (unsigned)m.fw_version, (int)m.init_status);
+  } else if (command_of(msg) != 0u) {
+    rc = pour_can_unpack_command(&f, command_of(msg));
     out[0] = '\0';
   } else {
     puts("error message");

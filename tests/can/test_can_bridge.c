@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* can_bridge's mapping between LCM messages and CAN frames, without sockets. */
+#include <math.h>
 #include <string.h>
 
 #include "bridge.h"
@@ -10,7 +11,6 @@ static pour_bridge_t b;
 void setUp(void) {
   pour_bridge_config_t c = pour_bridge_default_config();
   c.node_id = 2;
-  c.tau_max_mnm = 40000;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_bridge_init(&b, &c));
 }
 
@@ -33,9 +33,6 @@ static pour_plant_state_t state(int64_t seq, double theta) {
 static void test_bridge_init_RejectsBadConfig(void) {
   pour_bridge_config_t c = pour_bridge_default_config();
   c.node_id = 64;
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_bridge_init(&b, &c));
-  c = pour_bridge_default_config();
-  c.tau_max_mnm = 0;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_bridge_init(&b, &c));
   c = pour_bridge_default_config();
   c.n_actions = 17;
@@ -74,7 +71,18 @@ static pour_can_frame_t torque_frame(uint8_t node, uint16_t seq, q15_t torque) {
   return f;
 }
 
+/* The controller announces who it is: the scale of its torque and its policy. */
+static void receive_identity(uint16_t tau_max_cnm, uint32_t hash) {
+  const pour_can_identity_t id = {hash, tau_max_cnm, 2u, 0};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_identity(2, &id, &f));
+  pour_torque_t tq;
+  pour_controller_status_t st;
+  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_NONE, pour_bridge_from_frame(&b, &f, 0, &tq, &st));
+}
+
 static void test_bridge_TorqueAnswersTheStateItMatches(void) {
+  receive_identity(4000u, 0x12345678u); /* 40 N·m */
   pour_can_frame_t f[2];
   const pour_plant_state_t m = state(70000, 0.5);
   pour_bridge_from_state(&b, &m, f);
@@ -91,6 +99,24 @@ static void test_bridge_TorqueAnswersTheStateItMatches(void) {
   TEST_ASSERT_EQUAL_INT8(5, tq.action);
   TEST_ASSERT_EQUAL_INT8(1, tq.mode);
   TEST_ASSERT_EQUAL_INT8(11, tq.n_actions);
+  TEST_ASSERT_EQUAL_INT32(0x12345678, tq.weights_hash);
+}
+
+/* No scale is guessed: before the controller's Identity frame the torque in N·m is unknown (NaN). */
+static void test_bridge_TorqueScaleComesFromTheBusOnly(void) {
+  pour_can_frame_t f[2];
+  const pour_plant_state_t m = state(5, 0.5);
+  pour_bridge_from_state(&b, &m, f);
+  pour_torque_t tq;
+  pour_controller_status_t st;
+  const pour_can_frame_t tf = torque_frame(2, 5, 16384);
+  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_TORQUE, pour_bridge_from_frame(&b, &tf, 0, &tq, &st));
+  TEST_ASSERT_TRUE(isnan(tq.torque));
+  TEST_ASSERT_EQUAL_INT32(0, tq.weights_hash);
+  receive_identity(2000u, 7u); /* 20 N·m, the shipped policy's */
+  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_TORQUE, pour_bridge_from_frame(&b, &tf, 0, &tq, &st));
+  TEST_ASSERT_EQUAL_DOUBLE(10.0, tq.torque);
+  TEST_ASSERT_EQUAL_INT32(7, tq.weights_hash);
 }
 
 static void test_bridge_DropsTorqueForAStateNeverSent(void) {
@@ -134,15 +160,23 @@ static void test_bridge_IgnoresOtherNodesAndHostFramesButDropsMalformed(void) {
 }
 
 static void test_bridge_CommandBecomesEstopAndClear(void) {
-  pour_command_t c = {0, 1, 1};
-  pour_can_frame_t f[2];
+  pour_command_t c = {0, 1, 1, 0, 0};
+  pour_can_frame_t f[4];
   TEST_ASSERT_EQUAL_INT(2, pour_bridge_from_command(&b, &c, f));
   pour_can_estop_t e;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_estop(&f[0], &e));
   TEST_ASSERT_EQUAL_UINT8(1, e.assert_estop);
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_clear_errors(&f[1]));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f[1], POUR_CAN_CMD_CLEAR_ERRORS));
+  c.stop = 1;
+  c.reset = 1;
+  TEST_ASSERT_EQUAL_INT(4, pour_bridge_from_command(&b, &c, f)); /* in the order the core acts on them */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f[1], POUR_CAN_CMD_STOP));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f[2], POUR_CAN_CMD_CLEAR_ERRORS));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f[3], POUR_CAN_CMD_RESET));
   c.estop = 0;
   c.clear_faults = 0;
+  c.stop = 0;
+  c.reset = 0;
   TEST_ASSERT_EQUAL_INT(1, pour_bridge_from_command(&b, &c, f));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_estop(&f[0], &e));
   TEST_ASSERT_EQUAL_UINT8(0, e.assert_estop);
@@ -154,6 +188,7 @@ int main(void) {
   RUN_TEST(test_bridge_StateBecomesTwoFramesInFixedPoint);
   RUN_TEST(test_bridge_RefusesStatesOutsideTheCanRange);
   RUN_TEST(test_bridge_TorqueAnswersTheStateItMatches);
+  RUN_TEST(test_bridge_TorqueScaleComesFromTheBusOnly);
   RUN_TEST(test_bridge_DropsTorqueForAStateNeverSent);
   RUN_TEST(test_bridge_HeartbeatBecomesStatus);
   RUN_TEST(test_bridge_IgnoresOtherNodesAndHostFramesButDropsMalformed);

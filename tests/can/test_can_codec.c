@@ -61,8 +61,11 @@ static void test_can_pack_RefusesOutOfRangeAndLeavesFrame(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_heartbeat(0, &hb, &f));
   pour_can_estop_t e = {.assert_estop = 2};
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_estop(0, &e, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_clear_errors(64, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_clear_errors(0, NULL));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_command(64, POUR_CAN_CMD_CLEAR_ERRORS, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_command(0, POUR_CAN_CMD_CLEAR_ERRORS, NULL));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_command(0, POUR_CAN_CMD_ESTOP, &f)); /* has a signal */
+  pour_can_identity_t id = {.weights_hash = 1u, .tau_max_cnm = 2000u, .fw_version = 2u, .init_status = 1};
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_identity(0, &id, &f)); /* no positive status exists */
   TEST_ASSERT_EQUAL_HEX8(0x5A, f.data[0]);
 }
 
@@ -116,7 +119,7 @@ static void test_can_heartbeat_CarriesOnlyNamedFaultBits(void) {
                              .counter = 255};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_heartbeat(0, &hb, &f));
-  const uint8_t want[8] = {0x02, 0x07, 0x01, 0x34, 0x12, 0xFF, 0xFF, 0xFF};
+  const uint8_t want[8] = {0x02, 0xFF, 0x03, 0x34, 0x12, 0xFF, 0xFF, 0xFF};
   TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
   pour_can_heartbeat_t back;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&f, &back));
@@ -136,11 +139,28 @@ static void test_can_unpack_RejectsWrongDlcAndWrongCmd(void) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_estop(&f, &e));
   pour_can_state_b_t b;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_state_b(&f, &b));
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_clear_errors(3, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_clear_errors(&f));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(3, POUR_CAN_CMD_CLEAR_ERRORS, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f, POUR_CAN_CMD_CLEAR_ERRORS));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_command(&f, POUR_CAN_CMD_RESET));
   f.dlc = 1;
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_DLC, pour_can_unpack_clear_errors(&f));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_clear_errors(NULL));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_DLC, pour_can_unpack_command(&f, POUR_CAN_CMD_CLEAR_ERRORS));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_command(NULL, POUR_CAN_CMD_CLEAR_ERRORS));
+}
+
+static void test_can_identity_RoundTripsHashScaleVersionAndNegativeStatus(void) {
+  const pour_can_identity_t id = {.weights_hash = 0xfedcba98u, .tau_max_cnm = 2000u, .fw_version = 2u,
+                                  .init_status = (int8_t)POUR_ECORRUPT};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_identity(5, &id, &f));
+  TEST_ASSERT_EQUAL_HEX16(pour_can_id(5, POUR_CAN_CMD_IDENTITY), f.id);
+  pour_can_identity_t got;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_identity(&f, &got));
+  TEST_ASSERT_EQUAL_HEX32(0xfedcba98u, got.weights_hash);
+  TEST_ASSERT_EQUAL_UINT16(2000u, got.tau_max_cnm);
+  TEST_ASSERT_EQUAL_UINT8(2u, got.fw_version);
+  TEST_ASSERT_EQUAL_INT8(POUR_ECORRUPT, got.init_status);
+  f.data[7] = 1; /* a positive status is out of range */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_identity(&f, &got));
 }
 
 static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {
@@ -173,6 +193,7 @@ int main(void) {
   RUN_TEST(test_can_torque_RoundTripsFullQ15Range);
   RUN_TEST(test_can_heartbeat_CarriesOnlyNamedFaultBits);
   RUN_TEST(test_can_unpack_RejectsWrongDlcAndWrongCmd);
+  RUN_TEST(test_can_identity_RoundTripsHashScaleVersionAndNegativeStatus);
   RUN_TEST(test_can_classify_SeparatesNodesCmdsAndDlcs);
   return UNITY_END();
 }

@@ -1,19 +1,27 @@
 /* SPDX-License-Identifier: MIT */
-/* CAN node: frames -> control input, watchdog, heartbeat schedule, dropped-frame accounting. */
+/* CAN node: frames -> control input, watchdog, heartbeat schedule, dropped-frame accounting; and the node
+ * with the real control core behind it, as both ports run them (one state for node and core). */
 #include <string.h>
 
 #include "pour/can_node.h"
+#include "pour/weights_compiled.h"
 #include "unity.h"
 
 static pour_can_node_t node;
 static pour_can_node_config_t cfg;
+static pour_control_t ctl;
+static pour_control_config_t ccfg;
 
 void setUp(void) {
   cfg = pour_can_node_default_config();
   cfg.node_id = 3;
   cfg.watchdog_ms = 5;
   cfg.heartbeat_period_ms = 4;
+  cfg.identity.weights_hash = 0xabcdef01u;
+  cfg.identity.tau_max_cnm = 2000u;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
+  ccfg = pour_control_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
 }
 
 void tearDown(void) {}
@@ -72,7 +80,7 @@ static void test_can_node_TorqueFrameEchoesSeqEveryTick(void) {
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   uint8_t n = tick(-1234, &in, tx);
-  TEST_ASSERT_EQUAL_UINT8(2, n); /* torque + first heartbeat */
+  TEST_ASSERT_EQUAL_UINT8(3, n); /* torque + first heartbeat and identity */
   pour_can_torque_t t;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &t));
   TEST_ASSERT_EQUAL_HEX16(pour_can_id(3, POUR_CAN_CMD_TORQUE), tx[0].id);
@@ -90,13 +98,20 @@ static void test_can_node_HeartbeatAtConfiguredPeriod(void) {
   for (unsigned t = 0; t < 12; ++t) {
     send_state((uint16_t)t, 0);
     uint8_t n = tick(0, &in, tx);
-    if (n == 2) {
+    if (n == 3) {
       pour_can_heartbeat_t hb;
       TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[1], &hb));
       TEST_ASSERT_EQUAL_UINT(0, t % 4u);
       TEST_ASSERT_EQUAL_UINT16(9, hb.overruns);
+      pour_can_identity_t id;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_identity(&tx[2], &id));
+      TEST_ASSERT_EQUAL_HEX32(0xabcdef01u, id.weights_hash);
+      TEST_ASSERT_EQUAL_UINT16(2000u, id.tau_max_cnm);
+      TEST_ASSERT_EQUAL_UINT8(POUR_FIRMWARE_VERSION, id.fw_version);
       last_counter = hb.counter;
       ++heartbeats;
+    } else {
+      TEST_ASSERT_EQUAL_UINT8(1, n);
     }
   }
   TEST_ASSERT_EQUAL_UINT(3, heartbeats);
@@ -108,49 +123,132 @@ static void test_can_node_SilenceTripsWatchdogAfterTimeout(void) {
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   for (unsigned t = 0; t < 20; ++t) { /* not armed before the first valid frame */
     tick(1000, &in, tx);
-    TEST_ASSERT_EQUAL_HEX16(0, node.faults);
+    TEST_ASSERT_FALSE(in.link_fault);
   }
   send_state(1, 0);
-  for (unsigned t = 0; t < 5; ++t) {
+  for (unsigned t = 0; t < 6; ++t) {
     tick(1000, &in, tx);
-    pour_can_torque_t tq;
-    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &tq));
-    TEST_ASSERT_EQUAL_INT16(1000, tq.torque);
+    TEST_ASSERT_FALSE(in.link_fault);
   }
   tick(1000, &in, tx); /* 6 ms without a valid frame > 5 ms */
-  pour_can_torque_t tq;
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &tq));
-  TEST_ASSERT_EQUAL_INT16(0, tq.torque);
-  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, tq.mode);
-  TEST_ASSERT_EQUAL_HEX16(POUR_CAN_FAULT_WATCHDOG, node.faults);
-  /* Latched: a fresh state does not clear it, ClearErrors does. */
-  send_state(2, 0);
+  TEST_ASSERT_TRUE(in.link_fault);
+  send_state(2, 0); /* a valid frame ends the trip; the core keeps it latched until a clear */
   tick(1000, &in, tx);
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &tq));
-  TEST_ASSERT_EQUAL_INT16(0, tq.torque);
-  pour_can_frame_t f;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_clear_errors(cfg.node_id, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
-  tick(1000, &in, tx);
-  TEST_ASSERT_TRUE(in.clear_faults);
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &tq));
-  TEST_ASSERT_EQUAL_INT16(1000, tq.torque);
-  tick(1000, &in, tx);
-  TEST_ASSERT_FALSE(in.clear_faults); /* one-shot */
+  TEST_ASSERT_FALSE(in.link_fault);
 }
 
-static void test_can_node_HeartbeatReportsWatchdogFault(void) {
+/* The core behind the node, one tick: what goes on the bus. */
+static pour_can_torque_t core_tick(pour_control_output_t *out) {
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
-  send_state(1, 0);
-  pour_can_heartbeat_t hb = {0};
-  for (unsigned t = 0; t < 12; ++t) {
-    if (tick(0, &in, tx) == 2) {
-      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[1], &hb));
-    }
+  pour_can_node_begin_tick(&node, &in);
+  pour_control_step(&ctl, &in, out);
+  TEST_ASSERT_TRUE(pour_can_node_end_tick(&node, out, 0, tx) >= 1u);
+  pour_can_torque_t tq;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_torque(&tx[0], &tq));
+  TEST_ASSERT_EQUAL_INT16(out->torque, tq.torque); /* the bus carries the core's output, nothing else */
+  return tq;
+}
+
+static void receive_command(uint8_t cmd) {
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(cfg.node_id, cmd, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+}
+
+/* The Linux port's watchdog runs on the wall clock: it can trip while states still arrive (a slow guest in
+ * lockstep). Then the core itself goes to FAULT, and ClearErrors lets the torque back only through the slew
+ * limit (it used to jump from 0 to the core's hidden command, 32767, in one tick). */
+static void test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew(void) {
+  pour_control_output_t out;
+  uint16_t seq = 0;
+  q15_t peak = 0;
+  for (unsigned t = 0; t < 40u; ++t) {
+    send_state(seq++, 0);
+    peak = core_tick(&out).torque > peak ? out.torque : peak;
   }
-  TEST_ASSERT_EQUAL_HEX16(POUR_CAN_FAULT_WATCHDOG, hb.faults & POUR_CAN_FAULT_WATCHDOG);
-  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, hb.mode);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_TRUE(peak > ccfg.safety.slew_per_tick); /* the policy did ramp up: a jump would show */
+  TEST_ASSERT_TRUE(pour_can_node_watchdog(&node, 60));
+  for (unsigned t = 0; t < 30u; ++t) { /* the core's command would keep ramping behind a bus override */
+    pour_can_torque_t tq = core_tick(&out);
+    TEST_ASSERT_EQUAL_INT16(0, tq.torque);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, tq.mode);
+    TEST_ASSERT_BITS_HIGH(POUR_FAULT_LINK, out.faults);
+    (void)pour_can_node_watchdog(&node, 60);
+  }
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  q15_t last = 0;
+  for (unsigned t = 0; t < 40u; ++t) {
+    send_state(seq++, 0);
+    pour_can_torque_t tq = core_tick(&out);
+    const int32_t step = (int32_t)tq.torque - last;
+    TEST_ASSERT_TRUE(step <= ccfg.safety.slew_per_tick && step >= -ccfg.safety.slew_per_tick);
+    last = tq.torque;
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_HEX16(0, out.faults);
+}
+
+/* E-stop wins over every other output: a tripped watchdog with a non-zero safe torque included. */
+static void test_can_node_EstopWinsOverWatchdogSafeTorque(void) {
+  ccfg.safe_torque = 3000;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
+  pour_control_output_t out;
+  send_state(1, 0);
+  core_tick(&out);
+  pour_can_frame_t f;
+  const pour_can_estop_t e = {.assert_estop = 1};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_estop(cfg.node_id, &e, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+  TEST_ASSERT_TRUE(pour_can_node_watchdog(&node, 60));
+  for (unsigned t = 0; t < 5u; ++t) {
+    pour_can_torque_t tq = core_tick(&out);
+    TEST_ASSERT_EQUAL_INT16(0, tq.torque);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, tq.mode);
+  }
+}
+
+/* StateB's seq wraps every 65,536 samples (65.5 s at 1 kHz): a wrap is the next sample, not a new run. */
+static void test_can_node_SeqWrapIsTheNextSampleNotANewRun(void) {
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  for (uint32_t k = 0; k < 70000u; ++k) {
+    send_state((uint16_t)(k & 0xFFFFu), 0);
+    pour_can_node_begin_tick(&node, &in);
+    TEST_ASSERT_TRUE(in.state_fresh);
+    TEST_ASSERT_EQUAL_UINT32(k, in.state.seq);
+    TEST_ASSERT_FALSE(in.reset);
+  }
+  (void)tx;
+  /* Only a Reset frame starts the count again (and asks the core for a new run). */
+  receive_command(POUR_CAN_CMD_RESET);
+  send_state(0, 0);
+  pour_can_node_begin_tick(&node, &in);
+  TEST_ASSERT_TRUE(in.reset);
+  TEST_ASSERT_EQUAL_UINT32(0, in.state.seq);
+}
+
+/* A reset is refused while the core runs; Stop first ends the run. */
+static void test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop(void) {
+  pour_control_output_t out;
+  uint16_t seq = 0;
+  for (unsigned t = 0; t < 30u; ++t) {
+    send_state(seq++, 0);
+    core_tick(&out);
+  }
+  const q15_t running = out.torque;
+  receive_command(POUR_CAN_CMD_RESET);
+  send_state(seq++, 0);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_UINT32(1, ctl.resets_refused);
+  TEST_ASSERT_TRUE(out.torque >= running - ccfg.safety.slew_per_tick); /* no drop to a fresh start */
+  receive_command(POUR_CAN_CMD_STOP);
+  receive_command(POUR_CAN_CMD_RESET);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_UINT32(1, ctl.resets_refused);
 }
 
 static void test_can_node_EstopLevelReachesTheNextTick(void) {
@@ -223,7 +321,10 @@ int main(void) {
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);
   RUN_TEST(test_can_node_SilenceTripsWatchdogAfterTimeout);
-  RUN_TEST(test_can_node_HeartbeatReportsWatchdogFault);
+  RUN_TEST(test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew);
+  RUN_TEST(test_can_node_EstopWinsOverWatchdogSafeTorque);
+  RUN_TEST(test_can_node_SeqWrapIsTheNextSampleNotANewRun);
+  RUN_TEST(test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop);
   RUN_TEST(test_can_node_EstopLevelReachesTheNextTick);
   RUN_TEST(test_can_node_MalformedFramesAreDroppedAndCounted);
   return UNITY_END();

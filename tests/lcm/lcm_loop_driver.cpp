@@ -131,6 +131,9 @@ int main(int argc, char **argv) {
       std::fprintf(stderr, "lcm_loop_driver: the core refused the built-in weights\n");
       return 1;
     }
+    if (link) {
+      link->request_new_run(); // the controller has no episodes: a new run is an explicit command
+    }
     poursim_observe(world, &obs);
     for (long k = 0; k < steps; k++) {
       int16_t q15 = 0;

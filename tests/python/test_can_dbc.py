@@ -25,10 +25,16 @@ MESSAGES = {
     "torque": ("Torque", ["Seq", "Torque", "Action", "Mode", "Limits"]),
     "heartbeat": ("Heartbeat", ["Mode", "Faults", "RxDropped", "Overruns", "Counter"]),
     "estop": ("Estop", ["Assert"]),
+    "identity": ("Identity", ["WeightsHash", "TauMax", "FwVersion", "InitStatus"]),
     "clear_errors": ("ClearErrors", []),
+    "stop": ("Stop", []),
+    "reset": ("Reset", []),
 }
+SIGNAL_FREE = ("clear_errors", "stop", "reset")
 FAULT_BITS = {"Fault_StaleInput": 0x0001, "Fault_EStop": 0x0002, "Fault_BadInput": 0x0004,
-              "Fault_CanWatchdog": 0x0100}
+              "Fault_Position": 0x0008, "Fault_Overspeed": 0x0010, "Fault_TorqueSign": 0x0020,
+              "Fault_Encoder": 0x0040, "Fault_Volume": 0x0080, "Fault_CanWatchdog": 0x0100,
+              "Fault_Seq": 0x0200}
 
 
 @pytest.fixture(scope="module")
@@ -154,7 +160,7 @@ def test_pack_matches_dbc_for_random_and_edge_values(db, harness, cname):
         assert from_signals(cname, msg.decode(data, scaling=False, decode_choices=False)) == values
 
 
-@pytest.mark.parametrize("cname", sorted(n for n in MESSAGES if n != "clear_errors"))
+@pytest.mark.parametrize("cname", sorted(n for n in MESSAGES if n not in SIGNAL_FREE))
 def test_pack_refuses_what_the_dbc_calls_out_of_range(db, harness, cname):
     ranges = field_ranges(db, cname)
     dbc_name, fields = MESSAGES[cname]
@@ -175,7 +181,7 @@ def test_pack_refuses_what_the_dbc_calls_out_of_range(db, harness, cname):
             with pytest.raises(cantools.database.errors.EncodeError):
                 msg.encode(to_signals(cname, case), scaling=False, strict=True)
             refused += 1
-    if cname in ("state_a", "state_b", "torque", "heartbeat", "estop"):
+    if cname in ("state_a", "state_b", "torque", "heartbeat", "estop", "identity"):
         assert refused > 0
 
 
@@ -218,9 +224,10 @@ def test_unpack_rejects_every_wrong_dlc(db, harness, cname):
 
 
 def test_cmd_ids_and_lengths_match_the_c_header(db, source_dir):
-    header = (source_dir / "firmware" / "include" / "pour" / "can_codec.h").read_text()
+    header = (source_dir / "firmware" / "can" / "include" / "pour" / "can_codec.h").read_text()
     names = {"Heartbeat": "HEARTBEAT", "Estop": "ESTOP", "StateA": "STATE_A", "StateB": "STATE_B",
-             "Torque": "TORQUE", "ClearErrors": "CLEAR_ERRORS"}
+             "Torque": "TORQUE", "ClearErrors": "CLEAR_ERRORS", "Stop": "STOP", "Reset": "RESET",
+             "Identity": "IDENTITY"}
     assert sorted(m.name for m in db.messages) == sorted(names)
     for m in db.messages:
         c = names[m.name]
@@ -235,15 +242,16 @@ def test_every_signal_has_a_unit_or_choices_and_a_comment(db):
         for s in m.signals:
             assert s.comment, (m.name, s.name)
             assert s.unit or s.choices or s.length == 1 or s.name in ("Seq", "SeqLow", "Counter", "Action",
-                                                                        "Limits"), (m.name, s.name)
+                                                                        "Limits", "WeightsHash", "FwVersion",
+                                                                        "InitStatus"), (m.name, s.name)
 
 
 def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     """What a bench engineer runs: candump -L lines piped through cantools decode."""
     lines = []
     frames = [("state_a", [1500000, -2500000, 7]), ("state_b", [7, 16384, 8192, 3]),
-              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0101, 3, 4, 5]), ("estop", [1]),
-              ("clear_errors", [])]
+              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5]), ("estop", [1]),
+              ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", [])]
     for cname, values in frames:
         frame_id, _, data = c_pack(harness, cname, 0, values)
         lines.append(f"(1700000000.{len(lines):06d}) vcan0 {frame_id:03X}#{data.hex().upper()}")
@@ -256,8 +264,11 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "Torque: -50.0 %" in text
     assert "Mode: RUN" in text
     assert "Fault_CanWatchdog: 1" in text
+    assert "Fault_TorqueSign: 1" in text
+    assert "TauMax: 20.0 N.m" in text
     assert "Assert: ASSERT" in text
     assert "ClearErrors(" in text
+    assert "Stop(" in text and "Reset(" in text
 
 
 def test_dbc_for_node_shifts_every_id(db):

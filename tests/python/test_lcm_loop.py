@@ -50,7 +50,7 @@ def test_lockstep_loop_is_bit_identical_to_in_process(tools, tmp_path):
     assert hash_of(r.stdout) == hash_of(ref.stdout)
     s = stats_of(r.stdout)
     assert s["states"] == 2 * int(STEPS) and s["on_time"] == s["states"] and s["missing"] == 0
-    assert "episodes 2" in c.out
+    assert "resets 2" in c.out
     # The policy acted: some torque was non-zero.
     assert any(line.split()[-1] != "0" for line in (tmp_path / "lcm.txt").read_text().splitlines())
 
@@ -149,7 +149,7 @@ def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, so
     assert "lcm lockstep: states 6000 answers 6000 on_time 6000" in r.stdout
     summary = [x for x in r.stdout.splitlines() if x.startswith("summary")]
     assert summary == [x for x in ref.stdout.splitlines() if x.startswith("summary")]
-    assert "answers 6000" in c.out and "episodes 2" in c.out
+    assert "answers 6000" in c.out and "resets 2" in c.out
 
 
 def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_dir, source_dir):

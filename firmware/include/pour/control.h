@@ -11,6 +11,10 @@
 #include "pour/policy.h"
 #include "pour/safety.h"
 
+/* Version of the firmware as the bus reports it (Identity.FwVersion): +1 with any change in behaviour a
+ * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity. */
+#define POUR_FIRMWARE_VERSION 2u
+
 typedef enum {
   POUR_MODE_IDLE = 0,  /* no state yet (or faults just cleared): safe torque */
   POUR_MODE_RUN = 1,   /* policy in command, inside the envelope */
@@ -22,6 +26,14 @@ typedef enum {
 #define POUR_FAULT_STALE_INPUT 0x0001u /* no fresh state for longer than input_timeout_ms */
 #define POUR_FAULT_ESTOP 0x0002u       /* e-stop was asserted */
 #define POUR_FAULT_BAD_INPUT 0x0004u   /* a state outside its physical range was received */
+#define POUR_FAULT_POSITION 0x0008u    /* supervisor: θ outside [θmin - margin, θmax + margin] */
+#define POUR_FAULT_OVERSPEED 0x0010u   /* supervisor: |θ̇| above the overspeed limit */
+#define POUR_FAULT_TORQUE_SIGN 0x0020u /* supervisor: the axis accelerates against the commanded torque */
+#define POUR_FAULT_ENCODER 0x0040u     /* supervisor: the encoder does not move under sustained torque */
+#define POUR_FAULT_VOLUME 0x0080u      /* supervisor: a volume reading jumped faster than liquid can flow */
+#define POUR_FAULT_LINK 0x0100u        /* the transport's command watchdog tripped (the CAN node's) */
+#define POUR_FAULT_SEQ 0x0200u         /* supervisor: states keep arriving but their seq does not advance */
+#define POUR_FAULT_ALL 0x03FFu
 
 typedef struct {
   pour_safety_config_t safety;
@@ -41,6 +53,9 @@ typedef struct {
   pour_state_t state;
   bool estop;        /* e-stop line/frame asserted (level) */
   bool clear_faults; /* request to clear latched faults (acted on when e-stop is released) */
+  bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
+  bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
+  bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN and ESTOP */
 } pour_control_input_t;
 
 /* Outputs of one tick. */
@@ -66,6 +81,7 @@ typedef struct {
   pour_state_t state; /* latest fresh, plausible state */
   pour_obs_t obs;
   pour_policy_eval_t eval;
+  uint32_t resets_refused; /* reset requests refused because the core was in RUN or ESTOP */
 } pour_control_t;
 
 /* Defaults: docs/safety.md lists them with their reasons. */
@@ -77,9 +93,11 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
                                 const pour_policy_weights_t *weights);
 
 /* One 1 ms tick. Never fails: problems show as mode and fault bits in the output.
- * Order: e-stop (zero torque now), clear request, input check (BAD_INPUT), timeout (STALE_INPUT,
- * armed in RUN only), IDLE -> RUN on the first fresh state, policy decision on the first RUN tick and
- * every decision_period_ms ticks after, envelope. out->tick counts the steps including this one. */
+ * Order: e-stop (zero torque now, whatever else the input says), link fault (FAULT), clear request,
+ * stop, reset, input check (BAD_INPUT), timeout (STALE_INPUT, armed in RUN only), IDLE -> RUN on the
+ * first fresh state, policy decision on the first RUN tick and every decision_period_ms ticks after,
+ * envelope. A clear never bypasses the envelope: RUN resumes from the safe torque through the slew limit.
+ * out->tick counts the steps including this one. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
 
 #endif /* POUR_CONTROL_H */

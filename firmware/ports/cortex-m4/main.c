@@ -52,7 +52,9 @@ static void can_init(void) {
   pour_fdcan_config_t fc = pour_fdcan_default_config();
   fc.kernel_clock_hz = POUR_CORE_CLOCK_HZ;
   (void)pour_fdcan_init(&fdcan, pour_fdcan_stm32g4_fdcan1(), &fc);
-  const pour_can_node_config_t nc = pour_can_node_default_config();
+  pour_can_node_config_t nc = pour_can_node_default_config();
+  nc.identity.weights_hash = pour_weights_compiled.content_hash;
+  nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
   (void)pour_can_node_init(&can_node, &nc);
 }
 #endif
@@ -65,7 +67,7 @@ int main(void) {
     }
   }
   pour_hal_timer_init(POUR_CORE_CLOCK_HZ);
-  pour_control_input_t in = {false, {0u, 0, 0, 0, 0, 0}, false, false};
+  pour_control_input_t in = {false, {0u, 0, 0, 0, 0, 0}, false, false, false, false, false};
   pour_control_output_t out;
 #ifdef POUR_SMOKE_TICKS
   uint32_t missed = 0u;
@@ -93,7 +95,7 @@ int main(void) {
     overruns += pour_hal_timer_wait_tick();
     poll_input(&in, tick);
     pour_control_step(&controller, &in, &out);
-    const uint8_t n_tx = pour_can_node_end_tick(&can_node, &out, overruns, tx); /* the watchdog may cut torque */
+    const uint8_t n_tx = pour_can_node_end_tick(&can_node, &out, overruns, tx);
     pour_hal_motor_set_torque(out.torque);
     for (uint8_t i = 0; i < n_tx; ++i) {
       (void)pour_fdcan_transmit(&fdcan, &tx[i]);

@@ -43,6 +43,8 @@ typedef struct {
   pour_linux_stats_t *stats;
   bool estop;             /* level from the latest command */
   bool clear_pending;     /* a clear request waiting for the next tick */
+  bool stop_pending;      /* a stop request waiting for the next tick */
+  bool reset_pending;     /* a reset request waiting for the next tick */
   bool have_last;         /* an answer was sent (for lockstep resends) */
   int32_t last_episode;
   int64_t last_seq;
@@ -116,20 +118,8 @@ static void absorb(loop_t *l, const pour_io_input_t *in) {
   if (in->have_command) {
     l->estop = in->estop;
     l->clear_pending = l->clear_pending || in->clear_faults;
-  }
-}
-
-/* A state with seq 0 starts an episode: the core starts afresh, as the in-process simulator's does,
- * unless a fault is latched (that needs an explicit clear, whatever the sender does). */
-static void maybe_new_episode(loop_t *l, const pour_io_input_t *in) {
-  if (in->n_states == 0 || in->state_seq != 0) {
-    return;
-  }
-  if (l->ctl.mode == POUR_MODE_FAULT || l->ctl.mode == POUR_MODE_ESTOP || l->estop) {
-    return;
-  }
-  if (pour_control_init(&l->ctl, &l->config->control, l->config->weights) == POUR_OK) {
-    l->stats->episodes++;
+    l->stop_pending = l->stop_pending || in->stop;
+    l->reset_pending = l->reset_pending || in->reset;
   }
 }
 
@@ -142,15 +132,26 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   }
   ci.estop = l->estop;
   ci.clear_faults = l->clear_pending;
+  ci.stop = l->stop_pending;
+  ci.reset = l->reset_pending;
   l->clear_pending = false;
+  l->stop_pending = false;
+  l->reset_pending = false;
+  if (l->io->begin_tick != NULL) {
+    l->io->begin_tick(l->io, &ci);
+  }
+  /* No episode logic here: a new run starts only on an explicit reset, which the core refuses in RUN. */
+  if (ci.reset) {
+    l->stats->resets++;
+  }
 
   const uint16_t faults_before = l->out.faults;
   const int64_t t0 = mono_ns();
   pour_control_step(&l->ctl, &ci, &l->out);
   const int64_t dt = mono_ns() - t0;
   if ((l->out.faults & ~faults_before) != 0u) {
-    fprintf(stderr, "pour_controller: fault 0x%04x latched at tick %lu (0x1 stale input, 0x2 e-stop, 0x4 bad input); "
-            "safe torque until cleared (POUR_COMMAND clear_faults, e.g. pour-lcm-cmd --clear)\n",
+    fprintf(stderr, "pour_controller: fault 0x%04x latched at tick %lu (docs/safety.md names the bits); "
+            "controlled stop, then safe until cleared (POUR_COMMAND clear_faults, e.g. pour-lcm-cmd --clear)\n",
             (unsigned)l->out.faults, (unsigned long)l->out.tick);
   }
 
@@ -213,7 +214,6 @@ static void run_realtime(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
       l->stats->io_errors++;
     }
     absorb(l, &in);
-    maybe_new_episode(l, &in);
     tick(l, &in, in.n_states > 0);
     maybe_send_status(l, false);
     const int64_t end = mono_ns();
@@ -260,7 +260,6 @@ static void run_lockstep(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
         l->stats->duplicates++;
         send_answer(l);
       } else {
-        maybe_new_episode(l, &in);
         tick(l, &in, true);
       }
     } else {

@@ -34,7 +34,7 @@ typedef struct {
   int64_t late_sum_us;      /* real time: sum of tick-start lateness [µs] (mean = sum / ticks) */
   int64_t step_time_max_ns; /* longest pour_control_step [ns] */
   int64_t io_errors;        /* failed sends or waits */
-  int64_t episodes;         /* episode starts (seq 0) that re-initialised the core */
+  int64_t resets;           /* reset commands received (the core refuses those that come in RUN) */
   uint8_t mode;             /* pour_mode_t at exit */
   uint16_t faults;          /* fault bits at exit */
 } pour_linux_stats_t;

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The controller process's I/O, behind one narrow interface: one implementation per transport
- * (io_lcm.c: LCM; a SocketCAN backend plugs in the same way). The loop in controller.c never
- * sees a transport. */
+ * (io_lcm.c: LCM, io_socketcan.c: the CAN node on SocketCAN). The loop in controller.c never sees a
+ * transport. */
 #ifndef POUR_LINUX_IO_H
 #define POUR_LINUX_IO_H
 
@@ -20,6 +20,8 @@ typedef struct {
   bool have_command;     /* a command arrived */
   bool estop;            /* e-stop level of the latest command */
   bool clear_faults;     /* any command during this wait asked to clear faults */
+  bool stop;             /* any command during this wait asked to end the run */
+  bool reset;            /* any command during this wait asked for a new run */
   uint32_t n_dropped;    /* messages on our channels that failed to decode */
 } pour_io_input_t;
 
@@ -60,6 +62,9 @@ struct pour_io {
   /* Waits at most timeout_us (0: poll) for input and accumulates it into *in (which the caller
    * zeroes). Returns 1 if a state arrived, 0 if not, negative on a transport error. */
   int (*wait)(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in);
+  /* Optional (NULL: the loop's own input stands): once per tick, the transport's part of the control
+   * input. The CAN node supplies all of it there, its watchdog as the link fault included. */
+  void (*begin_tick)(pour_io_t *io, pour_control_input_t *in);
   /* Sends the answer to a state; returns 0 or negative on a transport error. */
   int (*send_torque)(pour_io_t *io, const pour_io_answer_t *answer);
   /* Sends the health status; returns 0 or negative on a transport error. */

@@ -55,6 +55,8 @@ static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *us
   s->in->have_command = true;
   s->in->estop = msg.estop != 0;
   s->in->clear_faults = s->in->clear_faults || msg.clear_faults != 0;
+  s->in->stop = s->in->stop || msg.stop != 0;
+  s->in->reset = s->in->reset || msg.reset != 0;
 }
 
 static int64_t now_us(void) {

@@ -20,11 +20,7 @@ typedef struct {
   int64_t last_ms;          /* wall clock of the last watchdog update [ms] */
   int64_t next_heartbeat_ms;
   uint32_t dropped_reported;
-  uint32_t rx_errors;       /* frames the codec never saw: error, RTR, extended or FD frames */
-  uint16_t last_seq16;
-  int64_t last_seq64;
-  uint8_t mode;             /* latest mode, faults and overruns the loop told us of */
-  uint16_t faults;
+  pour_control_output_t out; /* the latest output the loop told us of (what the heartbeat reports) */
   uint32_t overruns;
 } socketcan_t;
 
@@ -46,31 +42,20 @@ static int send_frame(socketcan_t *s, const pour_can_frame_t *f) {
   return write(s->fd, &cf, sizeof cf) == (ssize_t)sizeof cf ? 0 : -1;
 }
 
-static void heartbeat(socketcan_t *s) {
-  pour_can_heartbeat_t hb;
-  hb.mode = s->mode;
-  hb.faults = (uint16_t)(s->faults | s->node.faults);
-  hb.rx_dropped = (uint16_t)((pour_can_node_dropped(&s->node) + s->rx_errors) & 0xFFFFu);
-  hb.overruns = (uint16_t)(s->overruns & 0xFFFFu);
-  hb.counter = s->node.heartbeat_counter++;
-  if ((s->node.faults & POUR_CAN_FAULT_WATCHDOG) != 0u && hb.mode != (uint8_t)POUR_MODE_ESTOP) {
-    hb.mode = (uint8_t)POUR_MODE_FAULT;
-  }
-  pour_can_frame_t f;
-  if (pour_can_pack_heartbeat(s->config.node.node_id, &hb, &f) == POUR_OK) {
-    (void)send_frame(s, &f);
-  }
-}
-
-/* Wall-clock housekeeping: the watchdog and the heartbeat schedule. */
+/* Wall-clock housekeeping: the node's watchdog, and its heartbeat and identity frames on schedule (the
+ * loop ticks only on states in lockstep, yet a bench must see the controller alive while it waits). */
 static void housekeeping(socketcan_t *s) {
   const int64_t now = mono_ms();
   if (now > s->last_ms) {
-    pour_can_node_watchdog(&s->node, (uint32_t)(now - s->last_ms));
+    (void)pour_can_node_watchdog(&s->node, (uint32_t)(now - s->last_ms));
     s->last_ms = now;
   }
   if (now >= s->next_heartbeat_ms) {
-    heartbeat(s);
+    pour_can_frame_t f[2];
+    const uint8_t n = pour_can_node_status_frames(&s->node, &s->out, s->overruns, f);
+    for (uint8_t i = 0; i < n; ++i) {
+      (void)send_frame(s, &f[i]);
+    }
     s->next_heartbeat_ms += s->config.node.heartbeat_period_ms;
     if (s->next_heartbeat_ms <= now) {
       s->next_heartbeat_ms = now + s->config.node.heartbeat_period_ms;
@@ -78,25 +63,8 @@ static void housekeeping(socketcan_t *s) {
   }
 }
 
-/* CAN carries 16 bits of seq: extend it to the loop's 64-bit seq (0 always starts an episode). */
-static int64_t unwrap_seq(socketcan_t *s, uint32_t seq32) {
-  const uint16_t seq16 = (uint16_t)(seq32 & 0xFFFFu);
-  int64_t seq64;
-  if (seq16 == 0u) {
-    seq64 = 0;
-  } else {
-    const int32_t delta = (int32_t)(int16_t)(uint16_t)(seq16 - s->last_seq16);
-    seq64 = s->last_seq64 + delta;
-    if (seq64 < 0) {
-      seq64 = seq16;
-    }
-  }
-  s->last_seq16 = seq16;
-  s->last_seq64 = seq64;
-  return seq64;
-}
-
-/* Reads the frames waiting on the socket; stops after the first completed state. */
+/* Moves the frames waiting on the socket into the node; stops after the first completed state. The
+ * control input itself is taken once per tick, in can_begin_tick. */
 static int drain(socketcan_t *s, pour_io_input_t *in) {
   for (;;) {
     struct can_frame cf;
@@ -106,7 +74,11 @@ static int drain(socketcan_t *s, pour_io_input_t *in) {
     }
     if (n != (ssize_t)sizeof cf || (cf.can_id & (CAN_ERR_FLAG | CAN_RTR_FLAG | CAN_EFF_FLAG)) != 0u ||
         cf.can_dlc > 8u) {
-      s->rx_errors++;
+      /* Error, RTR, extended or FD frames: the codec never sees them, the heartbeat counts them. */
+      if (s->node.counters.bad_id != UINT32_MAX) {
+        s->node.counters.bad_id++;
+      }
+      s->dropped_reported++;
       in->n_dropped++;
       continue;
     }
@@ -114,26 +86,16 @@ static int drain(socketcan_t *s, pour_io_input_t *in) {
     f.id = (uint16_t)(cf.can_id & CAN_SFF_MASK);
     f.dlc = cf.can_dlc;
     memcpy(f.data, cf.data, sizeof f.data);
-    const pour_can_rx_t rc = pour_can_node_receive(&s->node, &f);
-    if (rc != POUR_CAN_RX_OK) {
+    if (pour_can_node_receive(&s->node, &f) != POUR_CAN_RX_OK) {
       const uint32_t d = pour_can_node_dropped(&s->node);
       in->n_dropped += d - s->dropped_reported;
       s->dropped_reported = d;
       continue;
     }
-    pour_control_input_t ci;
-    const uint8_t cmd = (uint8_t)(f.id & POUR_CAN_CMD_MASK);
-    pour_can_node_begin_tick(&s->node, &ci);
-    if (cmd == POUR_CAN_CMD_ESTOP || cmd == POUR_CAN_CMD_CLEAR_ERRORS) {
-      in->have_command = true;
-      in->estop = ci.estop;
-      in->clear_faults = in->clear_faults || ci.clear_faults;
-    }
-    if (ci.state_fresh) {
+    if (s->node.state_fresh) {
       in->n_states++;
-      in->state = ci.state;
-      in->state_seq = unwrap_seq(s, ci.state.seq);
-      in->state.seq = (uint32_t)in->state_seq;
+      in->state = s->node.state;
+      in->state_seq = (int64_t)s->node.state.seq; /* 32 bits, extended by the node: no wrap, no reset */
       in->state_utime = 0; /* CAN carries no time stamp; the bridge restores it */
       in->episode = 0;
       return 1;
@@ -164,31 +126,29 @@ static int can_wait(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in) {
   }
 }
 
-static int can_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
+static void can_begin_tick(pour_io_t *io, pour_control_input_t *in) {
   socketcan_t *s = io->ctx;
   housekeeping(s);
-  pour_control_output_t out = *a->out;
-  pour_can_node_override(&s->node, &out);
-  s->mode = out.mode;
-  s->faults = out.faults;
-  pour_can_torque_t t;
-  t.seq = (uint16_t)((uint64_t)a->state_seq & 0xFFFFu);
-  t.torque = out.torque;
-  t.action = (uint8_t)(out.action & POUR_CAN_ACTION_MAX);
-  t.mode = (uint8_t)(out.mode & 0x03u);
-  t.limits = (uint8_t)(out.limits & POUR_CAN_LIMITS_MAX);
+  pour_can_node_begin_tick(&s->node, in);
+}
+
+static int can_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
+  socketcan_t *s = io->ctx;
+  s->out = *a->out;
   pour_can_frame_t f;
-  if (pour_can_pack_torque(s->config.node.node_id, &t, &f) != POUR_OK) {
+  if (pour_can_node_torque_frame(&s->node, a->out, &f) != POUR_OK) {
     return -1;
   }
-  return send_frame(s, &f);
+  const int rc = send_frame(s, &f);
+  housekeeping(s);
+  return rc;
 }
 
 static int can_send_status(pour_io_t *io, const pour_io_status_t *st) {
   socketcan_t *s = io->ctx;
   /* The heartbeat keeps its own period; the status only refreshes what it reports. */
-  s->mode = st->mode;
-  s->faults = st->faults;
+  s->out.mode = st->mode;
+  s->out.faults = st->faults;
   s->overruns = st->overruns > (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)st->overruns;
   housekeeping(s);
   return 0;
@@ -305,6 +265,7 @@ int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *conf
   s->next_heartbeat_ms = s->last_ms;
   io->ctx = s;
   io->wait = can_wait;
+  io->begin_tick = can_begin_tick;
   io->send_torque = can_send_torque;
   io->send_status = can_send_status;
   io->close = can_close;

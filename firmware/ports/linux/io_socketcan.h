@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* SocketCAN transport for the controller: the pour CAN protocol (can/pour.dbc) on a Linux CAN interface.
- * StateA/StateB, Estop and ClearErrors in; Torque (one per answered state) and Heartbeat out. Frame
- * handling, the command watchdog and the heartbeat contents are the core's pour_can_node; this file only
- * moves frames and keeps the wall clock. */
+ * StateA/StateB, Estop, Stop, ClearErrors and Reset in; Torque (one per answered state), Heartbeat and
+ * Identity out. Every frame, the command watchdog and the control input of a tick are pour::can's node
+ * (the same calls as the Cortex-M4 port); this file only moves frames and keeps the wall clock. */
 #ifndef POUR_LINUX_IO_SOCKETCAN_H
 #define POUR_LINUX_IO_SOCKETCAN_H
 
@@ -13,7 +13,7 @@
 
 typedef struct {
   char iface[16];                /* interface name, e.g. "vcan0" (IFNAMSIZ) */
-  pour_can_node_config_t node;   /* node id, watchdog [ms], heartbeat period [ms], safe torque */
+  pour_can_node_config_t node;   /* node id, watchdog [ms], heartbeat period [ms], identity */
   uint32_t watchdog_grace_ms;    /* added to the watchdog (lockstep: the loop's stall time) [ms] */
 } pour_io_socketcan_config_t;
 

@@ -78,6 +78,8 @@ static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *c
   }
   if (strncmp(spec, "can:", 4) == 0) {
     pour_io_socketcan_config_t can = {.node = pour_can_node_default_config()};
+    can.node.identity.weights_hash = cfg->weights->content_hash;
+    can.node.identity.tau_max_cnm = (uint16_t)(cfg->weights->tau_max_mnm / 10);
     /* In lockstep the loop itself waits stall_ms before it treats silence as stale input. */
     can.watchdog_grace_ms = cfg->lockstep ? (uint32_t)cfg->stall_ms : 0u;
     return pour_io_socketcan_parse(spec + 4, &can) == 0 ? pour_io_socketcan_open(io, &can) : -1;
@@ -169,12 +171,12 @@ int main(int argc, char **argv) {
     return 1;
   }
   printf("pour_controller: ticks %lld states %lld answers %lld duplicates %lld dropped %lld stale_ticks %lld "
-         "overruns %lld late_mean_us %.1f late_max_us %lld step_max_ns %lld io_errors %lld episodes %lld "
+         "overruns %lld late_mean_us %.1f late_max_us %lld step_max_ns %lld io_errors %lld resets %lld "
          "mode %u faults 0x%04x\n",
          (long long)st.ticks, (long long)st.states_received, (long long)st.answers, (long long)st.duplicates,
          (long long)st.messages_dropped, (long long)st.stale_ticks, (long long)st.overruns,
          st.ticks > 0 ? (double)st.late_sum_us / (double)st.ticks : 0.0, (long long)st.late_max_us,
-         (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.episodes, (unsigned)st.mode,
+         (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.resets, (unsigned)st.mode,
          (unsigned)st.faults);
   return 0;
 }

@@ -76,7 +76,9 @@ def test_bridge_makes_a_can_controller_look_like_an_lcm_one():
         assert a.mode == 1 and a.torque_q15 != 0
         weights = (SOURCE_DIR / "policy" / "weights.h").read_text()
         tau_max_nm = int(re.search(r"#define POUR_WEIGHTS_TAU_MAX_MNM (\d+)", weights).group(1)) / 1000
-        assert a.torque == pytest.approx(a.torque_q15 / 32768 * tau_max_nm)
+        assert a.torque == pytest.approx(a.torque_q15 / 32768 * tau_max_nm)  # the scale the Identity frame announced
+        weights_hash = int(re.search(r"#define POUR_WEIGHTS_CONTENT_HASH (0x[0-9a-fA-F]+)u", weights).group(1), 16)
+        assert a.weights_hash & 0xFFFFFFFF == weights_hash
         assert host.status(lambda s: s.mode == 1).faults == 0
 
         host.command(estop=True, clear=False)
@@ -104,9 +106,10 @@ def test_bridge_makes_a_can_controller_look_like_an_lcm_one():
         ctl.send_signal(signal.SIGINT)
         ctl.communicate(timeout=20)
     assert bridge.returncode == 0, err
-    m = re.search(r"states (\d+) refused (\d+) torques (\d+) unmatched (\d+) heartbeats (\d+) frames_dropped (\d+) "
-                  r"commands (\d+) lcm_dropped (\d+)", out)
+    m = re.search(r"states (\d+) refused (\d+) torques (\d+) unmatched (\d+) heartbeats (\d+) identities (\d+) "
+                  r"frames_dropped (\d+) commands (\d+) lcm_dropped (\d+)", out)
     assert m, out
-    states, refused, torques, unmatched, heartbeats, frames_dropped, commands, lcm_dropped = map(int, m.groups())
+    states, refused, torques, unmatched, heartbeats, identities, frames_dropped, commands, lcm_dropped = map(
+        int, m.groups())
     assert states == torques == 62 and refused == unmatched == frames_dropped == 0
-    assert heartbeats > 0 and commands == 2 and lcm_dropped == 10
+    assert heartbeats > 0 and identities > 0 and commands == 2 and lcm_dropped == 10

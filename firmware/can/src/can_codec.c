@@ -118,11 +118,27 @@ pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, 
   return POUR_OK;
 }
 
-pour_status_t pour_can_pack_clear_errors(uint8_t node_id, pour_can_frame_t *frame) {
-  if (frame == NULL || node_id > POUR_CAN_NODE_ID_MAX) {
+pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->init_status > 0) {
     return POUR_EINVAL;
   }
-  frame_begin(frame, node_id, POUR_CAN_CMD_CLEAR_ERRORS, POUR_CAN_DLC_CLEAR_ERRORS);
+  frame_begin(frame, node_id, POUR_CAN_CMD_IDENTITY, POUR_CAN_DLC_IDENTITY);
+  put_u32(&frame->data[0], msg->weights_hash);
+  put_u16(&frame->data[4], msg->tau_max_cnm);
+  frame->data[6] = msg->fw_version;
+  frame->data[7] = (uint8_t)((uint32_t)(int32_t)msg->init_status & 0xFFu);
+  return POUR_OK;
+}
+
+static int is_signal_free_command(uint8_t cmd) {
+  return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET;
+}
+
+pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame) {
+  if (frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !is_signal_free_command(cmd)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, cmd, 0u);
   return POUR_OK;
 }
 
@@ -130,6 +146,9 @@ int pour_can_dlc_of(uint8_t cmd) {
   switch (cmd) {
     case POUR_CAN_CMD_HEARTBEAT: return (int)POUR_CAN_DLC_HEARTBEAT;
     case POUR_CAN_CMD_ESTOP: return (int)POUR_CAN_DLC_ESTOP;
+    case POUR_CAN_CMD_STOP: return (int)POUR_CAN_DLC_STOP;
+    case POUR_CAN_CMD_IDENTITY: return (int)POUR_CAN_DLC_IDENTITY;
+    case POUR_CAN_CMD_RESET: return (int)POUR_CAN_DLC_RESET;
     case POUR_CAN_CMD_STATE_A: return (int)POUR_CAN_DLC_STATE_A;
     case POUR_CAN_CMD_STATE_B: return (int)POUR_CAN_DLC_STATE_B;
     case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
@@ -228,8 +247,23 @@ pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_esto
   return POUR_CAN_RX_OK;
 }
 
-pour_can_rx_t pour_can_unpack_clear_errors(const pour_can_frame_t *frame) {
-  return check_header(frame, POUR_CAN_CMD_CLEAR_ERRORS);
+pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_IDENTITY);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if ((frame->data[7] & 0x80u) == 0u && frame->data[7] != 0u) {
+    return POUR_CAN_RX_OUT_OF_RANGE; /* a positive status does not exist */
+  }
+  msg->weights_hash = get_u32(&frame->data[0]);
+  msg->tau_max_cnm = get_u16(&frame->data[4]);
+  msg->fw_version = frame->data[6];
+  msg->init_status = (int8_t)((int32_t)frame->data[7] - ((frame->data[7] & 0x80u) ? 256 : 0));
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd) {
+  return is_signal_free_command(cmd) ? check_header(frame, cmd) : POUR_CAN_RX_BAD_ID;
 }
 
 pour_can_rx_t pour_can_classify(const pour_can_frame_t *frame, uint8_t node_id, uint32_t accept_mask,

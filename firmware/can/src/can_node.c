@@ -3,22 +3,25 @@
 
 #include <stddef.h>
 
-/* Commands a controller accepts; HEARTBEAT and TORQUE are its own transmissions. */
-#define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STATE_A) | (1u << POUR_CAN_CMD_STATE_B) | \
-                     (1u << POUR_CAN_CMD_CLEAR_ERRORS))
+/* Commands a controller accepts; HEARTBEAT, IDENTITY and TORQUE are its own transmissions. */
+#define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_STATE_A) | \
+                     (1u << POUR_CAN_CMD_STATE_B) | (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET))
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
   c.node_id = 0;
   c.watchdog_ms = 50;
   c.heartbeat_period_ms = 100;
-  c.safe_torque = 0;
+  c.identity.weights_hash = 0u;
+  c.identity.tau_max_cnm = 0u;
+  c.identity.fw_version = (uint8_t)POUR_FIRMWARE_VERSION;
+  c.identity.init_status = (int8_t)POUR_OK;
   return c;
 }
 
 pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config) {
   if (node == NULL || config == NULL || config->node_id > POUR_CAN_NODE_ID_MAX || config->watchdog_ms == 0u ||
-      config->heartbeat_period_ms == 0u) {
+      config->heartbeat_period_ms == 0u || config->identity.init_status > 0) {
     return POUR_EINVAL;
   }
   pour_can_node_t zero = {0};
@@ -48,6 +51,20 @@ static pour_can_rx_t drop(pour_can_node_t *node, pour_can_rx_t why) {
     default: count(&node->counters.bad_id); break;
   }
   return why;
+}
+
+/* Completes a sample: StateB's 16-bit seq continues the 32-bit count by its forward distance (mod 2^16),
+ * so a wrap is the next sample and a repeated frame repeats the seq (the core's supervisor sees it). */
+static void complete_state(pour_can_node_t *node, const pour_can_state_b_t *b) {
+  const uint16_t last16 = (uint16_t)(node->state.seq & 0xFFFFu);
+  node->state.seq = node->have_seq ? node->state.seq + (uint16_t)(b->seq - last16) : b->seq;
+  node->have_seq = true;
+  node->state.theta_urad = node->pending_a.theta_urad;
+  node->state.omega_urad_s = node->pending_a.omega_urad_s;
+  node->state.v_rotating = b->v_rotating;
+  node->state.v_target = b->v_target;
+  node->state.v_spill = b->v_spill;
+  node->state_fresh = true;
 }
 
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame) {
@@ -82,13 +99,7 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
         return POUR_CAN_RX_UNPAIRED;
       }
       node->have_a = false;
-      node->state.seq = b.seq;
-      node->state.theta_urad = node->pending_a.theta_urad;
-      node->state.omega_urad_s = node->pending_a.omega_urad_s;
-      node->state.v_rotating = b.v_rotating;
-      node->state.v_target = b.v_target;
-      node->state.v_spill = b.v_spill;
-      node->state_fresh = true;
+      complete_state(node, &b);
       kick(node);
       break;
     }
@@ -102,7 +113,16 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       kick(node);
       break;
     }
-    default: /* POUR_CAN_CMD_CLEAR_ERRORS: classify checked its DLC, it has no signals. */
+    case POUR_CAN_CMD_STOP: /* classify checked the DLC of these three: they have no signals */
+      node->stop_request = true;
+      kick(node);
+      break;
+    case POUR_CAN_CMD_RESET:
+      node->reset_request = true;
+      node->have_seq = false; /* the new run's first sample starts the count again */
+      kick(node);
+      break;
+    default: /* POUR_CAN_CMD_CLEAR_ERRORS */
       node->clear_request = true;
       kick(node);
       break;
@@ -111,37 +131,30 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
   return POUR_CAN_RX_OK;
 }
 
+static bool tripped(const pour_can_node_t *node) {
+  return node->armed && node->ms_since_valid > node->config.watchdog_ms;
+}
+
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
   in->state_fresh = node->state_fresh;
   in->state = node->state;
   in->estop = node->estop;
   in->clear_faults = node->clear_request;
-  if (node->clear_request) {
-    node->faults = 0;
-  }
+  in->stop = node->stop_request;
+  in->reset = node->reset_request;
+  in->link_fault = tripped(node);
   node->state_fresh = false;
   node->clear_request = false;
+  node->stop_request = false;
+  node->reset_request = false;
 }
 
-uint16_t pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {
+bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {
   if (node->armed) {
     uint64_t t = (uint64_t)node->ms_since_valid + elapsed_ms;
     node->ms_since_valid = t > UINT32_MAX ? UINT32_MAX : (uint32_t)t;
-    if (node->ms_since_valid > node->config.watchdog_ms) {
-      node->faults |= POUR_CAN_FAULT_WATCHDOG;
-    }
   }
-  return node->faults;
-}
-
-void pour_can_node_override(const pour_can_node_t *node, pour_control_output_t *out) {
-  if ((node->faults & POUR_CAN_FAULT_WATCHDOG) != 0u) {
-    out->torque = node->config.safe_torque;
-    if (out->mode == (uint8_t)POUR_MODE_RUN || out->mode == (uint8_t)POUR_MODE_IDLE) {
-      out->mode = (uint8_t)POUR_MODE_FAULT;
-    }
-  }
-  out->faults = (uint16_t)(out->faults | node->faults);
+  return tripped(node);
 }
 
 uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
@@ -150,31 +163,42 @@ uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
   return sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
 }
 
-uint8_t pour_can_node_end_tick(pour_can_node_t *node, pour_control_output_t *out, uint32_t overruns,
-                               pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]) {
-  pour_can_node_watchdog(node, 1);
-  pour_can_node_override(node, out);
-
-  uint8_t n = 0;
+pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour_control_output_t *out,
+                                         pour_can_frame_t *frame) {
   pour_can_torque_t t;
   t.seq = (uint16_t)(node->state.seq & 0xFFFFu);
   t.torque = out->torque;
   t.action = (uint8_t)(out->action & POUR_CAN_ACTION_MAX);
-  t.mode = (uint8_t)(out->mode & 0x03u);
+  t.mode = (uint8_t)(out->mode & POUR_CAN_MODE_MAX);
   t.limits = (uint8_t)(out->limits & POUR_CAN_LIMITS_MAX);
-  if (pour_can_pack_torque(node->config.node_id, &t, &tx[n]) == POUR_OK) {
+  return pour_can_pack_torque(node->config.node_id, &t, frame);
+}
+
+uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
+                                    pour_can_frame_t tx[2]) {
+  pour_can_heartbeat_t hb;
+  hb.mode = (uint8_t)(out->mode & POUR_CAN_MODE_MAX);
+  hb.faults = out->faults;
+  hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
+  hb.overruns = (uint16_t)(overruns & 0xFFFFu);
+  hb.counter = node->heartbeat_counter;
+  if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[0]) != POUR_OK ||
+      pour_can_pack_identity(node->config.node_id, &node->config.identity, &tx[1]) != POUR_OK) {
+    return 0u;
+  }
+  node->heartbeat_counter++;
+  return 2u;
+}
+
+uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
+                               pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]) {
+  (void)pour_can_node_watchdog(node, 1);
+  uint8_t n = 0;
+  if (pour_can_node_torque_frame(node, out, &tx[n]) == POUR_OK) {
     ++n;
   }
   if (node->ms_to_heartbeat == 0u) {
-    pour_can_heartbeat_t hb;
-    hb.mode = t.mode;
-    hb.faults = out->faults;
-    hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
-    hb.overruns = (uint16_t)(overruns & 0xFFFFu);
-    hb.counter = node->heartbeat_counter++;
-    if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[n]) == POUR_OK) {
-      ++n;
-    }
+    n = (uint8_t)(n + pour_can_node_status_frames(node, out, overruns, &tx[n]));
     node->ms_to_heartbeat = node->config.heartbeat_period_ms;
   }
   --node->ms_to_heartbeat;

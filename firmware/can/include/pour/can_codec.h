@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "pour/control.h"
 #include "pour/fixed.h"
 
 #define POUR_CAN_NODE_ID_MAX 63u /* node ids 0 .. 63 (6 bits) */
@@ -17,18 +18,24 @@
 /* Command ids (the DBC's frame ids for node 0). */
 #define POUR_CAN_CMD_HEARTBEAT 0x01u    /* controller -> host, every heartbeat period */
 #define POUR_CAN_CMD_ESTOP 0x02u        /* host -> controller */
+#define POUR_CAN_CMD_STOP 0x03u         /* host -> controller: end the run */
+#define POUR_CAN_CMD_IDENTITY 0x04u     /* controller -> host, with every heartbeat: policy, scale, version */
 #define POUR_CAN_CMD_STATE_A 0x10u      /* host -> controller: θ, θ̇, seq low byte */
 #define POUR_CAN_CMD_STATE_B 0x11u      /* host -> controller: seq, three volumes; completes a state */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
+#define POUR_CAN_CMD_RESET 0x19u        /* host -> controller: start a new run (refused while running) */
 
 /* Data length of each message [bytes]; a frame with another DLC is malformed. */
 #define POUR_CAN_DLC_HEARTBEAT 8u
 #define POUR_CAN_DLC_ESTOP 1u
+#define POUR_CAN_DLC_STOP 0u
+#define POUR_CAN_DLC_IDENTITY 8u
 #define POUR_CAN_DLC_STATE_A 8u
 #define POUR_CAN_DLC_STATE_B 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
+#define POUR_CAN_DLC_RESET 0u
 
 /* Signal ranges, as the DBC's [min|max] in raw units; a value outside is out of range. */
 #define POUR_CAN_THETA_MAX_URAD 3200000   /* |θ| <= 3.2 rad; 24-bit signed field [µrad] */
@@ -37,9 +44,10 @@
 #define POUR_CAN_MODE_MAX 3u               /* pour_mode_t */
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 15u
+#define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
 
-/* Controller fault bits carried in the heartbeat beside the control core's POUR_FAULT_* (bits 0..7). */
-#define POUR_CAN_FAULT_WATCHDOG 0x0100u /* latched: no valid frame within the command watchdog timeout */
+/* The CAN node's command watchdog latches in the core as its link fault. */
+#define POUR_CAN_FAULT_WATCHDOG POUR_FAULT_LINK
 
 /* A classic CAN data frame with an 11-bit id. */
 typedef struct {
@@ -81,8 +89,16 @@ typedef struct {
   uint8_t assert_estop; /* 1 assert, 0 release */
 } pour_can_estop_t;
 
-/* The fault bits the heartbeat carries (POUR_FAULT_STALE_INPUT, _ESTOP, _BAD_INPUT, POUR_CAN_FAULT_WATCHDOG). */
-#define POUR_CAN_HEARTBEAT_FAULT_MASK 0x0107u
+/* Who is on the bus: the policy it runs and the scale of its Torque frames. */
+typedef struct {
+  uint32_t weights_hash;   /* content hash of the compiled-in weights.h (FNV-1a 32) */
+  uint16_t tau_max_cnm;    /* tau_max, the torque of Q15 1.0 in the Torque frame [0.01 N·m] */
+  uint8_t fw_version;      /* POUR_FIRMWARE_VERSION */
+  int8_t init_status;      /* pour_status_t of the controller's start-up (0 = OK, else it never runs) */
+} pour_can_identity_t;
+
+/* The fault bits the heartbeat carries: every POUR_FAULT_* of the core, the link (watchdog) fault included. */
+#define POUR_CAN_HEARTBEAT_FAULT_MASK POUR_FAULT_ALL
 
 /* Decoded frame classes and the reasons a frame is not accepted. */
 typedef enum {
@@ -108,7 +124,9 @@ pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg
 pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
                                       pour_can_frame_t *frame);
 pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, pour_can_frame_t *frame);
-pour_status_t pour_can_pack_clear_errors(uint8_t node_id, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t *msg, pour_can_frame_t *frame);
+/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP and _RESET (POUR_EINVAL for another cmd). */
+pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame);
 
 /* Unpack functions check the id's cmd, the DLC and every range; msg is written only on POUR_CAN_RX_OK.
  * The node id of the frame is not checked here (pour_can_classify does that). */
@@ -117,7 +135,9 @@ pour_can_rx_t pour_can_unpack_state_b(const pour_can_frame_t *frame, pour_can_st
 pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg);
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg);
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg);
-pour_can_rx_t pour_can_unpack_clear_errors(const pour_can_frame_t *frame);
+pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg);
+/* The commands without signals: checks the id's cmd (as given) and the DLC. */
+pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd);
 
 /* Classifies a frame for a receiver: POUR_CAN_RX_OTHER_NODE, or for node_id's frames whether cmd is one
  * of the accepted ones (accept_mask bit cmd set) with the expected DLC; *cmd gets the cmd id. */

@@ -1,0 +1,87 @@
+/* SPDX-License-Identifier: MIT */
+/* The controller's side of the CAN protocol: received frames -> control input, control output -> frames,
+ * plus the command watchdog and the heartbeat schedule. Pure: no I/O; the port moves the frames. The node
+ * keeps no fault of its own: a tripped watchdog reaches the core as its link fault (POUR_FAULT_LINK), and
+ * the core's output, e-stop and faults included, is what goes on the bus. */
+#ifndef POUR_CAN_NODE_H
+#define POUR_CAN_NODE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pour/can_codec.h"
+#include "pour/control.h"
+#include "pour/fixed.h"
+
+#define POUR_CAN_NODE_MAX_TX 3u /* frames one tick can produce: torque, heartbeat and identity */
+
+typedef struct {
+  uint8_t node_id;              /* 0 .. 63 */
+  uint16_t watchdog_ms;         /* >= 1: no valid state or command for longer trips the watchdog [ms] */
+  uint16_t heartbeat_period_ms; /* >= 1: a heartbeat and an identity frame every this many ticks [ms] */
+  pour_can_identity_t identity; /* what the identity frame says (policy hash, tau_max, version, init) */
+} pour_can_node_config_t;
+
+/* Receive counters; they saturate at UINT32_MAX. */
+typedef struct {
+  uint32_t accepted;     /* well-formed frames of ours */
+  uint32_t bad_id;       /* our node, unknown or send-only cmd */
+  uint32_t bad_dlc;      /* wrong data length */
+  uint32_t out_of_range; /* a signal outside its DBC range */
+  uint32_t unpaired;     /* StateB without the StateA of the same sample */
+  uint32_t other_node;   /* other nodes' frames (ignored, not an error) */
+} pour_can_node_counters_t;
+
+typedef struct {
+  pour_can_node_config_t config;
+  pour_can_state_a_t pending_a; /* the latest StateA, waiting for its StateB */
+  bool have_a;
+  bool have_seq;                /* a state arrived since init or the last Reset */
+  pour_state_t state;           /* latest complete state, seq extended to 32 bits */
+  bool state_fresh;             /* completed since the last tick */
+  bool estop;                   /* level, from the latest Estop frame */
+  bool clear_request;           /* one-shot, from ClearErrors */
+  bool stop_request;            /* one-shot, from Stop */
+  bool reset_request;           /* one-shot, from Reset */
+  bool armed;                   /* watchdog runs once the first valid state or command arrived */
+  uint32_t ms_since_valid;
+  uint16_t ms_to_heartbeat;
+  uint8_t heartbeat_counter;
+  pour_can_node_counters_t counters;
+} pour_can_node_t;
+
+/* Node 0, watchdog 50 ms (above the core's input timeout, so the core trips first), heartbeat 100 ms,
+ * an identity of hash 0, tau_max 0 and this firmware's version. */
+pour_can_node_config_t pour_can_node_default_config(void);
+
+/* Validates config (POUR_EINVAL otherwise); no state, heartbeat due on the first tick. */
+pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config);
+
+/* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
+pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
+
+/* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick, the
+ * watchdog's state as in->link_fault. StateB's 16-bit seq reaches the core extended to 32 bits (it wraps
+ * every 65.5 s at 1 kHz; a wrap is just the next sample, only a Reset frame restarts the count). */
+void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
+
+/* End of a tick: advances the watchdog by 1 ms, then writes the torque frame and, when due, the
+ * heartbeat and the identity frame into tx. overruns: the port's missed deadlines. Returns the count. */
+uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
+                               pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
+
+/* Advances the command watchdog by elapsed_ms (end_tick does it by 1 each tick; a port without a tick of
+ * its own, such as the Linux one, by wall-clock time). Returns whether it has tripped. */
+bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms);
+
+/* The frames end_tick is made of, for a port that schedules them itself (the Linux one, by wall clock). */
+pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour_control_output_t *out,
+                                         pour_can_frame_t *frame);
+/* Heartbeat (counter advanced) then identity: 2 frames, or 0 if the output cannot be packed. */
+uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
+                                    pour_can_frame_t tx[2]);
+
+/* Total of the dropped-frame counters (what the heartbeat's RxDropped carries, mod 2^16). */
+uint32_t pour_can_node_dropped(const pour_can_node_t *node);
+
+#endif /* POUR_CAN_NODE_H */
