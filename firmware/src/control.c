@@ -9,6 +9,13 @@
 #define DEFAULT_PLAUSIBLE_THETA_URAD 3141593   /* π: the tilt cannot pass half a turn */
 #define DEFAULT_PLAUSIBLE_OMEGA_URAD_S 50000000 /* 50 rad/s, ~8 turns/s */
 #define DEFAULT_PLAUSIBLE_VOLUME_SUM 32896      /* 1.0 + 128 LSB (0.4 %) of slack for rounding */
+#define DEFAULT_STOP_TORQUE_MAX 16384            /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s */
+#define DEFAULT_STOP_RETURN_SPEED_URAD_S 1000000 /* 1 rad/s back toward upright: no slosh over the lip */
+#define DEFAULT_STOP_RETURN_GAIN_PER_S 2u
+#define DEFAULT_STOP_TORQUE_PER_RAD_S 16384      /* 0.5 tau_max per rad/s of speed error */
+#define DEFAULT_STOP_REST_THETA_URAD 87266       /* 5 deg of upright */
+#define DEFAULT_STOP_REST_OMEGA_URAD_S 50000     /* 0.05 rad/s: at rest */
+#define DEFAULT_STOP_TIMEOUT_MS 5000u            /* from 135 deg at 1 rad/s takes 2.4 s: twice that */
 
 pour_control_config_t pour_control_default_config(void) {
   pour_control_config_t config;
@@ -20,6 +27,14 @@ pour_control_config_t pour_control_default_config(void) {
   config.plausible_theta_urad = DEFAULT_PLAUSIBLE_THETA_URAD;
   config.plausible_omega_urad_s = DEFAULT_PLAUSIBLE_OMEGA_URAD_S;
   config.plausible_volume_sum = DEFAULT_PLAUSIBLE_VOLUME_SUM;
+  config.supervisor = pour_supervisor_default_config();
+  config.stop.torque_max = DEFAULT_STOP_TORQUE_MAX;
+  config.stop.return_speed_urad_s = DEFAULT_STOP_RETURN_SPEED_URAD_S;
+  config.stop.return_gain_per_s = DEFAULT_STOP_RETURN_GAIN_PER_S;
+  config.stop.torque_per_rad_s = DEFAULT_STOP_TORQUE_PER_RAD_S;
+  config.stop.rest_theta_urad = DEFAULT_STOP_REST_THETA_URAD;
+  config.stop.rest_omega_urad_s = DEFAULT_STOP_REST_OMEGA_URAD_S;
+  config.stop.timeout_ms = DEFAULT_STOP_TIMEOUT_MS;
   return config;
 }
 
@@ -40,6 +55,14 @@ static void start_afresh(pour_control_t *ctl) {
     ctl->eval.probs[a] = 0;
   }
   ctl->eval.action = 0u;
+  pour_supervisor_restart(&ctl->supervisor);
+  ctl->stop_ms = 0u;
+  ctl->stopped = false;
+}
+
+static bool stop_config_ok(const pour_stop_config_t *s) {
+  return s->torque_max > 0 && s->return_speed_urad_s > 0 && s->return_gain_per_s >= 1u && s->torque_per_rad_s > 0 &&
+         s->rest_theta_urad > 0 && s->rest_omega_urad_s > 0 && s->timeout_ms >= 1u;
 }
 
 pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
@@ -52,7 +75,9 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
       c->plausible_volume_sum <= 0) {
     return POUR_EINVAL;
   }
-  if (pour_safety_init(&ctl->safety, &c->safety) != POUR_OK) {
+  if (pour_safety_init(&ctl->safety, &c->safety) != POUR_OK || !stop_config_ok(&c->stop) ||
+      pour_supervisor_init(&ctl->supervisor, &c->supervisor, c->safety.theta_min_urad, c->safety.theta_max_urad) !=
+          POUR_OK) {
     return POUR_EINVAL;
   }
   if (c->safe_torque > c->safety.tau_limit || c->safe_torque < -c->safety.tau_limit) {
@@ -96,6 +121,42 @@ static q15_t force_safe(pour_control_t *ctl) {
   return torque;
 }
 
+/* The active stop's request: a speed reference that returns toward upright at a bounded speed, tracked by
+ * a bounded proportional torque. Units: θ [µrad], θ̇ [µrad/s]; torque Q15. */
+static q15_t stop_request(const pour_stop_config_t *c, const pour_state_t *s) {
+  int64_t ref = -(int64_t)c->return_gain_per_s * s->theta_urad;
+  ref = ref > c->return_speed_urad_s ? c->return_speed_urad_s
+                                      : (ref < -c->return_speed_urad_s ? -c->return_speed_urad_s : ref);
+  /* err [µrad/s] * Q15 per rad/s / 1e6; |err| < 2^32, |gain| < 2^15: int64 holds it. */
+  const int64_t t = ((ref - s->omega_urad_s) * c->torque_per_rad_s) / 1000000;
+  return (q15_t)(t > c->torque_max ? c->torque_max : (t < -c->torque_max ? -c->torque_max : t));
+}
+
+static bool at_rest(const pour_stop_config_t *c, const pour_state_t *s) {
+  return s->theta_urad <= c->rest_theta_urad && s->theta_urad >= -c->rest_theta_urad &&
+         s->omega_urad_s <= c->rest_omega_urad_s && s->omega_urad_s >= -c->rest_omega_urad_s;
+}
+
+/* FAULT: an active stop while the fault allows it and fresh states keep coming, else (and after it) the
+ * safe torque with the brake engaged and the power cut. Returns the torque; *active tells which. */
+static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
+  const pour_stop_config_t *c = &ctl->config.stop;
+  *active = false;
+  if (!ctl->stopped) {
+    const bool can_act = (ctl->faults & ~(uint16_t)POUR_FAULT_ACTIVE_STOP) == 0u &&
+                         ctl->ms_since_fresh <= ctl->config.input_timeout_ms && ctl->stop_ms < c->timeout_ms;
+    if (!can_act || at_rest(c, &ctl->state)) {
+      ctl->stopped = true;
+    } else {
+      ctl->stop_ms++;
+      *active = true;
+      /* Through the envelope: the stop never steps the torque by more than the slew limit. */
+      return pour_safety_apply(&ctl->safety, stop_request(c, &ctl->state), ctl->state.theta_urad);
+    }
+  }
+  return force_safe(ctl);
+}
+
 static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_output_t *out) {
   out->torque = torque;
   out->action = ctl->eval.action;
@@ -106,6 +167,8 @@ static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_ou
   out->faults = ctl->faults;
   out->limits = ctl->safety.active;
   out->tick = ctl->tick;
+  out->brake = ctl->mode != POUR_MODE_RUN;
+  out->power = ctl->mode == POUR_MODE_RUN;
 }
 
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out) {
@@ -114,6 +177,7 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
     ctl->mode = POUR_MODE_ESTOP;
     ctl->faults |= POUR_FAULT_ESTOP;
     pour_safety_force(&ctl->safety, 0);
+    ctl->stopped = true; /* after the release: brake and power cut until a clear */
     fill_output(ctl, 0, out);
     return;
   }
@@ -132,6 +196,8 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
     ctl->faults = 0u;
     ctl->mode = POUR_MODE_IDLE;
     ctl->ms_since_fresh = 0u;
+    ctl->stop_ms = 0u;
+    ctl->stopped = false;
   }
   if (in->stop && ctl->mode == POUR_MODE_RUN) {
     ctl->mode = POUR_MODE_IDLE;
@@ -146,19 +212,22 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
   }
 
   bool fresh = false;
-  if (in->state_fresh) {
-    if (plausible(&ctl->config, &in->state)) {
-      ctl->state = in->state;
-      ctl->ms_since_fresh = 0u;
-      fresh = true;
-    } else {
-      ctl->faults |= POUR_FAULT_BAD_INPUT;
-      ctl->mode = POUR_MODE_FAULT;
+  if (in->state_fresh && !plausible(&ctl->config, &in->state)) {
+    ctl->faults |= POUR_FAULT_BAD_INPUT;
+    ctl->mode = POUR_MODE_FAULT;
+  } else if (in->state_fresh && pour_supervisor_accept(&ctl->supervisor, &in->state)) {
+    ctl->state = in->state;
+    ctl->ms_since_fresh = 0u;
+    fresh = true;
+  } else {
+    if (ctl->ms_since_fresh != UINT32_MAX) {
+      ctl->ms_since_fresh++;
     }
-  } else if (ctl->mode == POUR_MODE_RUN) {
-    ctl->ms_since_fresh++;
-    if (ctl->ms_since_fresh > ctl->config.input_timeout_ms) {
+    if (ctl->mode == POUR_MODE_RUN && ctl->ms_since_fresh > ctl->config.input_timeout_ms) {
       ctl->faults |= POUR_FAULT_STALE_INPUT;
+      if (ctl->supervisor.seq_repeats > 0u) {
+        ctl->faults |= POUR_FAULT_SEQ; /* states came, but the same one again: a frozen sender */
+      }
       ctl->mode = POUR_MODE_FAULT;
     }
   }
@@ -166,6 +235,14 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
   if (ctl->mode == POUR_MODE_IDLE && fresh) {
     ctl->mode = POUR_MODE_RUN;
     ctl->ms_to_decision = 0u;
+    pour_supervisor_restart(&ctl->supervisor); /* the new run's windows start empty */
+  }
+  if (ctl->mode == POUR_MODE_RUN) {
+    const uint16_t proven = pour_supervisor_step(&ctl->supervisor, &ctl->state, fresh);
+    if (proven != 0u) {
+      ctl->faults |= proven;
+      ctl->mode = POUR_MODE_FAULT;
+    }
   }
 
   q15_t torque;
@@ -178,8 +255,15 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
     }
     ctl->ms_to_decision--;
     torque = pour_safety_apply(&ctl->safety, w->action_levels[ctl->eval.action], ctl->state.theta_urad);
+    pour_supervisor_record(&ctl->supervisor, &ctl->state, torque);
+    fill_output(ctl, torque, out);
+  } else if (ctl->mode == POUR_MODE_FAULT) {
+    bool active = false;
+    torque = controlled_stop(ctl, &active);
+    fill_output(ctl, torque, out);
+    out->brake = !active;
+    out->power = active;
   } else {
-    torque = force_safe(ctl);
+    fill_output(ctl, force_safe(ctl), out);
   }
-  fill_output(ctl, torque, out);
 }

@@ -21,6 +21,7 @@ void setUp(void) {
   cfg.identity.tau_max_cnm = 2000u;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
   ccfg = pour_control_default_config();
+  ccfg.supervisor.checks = POUR_CHECK_ALL & ~(POUR_CHECK_ENCODER | POUR_CHECK_TORQUE_SIGN); /* scripted states */
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
 }
 

@@ -24,6 +24,9 @@ static void step(bool fresh) {
 
 void setUp(void) {
   config = pour_control_default_config();
+  /* The states here are scripted, not physical (a bucket that never moves under torque, volumes that jump):
+   * the supervisor's motion and volume checks would rightly object. test_supervisor.c covers them. */
+  config.supervisor.checks = POUR_CHECK_POSITION | POUR_CHECK_OVERSPEED | POUR_CHECK_SEQ;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &config, &pour_weights_compiled));
   in.state_fresh = false;
   in.state = start_state();

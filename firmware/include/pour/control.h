@@ -10,6 +10,7 @@
 #include "pour/obs.h"
 #include "pour/policy.h"
 #include "pour/safety.h"
+#include "pour/supervisor.h"
 
 /* Version of the firmware as the bus reports it (Identity.FwVersion): +1 with any change in behaviour a
  * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity. */
@@ -18,8 +19,8 @@
 typedef enum {
   POUR_MODE_IDLE = 0,  /* no state yet (or faults just cleared): safe torque */
   POUR_MODE_RUN = 1,   /* policy in command, inside the envelope */
-  POUR_MODE_FAULT = 2, /* a latched fault: safe torque until clear_faults */
-  POUR_MODE_ESTOP = 3  /* e-stop asserted: zero torque while it lasts, then FAULT until cleared */
+  POUR_MODE_FAULT = 2, /* a latched fault: the controlled stop, then brake and power cut until clear_faults */
+  POUR_MODE_ESTOP = 3  /* e-stop asserted: zero torque, brake, power cut while it lasts, then FAULT */
 } pour_mode_t;
 
 /* Latched fault bits (pour_control_t.faults); only clear_faults resets them. */
@@ -33,7 +34,22 @@ typedef enum {
 #define POUR_FAULT_VOLUME 0x0080u      /* supervisor: a volume reading jumped faster than liquid can flow */
 #define POUR_FAULT_LINK 0x0100u        /* the transport's command watchdog tripped (the CAN node's) */
 #define POUR_FAULT_SEQ 0x0200u         /* supervisor: states keep arriving but their seq does not advance */
-#define POUR_FAULT_ALL 0x03FFu
+#define POUR_FAULT_SCALE 0x0400u       /* supervisor: the axis accelerates more than the command can (scale) */
+#define POUR_FAULT_ALL 0x07FFu
+/* Faults the controlled stop answers actively (the sensors and the motor are still trusted): decelerate,
+ * return toward upright at a bounded speed, then brake. Every other fault brakes at once. */
+#define POUR_FAULT_ACTIVE_STOP (POUR_FAULT_POSITION | POUR_FAULT_OVERSPEED | POUR_FAULT_VOLUME)
+
+/* The controlled stop (docs/safety.md gives the reasons for the defaults). */
+typedef struct {
+  q15_t torque_max;             /* |stop torque| <= this, Q15, > 0 (then the envelope's clamp and slew) */
+  int32_t return_speed_urad_s;  /* toward upright at no more than this [µrad/s], > 0 */
+  uint16_t return_gain_per_s;   /* speed reference = -gain * θ [1/s], >= 1 */
+  q15_t torque_per_rad_s;       /* torque per rad/s of speed error, Q15, > 0 */
+  int32_t rest_theta_urad;      /* done when |θ| <= this ... [µrad], > 0 */
+  int32_t rest_omega_urad_s;    /* ... and |θ̇| <= this [µrad/s], > 0 */
+  uint16_t timeout_ms;          /* brake anyway after this long [ms], >= 1 */
+} pour_stop_config_t;
 
 typedef struct {
   pour_safety_config_t safety;
@@ -45,6 +61,8 @@ typedef struct {
   int32_t plausible_theta_urad;    /* |θ| <= this [µrad], > 0 */
   int32_t plausible_omega_urad_s;  /* |θ̇| <= this [µrad/s], > 0 */
   int32_t plausible_volume_sum;    /* V_rot + V_tgt + V_spill <= this, Q15 (32768 = all the liquid) */
+  pour_supervisor_config_t supervisor;
+  pour_stop_config_t stop;
 } pour_control_config_t;
 
 /* Inputs of one tick. */
@@ -67,6 +85,8 @@ typedef struct {
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
   uint32_t tick;   /* ticks since init */
+  bool brake;      /* engage the holding brake (IDLE, ESTOP, and FAULT once the stop is done) */
+  bool power;      /* motor power stage enabled (RUN and an active stop only) */
 } pour_control_output_t;
 
 typedef struct {
@@ -81,6 +101,9 @@ typedef struct {
   pour_state_t state; /* latest fresh, plausible state */
   pour_obs_t obs;
   pour_policy_eval_t eval;
+  pour_supervisor_t supervisor;
+  uint32_t stop_ms;       /* ticks of the active stop so far */
+  bool stopped;           /* the stop is over: brake and power cut until a clear */
   uint32_t resets_refused; /* reset requests refused because the core was in RUN or ESTOP */
 } pour_control_t;
 
@@ -94,9 +117,10 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
 
 /* One 1 ms tick. Never fails: problems show as mode and fault bits in the output.
  * Order: e-stop (zero torque now, whatever else the input says), link fault (FAULT), clear request,
- * stop, reset, input check (BAD_INPUT), timeout (STALE_INPUT, armed in RUN only), IDLE -> RUN on the
- * first fresh state, policy decision on the first RUN tick and every decision_period_ms ticks after,
- * envelope. A clear never bypasses the envelope: RUN resumes from the safe torque through the slew limit.
+ * stop, reset, input check (BAD_INPUT; a seq that does not advance makes the state not fresh), timeout
+ * (STALE_INPUT, with SEQ if repeated states were refused; armed in RUN only), IDLE -> RUN on the first
+ * fresh state, supervisor (RUN), policy decision on the first RUN tick and every decision_period_ms ticks
+ * after, envelope; in FAULT the controlled stop. A clear never bypasses the envelope: RUN resumes from the safe torque through the slew limit.
  * out->tick counts the steps including this one. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
 

@@ -20,9 +20,16 @@ static pour_control_t controller;
 #ifdef POUR_SMOKE_TICKS
 #include <stdio.h>
 
-/* Ticks 10..59 bring a fresh state (full bucket, upright), then the input stops. */
+/* Ticks 10..59 bring a fresh state of a bucket that moves with the torque (the supervisor judges
+ * physics: a scripted bucket that never moved would be a frozen encoder), then the input stops. */
 static void poll_input(pour_control_input_t *in, uint32_t tick) {
+  static int32_t omega_urad_s = 0;
   in->state_fresh = tick >= 10u && tick < 60u;
+  if (in->state_fresh) {
+    omega_urad_s += (int32_t)controller.safety.torque * 6; /* ~200 rad/s² at full torque */
+    in->state.theta_urad += omega_urad_s / 1000;
+    in->state.omega_urad_s = omega_urad_s;
+  }
   in->state.seq = tick;
   in->state.v_rotating = 32767;
   in->estop = false;

@@ -1,0 +1,187 @@
+/* SPDX-License-Identifier: MIT */
+#include "pour/supervisor.h"
+
+#include <stddef.h>
+
+#include "pour/control.h"
+
+/* docs/safety.md gives the reason for each default; the figures come from 20 held-out pours of the shipped
+ * policy and 5 of the hand-written baseline in the simulator (tau_max 20 N·m, 10 kg of liquid). */
+#define DEFAULT_THETA_MARGIN_URAD 87266     /* 5 deg past the envelope's limits */
+#define DEFAULT_OMEGA_MAX_URAD_S 22000000   /* 22 rad/s: nominal peak 16.0 rad/s + 35 % */
+#define DEFAULT_WINDOW_MS 10u
+#define DEFAULT_TORQUE_MIN 16384            /* 0.5 tau_max = 10 N·m, twice the liquid's worst gravity torque */
+#define DEFAULT_OMEGA_AGAINST_URAD_S 300000 /* 0.3 rad/s */
+#define DEFAULT_AGAINST_MS 3u
+#define DEFAULT_ENCODER_MOVE_URAD 500       /* 10 ms at >= 0.5 tau_max move the full bucket >= 1,800 urad */
+#define DEFAULT_VOLUME_STEP_MAX 2621        /* 8 % of the liquid per tick; nominal worst 2.7 % */
+#define DEFAULT_ACCEL_FULL_URAD_S2 350000000    /* 350 rad/s²: 20 N·m on the empty bucket measured 335 */
+#define DEFAULT_ACCEL_PASSIVE_URAD_S2 150000000 /* 150 rad/s²: nominal never beyond it 2 ticks in a row */
+#define SEQ_ADVANCE_MAX 32767u              /* a forward gap larger than this is a jump back, not a gap */
+#define VOLUME_GAP_MAX 32u                  /* missed ticks credited to a volume change, at most */
+
+pour_supervisor_config_t pour_supervisor_default_config(void) {
+  pour_supervisor_config_t c;
+  c.checks = POUR_CHECK_ALL;
+  c.theta_margin_urad = DEFAULT_THETA_MARGIN_URAD;
+  c.omega_max_urad_s = DEFAULT_OMEGA_MAX_URAD_S;
+  c.window_ms = DEFAULT_WINDOW_MS;
+  c.torque_min = DEFAULT_TORQUE_MIN;
+  c.omega_against_urad_s = DEFAULT_OMEGA_AGAINST_URAD_S;
+  c.against_ms = DEFAULT_AGAINST_MS;
+  c.encoder_move_urad = DEFAULT_ENCODER_MOVE_URAD;
+  c.volume_step_max = DEFAULT_VOLUME_STEP_MAX;
+  c.accel_full_urad_s2 = DEFAULT_ACCEL_FULL_URAD_S2;
+  c.accel_passive_urad_s2 = DEFAULT_ACCEL_PASSIVE_URAD_S2;
+  return c;
+}
+
+pour_status_t pour_supervisor_init(pour_supervisor_t *sup, const pour_supervisor_config_t *config,
+                                   int32_t theta_min_urad, int32_t theta_max_urad) {
+  if (sup == NULL || config == NULL) {
+    return POUR_EINVAL;
+  }
+  const pour_supervisor_config_t *c = config;
+  if ((c->checks & ~POUR_CHECK_ALL) != 0u || c->theta_margin_urad <= 0 || c->omega_max_urad_s <= 0 ||
+      c->window_ms < 2u || c->window_ms > POUR_SUPERVISOR_WINDOW_MAX || c->torque_min <= 0 ||
+      c->omega_against_urad_s <= 0 || c->against_ms < 1u || c->encoder_move_urad <= 0 || c->volume_step_max <= 0 ||
+      c->accel_full_urad_s2 <= 0 || c->accel_passive_urad_s2 <= 0 ||
+      theta_max_urad <= theta_min_urad) {
+    return POUR_EINVAL;
+  }
+  sup->config = *c;
+  sup->theta_min_urad = theta_min_urad;
+  sup->theta_max_urad = theta_max_urad;
+  pour_supervisor_restart(sup);
+  return POUR_OK;
+}
+
+void pour_supervisor_restart(pour_supervisor_t *sup) {
+  sup->head = 0u;
+  sup->filled = 0u;
+  sup->against = 0u;
+  sup->over = 0u;
+  sup->have_state = false;
+  sup->ticks_since_state = 0u;
+  sup->seq_repeats = 0u;
+}
+
+bool pour_supervisor_accept(pour_supervisor_t *sup, const pour_state_t *state) {
+  if (!sup->have_state || (sup->config.checks & POUR_CHECK_SEQ) == 0u) {
+    return true;
+  }
+  const uint32_t advance = state->seq - sup->last.seq; /* unsigned: wraps by definition */
+  if (advance >= 1u && advance <= SEQ_ADVANCE_MAX) {
+    return true;
+  }
+  if (sup->seq_repeats != UINT32_MAX) {
+    sup->seq_repeats++;
+  }
+  return false;
+}
+
+static int64_t abs64(int64_t x) { return x < 0 ? -x : x; }
+
+static bool volume_jumped(const pour_supervisor_t *sup, const pour_state_t *s) {
+  const uint32_t gap = sup->ticks_since_state < VOLUME_GAP_MAX ? sup->ticks_since_state : VOLUME_GAP_MAX;
+  const int32_t allowed = (int32_t)sup->config.volume_step_max * (int32_t)(gap > 0u ? gap : 1u);
+  const pour_state_t *l = &sup->last;
+  return abs64((int64_t)s->v_rotating - l->v_rotating) > allowed ||
+         abs64((int64_t)s->v_target - l->v_target) > allowed || abs64((int64_t)s->v_spill - l->v_spill) > allowed;
+}
+
+/* The oldest entry of a full window: the state W ticks ago. */
+static uint8_t oldest(const pour_supervisor_t *sup) { return sup->head; }
+
+static uint8_t count_up(uint8_t n, bool yes) { return yes ? (n < UINT8_MAX ? (uint8_t)(n + 1u) : n) : 0u; }
+
+/* TORQUE_SIGN and ENCODER from the last W commands. Under a mean torque beyond what gravity can resist, the
+ * bucket cannot move against it and speed up that way (a motor or encoder of the wrong sign), and a moving
+ * bucket cannot keep the same encoder reading (a frozen encoder). */
+static uint16_t window_faults(pour_supervisor_t *sup, const pour_state_t *s) {
+  const pour_supervisor_config_t *c = &sup->config;
+  const uint8_t w = c->window_ms;
+  if (sup->filled < w) {
+    return 0u;
+  }
+  int32_t sum = 0;
+  int32_t sum_abs = 0;
+  bool all_strong = true;
+  int sign = 0;
+  for (uint8_t i = 0; i < w; ++i) {
+    const q15_t t = sup->torque[i];
+    sum += t; /* |sum| <= 32 * 32768: no overflow */
+    sum_abs += t < 0 ? -(int32_t)t : t;
+    const int si = t >= c->torque_min ? 1 : (t <= -c->torque_min ? -1 : 0);
+    if (si == 0 || (sign != 0 && si != sign)) {
+      all_strong = false;
+    }
+    sign = si != 0 ? si : sign;
+  }
+  const int32_t mean = sum / (int32_t)w;
+  const uint8_t o = oldest(sup);
+  uint16_t faults = 0u;
+  if ((c->checks & POUR_CHECK_TORQUE_SIGN) != 0u) {
+    const int dir = mean >= c->torque_min ? 1 : (mean <= -c->torque_min ? -1 : 0);
+    const int64_t against_speed = -(int64_t)dir * s->omega_urad_s;
+    const int64_t speeding_up = -(int64_t)dir * ((int64_t)s->omega_urad_s - sup->omega[o]);
+    sup->against = count_up(sup->against, dir != 0 && against_speed > c->omega_against_urad_s && speeding_up > 0);
+    if (sup->against >= c->against_ms) {
+      faults |= POUR_FAULT_TORQUE_SIGN;
+    }
+  }
+  if ((c->checks & POUR_CHECK_SCALE) != 0u) {
+    /* Speed change over the window against the most the commands and the passive loads could give:
+     * (a_full * mean|torque| / 32768 + a_passive) * W / 1000 [µrad/s]. */
+    const int64_t most = ((int64_t)c->accel_full_urad_s2 * sum_abs / 32768 +
+                          (int64_t)c->accel_passive_urad_s2 * w) / 1000;
+    sup->over = count_up(sup->over, abs64((int64_t)s->omega_urad_s - sup->omega[o]) > most);
+    if (sup->over >= c->against_ms) {
+      faults |= POUR_FAULT_SCALE;
+    }
+  }
+  if ((c->checks & POUR_CHECK_ENCODER) != 0u && all_strong &&
+      abs64((int64_t)s->theta_urad - sup->theta[o]) <= c->encoder_move_urad) {
+    faults |= POUR_FAULT_ENCODER;
+  }
+  return faults;
+}
+
+uint16_t pour_supervisor_step(pour_supervisor_t *sup, const pour_state_t *state, bool fresh) {
+  if (sup->ticks_since_state != UINT32_MAX) {
+    sup->ticks_since_state++;
+  }
+  if (!fresh) {
+    return 0u; /* a repeated state is no new evidence */
+  }
+  const pour_supervisor_config_t *c = &sup->config;
+  uint16_t faults = 0u;
+  if ((c->checks & POUR_CHECK_POSITION) != 0u &&
+      ((int64_t)state->theta_urad < (int64_t)sup->theta_min_urad - c->theta_margin_urad ||
+       (int64_t)state->theta_urad > (int64_t)sup->theta_max_urad + c->theta_margin_urad)) {
+    faults |= POUR_FAULT_POSITION;
+  }
+  if ((c->checks & POUR_CHECK_OVERSPEED) != 0u && abs64(state->omega_urad_s) > c->omega_max_urad_s) {
+    faults |= POUR_FAULT_OVERSPEED;
+  }
+  if ((c->checks & POUR_CHECK_VOLUME) != 0u && sup->have_state && volume_jumped(sup, state)) {
+    faults |= POUR_FAULT_VOLUME;
+  }
+  faults |= window_faults(sup, state);
+  sup->last = *state;
+  sup->have_state = true;
+  sup->ticks_since_state = 0u;
+  sup->seq_repeats = 0u;
+  return faults;
+}
+
+void pour_supervisor_record(pour_supervisor_t *sup, const pour_state_t *state, q15_t torque) {
+  const uint8_t w = sup->config.window_ms;
+  sup->torque[sup->head] = torque;
+  sup->theta[sup->head] = state->theta_urad;
+  sup->omega[sup->head] = state->omega_urad_s;
+  sup->head = (uint8_t)((sup->head + 1u) % w);
+  if (sup->filled < w) {
+    sup->filled++;
+  }
+}
