@@ -47,12 +47,12 @@ bench_core() {
     read -r t d b < <(arm-none-eabi-size "$o" | awk 'NR == 2 {print $1, $2, $3}')
     all_text=$((all_text + t + d))
     case "$(basename "$o")" in
-      fixed.c.obj|obs.c.obj|policy.c.obj|safety.c.obj|control.c.obj)
+      fixed.c.obj|obs.c.obj|policy.c.obj|safety.c.obj|supervisor.c.obj|control.c.obj)
         core_text=$((core_text + t + d)); core_ram=$((core_ram + d + b))
         printf '   %-18s %5d B flash\n' "$(basename "$o" .c.obj).c" $((t + d)) ;;
     esac
   done
-  printf '   control core (fixed, obs, policy, safety, control): %d B flash, %d B static RAM;\n' \
+  printf '   control core (fixed, obs, policy, safety, supervisor, control): %d B flash, %d B static RAM;\n' \
     "$core_text" "$core_ram"
   printf '   one controller instance (pour_control_t): %s B RAM\n' "${state:-?}"
   # Deepest stack of one step: pour_control_step -> pour_policy_eval -> its deepest kernel (gcc -fstack-usage).
@@ -63,7 +63,7 @@ bench_core() {
           print f["pour_control_step"] + f["pour_policy_eval"] + k }')
   printf '   deepest stack of a control step: %s B (pour_control_step + pour_policy_eval + deepest kernel)\n' \
     "${stack:-?}"
-  printf '   whole pour_core library (with the CAN codec and node): %d B flash\n' "$all_text"
+  printf '   whole pour_core library: %d B flash\n' "$all_text"
   read -r t d b < <(arm-none-eabi-size "$port/pour_firmware.elf" | awk 'NR == 2 {print $1, $2, $3}')
   printf '   image pour_firmware.elf: %d B flash (text+data), %d B RAM (data+bss) + 2048 B stack reserve\n' \
     $((t + d)) $((d + b))

@@ -50,8 +50,9 @@ pour_status_t pour_supervisor_init(pour_supervisor_t *sup, const pour_supervisor
     return POUR_EINVAL;
   }
   sup->config = *c;
-  sup->theta_min_urad = theta_min_urad;
-  sup->theta_max_urad = theta_max_urad;
+  sup->passive_term = (int64_t)c->accel_passive_urad_s2 * c->window_ms * 32768;
+  sup->theta_low_urad = pour_sat_i32((int64_t)theta_min_urad - c->theta_margin_urad);
+  sup->theta_high_urad = pour_sat_i32((int64_t)theta_max_urad + c->theta_margin_urad);
   pour_supervisor_restart(sup);
   return POUR_OK;
 }
@@ -59,6 +60,8 @@ pour_status_t pour_supervisor_init(pour_supervisor_t *sup, const pour_supervisor
 void pour_supervisor_restart(pour_supervisor_t *sup) {
   sup->head = 0u;
   sup->filled = 0u;
+  sup->sum = 0;
+  sup->sum_abs = 0;
   sup->against = 0u;
   sup->over = 0u;
   sup->have_state = false;
@@ -80,68 +83,60 @@ bool pour_supervisor_accept(pour_supervisor_t *sup, const pour_state_t *state) {
   return false;
 }
 
-static int64_t abs64(int64_t x) { return x < 0 ? -x : x; }
+static int32_t abs_q15_diff(q15_t a, q15_t b) {
+  const int32_t d = (int32_t)a - b;
+  return d < 0 ? -d : d;
+}
 
 static bool volume_jumped(const pour_supervisor_t *sup, const pour_state_t *s) {
   const uint32_t gap = sup->ticks_since_state < VOLUME_GAP_MAX ? sup->ticks_since_state : VOLUME_GAP_MAX;
   const int32_t allowed = (int32_t)sup->config.volume_step_max * (int32_t)(gap > 0u ? gap : 1u);
   const pour_state_t *l = &sup->last;
-  return abs64((int64_t)s->v_rotating - l->v_rotating) > allowed ||
-         abs64((int64_t)s->v_target - l->v_target) > allowed || abs64((int64_t)s->v_spill - l->v_spill) > allowed;
+  return abs_q15_diff(s->v_rotating, l->v_rotating) > allowed || abs_q15_diff(s->v_target, l->v_target) > allowed ||
+         abs_q15_diff(s->v_spill, l->v_spill) > allowed;
 }
-
-/* The oldest entry of a full window: the state W ticks ago. */
-static uint8_t oldest(const pour_supervisor_t *sup) { return sup->head; }
 
 static uint8_t count_up(uint8_t n, bool yes) { return yes ? (n < UINT8_MAX ? (uint8_t)(n + 1u) : n) : 0u; }
 
-/* TORQUE_SIGN and ENCODER from the last W commands. Under a mean torque beyond what gravity can resist, the
- * bucket cannot move against it and speed up that way (a motor or encoder of the wrong sign), and a moving
- * bucket cannot keep the same encoder reading (a frozen encoder). */
+static int32_t abs32(int32_t x) { return x < 0 ? -x : x; } /* callers pass differences of checked states */
+
+/* TORQUE_SIGN, SCALE and ENCODER from the last W commands, in O(1): the ring's sums are kept as entries come
+ * and go. Under a mean torque beyond what gravity can resist, the bucket cannot move against it and speed
+ * up that way (a motor or encoder of the wrong sign); no speed change can exceed what the commands give the
+ * lightest load plus what gravity and the liquid add (a scale stuck high); a bucket under that torque one
+ * way for the whole window cannot keep its encoder reading (a frozen encoder). States reaching here passed
+ * the core's plausibility check (|θ| <= π, |θ̇| <= 50 rad/s): their differences fit in int32. */
 static uint16_t window_faults(pour_supervisor_t *sup, const pour_state_t *s) {
   const pour_supervisor_config_t *c = &sup->config;
   const uint8_t w = c->window_ms;
   if (sup->filled < w) {
     return 0u;
   }
-  int32_t sum = 0;
-  int32_t sum_abs = 0;
-  bool all_strong = true;
-  int sign = 0;
-  for (uint8_t i = 0; i < w; ++i) {
-    const q15_t t = sup->torque[i];
-    sum += t; /* |sum| <= 32 * 32768: no overflow */
-    sum_abs += t < 0 ? -(int32_t)t : t;
-    const int si = t >= c->torque_min ? 1 : (t <= -c->torque_min ? -1 : 0);
-    if (si == 0 || (sign != 0 && si != sign)) {
-      all_strong = false;
-    }
-    sign = si != 0 ? si : sign;
-  }
-  const int32_t mean = sum / (int32_t)w;
-  const uint8_t o = oldest(sup);
+  const uint8_t o = sup->head; /* the oldest entry of a full ring: the state W ticks ago */
+  const int32_t d_omega = s->omega_urad_s - sup->omega[o];
+  const int32_t mean = sup->sum / (int32_t)w;
   uint16_t faults = 0u;
   if ((c->checks & POUR_CHECK_TORQUE_SIGN) != 0u) {
-    const int dir = mean >= c->torque_min ? 1 : (mean <= -c->torque_min ? -1 : 0);
-    const int64_t against_speed = -(int64_t)dir * s->omega_urad_s;
-    const int64_t speeding_up = -(int64_t)dir * ((int64_t)s->omega_urad_s - sup->omega[o]);
-    sup->against = count_up(sup->against, dir != 0 && against_speed > c->omega_against_urad_s && speeding_up > 0);
+    const int32_t dir = mean >= c->torque_min ? 1 : (mean <= -c->torque_min ? -1 : 0);
+    const bool against = dir != 0 && -dir * s->omega_urad_s > c->omega_against_urad_s && -dir * d_omega > 0;
+    sup->against = count_up(sup->against, against);
     if (sup->against >= c->against_ms) {
       faults |= POUR_FAULT_TORQUE_SIGN;
     }
   }
   if ((c->checks & POUR_CHECK_SCALE) != 0u) {
-    /* Speed change over the window against the most the commands and the passive loads could give:
-     * (a_full * mean|torque| / 32768 + a_passive) * W / 1000 [µrad/s]. */
-    const int64_t most = ((int64_t)c->accel_full_urad_s2 * sum_abs / 32768 +
-                          (int64_t)c->accel_passive_urad_s2 * w) / 1000;
-    sup->over = count_up(sup->over, abs64((int64_t)s->omega_urad_s - sup->omega[o]) > most);
+    /* |Δθ̇| [µrad/s] > (a_full · Σ|τ|/32768 + a_passive · W) / 1000, multiplied out (no division):
+     * 32768000 · 5e7 and 3.5e8 · 16 · 32768 both fit int64. */
+    const int64_t lhs = (int64_t)abs32(d_omega) * 32768000;
+    const int64_t rhs = (int64_t)c->accel_full_urad_s2 * sup->sum_abs + sup->passive_term;
+    sup->over = count_up(sup->over, lhs > rhs);
     if (sup->over >= c->against_ms) {
       faults |= POUR_FAULT_SCALE;
     }
   }
-  if ((c->checks & POUR_CHECK_ENCODER) != 0u && all_strong &&
-      abs64((int64_t)s->theta_urad - sup->theta[o]) <= c->encoder_move_urad) {
+  /* One direction for the whole window (|Σ| = Σ|τ|) with a mean beyond what gravity resists. */
+  if ((c->checks & POUR_CHECK_ENCODER) != 0u && (mean >= c->torque_min || mean <= -c->torque_min) &&
+      abs32(sup->sum) == sup->sum_abs && abs32(s->theta_urad - sup->theta[o]) <= c->encoder_move_urad) {
     faults |= POUR_FAULT_ENCODER;
   }
   return faults;
@@ -157,11 +152,10 @@ uint16_t pour_supervisor_step(pour_supervisor_t *sup, const pour_state_t *state,
   const pour_supervisor_config_t *c = &sup->config;
   uint16_t faults = 0u;
   if ((c->checks & POUR_CHECK_POSITION) != 0u &&
-      ((int64_t)state->theta_urad < (int64_t)sup->theta_min_urad - c->theta_margin_urad ||
-       (int64_t)state->theta_urad > (int64_t)sup->theta_max_urad + c->theta_margin_urad)) {
+      (state->theta_urad < sup->theta_low_urad || state->theta_urad > sup->theta_high_urad)) {
     faults |= POUR_FAULT_POSITION;
   }
-  if ((c->checks & POUR_CHECK_OVERSPEED) != 0u && abs64(state->omega_urad_s) > c->omega_max_urad_s) {
+  if ((c->checks & POUR_CHECK_OVERSPEED) != 0u && abs32(state->omega_urad_s) > c->omega_max_urad_s) {
     faults |= POUR_FAULT_OVERSPEED;
   }
   if ((c->checks & POUR_CHECK_VOLUME) != 0u && sup->have_state && volume_jumped(sup, state)) {
@@ -177,10 +171,17 @@ uint16_t pour_supervisor_step(pour_supervisor_t *sup, const pour_state_t *state,
 
 void pour_supervisor_record(pour_supervisor_t *sup, const pour_state_t *state, q15_t torque) {
   const uint8_t w = sup->config.window_ms;
+  if (sup->filled == w) { /* the oldest leaves the sums */
+    const int32_t old = sup->torque[sup->head];
+    sup->sum -= old;
+    sup->sum_abs -= old < 0 ? -old : old;
+  }
+  sup->sum += torque;
+  sup->sum_abs += torque < 0 ? -(int32_t)torque : torque;
   sup->torque[sup->head] = torque;
   sup->theta[sup->head] = state->theta_urad;
   sup->omega[sup->head] = state->omega_urad_s;
-  sup->head = (uint8_t)((sup->head + 1u) % w);
+  sup->head = (uint8_t)(sup->head + 1u == w ? 0u : sup->head + 1u);
   if (sup->filled < w) {
     sup->filled++;
   }

@@ -67,12 +67,30 @@ class Proc:
             self.stop()
 
 
+class Plant:
+    """A damped bucket that moves with the controller's torque, so that scripted states are physical (the
+    controller's supervisor calls a bucket that never moves under torque a frozen encoder). Per asked state:
+    θ̇ ← 0.9 θ̇ + 6e-6 rad/s per Q15 LSB of the last answer's torque (≤ 2 rad/s), θ += θ̇ · 1 ms; added to
+    what a test asks with."""
+
+    def __init__(self) -> None:
+        self.theta = 0.0
+        self.omega = 0.0
+        self.torque_q15 = 0
+
+    def advance(self) -> tuple[float, float]:
+        self.omega = 0.9 * self.omega + 6e-6 * self.torque_q15
+        self.theta += self.omega * 1e-3
+        return self.theta, self.omega
+
+
 class Bus:
     """An LCM instance that records what arrives on the channels it is asked to watch."""
 
     def __init__(self, u: str):
         self.lc = lcm.LCM(u)
         self.got: dict[str, list[bytes]] = {}
+        self.plant = Plant()
 
     def watch(self, channel: str) -> None:
         self.got.setdefault(channel, [])
@@ -104,6 +122,8 @@ class Bus:
         """Publishes a state (again every 100 ms, as host_sim does) and waits for the torque answering it."""
         if channels.TORQUE not in self.got:
             self.watch(channels.TORQUE)
+        dtheta, domega = self.plant.advance()
+        kw = dict(kw, theta=kw.get("theta", 0.1) + dtheta, omega=kw.get("omega", 0.0) + domega)
         data = self.state(seq, **kw)
         episode = kw.get("episode", 0)
 
@@ -115,6 +135,7 @@ class Bus:
         while time.monotonic() < end:
             self.lc.publish(channels.STATE, data)
             if self.wait_for(lambda: bool(answers()), min(0.1, end - time.monotonic())):
+                self.plant.torque_q15 = answers()[-1].torque_q15
                 return answers()[-1]
         raise AssertionError(f"no answer on {channels.TORQUE} to seq {seq} within {seconds} s")
 
@@ -127,7 +148,8 @@ class Bus:
     def last_status(self) -> "msgs.controller_status_t":
         return msgs.controller_status_t.decode(self.got[channels.STATUS][-1])
 
-    def command(self, estop: bool = False, clear_faults: bool = False) -> None:
+    def command(self, estop: bool = False, clear_faults: bool = False, stop: bool = False, reset: bool = False) -> None:
         m = msgs.command_t()
         m.utime, m.estop, m.clear_faults = int(time.time() * 1e6), estop, clear_faults
+        m.stop, m.reset = stop, reset
         self.lc.publish(channels.COMMAND, m.encode())

@@ -74,9 +74,12 @@ def test_controller_input_timeout_latches_fault_until_clear(controller):
         assert bus.wait_for(lambda: bus.got[channels.STATUS] and bus.last_status().faults & FAULT_STALE_INPUT, 5.0)
         st = bus.last_status()
         assert st.mode == MODE_FAULT and st.stale_ticks >= 20
-        # States are back, but the fault is latched: safe torque, still FAULT, even for a new episode.
+        # States are back, but the fault is latched: safe torque, still FAULT, even for a new run (a reset
+        # starts one afresh, and does not clear a fault).
         a = bus.ask(20, theta=0.2)
         assert a.mode == MODE_FAULT and a.faults & FAULT_STALE_INPUT and a.torque_q15 == 0
+        bus.command(reset=True)
+        bus.pump(0.05)
         assert bus.ask(0, episode=1, theta=0.2).mode == MODE_FAULT
         bus.command(clear_faults=True)
         bus.pump(0.05)

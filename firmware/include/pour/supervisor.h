@@ -12,7 +12,7 @@
 #include "pour/fixed.h"
 #include "pour/obs.h"
 
-#define POUR_SUPERVISOR_WINDOW_MAX 32u /* longest plausibility window [ticks] */
+#define POUR_SUPERVISOR_WINDOW_MAX 16u /* longest plausibility window [ticks] */
 
 /* Checks that can be armed (pour_supervisor_config_t.checks); the default arms all of them. */
 #define POUR_CHECK_POSITION 0x01u
@@ -33,7 +33,7 @@ typedef struct {
   q15_t torque_min;              /* a mean |torque| over W at least this is beyond what gravity can resist, Q15 */
   int32_t omega_against_urad_s;  /* TORQUE_SIGN: moving against that torque faster than this [µrad/s], > 0 */
   uint8_t against_ms;            /* ... and speeding up that way, this many ticks in a row [ticks], >= 1 */
-  int32_t encoder_move_urad;     /* ENCODER: under that torque for W ticks θ moves more than this [µrad], > 0 */
+  int32_t encoder_move_urad;     /* ENCODER: under that mean torque, one way all W ticks, θ moves more than this [µrad], > 0 */
   q15_t volume_step_max;         /* VOLUME: no volume changes by more than this per tick, Q15, > 0 */
   int32_t accel_full_urad_s2;    /* SCALE: full torque accelerates the lightest load at most this [µrad/s²] */
   int32_t accel_passive_urad_s2; /* ... and gravity and the liquid add at most this [µrad/s²], > 0 */
@@ -41,13 +41,16 @@ typedef struct {
 
 typedef struct {
   pour_supervisor_config_t config;
-  int32_t theta_min_urad;        /* the envelope's angle limits [µrad] */
-  int32_t theta_max_urad;
+  int32_t theta_low_urad;        /* POSITION below this: the envelope's θmin - margin [µrad] */
+  int32_t theta_high_urad;       /* ... or above this: θmax + margin [µrad] */
   q15_t torque[POUR_SUPERVISOR_WINDOW_MAX];  /* commanded torque of the last W ticks (ring), Q15 */
   int32_t theta[POUR_SUPERVISOR_WINDOW_MAX]; /* θ and θ̇ seen at those ticks (ring) */
   int32_t omega[POUR_SUPERVISOR_WINDOW_MAX];
   uint8_t head;                  /* next ring slot */
   uint8_t filled;                /* ring entries in use, up to W */
+  int32_t sum;                   /* Σ torque over the ring, Q15 (kept as entries come and go: O(1) a tick) */
+  int32_t sum_abs;               /* Σ |torque| */
+  int64_t passive_term;          /* accel_passive * W * 32768 [µrad/s² · ticks · Q15], fixed at init */
   uint8_t against;               /* consecutive ticks moving and speeding up against the torque */
   uint8_t over;                  /* consecutive ticks accelerating beyond what the command explains */
   bool have_state;

@@ -24,8 +24,16 @@ void pour_hal_timer_init(uint32_t core_clock_hz) {
 void pour_hal_timer_isr(void) { ticks = ticks + 1u; }
 
 uint32_t pour_hal_timer_wait_tick(void) {
-  while (ticks == ticks_seen) {
+  for (;;) {
+    /* With PRIMASK set, a SysTick that fires after the check stays pending and WFI returns at once;
+     * checking and then sleeping with interrupts on could sleep through it (a whole period lost). */
+    __asm volatile("cpsid i" ::: "memory");
+    if (ticks != ticks_seen) {
+      __asm volatile("cpsie i" ::: "memory");
+      break;
+    }
     __asm volatile("wfi");
+    __asm volatile("cpsie i" ::: "memory");
   }
   const uint32_t now = ticks;
   const uint32_t missed = now - ticks_seen - 1u;
@@ -34,5 +42,3 @@ uint32_t pour_hal_timer_wait_tick(void) {
 }
 
 uint32_t pour_hal_timer_ticks(void) { return ticks; }
-
-uint32_t pour_hal_timer_systick_value(void) { return SYST_CVR; }

@@ -1,112 +1,117 @@
 /* SPDX-License-Identifier: MIT */
-/* Cortex-M4 firmware: the 1 kHz loop around the control step. Inputs come from FDCAN1 through the core's
- * CAN node (can/pour.dbc: states, e-stop, clear-errors); torque and heartbeat frames go back the same way.
- * Built with POUR_SMOKE_TICKS (QEMU, semihosted), the same loop runs that many ticks on a scripted
- * input and checks what the controller did: the on-target smoke test of SysTick and the loop. */
+/* Cortex-M4 firmware: the 1 kHz loop around the control step. Inputs come from the bus through pour::can's
+ * node (can/pour.dbc: states, e-stop, stop, clear-errors, reset) and from the hardwired e-stop line; the
+ * torque, the brake and the power stage follow the core's output; torque, heartbeat and identity frames go
+ * back on the bus. The same file runs in the STM32G431 image (board_stm32g431.c behind the hal_* calls)
+ * and in the QEMU smoke test (smoke_bench.c, a scripted bench behind the same calls). */
 #include <stdbool.h>
 
+#include "clock.h"
+#include "hal_brake.h"
+#include "hal_can.h"
+#include "hal_estop.h"
 #include "hal_motor.h"
+#include "hal_power.h"
 #include "hal_timer.h"
+#include "hal_watchdog.h"
+#include "pour/can_node.h"
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
 
-/* STM32G431 reset clock: HSI16. A PLL set-up to 170 MHz changes only this number. */
-#ifndef POUR_CORE_CLOCK_HZ
-#define POUR_CORE_CLOCK_HZ 16000000u
-#endif
+#define WATCHDOG_TIMEOUT_MS 10u /* ten missed ticks: the loop is gone, reset (brake engaged meanwhile) */
 
 static pour_control_t controller;
-
-#ifdef POUR_SMOKE_TICKS
-#include <stdio.h>
-
-/* Ticks 10..59 bring a fresh state of a bucket that moves with the torque (the supervisor judges
- * physics: a scripted bucket that never moved would be a frozen encoder), then the input stops. */
-static void poll_input(pour_control_input_t *in, uint32_t tick) {
-  static int32_t omega_urad_s = 0;
-  in->state_fresh = tick >= 10u && tick < 60u;
-  if (in->state_fresh) {
-    omega_urad_s += (int32_t)controller.safety.torque * 6; /* ~200 rad/s² at full torque */
-    in->state.theta_urad += omega_urad_s / 1000;
-    in->state.omega_urad_s = omega_urad_s;
-  }
-  in->state.seq = tick;
-  in->state.v_rotating = 32767;
-  in->estop = false;
-  in->clear_faults = false;
-}
-#else
-#include "fdcan.h"
-#include "pour/can_node.h"
-
 static pour_can_node_t can_node;
-static pour_fdcan_t fdcan;
 
-/* Fills one tick's inputs from the frames received since the last tick (the latest state wins). */
-static void poll_input(pour_control_input_t *in, uint32_t tick) {
-  (void)tick;
-  pour_can_frame_t f;
-  (void)pour_fdcan_poll(&fdcan);
-  while (pour_fdcan_receive(&fdcan, &f) == 1) {
-    (void)pour_can_node_receive(&can_node, &f);
+static void transmit(const pour_can_frame_t *tx, uint8_t n) {
+  for (uint8_t i = 0; i < n; ++i) {
+    (void)pour_hal_can_transmit(&tx[i]);
   }
-  pour_can_node_begin_tick(&can_node, in);
 }
 
-/* CAN up: pins and clocks, the peripheral, the node. If it fails no state arrives: IDLE, safe torque. */
-static void can_init(void) {
-  pour_fdcan_stm32g4_board_init();
-  pour_fdcan_config_t fc = pour_fdcan_default_config();
-  fc.kernel_clock_hz = POUR_CORE_CLOCK_HZ;
-  (void)pour_fdcan_init(&fdcan, pour_fdcan_stm32g4_fdcan1(), &fc);
+/* Brake and power as the core asks, in the order that never lets the bucket drop: power comes on before
+ * the brake releases, and the brake engages before the power goes off. */
+static void drive(const pour_control_output_t *out) {
+  pour_hal_motor_set_torque(out->power ? out->torque : 0);
+  if (out->brake) {
+    pour_hal_brake_set(true);
+    pour_hal_power_set(false);
+  } else {
+    pour_hal_power_set(true);
+    pour_hal_brake_set(false);
+  }
+}
+
+/* A controller that cannot run says why, forever: brake engaged, power off, heartbeat and identity frames
+ * with the start-up status (Identity.InitStatus), and no motion whatever arrives. */
+static void report_forever(void) {
+  pour_control_output_t out = {0};
+  out.mode = (uint8_t)POUR_MODE_IDLE;
+  out.brake = true;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  for (;;) {
+    (void)pour_hal_timer_wait_tick();
+    pour_hal_can_poll();
+    pour_can_frame_t f;
+    while (pour_hal_can_receive(&f) == 1) {
+      (void)pour_can_node_receive(&can_node, &f);
+    }
+    drive(&out);
+    /* The torque frame says IDLE and 0; the heartbeat and identity frames carry the reason. */
+    transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
+    pour_hal_watchdog_feed();
+  }
+}
+
+int main(void) {
+  /* Safe levels first: the brake engaged and the power off until the core says otherwise. */
+  pour_hal_brake_init();
+  pour_hal_power_init();
+  pour_hal_motor_init();
+  pour_hal_estop_init();
+  uint32_t clock_hz = 0u;
+  const pour_status_t clock_status = pour_clock_init(&clock_hz);
+  pour_hal_watchdog_start(WATCHDOG_TIMEOUT_MS);
+  pour_hal_timer_init(clock_hz);
+
+  const pour_control_config_t config = pour_control_default_config();
+  pour_status_t status = pour_control_init(&controller, &config, &pour_weights_compiled);
+  if (status == POUR_OK) {
+    status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
+  }
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
-  (void)pour_can_node_init(&can_node, &nc);
-}
-#endif
-
-int main(void) {
-  pour_hal_motor_init();
-  const pour_control_config_t config = pour_control_default_config();
-  if (pour_control_init(&controller, &config, &pour_weights_compiled) != POUR_OK) {
-    for (;;) { /* a policy that fails validation never drives the motor */
+  nc.identity.init_status = (int8_t)status;
+  if (pour_can_node_init(&can_node, &nc) != POUR_OK || pour_hal_can_init(clock_hz, nc.node_id) != POUR_OK) {
+    /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
+     * watchdog resets the MCU, which tries again. */
+    for (;;) {
     }
   }
-  pour_hal_timer_init(POUR_CORE_CLOCK_HZ);
-  pour_control_input_t in = {false, {0u, 0, 0, 0, 0, 0}, false, false, false, false, false};
-  pour_control_output_t out;
-#ifdef POUR_SMOKE_TICKS
-  uint32_t missed = 0u;
-  bool ran = false;
-  q15_t peak = 0;
-  for (uint32_t tick = 0; tick < POUR_SMOKE_TICKS; ++tick) {
-    missed += pour_hal_timer_wait_tick();
-    poll_input(&in, tick);
-    pour_control_step(&controller, &in, &out);
-    pour_hal_motor_set_torque(out.torque);
-    ran = ran || out.mode == POUR_MODE_RUN;
-    peak = out.torque > peak ? out.torque : peak;
+  if (status != POUR_OK) {
+    report_forever();
   }
-  const bool ok = ran && peak > 0 && out.mode == POUR_MODE_FAULT && out.faults == POUR_FAULT_STALE_INPUT &&
-                  pour_hal_motor_torque() == config.safe_torque && pour_hal_timer_ticks() >= POUR_SMOKE_TICKS;
-  printf("smoke: %u ticks (%u missed), ran %d, peak torque %d, final mode %u faults 0x%x torque %d: %s\n",
-         (unsigned)pour_hal_timer_ticks(), (unsigned)missed, (int)ran, (int)peak, (unsigned)out.mode,
-         (unsigned)out.faults, (int)pour_hal_motor_torque(), ok ? "ok" : "FAILED");
-  return ok ? 0 : 1;
-#else
-  can_init();
+
   uint32_t overruns = 0u;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
-  for (uint32_t tick = 0;; ++tick) {
-    overruns += pour_hal_timer_wait_tick();
-    poll_input(&in, tick);
+  for (;;) {
+    const uint32_t missed = pour_hal_timer_wait_tick();
+    overruns += missed;
+    pour_hal_can_poll();
+    pour_can_frame_t f;
+    while (pour_hal_can_receive(&f) == 1) {
+      (void)pour_can_node_receive(&can_node, &f);
+    }
+    pour_control_input_t in;
+    pour_can_node_begin_tick(&can_node, &in);
+    in.estop = in.estop || pour_hal_estop_asserted(); /* the hardwired line, every tick, beside the frame */
+    pour_control_output_t out;
     pour_control_step(&controller, &in, &out);
-    const uint8_t n_tx = pour_can_node_end_tick(&can_node, &out, overruns, tx);
-    pour_hal_motor_set_torque(out.torque);
-    for (uint8_t i = 0; i < n_tx; ++i) {
-      (void)pour_fdcan_transmit(&fdcan, &tx[i]);
+    drive(&out);
+    transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
+    if (missed == 0u) {
+      pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */
     }
   }
-#endif
 }

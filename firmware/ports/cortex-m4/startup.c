@@ -5,19 +5,27 @@
 #include <stdint.h>
 
 #include "hal_timer.h"
+#include "safe_outputs.h"
 
 extern uint32_t __data_load__, __data_start__, __data_end__, __bss_start__, __bss_end__, __StackTop;
 extern int main(void);
 void Reset_Handler(void);
 void Default_Handler(void);
+void Fault_Handler(void);
+__attribute__((weak)) void pour_safe_outputs(void) {}
 #ifdef POUR_SEMIHOSTED
 extern void _start(void);
 #endif
 
-void Default_Handler(void) {
+/* Every fault and unexpected interrupt: the outputs to their safe levels first, then stop. The loop no
+ * longer feeds the independent watchdog, which resets the MCU; it restarts with the brake engaged. */
+void Fault_Handler(void) {
+  pour_safe_outputs();
   for (;;) {
   }
 }
+
+void Default_Handler(void) { Fault_Handler(); }
 
 void Reset_Handler(void) {
   uint32_t *src = &__data_load__;
@@ -37,19 +45,12 @@ void Reset_Handler(void) {
 }
 
 #ifndef POUR_SEMIHOSTED
-/* STM32G431 device interrupts (RM0440): IRQ 0..101 follow the 16 core entries. A driver provides a
- * handler by defining its name (the FDCAN driver: FDCAN1_IT0_IRQHandler, FDCAN1_IT1_IRQHandler); every
- * other interrupt stops in Default_Handler. */
-void FDCAN1_IT0_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
-void FDCAN1_IT1_IRQHandler(void) __attribute__((weak, alias("Default_Handler")));
+/* STM32G431 device interrupts (RM0440): IRQ 0..101 follow the 16 core entries. The loop polls every
+ * peripheral, so none is enabled: each entry stops in Default_Handler (safe outputs first). */
 #define D1 Default_Handler
 #define D4 D1, D1, D1, D1
 #define D20 D4, D4, D4, D4, D4
-#define POUR_DEVICE_VECTORS                                                                    \
-  D20, D1,                           /* IRQ 0..20 */                                           \
-      FDCAN1_IT0_IRQHandler,         /* IRQ 21 */                                              \
-      FDCAN1_IT1_IRQHandler,         /* IRQ 22 */                                              \
-      D20, D20, D20, D4, D4, D4, D1, D1, D1 /* IRQ 23..101 */
+#define POUR_DEVICE_VECTORS D20, D20, D20, D20, D20, D1, D1 /* IRQ 0..101 */
 #define POUR_N_DEVICE_VECTORS 102
 #else
 /* QEMU mps2-an386 images (tests, benchmark) use no device interrupt. */
@@ -62,11 +63,11 @@ typedef void (*pour_vector_t)(void);
 __attribute__((section(".isr_vector"), used)) static const pour_vector_t vectors[16 + POUR_N_DEVICE_VECTORS] = {
     (pour_vector_t)(uintptr_t)&__StackTop,
     Reset_Handler,
-    Default_Handler, /* NMI */
-    Default_Handler, /* HardFault */
-    Default_Handler, /* MemManage */
-    Default_Handler, /* BusFault */
-    Default_Handler, /* UsageFault */
+    Fault_Handler, /* NMI */
+    Fault_Handler, /* HardFault */
+    Fault_Handler, /* MemManage */
+    Fault_Handler, /* BusFault */
+    Fault_Handler, /* UsageFault */
     0, 0, 0, 0,
     Default_Handler, /* SVCall */
     Default_Handler, /* DebugMonitor */

@@ -22,6 +22,23 @@ IFACE = "vcan0"
 FRAME = struct.Struct("=IB3x8s")
 
 
+class Plant:
+    """A damped bucket that moves with the controller's torque, so that scripted states are physical: the
+    controller's supervisor calls a bucket that never moves under torque a frozen encoder. Per state:
+    θ̇ ← 0.9 θ̇ + 6 µrad/s per Q15 LSB of the last torque (≤ 2 rad/s), θ += θ̇ · 1 ms; added to what a test
+    sends."""
+
+    def __init__(self) -> None:
+        self.theta_urad = 0.0
+        self.omega_urad_s = 0.0
+        self.torque_q15 = 0
+
+    def advance(self) -> tuple[int, int]:
+        self.omega_urad_s = 0.9 * self.omega_urad_s + 6.0 * self.torque_q15
+        self.theta_urad += self.omega_urad_s / 1000.0
+        return round(self.theta_urad), round(self.omega_urad_s)
+
+
 @dataclass
 class Frame:
     t: float
@@ -35,6 +52,7 @@ class Bus:
         self.sock = socket.socket(socket.PF_CAN, socket.SOCK_RAW, socket.CAN_RAW)
         self.sock.bind((iface,))
         self.log: list[Frame] = []
+        self.plant = Plant()
 
     def close(self) -> None:
         self.sock.close()
@@ -48,7 +66,8 @@ class Bus:
 
     def send_state(self, seq: int, theta_urad: int = 0, omega_urad_s: int = 0, vr: int = 32767, vt: int = 0,
                    vs: int = 0, node: int = 0) -> None:
-        self.send("StateA", node, Theta=theta_urad, Omega=omega_urad_s, SeqLow=seq & 0xFF)
+        dtheta, domega = self.plant.advance()
+        self.send("StateA", node, Theta=theta_urad + dtheta, Omega=omega_urad_s + domega, SeqLow=seq & 0xFF)
         self.send("StateB", node, Seq=seq & 0xFFFF, VRotating=vr, VTarget=vt, VSpill=vs)
 
     def recv(self, timeout: float) -> Frame | None:
@@ -76,6 +95,8 @@ class Bus:
         while (f := self.recv(end - time.monotonic())) is not None:
             if f.id == (node << 5) | m.frame_id:
                 d = m.decode(f.data, scaling=False, decode_choices=False)
+                if name == "Torque":
+                    self.plant.torque_q15 = d["Torque"]
                 if pred(d):
                     return d
         raise AssertionError(f"no {name} frame matching the condition within {timeout} s")

@@ -12,7 +12,7 @@ import time
 import lcm
 import pytest
 
-from canbus import BUILD_DIR, SOURCE_DIR
+from canbus import BUILD_DIR, SOURCE_DIR, Plant
 from pour import channels, lcm_types
 
 msgs = lcm_types.load()
@@ -26,6 +26,7 @@ class Host:
         self.lc = lcm.LCM(URL)
         self.torques: list = []
         self.statuses: list = []
+        self.plant = Plant()
         self.lc.subscribe(channels.TORQUE, lambda ch, data: self.torques.append(msgs.torque_t.decode(data)))
         self.lc.subscribe(channels.STATUS, lambda ch, data: self.statuses.append(msgs.controller_status_t.decode(data)))
 
@@ -37,13 +38,15 @@ class Host:
     def state(self, seq: int, episode: int = 7):
         m = msgs.plant_state_t()
         m.utime, m.seq, m.episode = 1000 * seq + 11, seq, episode
-        m.theta, m.omega, m.v_rotating, m.v_target, m.v_spill = 0.0, 0.0, 1.0, 0.0, 0.0
+        theta_urad, omega_urad_s = self.plant.advance()
+        m.theta, m.omega, m.v_rotating, m.v_target, m.v_spill = theta_urad * 1e-6, omega_urad_s * 1e-6, 1.0, 0.0, 0.0
         self.lc.publish(channels.STATE, m.encode())
         end = time.monotonic() + 5.0
         while time.monotonic() < end:
             self.lc.handle_timeout(20)
             hits = [t for t in self.torques if t.seq == seq and t.episode == episode]
             if hits:
+                self.plant.torque_q15 = hits[-1].torque_q15
                 return hits[-1]
         raise AssertionError(f"no POUR_TORQUE answer to seq {seq}")
 

@@ -40,15 +40,23 @@ static void make_inputs(void) {
   }
 }
 
-/* Average SysTick ticks (x1000) per step for N_STEPS steps, minus the loop's own cost. */
+/* Average SysTick ticks (x1000) per step for N_STEPS steps, minus the loop's own cost. The supervisor runs
+ * every check on every tick (all armed, windows full), with bounds these synthetic states never cross, so
+ * that every step is a RUN step: the worst case, not a cheap FAULT one. */
 static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
-  const pour_control_config_t config = pour_control_default_config();
+  pour_control_config_t config = pour_control_default_config();
+  config.supervisor.theta_margin_urad = INT32_MAX / 2;
+  config.supervisor.omega_against_urad_s = INT32_MAX;
+  config.supervisor.encoder_move_urad = 1;
+  config.supervisor.volume_step_max = POUR_Q15_MAX;
+  config.supervisor.accel_passive_urad_s2 = INT32_MAX;
   if (pour_control_init(&ctl, &config, w) != POUR_OK) {
     return 0u;
   }
   pour_control_output_t out;
   const uint32_t t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
+    inputs[i & 63u].state.seq = i + 1u; /* a sender that counts, as the supervisor requires */
     if (do_step) {
       pour_control_step(&ctl, &inputs[i & 63u], &out);
     } else {

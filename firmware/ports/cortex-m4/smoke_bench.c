@@ -1,0 +1,156 @@
+/* SPDX-License-Identifier: MIT */
+/* The QEMU smoke test's bench (mps2-an386, semihosted): the hal_* calls of main.c answered by a scripted
+ * host and a small plant instead of the STM32G431's pins and FDCAN, so that the production loop itself runs
+ * under SysTick on an emulated Cortex-M4. The script, by tick:
+ *     10..169  states of a bucket that moves with the torque (StateA + StateB frames, seq counting)
+ *   100..119  the hardwired e-stop line asserted
+ *        130  ClearErrors
+ *      170..  no more states: the input times out
+ *        205  the verdict (exit status 0 or 1), after the heartbeat of tick 201
+ * Checked: RUN and torque before the e-stop; zero torque, brake engaged and power off in the e-stop's own
+ * tick; ESTOP latched until the clear, then RUN again through the slew limit; the stale-input fault and the
+ * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
+ * healthy tick. */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "clock.h"
+#include "hal_brake.h"
+#include "hal_can.h"
+#include "hal_estop.h"
+#include "hal_power.h"
+#include "hal_watchdog.h"
+#include "pour/control.h"
+#include "pour/weights_compiled.h"
+
+#ifndef POUR_SMOKE_TICKS
+#define POUR_SMOKE_TICKS 205u /* one heartbeat past the stale-input fault */
+#endif
+#define MPS2_AN386_CLOCK_HZ 25000000u
+#define ESTOP_FROM 100u
+#define ESTOP_TO 120u
+#define CLEAR_AT 130u
+#define STATES_TO 170u
+
+static uint32_t tick;
+static bool brake = true, power;
+static int32_t theta_urad, omega_urad_s;
+static q15_t applied;
+static pour_can_frame_t rx[3];
+static unsigned rx_n, rx_i;
+
+static struct {
+  uint32_t feeds, heartbeats, identities, bad_identity, slew_steps;
+  bool ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
+  q15_t peak, last_torque;
+  uint8_t last_mode;
+  uint16_t last_faults;
+} seen;
+
+pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
+  *core_clock_hz = MPS2_AN386_CLOCK_HZ;
+  return POUR_OK;
+}
+
+void pour_hal_brake_init(void) { brake = true; }
+void pour_hal_brake_set(bool engage) { brake = engage; }
+bool pour_hal_brake_engaged(void) { return brake; }
+void pour_hal_power_init(void) { power = false; }
+void pour_hal_power_set(bool on) { power = on; }
+bool pour_hal_power_on(void) { return power; }
+void pour_hal_estop_init(void) {}
+bool pour_hal_estop_asserted(void) { return tick >= ESTOP_FROM && tick < ESTOP_TO; }
+void pour_hal_watchdog_start(uint32_t timeout_ms) { (void)timeout_ms; }
+
+pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
+  return clock_hz == MPS2_AN386_CLOCK_HZ && node_id == 0u ? POUR_OK : POUR_EINVAL;
+}
+
+/* Once per loop tick: the plant moves under the last applied torque, and this tick's frames are queued. */
+void pour_hal_can_poll(void) {
+  ++tick;
+  omega_urad_s += (int32_t)applied * 6; /* ~200 rad/s² at full torque */
+  theta_urad += omega_urad_s / 1000;
+  rx_n = 0u;
+  rx_i = 0u;
+  if (tick >= 10u && tick < STATES_TO) {
+    const pour_can_state_a_t a = {theta_urad, omega_urad_s, (uint8_t)(tick & 0xFFu)};
+    const pour_can_state_b_t b = {(uint16_t)tick, 32767, 0, 0};
+    (void)pour_can_pack_state_a(0, &a, &rx[rx_n++]);
+    (void)pour_can_pack_state_b(0, &b, &rx[rx_n++]);
+  }
+  if (tick == CLEAR_AT) {
+    (void)pour_can_pack_command(0, POUR_CAN_CMD_CLEAR_ERRORS, &rx[rx_n++]);
+  }
+}
+
+int pour_hal_can_receive(pour_can_frame_t *frame) {
+  if (rx_i == rx_n) {
+    return 0;
+  }
+  *frame = rx[rx_i++];
+  return 1;
+}
+
+static void on_torque(const pour_can_torque_t *t) {
+  applied = power ? t->torque : 0;
+  const int32_t step = (int32_t)t->torque - seen.last_torque;
+  if (t->torque != 0 && (step > 3277 || step < -3277)) {
+    seen.slew_steps++;
+  }
+  seen.last_torque = t->torque;
+  seen.last_mode = t->mode;
+  if (tick < ESTOP_FROM && t->mode == POUR_MODE_RUN) {
+    seen.ran = true;
+    seen.peak = t->torque > seen.peak ? t->torque : seen.peak;
+  }
+  if (tick == ESTOP_FROM) {
+    seen.estop_same_tick = t->torque == 0 && t->mode == POUR_MODE_ESTOP && brake && !power;
+  }
+  if (tick == CLEAR_AT - 1u) {
+    seen.estop_latched = t->mode == POUR_MODE_FAULT && brake && !power;
+  }
+  if (tick > CLEAR_AT && tick < STATES_TO && t->mode == POUR_MODE_RUN && power && !brake) {
+    seen.ran_again = true;
+  }
+}
+
+int pour_hal_can_transmit(const pour_can_frame_t *frame) {
+  pour_can_torque_t t;
+  pour_can_heartbeat_t hb;
+  pour_can_identity_t id;
+  if (pour_can_unpack_torque(frame, &t) == POUR_CAN_RX_OK) {
+    on_torque(&t);
+  } else if (pour_can_unpack_heartbeat(frame, &hb) == POUR_CAN_RX_OK) {
+    seen.heartbeats++;
+    seen.last_faults = hb.faults;
+  } else if (pour_can_unpack_identity(frame, &id) == POUR_CAN_RX_OK) {
+    seen.identities++;
+    if (id.weights_hash != pour_weights_compiled.content_hash || id.init_status != 0 ||
+        id.fw_version != POUR_FIRMWARE_VERSION) {
+      seen.bad_identity++;
+    }
+  }
+  return 0;
+}
+
+/* Called by the loop once per healthy tick: the last tick of the script gives the verdict. */
+void pour_hal_watchdog_feed(void) {
+  seen.feeds++;
+  if (tick < POUR_SMOKE_TICKS) {
+    return;
+  }
+  seen.stale_at_end = seen.last_mode == POUR_MODE_FAULT && brake && !power;
+  const bool ok = seen.ran && seen.peak > 0 && seen.estop_same_tick && seen.estop_latched && seen.ran_again &&
+                  seen.stale_at_end && (seen.last_faults & POUR_FAULT_STALE_INPUT) != 0u && seen.heartbeats >= 2u &&
+                  seen.identities == seen.heartbeats && seen.bad_identity == 0u && seen.slew_steps == 0u &&
+                  seen.feeds + 5u >= tick;
+  printf("smoke: %u ticks, watchdog fed %u; ran %d (peak torque %d); e-stop: zero torque, brake, power off in its "
+         "tick %d, latched %d; after the clear ran %d; stale at the end %d (faults 0x%x); heartbeats %u, identities "
+         "%u (%u wrong); slew-limit breaches %u: %s\n",
+         (unsigned)tick, (unsigned)seen.feeds, (int)seen.ran, (int)seen.peak, (int)seen.estop_same_tick,
+         (int)seen.estop_latched, (int)seen.ran_again, (int)seen.stale_at_end, (unsigned)seen.last_faults,
+         (unsigned)seen.heartbeats, (unsigned)seen.identities, (unsigned)seen.bad_identity,
+         (unsigned)seen.slew_steps, ok ? "ok" : "FAILED");
+  exit(ok ? 0 : 1);
+}
