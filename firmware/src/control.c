@@ -55,6 +55,7 @@ static void start_afresh(pour_control_t *ctl) {
     ctl->eval.probs[a] = 0;
   }
   ctl->eval.action = 0u;
+  ctl->probs_pending = false;
   pour_supervisor_restart(&ctl->supervisor);
   ctl->stop_ms = 0u;
   ctl->stopped = false;
@@ -250,8 +251,18 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
     const pour_policy_weights_t *w = ctl->policy.weights;
     if (ctl->ms_to_decision == 0u) {
       pour_obs_quantize(&w->norm, &ctl->state, &ctl->obs);
-      pour_policy_eval(&ctl->policy, &ctl->obs, &ctl->eval);
+      /* A greedy decision needs only the argmax; its probabilities (telemetry) follow on the next tick,
+       * which has the time: the decision tick stays the cheapest it can be. With a decision every tick
+       * there is no next tick to spare. */
+      ctl->probs_pending = !pour_policy_decide(&ctl->policy, &ctl->obs, &ctl->eval);
+      if (ctl->probs_pending && w->decision_period_ms == 1u) {
+        pour_policy_fill_probs(&ctl->policy, &ctl->eval);
+        ctl->probs_pending = false;
+      }
       ctl->ms_to_decision = w->decision_period_ms;
+    } else if (ctl->probs_pending) {
+      pour_policy_fill_probs(&ctl->policy, &ctl->eval);
+      ctl->probs_pending = false;
     }
     ctl->ms_to_decision--;
     torque = pour_safety_apply(&ctl->safety, w->action_levels[ctl->eval.action], ctl->state.theta_urad);

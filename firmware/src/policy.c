@@ -219,17 +219,32 @@ unsigned pour_policy_sample(const q15_t *probs, unsigned n, uint32_t *rng) {
   return n - 1u; /* only when every probability is 0 (never after pour_policy_softmax_q15) */
 }
 
-void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
+void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out) {
+  const unsigned n = policy->weights->n_actions;
+  pour_policy_softmax_q15(out->logits, n, out->probs);
+  for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    out->probs[a] = 0;
+  }
+}
+
+bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
   const pour_policy_weights_t *w = policy->weights;
   const unsigned n = w->n_actions;
   pour_policy_logits(w, obs, out->logits);
-  pour_policy_softmax_q15(out->logits, n, out->probs);
   for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
     out->logits[a] = 0;
-    out->probs[a] = 0;
   }
-  const unsigned action = policy->mode == POUR_POLICY_SAMPLED
-                              ? pour_policy_sample(out->probs, n, &policy->rng)
-                              : pour_policy_argmax(out->logits, n);
-  out->action = (uint8_t)action;
+  if (policy->mode == POUR_POLICY_SAMPLED) {
+    pour_policy_fill_probs(policy, out);
+    out->action = (uint8_t)pour_policy_sample(out->probs, n, &policy->rng);
+    return true;
+  }
+  out->action = (uint8_t)pour_policy_argmax(out->logits, n);
+  return false;
+}
+
+void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
+  if (!pour_policy_decide(policy, obs, out)) {
+    pour_policy_fill_probs(policy, out);
+  }
 }

@@ -75,11 +75,29 @@ static void test_control_step_FirstFreshStateStartsRunAndDecides(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[out.action] > 0);
   TEST_ASSERT_EQUAL_INT16(config.safety.slew_per_tick, out.torque); /* slewing up from zero */
+  step(true); /* a greedy decision's probabilities come with the tick after it */
   int32_t sum = 0;
   for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
     sum += out.probs[a];
   }
   TEST_ASSERT_INT_WITHIN(6, 32768, sum);
+}
+
+static void test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick(void) {
+  step(true);
+  const uint8_t action = out.action;
+  int32_t sum = 0;
+  for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    sum += out.probs[a];
+  }
+  TEST_ASSERT_EQUAL_INT32(0, sum); /* the decision tick carries only the action: it is the costly one */
+  step(true);
+  pour_policy_eval_t ev;
+  pour_policy_t policy;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
+  pour_policy_eval(&policy, &ctl.obs, &ev);
+  TEST_ASSERT_EQUAL_UINT8(action, ev.action);
+  TEST_ASSERT_EQUAL_INT16_ARRAY(ev.probs, out.probs, POUR_POLICY_MAX_ACTIONS);
 }
 
 static void test_control_step_DecidesEveryPeriodAndHoldsBetween(void) {
@@ -232,6 +250,7 @@ int main(void) {
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);
   RUN_TEST(test_control_step_FirstFreshStateStartsRunAndDecides);
+  RUN_TEST(test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick);
   RUN_TEST(test_control_step_DecidesEveryPeriodAndHoldsBetween);
   RUN_TEST(test_control_step_StaleInputAfterTimeoutGivesSafeTorqueAndLatches);
   RUN_TEST(test_control_step_ClearReturnsToIdleThenRun);

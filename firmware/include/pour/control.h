@@ -80,7 +80,8 @@ typedef struct {
 typedef struct {
   q15_t torque;   /* command, fraction of tau_max Q15 */
   uint8_t action; /* index of the current policy action */
-  q15_t probs[POUR_POLICY_MAX_ACTIONS]; /* probabilities of the latest decision, Q15 */
+  q15_t probs[POUR_POLICY_MAX_ACTIONS]; /* probabilities of the latest decision, Q15 (greedy: from the
+                                         * tick after it, unless decisions come every tick) */
   uint8_t mode;   /* pour_mode_t */
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
@@ -101,6 +102,7 @@ typedef struct {
   pour_state_t state; /* latest fresh, plausible state */
   pour_obs_t obs;
   pour_policy_eval_t eval;
+  bool probs_pending;     /* the latest greedy decision's probabilities are computed on the next tick */
   pour_supervisor_t supervisor;
   uint32_t stop_ms;       /* ticks of the active stop so far */
   bool stopped;           /* the stop is over: brake and power cut until a clear */

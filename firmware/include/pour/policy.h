@@ -3,6 +3,7 @@
 #ifndef POUR_POLICY_H
 #define POUR_POLICY_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "pour/fixed.h"
@@ -54,8 +55,15 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
                                pour_policy_mode_t mode, uint32_t seed);
 
 /* Evaluates the policy on one observation (elements in [0, 32767], as pour_obs_quantize makes them).
- * Never fails on an initialised policy. */
+ * Never fails on an initialised policy. Equals pour_policy_decide, then pour_policy_fill_probs if needed. */
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
+
+/* The decision alone: logits and the action. Greedy mode needs no probabilities for it and leaves out->probs
+ * as they were (returns false); sampled mode draws from them, so fills them (returns true). */
+bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
+
+/* The probabilities of out->logits (softmax, zero past n_actions): what a greedy decision left out. */
+void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out);
 
 /* The kernels pour_policy_eval is made of, exposed for tests and the benchmark. */
 

@@ -92,7 +92,8 @@ static int drain(socketcan_t *s, pour_io_input_t *in) {
       s->dropped_reported = d;
       continue;
     }
-    if (s->node.state_fresh) {
+    /* This frame completed a state (a command frame must not report the one still waiting for its tick). */
+    if ((f.id & POUR_CAN_CMD_MASK) == POUR_CAN_CMD_STATE_B && s->node.state_fresh) {
       in->n_states++;
       in->state = s->node.state;
       in->state_seq = (int64_t)s->node.state.seq; /* 32 bits, extended by the node: no wrap, no reset */
