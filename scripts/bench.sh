@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Benchmarks: measure and print; never fail on the figures (only on a build that does not work).
-#   scripts/bench.sh              all sections
+#   scripts/bench.sh              all sections but fuzz
 #   scripts/bench.sh core         only the named sections (see SECTIONS below)
+#   scripts/bench.sh fuzz 60      the fuzz targets, 60 s each (default 300)
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
@@ -235,9 +236,86 @@ for what in ("accepted, one long comment", "one token (refused)"):
 EOS
 }
 
-SECTIONS=(core lcm sim can weights)
-wanted=("$@")
-[ ${#wanted[@]} -gt 0 ] || wanted=("${SECTIONS[@]}")
+# --- section: fuzz — the libFuzzer targets of tests/fuzz, each for as long as asked ------------------------
+# scripts/bench.sh fuzz [seconds per target, default 300]: every target under nice, ASan+UBSan, on its
+# committed corpus and dictionary. Prints per target: executions, exec/s, libFuzzer's edge coverage, the
+# line coverage of the sources it drives (a second build with clang's source-based coverage replays the
+# final corpus) and the findings (crash inputs, kept in build/host-fuzz/bench/<target>/ for a regression).
+FUZZ_TARGETS=(fuzz_weights_h fuzz_config fuzz_control_step fuzz_can_node fuzz_lcm_decode fuzz_lcm_port)
+fuzz_sources() {
+  case $1 in
+    fuzz_weights_h) echo host_sim/src/weights_file.cpp ;;
+    fuzz_config) echo host_sim/src/config.cpp ;;
+    fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/policy.c firmware/src/obs.c ;;
+    fuzz_can_node) echo firmware/src/can_node.c firmware/src/can_codec.c firmware/src/control.c firmware/src/safety.c ;;
+    fuzz_lcm_decode) echo build/host-fuzz-cov/lcmtypes/c/pour_plant_state_t.c build/host-fuzz-cov/lcmtypes/c/pour_command_t.c \
+                          build/host-fuzz-cov/lcmtypes/c/pour_torque_t.c ;;
+    fuzz_lcm_port) echo firmware/ports/linux/io_lcm.c firmware/ports/linux/state_si.c ;;
+  esac
+}
+bench_fuzz() {
+  local seconds=${FUZZ_SECONDS:-300} log t work cov stats
+  log=$(mktemp)
+  echo "== fuzz: libFuzzer targets (clang-14, ASan+UBSan), ${seconds} s each, nice 10 =="
+  cov=build/host-fuzz-cov
+  if ! { cmake --preset host-fuzz && cmake --build --preset host-fuzz &&
+         cmake -S . -B "$cov" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOUR_FUZZ=ON \
+           -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+           "-DCMAKE_C_FLAGS=-fprofile-instr-generate -fcoverage-mapping -fsanitize=fuzzer-no-link" \
+           "-DCMAKE_CXX_FLAGS=-fprofile-instr-generate -fcoverage-mapping -fsanitize=fuzzer-no-link" \
+           -DCMAKE_EXE_LINKER_FLAGS=-fprofile-instr-generate -DCMAKE_SHARED_LINKER_FLAGS=-fprofile-instr-generate &&
+         cmake --build "$cov" --target pour_fuzz_all; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the fuzz builds failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  echo "   machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  local findings=0
+  for t in "${FUZZ_TARGETS[@]}"; do
+    work=build/host-fuzz/bench
+    rm -rf "${work:?}/$t"
+    nice -n 10 tests/fuzz/run_fuzz.sh "build/host-fuzz/bin/$t" "$seconds" "$work" >"$work.$t.log" 2>&1
+    stats=$(awk '/stat::number_of_executed_units/ {n = $2} /stat::average_exec_per_sec/ {r = $2}
+                 / DONE | INITED / {c = $0; sub(/.*cov: /, "", c); sub(/ .*/, "", c)}
+                 END {printf "%s executions, %s exec/s, %s edges", n, r, c}' "$work.$t.log")
+    # Line coverage: the coverage build replays the corpus the run ended with.
+    rm -f "$work/$t"/*.profraw
+    LLVM_PROFILE_FILE="$work/$t/%p.profraw" "$cov/bin/$t" -runs=0 "$work/$t/corpus" "tests/fuzz/corpus/$t" \
+      >/dev/null 2>&1 || true
+    local lines="?"
+    if llvm-profdata-14 merge -sparse "$work/$t"/*.profraw -o "$work/$t/all.profdata" 2>/dev/null; then
+      # shellcheck disable=SC2046
+      lines=$(llvm-cov-14 export -summary-only -instr-profile="$work/$t/all.profdata" "$cov/bin/$t" \
+                $(fuzz_sources "$t") 2>/dev/null | python3 -c '
+import json, sys
+t = json.load(sys.stdin)["data"][0]["totals"]["lines"]
+print(f"{t[\"covered\"]}/{t[\"count\"]} lines ({t[\"percent\"]:.1f} %)")' || echo "?")
+    fi
+    local crashes
+    crashes=$(find "$work/$t" -maxdepth 1 \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
+    findings=$((findings + crashes))
+    printf '   %-18s %s; line coverage of %s: %s; findings: %s\n' "$t" "$stats" \
+      "$(fuzz_sources "$t" | tr ' ' '\n' | xargs -n1 basename | paste -sd, -)" "$lines" "$crashes"
+    if [ "$crashes" != 0 ]; then
+      grep -m1 -E 'property broken|ERROR: ' "$work.$t.log" | sed 's/^/      /'
+    fi
+  done
+  echo "   findings in all: $findings (inputs in build/host-fuzz/bench/<target>/)"
+}
+
+SECTIONS=(core lcm sim can weights fuzz)
+wanted=()
+for a in "$@"; do
+  # `fuzz 600`: the number is the seconds each fuzz target runs.
+  if [[ $a =~ ^[0-9]+$ ]] && [ ${#wanted[@]} -gt 0 ] && [ "${wanted[-1]}" = fuzz ]; then
+    FUZZ_SECONDS=$a
+  else
+    wanted+=("$a")
+  fi
+done
+[ ${#wanted[@]} -gt 0 ] || wanted=(core lcm sim can weights) # fuzz only when asked: it runs for minutes
 status=0
 for s in "${wanted[@]}"; do
   if [[ " ${SECTIONS[*]} " != *" $s "* ]]; then

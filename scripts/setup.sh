@@ -12,6 +12,7 @@ log() { printf '[setup] %s\n' "$*" >&2; }
 # Debian 12 packages. Versions are those of the bookworm release (and its security updates).
 APT_PACKAGES=(
   cmake ninja-build gcc g++ make pkgconf git
+  clang-14 libclang-rt-14-dev llvm-14
   libeigen3-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
   can-utils user-mode-linux iproute2 kmod

@@ -1,27 +1,46 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Builds and tests everything: host (all labels), host under ASan+UBSan (unit tests), and the
-# Cortex-M4 image with its unit tests on an emulated MCU. Installs what is missing first.
+# Builds and tests everything: host (all labels), host under ASan+UBSan (unit tests), the Cortex-M4
+# image with its unit tests on an emulated MCU, and the libFuzzer targets (clang, ASan+UBSan) run on
+# their corpus and briefly fuzzed. Installs what is missing first. Warnings are errors here
+# (POUR_WERROR, which the presets read from the environment); a user's build only warns.
+# Each preset is judged by ctest's exit status; the counts come from its JUnit report.
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
 ./scripts/setup.sh || exit 1
+export POUR_WERROR=ON
 
 passed=0 failed=0 status=0
-for preset in host host-asan cortex-m4; do
+for preset in host host-asan cortex-m4 host-fuzz; do
   printf '\n=== %s ===\n' "$preset"
-  log=$(mktemp)
-  cmake --workflow --preset "$preset" 2>&1 | tee "$log"
-  rc=${PIPESTATUS[0]}
-  line=$(grep -E '^[0-9]+% tests passed, [0-9]+ tests? failed out of [0-9]+' "$log" | tail -n 1)
-  rm -f "$log"
-  if [ -z "$line" ]; then
-    echo "error: preset $preset did not get as far as running its tests (exit $rc)"
+  if ! { cmake --preset "$preset" && cmake --build --preset "$preset"; }; then
+    echo "error: preset $preset did not build"
     status=1
     continue
   fi
-  total=$(sed -E 's/.* out of ([0-9]+).*/\1/' <<<"$line")
-  nfail=$(sed -E 's/.*, ([0-9]+) tests? failed.*/\1/' <<<"$line")
+  junit="$ROOT/build/$preset/junit.xml"
+  rm -f "$junit"
+  ctest --preset "$preset" --output-junit "$junit"
+  rc=$?
+  # tests= counts every test run; failures= those that failed (errors: could not run).
+  counts=$(python3 - "$junit" <<'EOF'
+import sys
+import xml.etree.ElementTree as ET
+try:
+    s = ET.parse(sys.argv[1]).getroot()
+except (OSError, ET.ParseError):
+    print("0 0")
+    raise SystemExit
+bad = int(s.get("failures", 0)) + int(s.get("errors", 0))
+print(int(s.get("tests", 0)) - int(s.get("skipped", 0)) - int(s.get("disabled", 0)), bad)
+EOF
+)
+  read -r total nfail <<<"$counts"
+  if [ "$total" = 0 ]; then
+    echo "error: preset $preset ran no tests (ctest exit $rc)"
+    status=1
+  fi
   passed=$((passed + total - nfail))
   failed=$((failed + nfail))
   [ "$rc" = 0 ] || status=1

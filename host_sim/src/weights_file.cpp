@@ -357,7 +357,7 @@ struct Reader {
       float f = 0;
       if (t.kind != Tok::Number || !float_literal(t, &f))
         return ps.fail(POURSIM_EINVAL, t.line, "%s = %s is not a finite float", where, quoted(t).c_str());
-      a.values[flat] = f;
+      a.values[flat] = static_cast<double>(f);
     } else {
       long long v = 0;
       bool overflow = false;
