@@ -41,7 +41,10 @@ pour_control_config_t pour_control_default_config(void) {
 /* The run's state as at power-on: no state seen, zero torque, the decision schedule and the PRNG
  * from their start (init and an accepted reset; config and weights were validated at init). */
 static void start_afresh(pour_control_t *ctl) {
+  /* A reset is taken in IDLE or FAULT, which command the safe torque: a run started in the same tick
+   * ramps from it through the slew limit, not from zero (found by tests/fuzz/fuzz_can_node). */
   (void)pour_safety_init(&ctl->safety, &ctl->config.safety);
+  pour_safety_force(&ctl->safety, ctl->config.safe_torque);
   (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
   ctl->ms_since_fresh = 0u;
   ctl->ms_to_decision = 0u;

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* The rules of docs/safety.md as an independent model, checked after every tick of pour_control_step
- * (fuzz_control_step, fuzz_can_node). Written from the document, not from control.c: it tracks only what
- * the rules name (the latest plausible state, the ticks without one, the latched faults). */
+/* The rules of docs/safety.md and of pour_control_step's contract (control.h) as an independent model,
+ * checked after every tick (fuzz_control_step, fuzz_can_node). Written from the documents, not from
+ * control.c: it tracks only what the rules name (the latest plausible state, the ticks without one, the
+ * latched faults, the last command). */
 #ifndef POUR_FUZZ_CONTROL_MODEL_H
 #define POUR_FUZZ_CONTROL_MODEL_H
 
@@ -16,7 +17,9 @@ extern "C" {
 
 class ControlModel {
  public:
-  explicit ControlModel(const pour_control_config_t &c, uint8_t n_actions) : c_(c), n_actions_(n_actions) {}
+  // Before its first tick the controller is in IDLE, whose command is the safe torque.
+  explicit ControlModel(const pour_control_config_t &c, uint8_t n_actions)
+      : c_(c), n_actions_(n_actions), torque_(c.safe_torque) {}
 
   // Rule 3: what a state must satisfy to be used.
   bool plausible(const pour_state_t &s) const {
@@ -29,17 +32,34 @@ class ControlModel {
     const pour_safety_config_t &s = c_.safety;
     ++ticks_;
     FUZZ_CHECK(out.tick == ticks_, "tick %u after %u steps", out.tick, ticks_);
-    if (in.estop) { // rule 1: zero torque in the same tick, nothing else evaluated
+    if (in.estop) { // e-stop: zero torque in the same tick, whatever else the input says
       FUZZ_CHECK(out.torque == 0 && out.mode == POUR_MODE_ESTOP, "e-stop: torque %d mode %u", out.torque, out.mode);
       FUZZ_CHECK((out.faults & (faults_ | POUR_FAULT_ESTOP)) == (faults_ | POUR_FAULT_ESTOP), "e-stop faults %x", out.faults);
       end(out);
       return;
     }
-    // Rule 2: a clear acts when the e-stop is released and the controller is in FAULT (an ESTOP becomes FAULT).
-    const bool cleared = in.clear_faults && (mode_ == POUR_MODE_FAULT || mode_ == POUR_MODE_ESTOP);
-    const uint16_t kept = cleared ? 0u : faults_;
-    const uint8_t mode_before = cleared ? POUR_MODE_IDLE : mode_;
-    uint16_t may_add = 0;
+    // The mode the tick's requests leave before the state is looked at: a released e-stop and a link
+    // fault are FAULT; a clear takes FAULT to IDLE (all faults cleared); stop takes RUN to IDLE; a reset
+    // in IDLE or FAULT restarts from the power-on state (zero state).
+    uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault ? static_cast<uint8_t>(POUR_MODE_FAULT) : mode_;
+    uint16_t kept = faults_, may_add = in.link_fault ? POUR_FAULT_LINK : 0u;
+    if (in.clear_faults && mode == POUR_MODE_FAULT) {
+      kept = 0;
+      may_add = 0; // the link fault of this tick is cleared with the rest; the next tick latches it again
+      mode = POUR_MODE_IDLE;
+    }
+    // Through IDLE or FAULT this tick (a stop or a reset taken), a new run may also ramp from the safe
+    // torque those modes command at once.
+    bool via_safe = false;
+    if (in.stop && mode == POUR_MODE_RUN) {
+      mode = POUR_MODE_IDLE;
+      via_safe = true;
+    }
+    if (in.reset && (mode == POUR_MODE_IDLE || mode == POUR_MODE_FAULT)) {
+      theta_ = 0;
+      via_safe = true;
+    }
+    if (mode != POUR_MODE_RUN) stale_ = 0;
     bool fresh = false;
     if (in.state_fresh) {
       if (plausible(in.state)) {
@@ -50,19 +70,22 @@ class ControlModel {
         may_add |= POUR_FAULT_BAD_INPUT;
         FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible state did not latch BAD_INPUT");
       }
-    } else if (mode_before == POUR_MODE_RUN && ++stale_ > c_.input_timeout_ms) { // rule 4
+    } else if (mode == POUR_MODE_RUN && ++stale_ > c_.input_timeout_ms) { // timeout, armed in RUN only
       may_add |= POUR_FAULT_STALE_INPUT;
       FUZZ_CHECK(out.faults & POUR_FAULT_STALE_INPUT, "%u ticks without a state did not latch STALE_INPUT", stale_);
     }
+    if (in.link_fault && !in.clear_faults)
+      FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
     FUZZ_CHECK((out.faults & ~(kept | may_add)) == 0, "fault without a cause: %x (kept %x)", out.faults, kept);
     FUZZ_CHECK((out.faults != 0) == (out.mode == POUR_MODE_FAULT), "faults %x in mode %u", out.faults, out.mode);
-    if (out.mode == POUR_MODE_RUN) { // rule 5: RUN is entered on a fresh, plausible state only
-      FUZZ_CHECK(mode_before == POUR_MODE_RUN || (mode_before == POUR_MODE_IDLE && fresh), "RUN from mode %u", mode_before);
+    if (out.mode == POUR_MODE_RUN) { // RUN is entered on a fresh, plausible state only
+      FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && fresh), "RUN from mode %u", mode);
       FUZZ_CHECK(out.action < n_actions_, "action %u", out.action);
-      // Rule 7, the envelope.
+      // The envelope: clamp, and slew from the last command (a drop to zero never waits for it).
       FUZZ_CHECK(std::abs(out.torque) <= s.tau_limit, "|torque| %d > tau_limit %d", out.torque, s.tau_limit);
-      FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || out.torque == 0,
+      FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || out.torque == 0 ||
+                     (via_safe && std::abs(out.torque - c_.safe_torque) <= s.slew_per_tick),
                  "torque %d -> %d breaks the slew limit %d", torque_, out.torque, s.slew_per_tick);
     } else {
       FUZZ_CHECK(out.mode == POUR_MODE_IDLE || out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
@@ -70,6 +93,7 @@ class ControlModel {
       FUZZ_CHECK(out.torque == c_.safe_torque || (c_.safe_torque > 0 ? theta_ >= s.theta_max_urad : theta_ <= s.theta_min_urad),
                  "safe torque %d dropped to 0 inside the angle limits", c_.safe_torque);
     }
+    // Angle limits, in every mode: no torque that tilts further past a limit.
     FUZZ_CHECK(!(theta_ >= s.theta_max_urad && out.torque > 0), "tilting further at theta %d", theta_);
     FUZZ_CHECK(!(theta_ <= s.theta_min_urad && out.torque < 0), "tilting back further at theta %d", theta_);
     end(out);
@@ -80,7 +104,6 @@ class ControlModel {
     mode_ = out.mode;
     faults_ = out.faults;
     torque_ = out.torque;
-    if (mode_ != POUR_MODE_RUN) stale_ = 0;
   }
 
   pour_control_config_t c_;
@@ -88,7 +111,7 @@ class ControlModel {
   uint32_t ticks_ = 0, stale_ = 0;
   uint8_t mode_ = POUR_MODE_IDLE;
   uint16_t faults_ = 0;
-  q15_t torque_ = 0;
+  q15_t torque_;
   int32_t theta_ = 0; // the latest plausible state's tilt (the controller starts from a zero state)
 };
 
