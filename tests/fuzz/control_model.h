@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* The rules of docs/safety.md and of pour_control_step's contract (control.h) as an independent model,
- * checked after every tick (fuzz_control_step, fuzz_can_node). Written from the documents, not from
- * control.c: it tracks only what the rules name (the latest plausible state, the ticks without one, the
- * latched faults, the last command). */
+/* The safety rules of docs/safety.md and of pour_control_step's contract (control.h), checked after every
+ * tick (fuzz_control_step, fuzz_can_node). Written from the documents, not from control.c: it tracks only
+ * what the rules name (the ticks without a state, the latched faults, the last command). What the
+ * supervisor proves and how the controlled stop steers are for their own tests; here they must stay
+ * inside the envelope like everything else. */
 #ifndef POUR_FUZZ_CONTROL_MODEL_H
 #define POUR_FUZZ_CONTROL_MODEL_H
 
@@ -28,74 +29,64 @@ class ControlModel {
            static_cast<int32_t>(s.v_rotating) + s.v_target + s.v_spill <= c_.plausible_volume_sum;
   }
 
-  void check(const pour_control_input_t &in, const pour_control_output_t &out) {
+  // theta: the tilt of the state the core steers by (its latest accepted state): the angle limits are
+  // about that state, and which states the supervisor accepts (seq advancing) is its business.
+  void check(const pour_control_input_t &in, const pour_control_output_t &out, int32_t theta) {
     const pour_safety_config_t &s = c_.safety;
     ++ticks_;
     FUZZ_CHECK(out.tick == ticks_, "tick %u after %u steps", out.tick, ticks_);
-    if (in.estop) { // e-stop: zero torque in the same tick, whatever else the input says
-      FUZZ_CHECK(out.torque == 0 && out.mode == POUR_MODE_ESTOP, "e-stop: torque %d mode %u", out.torque, out.mode);
+    if (in.estop) { // e-stop: zero torque in the same tick, brake on, power cut, whatever else the input says
+      FUZZ_CHECK(out.torque == 0 && out.mode == POUR_MODE_ESTOP && out.brake && !out.power,
+                 "e-stop: torque %d mode %u brake %d power %d", out.torque, out.mode, out.brake, out.power);
       FUZZ_CHECK((out.faults & (faults_ | POUR_FAULT_ESTOP)) == (faults_ | POUR_FAULT_ESTOP), "e-stop faults %x", out.faults);
       end(out);
       return;
     }
     // The mode the tick's requests leave before the state is looked at: a released e-stop and a link
     // fault are FAULT; a clear takes FAULT to IDLE (all faults cleared); stop takes RUN to IDLE; a reset
-    // in IDLE or FAULT restarts from the power-on state (zero state).
+    // is taken in IDLE or FAULT. Through IDLE or FAULT, a new run may also ramp from the safe torque.
     uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault ? static_cast<uint8_t>(POUR_MODE_FAULT) : mode_;
-    uint16_t kept = faults_, may_add = in.link_fault ? POUR_FAULT_LINK : 0u;
+    uint16_t kept = faults_;
+    bool via_safe = false;
     if (in.clear_faults && mode == POUR_MODE_FAULT) {
       kept = 0;
-      may_add = 0; // the link fault of this tick is cleared with the rest; the next tick latches it again
       mode = POUR_MODE_IDLE;
+      via_safe = true;
     }
-    // Through IDLE or FAULT this tick (a stop or a reset taken), a new run may also ramp from the safe
-    // torque those modes command at once.
-    bool via_safe = false;
     if (in.stop && mode == POUR_MODE_RUN) {
       mode = POUR_MODE_IDLE;
       via_safe = true;
     }
-    if (in.reset && (mode == POUR_MODE_IDLE || mode == POUR_MODE_FAULT)) {
-      theta_ = 0;
-      via_safe = true;
-    }
-    if (mode != POUR_MODE_RUN) stale_ = 0;
-    bool fresh = false;
-    if (in.state_fresh) {
-      if (plausible(in.state)) {
-        fresh = true;
-        theta_ = in.state.theta_urad;
-        stale_ = 0;
-      } else {
-        may_add |= POUR_FAULT_BAD_INPUT;
-        FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible state did not latch BAD_INPUT");
-      }
-    } else if (mode == POUR_MODE_RUN && ++stale_ > c_.input_timeout_ms) { // timeout, armed in RUN only
-      may_add |= POUR_FAULT_STALE_INPUT;
-      FUZZ_CHECK(out.faults & POUR_FAULT_STALE_INPUT, "%u ticks without a state did not latch STALE_INPUT", stale_);
-    }
-    if (in.link_fault && !in.clear_faults)
-      FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
+    if (in.reset && (mode == POUR_MODE_IDLE || mode == POUR_MODE_FAULT)) via_safe = true;
+    stale_ = in.state_fresh ? 0u : stale_ + 1u;
+    if (in.state_fresh && !plausible(in.state))
+      FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible state did not latch BAD_INPUT");
+    if (in.link_fault && !in.clear_faults) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
-    FUZZ_CHECK((out.faults & ~(kept | may_add)) == 0, "fault without a cause: %x (kept %x)", out.faults, kept);
+    const uint16_t new_bits = static_cast<uint16_t>(out.faults & ~kept);
+    FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)),
+               "fault without a cause: %x (kept %x)", out.faults, kept);
     FUZZ_CHECK((out.faults != 0) == (out.mode == POUR_MODE_FAULT), "faults %x in mode %u", out.faults, out.mode);
-    if (out.mode == POUR_MODE_RUN) { // RUN is entered on a fresh, plausible state only
-      FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && fresh), "RUN from mode %u", mode);
-      FUZZ_CHECK(out.action < n_actions_, "action %u", out.action);
-      // The envelope: clamp, and slew from the last command (a drop to zero never waits for it).
-      FUZZ_CHECK(std::abs(out.torque) <= s.tau_limit, "|torque| %d > tau_limit %d", out.torque, s.tau_limit);
+    FUZZ_CHECK(out.brake == !out.power, "brake %d and power %d together", out.brake, out.power);
+    FUZZ_CHECK(std::abs(out.torque) <= s.tau_limit, "|torque| %d > tau_limit %d", out.torque, s.tau_limit);
+    if (out.mode == POUR_MODE_RUN) { // RUN is entered on a fresh state only, and never outlives the input timeout
+      FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && in.state_fresh), "RUN from mode %u", mode);
+      FUZZ_CHECK(stale_ <= c_.input_timeout_ms, "RUN after %u ticks without a state", stale_);
+      FUZZ_CHECK(out.action < n_actions_ && out.power, "action %u power %d", out.action, out.power);
+    } else if (out.mode == POUR_MODE_IDLE) {
+      FUZZ_CHECK(out.brake && (out.torque == c_.safe_torque || out.torque == 0), "torque %d in IDLE", out.torque);
+    } else {
+      FUZZ_CHECK(out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
+    }
+    // The envelope in RUN and in the active stop: the slew limit from the last command (a drop to zero or,
+    // through IDLE or FAULT, the safe torque never waits for it).
+    if (out.power)
       FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || out.torque == 0 ||
                      (via_safe && std::abs(out.torque - c_.safe_torque) <= s.slew_per_tick),
                  "torque %d -> %d breaks the slew limit %d", torque_, out.torque, s.slew_per_tick);
-    } else {
-      FUZZ_CHECK(out.mode == POUR_MODE_IDLE || out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
-      FUZZ_CHECK(out.torque == c_.safe_torque || out.torque == 0, "torque %d in mode %u", out.torque, out.mode);
-      FUZZ_CHECK(out.torque == c_.safe_torque || (c_.safe_torque > 0 ? theta_ >= s.theta_max_urad : theta_ <= s.theta_min_urad),
-                 "safe torque %d dropped to 0 inside the angle limits", c_.safe_torque);
-    }
     // Angle limits, in every mode: no torque that tilts further past a limit.
-    FUZZ_CHECK(!(theta_ >= s.theta_max_urad && out.torque > 0), "tilting further at theta %d", theta_);
-    FUZZ_CHECK(!(theta_ <= s.theta_min_urad && out.torque < 0), "tilting back further at theta %d", theta_);
+    FUZZ_CHECK(!(theta >= s.theta_max_urad && out.torque > 0), "tilting further at theta %d", theta);
+    FUZZ_CHECK(!(theta <= s.theta_min_urad && out.torque < 0), "tilting back further at theta %d", theta);
     end(out);
   }
 
@@ -112,7 +103,6 @@ class ControlModel {
   uint8_t mode_ = POUR_MODE_IDLE;
   uint16_t faults_ = 0;
   q15_t torque_;
-  int32_t theta_ = 0; // the latest plausible state's tilt (the controller starts from a zero state)
 };
 
 // A controller config drawn from the fuzz input: every field in the range pour_control_init accepts, or

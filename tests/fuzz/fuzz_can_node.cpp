@@ -91,7 +91,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     pour_can_node_begin_tick(&node, &in);
     pour_control_output_t out{};
     pour_control_step(&ctl, &in, &out);
-    model.check(in, out);
+    model.check(in, out, ctl.state.theta_urad);
     pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
     const uint8_t n_tx = pour_can_node_end_tick(&node, &out, fdp.ConsumeIntegral<uint8_t>(), tx);
     FUZZ_CHECK(n_tx == 1 || n_tx == 3, "%u frames", n_tx);

@@ -65,7 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         std::fprintf(stderr, "tick: fresh %d theta %d estop %d clear %d link %d stop %d reset %d -> mode %u faults %x torque %d\n",
                      in.state_fresh, in.state.theta_urad, in.estop, in.clear_faults, in.link_fault, in.stop, in.reset,
                      out.mode, out.faults, out.torque);
-      model.check(in, out);
+      model.check(in, out, ctl.state.theta_urad);
     }
   }
   return 0;
