@@ -127,7 +127,7 @@ static int open_can(const char *iface) {
 static int parse_long(const char *opt, const char *s, long lo, long hi, long *out) {
   char *end = NULL;
   errno = 0;
-  const long v = s != NULL ? strtol(s, &end, 0) : 0;
+  const long v = s != NULL ? strtol(s, &end, 10) : 0; /* decimal, as everywhere: 010 is 10 */
   if (s == NULL || end == s || *end != '\0' || errno != 0 || v < lo || v > hi) {
     fprintf(stderr, "can_bridge: %s needs an integer in [%ld, %ld], got '%s'\n", opt, lo, hi, s != NULL ? s : "(nothing)");
     return -1;
@@ -141,7 +141,10 @@ static void usage(FILE *f) {
              "  POUR_STATE, POUR_COMMAND (LCM) -> StateA/StateB, Estop, Stop, ClearErrors, Reset (CAN, can/pour.dbc)\n"
              "  Torque, Heartbeat (CAN)        -> POUR_TORQUE, POUR_STATUS (LCM)\n"
              "  the torque scale [N.m] and policy hash come from the controller's Identity frame\n"
-             "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n",
+             "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n"
+             "  numbers are decimal (--node 010 is node 10)\n"
+             "exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
+             "CAN interface or LCM cannot be opened); 2 bad command line\n",
           POUR_LCM_DEFAULT_URL);
 }
 

@@ -72,9 +72,10 @@ const char *kUsage =
     "Outputs (--csv, --render and its .png and .json) are checked before the run: none may name an input\n"
     "or another output. Each is written beside its target and renamed over it when complete, so a failed\n"
     "or interrupted run leaves an existing file as it was.\n"
-    "Exit status: 0 done, 1 bad file / config / output path or a failed renderer, 2 bad command line\n"
-    "(an output naming an input or another output included), 3 (--lcm) no answer, 4 (--lcm) the controller\n"
-    "runs other weights.\n"
+    "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (writing an\n"
+    "output, the renderer, the LCM link); 2 bad input, refused before any work: the command line, or a\n"
+    "file it names (policy, config, an output path that cannot be written or names an input); 3 (--lcm) the\n"
+    "controller does not answer; 4 (--lcm) it runs other weights.\n"
     "\n"
     "Examples:\n"
     "  host_sim --policy policy/weights.h --render pour.gif\n"
@@ -493,33 +494,33 @@ int main(int argc, char **argv) {
   if (!o.policy.empty()) {
     if (poursim_weights_load(o.policy.c_str(), &weights, err, sizeof err) != POURSIM_OK) {
       std::fprintf(stderr, "host_sim: bad policy: %s\n", err);
-      return 1;
+      return 2;
     }
     cfg.tau_max = weights.tau_max_mnm * 1e-3;
   }
   const double tau_policy = cfg.tau_max;
   if (!o.config_path.empty() && poursim_config_load(o.config_path.c_str(), &cfg, err, sizeof err) != POURSIM_OK) {
     std::fprintf(stderr, "host_sim: bad config: %s\n", err);
-    return 1;
+    return 2;
   }
   for (const std::string &s : o.sets) {
     size_t eq = s.find('=');
     if (eq == std::string::npos) return usage_error("--set wants KEY=VALUE, got '%s'", s.c_str());
     if (poursim_config_set(&cfg, s.substr(0, eq).c_str(), s.substr(eq + 1).c_str(), err, sizeof err) != POURSIM_OK) {
       std::fprintf(stderr, "host_sim: bad --set: %s\n", err);
-      return 1;
+      return 2;
     }
   }
   if (poursim_config_validate(&cfg, err, sizeof err) != POURSIM_OK) {
     std::fprintf(stderr, "host_sim: bad config: %s\n", err);
-    return 1;
+    return 2;
   }
   if (!o.policy.empty() && std::fabs(cfg.tau_max - tau_policy) > 1e-9) {
     std::fprintf(stderr,
                  "host_sim: mismatch: %s was trained with tau_max %.3f N·m (POUR_WEIGHTS_TAU_MAX_MNM) but the config "
                  "sets tau_max = %.3f\n",
                  o.policy.c_str(), tau_policy, cfg.tau_max);
-    return 1;
+    return 2;
   }
   if (o.bench) return run_bench(o, cfg);
 
@@ -536,7 +537,7 @@ int main(int argc, char **argv) {
     if (ext == ".mp4" && !on_path("ffmpeg")) {
       std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
                    o.render.c_str());
-      return 1;
+      return 2;
     }
     render_json = render_base + ".json";
     outputs.push_back({"--render", o.render});
@@ -544,12 +545,8 @@ int main(int argc, char **argv) {
     outputs.push_back({"--render (its .json trajectory)", render_json});
   }
   std::string why;
-  int bad_status = 0;
-  if (!poursim::check_outputs(outputs, {{"--policy", o.policy}, {"--config", o.config_path}}, &why, &bad_status)) {
-    if (bad_status == 2) return usage_error("%s", why.c_str());
-    std::fprintf(stderr, "host_sim: %s\n", why.c_str());
-    return bad_status;
-  }
+  if (!poursim::check_outputs(outputs, {{"--policy", o.policy}, {"--config", o.config_path}}, &why))
+    return usage_error("%s", why.c_str());
 
   std::unique_ptr<poursim::Controller> ctl;
   poursim::LcmController *lcm_ctl = nullptr;

@@ -71,9 +71,7 @@ bool same_file(const std::string &a, const std::string &b) {
 
 } // namespace
 
-bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<NamedPath> &inputs, std::string *err,
-                   int *status) {
-  *status = 2;
+bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<NamedPath> &inputs, std::string *err) {
   for (size_t i = 0; i < outputs.size(); ++i) {
     const NamedPath &o = outputs[i];
     if (o.path.empty()) {
@@ -92,7 +90,6 @@ bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<Name
         return false;
       }
   }
-  *status = 1;
   for (const NamedPath &o : outputs) {
     struct stat st;
     const std::string dir = dir_of(o.path);

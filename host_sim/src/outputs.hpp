@@ -17,10 +17,8 @@ struct NamedPath {
 
 // Before any work: every output a file name in an existing, writable folder, and no output naming an
 // input or another output (by resolved path, and by inode where the file exists: links count as the
-// same file). On failure returns false with the reason in *err and the exit status in *status (2: the
-// command line contradicts itself; 1: the file system refuses).
-bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<NamedPath> &inputs, std::string *err,
-                   int *status);
+// same file). On failure returns false with the reason in *err.
+bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<NamedPath> &inputs, std::string *err);
 
 // One output, written atomically: open() creates ".<name>.XXXXXX" beside path; commit() flushes, syncs
 // and renames it to path; discard() (and the destructor, and SIGINT/SIGTERM/SIGHUP) removes it.

@@ -99,7 +99,7 @@ def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
 def test_lcm_run_passes_on_host_sim_failures_and_refuses_doubled_flags(build_dir):
     r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--", "--policy",
                         "/nonexistent/weights.h"], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 1 and "bad policy" in r.stderr
+    assert r.returncode == 2 and "bad policy" in r.stderr
     r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--", "--lcm", "x"], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "not to host_sim" in r.stderr

@@ -49,7 +49,7 @@ def test_bad_arguments_exit_2_with_a_message(host_sim, args, message):
 
 def test_missing_policy_file(host_sim, tmp_path):
     r = host_sim("--policy", tmp_path / "none.h")
-    assert r.returncode == 1 and "cannot read weights file" in r.stderr
+    assert r.returncode == 2 and "cannot read weights file" in r.stderr
 
 
 def _edit(text, pattern, repl):
@@ -70,14 +70,14 @@ def test_bad_policy_is_refused_naming_the_field(host_sim, tmp_path, example, pat
     bad = tmp_path / "bad.h"
     bad.write_text(_edit(example, pattern, repl))
     r = host_sim("--policy", bad, *SHORT)
-    assert r.returncode == 1 and "bad policy" in r.stderr and field in r.stderr, r.stderr
+    assert r.returncode == 2 and "bad policy" in r.stderr and field in r.stderr, r.stderr
 
 
 def test_truncated_policy_is_refused(host_sim, tmp_path, example):
     bad = tmp_path / "cut.h"
     bad.write_text(example[: example.index("pour_weights_action_levels_q15[") + 60])
     r = host_sim("--policy", bad)
-    assert r.returncode == 1 and "pour_weights_action_levels_q15" in r.stderr and "truncated" in r.stderr
+    assert r.returncode == 2 and "pour_weights_action_levels_q15" in r.stderr and "truncated" in r.stderr
 
 
 @pytest.mark.parametrize("text, message", [
@@ -94,12 +94,12 @@ def test_bad_config_is_refused(host_sim, tmp_path, text, message):
     if text is not None:
         path.write_text(text)
     r = host_sim("--baseline", "rate", "--config", path)
-    assert r.returncode == 1 and "bad config" in r.stderr and message in r.stderr, r.stderr
+    assert r.returncode == 2 and "bad config" in r.stderr and message in r.stderr, r.stderr
 
 
 def test_endless_config_is_refused_at_the_size_cap(host_sim):
     r = host_sim("--baseline", "rate", "--config", "/dev/zero", timeout=60)
-    assert r.returncode == 1 and "/dev/zero: larger than 1048576 bytes" in r.stderr, r.stderr
+    assert r.returncode == 2 and "/dev/zero: larger than 1048576 bytes" in r.stderr, r.stderr
 
 
 def _files(folder):
@@ -144,9 +144,9 @@ def test_a_failed_output_check_leaves_no_file_behind(host_sim, inputs):
     (inputs / "sub").mkdir()
     before = _files(inputs)
     r = host_sim("--baseline", "full", "--csv", "new.csv", "--render", "nodir/x.gif", cwd=inputs, timeout=30)
-    assert r.returncode == 1 and "cannot write --render 'nodir/x.gif'" in r.stderr, r.stderr
+    assert r.returncode == 2 and "cannot write --render 'nodir/x.gif'" in r.stderr, r.stderr
     r = host_sim("--baseline", "full", "--csv", "sub", "--render", "x.gif", cwd=inputs, timeout=30)
-    assert r.returncode == 1 and "is a directory" in r.stderr, r.stderr
+    assert r.returncode == 2 and "is a directory" in r.stderr, r.stderr
     assert _files(inputs) == before
 
 
@@ -181,20 +181,20 @@ def test_a_complete_run_replaces_the_csv(host_sim, inputs):
 @pytest.mark.parametrize("flag, name", [("--csv", "run.csv"), ("--render", "pour.gif")])
 def test_unwritable_output_is_refused_before_running(host_sim, tmp_path, flag, name):
     r = host_sim("--baseline", "rate", flag, tmp_path / "no_such_dir" / name, timeout=30)
-    assert r.returncode == 1 and "cannot write" in r.stderr and "No such file or directory" in r.stderr
+    assert r.returncode == 2 and "cannot write" in r.stderr and "No such file or directory" in r.stderr
     assert "episode 1" not in r.stdout
 
 
 def test_out_of_range_set_is_refused(host_sim):
     r = host_sim("--baseline", "rate", "--set", "n_particles=5000")
-    assert r.returncode == 1 and "n_particles" in r.stderr
+    assert r.returncode == 2 and "n_particles" in r.stderr
 
 
 def test_config_tau_max_must_match_the_policy(host_sim, tmp_path, source_dir):
     cfg = tmp_path / "sim.cfg"
     cfg.write_text("tau_max = 12\n")
     r = host_sim("--policy", source_dir / "policy" / "weights.h", "--config", cfg)
-    assert r.returncode == 1 and "mismatch" in r.stderr and "tau_max" in r.stderr
+    assert r.returncode == 2 and "mismatch" in r.stderr and "tau_max" in r.stderr
 
 
 def test_shipped_config_file_loads(host_sim, source_dir):
@@ -270,7 +270,7 @@ def test_renderer_refuses_bad_input(tmp_path, content, out, message):
         traj.write_text(content)
     r = subprocess.run([sys.executable, "-m", "pour.render", str(traj), str(tmp_path / out)],
                        capture_output=True, text=True, timeout=120)
-    assert r.returncode == 1 and message in r.stderr, r.stderr
+    assert r.returncode == 2 and message in r.stderr, r.stderr
 
 
 def test_firmware_pour_is_bit_identical_across_runs(host_sim, tmp_path, source_dir):

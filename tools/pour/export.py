@@ -23,6 +23,10 @@ class ExportError(ValueError):
     """A policy.json that cannot be exported."""
 
 
+class ExportWriteError(ExportError):
+    """weights.h could not be written (the previous file, if any, is unchanged)."""
+
+
 def _number(path: Path, name: str, value: Any) -> float:
     """A finite JSON number (not a bool, a string or null)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -131,7 +135,7 @@ def export(policy: str | Path, out: str | Path, which: str = "best", frac_bits: 
     except weights_h.WeightsHError as exc:
         raise ExportError(str(exc)) from exc
     except OSError as exc:
-        raise ExportError(f"{out}: cannot write ({exc.strerror}); the previous file, if any, is unchanged") from exc
+        raise ExportWriteError(f"{out}: cannot write ({exc.strerror}); the previous file, if any, is unchanged") from exc
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -141,13 +145,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--which", default="best", choices=("best", "last"),
                     help="best: the weights with the best greedy validation score (default); last: the final ones")
     ap.add_argument("--frac-bits", type=int, help="fraction bits of W (default: the most that fit)")
-    ap.epilog = "exit status: 0 written, 2 bad command line or bad policy file (the message names the field)"
+    ap.epilog = ("exit status (the same meanings in every pour program): 0 written; 1 the write failed (the previous "
+                 "file is unchanged); 2 bad input: the command line or policy.json (the message names the field)")
     args = ap.parse_args(argv)
     try:
         res = export(args.run, args.out, args.which, args.frac_bits)
     except ExportError as exc:
         print(f"pour-export: error: {exc}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, ExportWriteError) else 2
     print(f"pour-export: wrote {args.out} ({res.n_actions} actions, Q{15 - res.w_frac_bits}.{res.w_frac_bits}, "
           f"hash 0x{res.content_hash:08x})", file=sys.stderr)
     return 0

@@ -207,14 +207,19 @@ def render(traj: Path, out: Path, fps: float | None = None) -> tuple[Path, Path]
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-render", description="Render a host_sim trajectory (JSON) as GIF/MP4 + PNG.")
+    ap = argparse.ArgumentParser(prog="pour-render", description="Render a host_sim trajectory (JSON) as GIF/MP4 + PNG.",
+                                 epilog="exit status (the same meanings in every pour program): 0 written; 1 a write "
+                                        "failed; 2 bad input (the trajectory, the output name)")
     ap.add_argument("trajectory", type=Path, help="JSON written by host_sim --render")
     ap.add_argument("out", type=Path, help="animation to write: .gif or .mp4 (a .png snapshot goes beside it)")
     ap.add_argument("--fps", type=float, default=None, help="frames per second (default: as recorded)")
     args = ap.parse_args(argv)
     try:
         out, png = render(args.trajectory, args.out, args.fps)
-    except (RenderError, OSError) as e:
+    except RenderError as e:
+        print(f"pour-render: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
         print(f"pour-render: {e}", file=sys.stderr)
         return 1
     print(f"pour-render: wrote {out} and {png}")

@@ -34,7 +34,10 @@ static void usage(FILE *f) {
           "  --seed N               seed of the sampled mode\n"
           "  --verbose              a status line on stderr every 100 ms\n"
           "  --help\n"
-          "Weights: the weights.h named by CMake's POUR_WEIGHTS (compiled in, hash 0x%08x).\n",
+          "Weights: the weights.h named by CMake's POUR_WEIGHTS (compiled in, hash 0x%08x).\n"
+          "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
+          "transport cannot be opened, the core refuses its configuration); 2 bad command line (an unknown\n"
+          "option or a bad value, --io's included). Numbers are decimal: node=010 is node 10.\n",
           (unsigned)pour_weights_compiled.content_hash);
 }
 
@@ -68,7 +71,8 @@ static int parse_seconds(const char *opt, const char *s, long long *out_ms) {
   return 0;
 }
 
-/* Opens the transport named by spec: "lcm", "lcm:URL" or "can:IFACE[,...]". Other backends add a branch here. */
+/* Opens the transport named by spec: "lcm", "lcm:URL" or "can:IFACE[,...]". Other backends add a branch here.
+ * Returns 0, -2 for a spec that does not parse (a command-line error), -1 if the transport cannot open. */
 static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *cfg) {
   if (strcmp(spec, "lcm") == 0) {
     return pour_io_lcm_open(io, NULL);
@@ -82,10 +86,10 @@ static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *c
     can.node.identity.tau_max_cnm = (uint16_t)(cfg->weights->tau_max_mnm / 10);
     /* In lockstep the loop itself waits stall_ms before it treats silence as stale input. */
     can.watchdog_grace_ms = cfg->lockstep ? (uint32_t)cfg->stall_ms : 0u;
-    return pour_io_socketcan_parse(spec + 4, &can) == 0 ? pour_io_socketcan_open(io, &can) : -1;
+    return pour_io_socketcan_parse(spec + 4, &can) == 0 ? pour_io_socketcan_open(io, &can) : -2;
   }
   fprintf(stderr, "pour_controller: unknown transport '%s' (known: lcm[:URL], can:IFACE)\n", spec);
-  return -1;
+  return -2;
 }
 
 int main(int argc, char **argv) {
@@ -150,8 +154,9 @@ int main(int argc, char **argv) {
 
   pour_io_t io;
   memset(&io, 0, sizeof io);
-  if (open_io(io_spec, &io, &cfg) != 0) {
-    return 1;
+  const int opened = open_io(io_spec, &io, &cfg);
+  if (opened != 0) {
+    return opened == -2 ? 2 : 1;
   }
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
