@@ -126,7 +126,7 @@ static uint16_t window_faults(pour_supervisor_t *sup, const pour_state_t *s) {
   }
   if ((c->checks & POUR_CHECK_SCALE) != 0u) {
     /* |Δθ̇| [µrad/s] > (a_full · Σ|τ|/32768 + a_passive · W) / 1000, multiplied out (no division):
-     * 32768000 · 5e7 and 3.5e8 · 16 · 32768 both fit int64. */
+     * 32768000 · 5e7 and 3.5e8 · 10 · 32768 both fit int64. */
     const int64_t lhs = (int64_t)abs32(d_omega) * 32768000;
     const int64_t rhs = (int64_t)c->accel_full_urad_s2 * sup->sum_abs + sup->passive_term;
     sup->over = count_up(sup->over, lhs > rhs);

@@ -7,8 +7,6 @@
 
 /* Q1.15: [-1, 1 - 2^-15], one LSB = 2^-15. */
 typedef int16_t q15_t;
-/* Q1.31 range int32; the Q format of a q31_t value is stated wherever it is used. */
-typedef int32_t q31_t;
 
 #define POUR_Q15_ONE_INT 32768 /* 1.0 in Q15, as an int32 (not representable in q15_t) */
 #define POUR_Q15_MAX INT16_MAX

@@ -12,7 +12,7 @@
 #include "pour/fixed.h"
 #include "pour/obs.h"
 
-#define POUR_SUPERVISOR_WINDOW_MAX 16u /* longest plausibility window [ticks] */
+#define POUR_SUPERVISOR_WINDOW_MAX 10u /* longest plausibility window [ticks]: one decision period */
 
 /* Checks that can be armed (pour_supervisor_config_t.checks); the default arms all of them. */
 #define POUR_CHECK_POSITION 0x01u

@@ -77,3 +77,24 @@ def test_lockstep_loop_over_can_is_bit_identical_to_in_process(tmp_path):
     assert frames >= 3 * steps  # StateA, StateB and Torque of every step really crossed vcan0
     print(f"full loop over CAN (lockstep, in the user-mode Linux guest): {steps} steps in {wall:.2f} s "
           f"= {steps / wall:.0f} steps/s, {frames} frames")
+
+
+def test_host_refuses_a_controller_with_another_policy_over_can(tmp_path):
+    """The Identity frame carries the controller's policy hash through the bridge: host_sim, given another
+    policy, refuses to pour with it (exit 4), as it does over LCM."""
+    bus = Bus()
+    ctl = subprocess.Popen([str(BUILD_DIR / "bin" / "pour_controller"), "--io", "can:vcan0", "--lockstep"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        bus.wait_for("Identity", timeout=10.0)
+        exe = BUILD_DIR / "bin" / "host_sim"
+        run = subprocess.run([str(exe), "--policy", str(SOURCE_DIR / "policy" / "example_weights.h"), "--set",
+                              "episode_s=0.2", "--lcm", URL], capture_output=True, text=True, timeout=300)
+    finally:
+        stop(bridge)
+        stop(ctl)
+        bus.close()
+    assert run.returncode == 4, (run.returncode, run.stderr)
+    assert "weights" in run.stderr

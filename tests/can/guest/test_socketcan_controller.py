@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from canbus import DBC, Bus, Controller
+from canbus import DBC, SOURCE_DIR, Bus, Controller
 
 MODE = {"IDLE": 0, "RUN": 1, "FAULT": 2, "ESTOP": 3}
 
@@ -92,14 +92,62 @@ def test_silent_bus_trips_the_watchdog(bus):
         # Latched: a state now gets safe torque, not the policy's.
         answer = run_states(bus, 40, 3)[-1]
         assert answer["Torque"] == 0 and answer["Mode"] == MODE["FAULT"]
-        # ClearErrors clears it; fresh states bring the controller back to RUN.
+        # ClearErrors clears it through the core: fresh states bring RUN back, the torque ramping up from zero
+        # through the slew limit (3277 per 1 ms tick; a real-time answer comes every few ticks), never jumping
+        # to the command the policy had before the trip.
         bus.send("ClearErrors")
         answers = run_states(bus, 43, 20)
         assert answers[-1]["Mode"] == MODE["RUN"]
+        torques = [a["Torque"] for a in answers]
+        assert 0 < torques[0] <= 2 * 3277, torques
+        assert sum(1 for t in torques if 0 < t < 32767) >= 2, torques  # on its way up, not there at once
         hb = bus.wait_for("Heartbeat", timeout=1.0)
         assert hb["Fault_CanWatchdog"] == 0
     finally:
         ctl.stop()
+
+
+def test_seq_wrap_is_the_next_sample_not_a_new_run(bus):
+    # Lockstep across StateB.Seq's 16-bit wrap (65,535 -> 0): the run goes on, nothing re-initialises.
+    ctl = start(bus, "--lockstep")
+    try:
+        answers = run_states(bus, 65536 - 60, 120, period=0.0)
+        assert all(a["Mode"] == MODE["RUN"] for a in answers[1:]), [a["Mode"] for a in answers]
+        torques = [0] + [a["Torque"] for a in answers]
+        assert all(abs(b - a) <= 3277 for a, b in zip(torques, torques[1:])), torques
+        hb = bus.wait_for("Heartbeat", timeout=1.0)
+        assert hb["Mode"] == MODE["RUN"] and hb["Fault_Seq"] == 0 and hb["Fault_StaleInput"] == 0
+    finally:
+        out = ctl.stop()
+    assert "resets 0" in out, out
+
+
+def test_reset_is_refused_while_running_and_accepted_after_stop(bus):
+    ctl = start(bus, "--lockstep")
+    try:
+        run_states(bus, 0, 30, period=0.0)
+        bus.send("Reset")  # refused in RUN: the next state continues the run, seq and all
+        a = run_states(bus, 30, 1)[-1]
+        assert a["Mode"] == MODE["RUN"] and a["Torque"] != 0
+        bus.send("Stop")
+        bus.send("Reset")  # now a new run: seq 0 is its first sample
+        b = run_states(bus, 0, 3)
+        assert b[0]["Mode"] == MODE["RUN"] and abs(b[0]["Torque"]) <= 3277
+    finally:
+        out = ctl.stop()
+    assert "resets 2" in out, out
+
+
+def test_identity_frame_names_the_policy_and_its_scale(bus):
+    ctl = start(bus, "--lockstep")
+    try:
+        ident = bus.wait_for("Identity", timeout=2.0)
+    finally:
+        ctl.stop()
+    weights = (SOURCE_DIR / "policy" / "weights.h").read_text()
+    want_hash = int(re.search(r"#define POUR_WEIGHTS_CONTENT_HASH (0x[0-9a-fA-F]+)u", weights).group(1), 16)
+    tau_mnm = int(re.search(r"#define POUR_WEIGHTS_TAU_MAX_MNM (\d+)", weights).group(1))
+    assert ident["WeightsHash"] == want_hash and ident["TauMax"] == tau_mnm // 10 and ident["InitStatus"] == 0
 
 
 def test_malformed_frames_are_dropped_and_counted(bus):
