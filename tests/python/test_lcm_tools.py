@@ -75,7 +75,10 @@ def test_lcm_cmd_estop_and_clear_reach_the_controller(build_dir):
         cmd("--clear")
         bus.ask(3, theta=0.3)
         assert bus.ask(4, theta=0.3).mode == 1
-        c.stop()
+        cmd("--new-run")  # stop + reset: the next state, seq 0, starts a fresh run
+        assert bus.ask(0, episode=1, theta=0.3).mode == 1
+        assert c.stop() == 0
+    assert "resets 1" in c.out
 
 
 def test_lcm_cmd_bad_inputs():

@@ -40,16 +40,22 @@ static void make_inputs(void) {
   }
 }
 
-/* Average SysTick ticks (x1000) per step for N_STEPS steps, minus the loop's own cost. The supervisor runs
- * every check on every tick (all armed, windows full), with bounds these synthetic states never cross, so
- * that every step is a RUN step: the worst case, not a cheap FAULT one. */
-static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
+/* The default configuration with the supervisor running every check on every tick (all armed, windows
+ * full) against bounds these synthetic states never cross, so that every step is a RUN step: the worst
+ * case, not a cheap FAULT one. */
+static pour_control_config_t bench_config(void) {
   pour_control_config_t config = pour_control_default_config();
   config.supervisor.theta_margin_urad = INT32_MAX / 2;
   config.supervisor.omega_against_urad_s = INT32_MAX;
   config.supervisor.encoder_move_urad = 1;
   config.supervisor.volume_step_max = POUR_Q15_MAX;
   config.supervisor.accel_passive_urad_s2 = INT32_MAX;
+  return config;
+}
+
+/* Average SysTick ticks (x1000) per step for N_STEPS steps, minus the loop's own cost. */
+static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
+  const pour_control_config_t config = bench_config();
   if (pour_control_init(&ctl, &config, w) != POUR_OK) {
     return 0u;
   }
@@ -70,12 +76,7 @@ static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
  * decision period (phase 0: the decision tick, 1: the tick after it, ...), the timer's own cost taken off.
  * Returns the largest per-phase mean [instructions] and prints every phase. */
 static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_kilotick) {
-  pour_control_config_t config = pour_control_default_config();
-  config.supervisor.theta_margin_urad = INT32_MAX / 2;
-  config.supervisor.omega_against_urad_s = INT32_MAX;
-  config.supervisor.encoder_move_urad = 1;
-  config.supervisor.volume_step_max = POUR_Q15_MAX;
-  config.supervisor.accel_passive_urad_s2 = INT32_MAX;
+  const pour_control_config_t config = bench_config();
   if (pour_control_init(&ctl, &config, w) != POUR_OK || w->decision_period_ms > 16u) {
     return 0u;
   }
