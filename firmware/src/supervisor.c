@@ -75,6 +75,7 @@ bool pour_supervisor_accept(pour_supervisor_t *sup, const pour_state_t *state) {
   }
   const uint32_t advance = state->seq - sup->last.seq; /* unsigned: wraps by definition */
   if (advance >= 1u && advance <= SEQ_ADVANCE_MAX) {
+    sup->last.seq = state->seq; /* also outside RUN (no step there): a long FAULT must not lose the count */
     return true;
   }
   if (sup->seq_repeats != UINT32_MAX) {

@@ -210,6 +210,30 @@ static void test_supervisor_ClearAfterAStopRampsThroughSlewAndRunsAgain(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
 }
 
+/* The seq check follows the count outside RUN too: after 40 s in FAULT (more than the 32,767-sample window
+ * of a forward step), a clear still lets the run resume. */
+static void test_supervisor_LongFaultThenClearStillResumes(void) {
+  run_ticks(20u);
+  pour_control_input_t in = {0};
+  in.estop = true;
+  pour_control_step(&ctl, &in, &out);
+  in.estop = false;
+  in.state_fresh = true;
+  in.state = ctl.state;
+  for (uint32_t t = 0; t < 40000u; ++t) {
+    in.state.seq = ++plant.seq;
+    pour_control_step(&ctl, &in, &out);
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  in.clear_faults = true;
+  in.state.seq = ++plant.seq;
+  pour_control_step(&ctl, &in, &out);
+  in.clear_faults = false;
+  in.state.seq = ++plant.seq;
+  pour_control_step(&ctl, &in, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+}
+
 static void test_supervisor_init_RefusesBadConfig(void) {
   config.supervisor.window_ms = 1u;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init(&ctl, &config, &pour_weights_compiled));
@@ -237,6 +261,7 @@ int main(void) {
   RUN_TEST(test_supervisor_OverspeedStopsActivelyThenBrakes);
   RUN_TEST(test_supervisor_PositionPastTheMarginIsCaught);
   RUN_TEST(test_supervisor_ClearAfterAStopRampsThroughSlewAndRunsAgain);
+  RUN_TEST(test_supervisor_LongFaultThenClearStillResumes);
   RUN_TEST(test_supervisor_init_RefusesBadConfig);
   return UNITY_END();
 }
