@@ -106,6 +106,8 @@ def test_controller_estop_zeroes_torque_and_latches(controller):
         bus.ask(3, theta=0.5)
         assert bus.ask(4, theta=0.5).mode == MODE_RUN
         assert c.stop() == 0
+    # The e-stop engaged the brake and cut the power once (hal_brake, hal_power of the Linux port).
+    assert "brake_engagements 1 power_cuts 1" in c.out, c.out
 
 
 def test_controller_real_time_ticks_without_states_and_counts(controller):

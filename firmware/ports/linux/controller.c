@@ -5,6 +5,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "hal_brake.h"
+#include "hal_lines.h"
+#include "hal_power.h"
 #include "pour_lcm/channels.h"
 
 #define PERIOD_NS 1000000LL
@@ -149,6 +152,14 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   const int64_t t0 = mono_ns();
   pour_control_step(&l->ctl, &ci, &l->out);
   const int64_t dt = mono_ns() - t0;
+  /* As the Cortex-M4 port drives them: power on before the brake releases, brake on before power off. */
+  if (l->out.brake) {
+    pour_hal_brake_set(true);
+    pour_hal_power_set(false);
+  } else {
+    pour_hal_power_set(true);
+    pour_hal_brake_set(false);
+  }
   if ((l->out.faults & ~faults_before) != 0u) {
     fprintf(stderr, "pour_controller: fault 0x%04x latched at tick %lu (docs/safety.md names the bits); "
             "controlled stop, then safe until cleared (POUR_COMMAND clear_faults, e.g. pour-lcm-cmd --clear)\n",
@@ -288,6 +299,8 @@ int pour_linux_run(const pour_linux_config_t *config, pour_io_t *io, volatile si
   l.config = config;
   l.io = io;
   l.stats = stats;
+  pour_hal_brake_init();
+  pour_hal_power_init();
   const pour_status_t s = pour_control_init(&l.ctl, &config->control, config->weights);
   if (s != POUR_OK) {
     return (int)s;
@@ -303,5 +316,7 @@ int pour_linux_run(const pour_linux_config_t *config, pour_io_t *io, volatile si
   maybe_send_status(&l, true);
   stats->mode = l.out.mode;
   stats->faults = l.out.faults;
+  stats->brake_engagements = pour_hal_brake_engagements();
+  stats->power_cuts = pour_hal_power_cuts();
   return 0;
 }

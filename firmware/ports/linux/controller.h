@@ -35,6 +35,8 @@ typedef struct {
   int64_t step_time_max_ns; /* longest pour_control_step [ns] */
   int64_t io_errors;        /* failed sends or waits */
   int64_t resets;           /* reset commands received (the core refuses those that come in RUN) */
+  int64_t brake_engagements; /* the brake line engaged after a release (hal_brake) */
+  int64_t power_cuts;       /* the power line cut after being on (hal_power) */
   uint8_t mode;             /* pour_mode_t at exit */
   uint16_t faults;          /* fault bits at exit */
 } pour_linux_stats_t;

@@ -177,11 +177,11 @@ int main(int argc, char **argv) {
   }
   printf("pour_controller: ticks %lld states %lld answers %lld duplicates %lld dropped %lld stale_ticks %lld "
          "overruns %lld late_mean_us %.1f late_max_us %lld step_max_ns %lld io_errors %lld resets %lld "
-         "mode %u faults 0x%04x\n",
+         "mode %u faults 0x%04x brake_engagements %lld power_cuts %lld\n",
          (long long)st.ticks, (long long)st.states_received, (long long)st.answers, (long long)st.duplicates,
          (long long)st.messages_dropped, (long long)st.stale_ticks, (long long)st.overruns,
          st.ticks > 0 ? (double)st.late_sum_us / (double)st.ticks : 0.0, (long long)st.late_max_us,
          (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.resets, (unsigned)st.mode,
-         (unsigned)st.faults);
+         (unsigned)st.faults, (long long)st.brake_engagements, (long long)st.power_cuts);
   return 0;
 }

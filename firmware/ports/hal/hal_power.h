@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* hal_power: the motor power stage's enable. Fail-safe: enabled only while driven. */
+/* hal_power: the motor power stage's enable. Fail-safe: enabled only while driven. One implementation per
+ * port (Cortex-M4: a pin; Linux: the line kept for the process's summary). */
 #ifndef POUR_HAL_POWER_H
 #define POUR_HAL_POWER_H
 
