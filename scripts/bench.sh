@@ -246,8 +246,8 @@ fuzz_sources() {
   case $1 in
     fuzz_weights_h) echo host_sim/src/weights_file.cpp ;;
     fuzz_config) echo host_sim/src/config.cpp ;;
-    fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/policy.c firmware/src/obs.c ;;
-    fuzz_can_node) echo firmware/src/can_node.c firmware/src/can_codec.c firmware/src/control.c firmware/src/safety.c ;;
+    fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/supervisor.c firmware/src/policy.c firmware/src/obs.c ;;
+    fuzz_can_node) echo firmware/can/src/can_node.c firmware/can/src/can_codec.c firmware/src/control.c firmware/src/safety.c ;;
     fuzz_lcm_decode) echo build/host-fuzz-cov/lcmtypes/c/pour_plant_state_t.c build/host-fuzz-cov/lcmtypes/c/pour_command_t.c \
                           build/host-fuzz-cov/lcmtypes/c/pour_torque_t.c ;;
     fuzz_lcm_port) echo firmware/ports/linux/io_lcm.c firmware/ports/linux/state_si.c ;;
@@ -278,7 +278,7 @@ bench_fuzz() {
     rm -rf "${work:?}/$t"
     nice -n 10 tests/fuzz/run_fuzz.sh "build/host-fuzz/bin/$t" "$seconds" "$work" >"$work.$t.log" 2>&1
     stats=$(awk '/stat::number_of_executed_units/ {n = $2} /stat::average_exec_per_sec/ {r = $2}
-                 / DONE | INITED / {c = $0; sub(/.*cov: /, "", c); sub(/ .*/, "", c)}
+                 /(DONE|INITED) +cov: / {c = $0; sub(/.*cov: /, "", c); sub(/ .*/, "", c)}
                  END {printf "%s executions, %s exec/s, %s edges", n, r, c}' "$work.$t.log")
     # Line coverage: the coverage build replays the corpus the run ended with.
     rm -f "$work/$t"/*.profraw
@@ -291,7 +291,7 @@ bench_fuzz() {
                 $(fuzz_sources "$t") 2>/dev/null | python3 -c '
 import json, sys
 t = json.load(sys.stdin)["data"][0]["totals"]["lines"]
-print(f"{t[\"covered\"]}/{t[\"count\"]} lines ({t[\"percent\"]:.1f} %)")' || echo "?")
+print("%d/%d lines (%.1f %%)" % (t["covered"], t["count"], t["percent"]))' || echo "?")
     fi
     local crashes
     crashes=$(find "$work/$t" -maxdepth 1 \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
