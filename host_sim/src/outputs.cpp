@@ -97,9 +97,10 @@ bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<Name
       *err = "cannot write " + o.flag + " '" + o.path + "': it is a directory";
       return false;
     }
-    if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    const int found = stat(dir.c_str(), &st);
+    if (found != 0 || !S_ISDIR(st.st_mode)) {
       *err = "cannot write " + o.flag + " '" + o.path + "': folder '" + dir + "': " +
-             std::strerror(errno != 0 ? errno : ENOTDIR);
+             std::strerror(found != 0 ? errno : ENOTDIR);
       return false;
     }
     if (access(dir.c_str(), W_OK) != 0) {

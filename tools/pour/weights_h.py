@@ -445,18 +445,19 @@ class _Reader:
         name, nd = _ARRAYS[ai][0].decode(), _ARRAYS[ai][2]
         out: list = []
         while True:
-            if self.next_code().text == b"}" and self.tok.kind == "punct":
+            self.next_code()
+            if self.punct(b"}"):
                 return out
             if len(out) == _MAX_COLS:
                 raise self.fail(self.tok.line, f"{name}{f' row {row}' if nd == 2 else ''} has more than "
                                                f"{_MAX_COLS} values")
             out.append(self.value(ai, row, len(out)))
             t = self.next_code()
-            if t.kind == "punct" and t.text == b"}":
+            if self.punct(b"}"):
                 return out
             if t.kind == "end":
                 raise self.fail(t.line, f"{name} ends before its closing '}}' (truncated)")
-            if not (t.kind == "punct" and t.text == b","):
+            if not self.punct(b","):
                 raise self.fail_tok(f"{name}: expected ',' or '}}'")
 
     def punct(self, c: bytes) -> bool:
@@ -483,12 +484,12 @@ class _Reader:
                                   "#ifdef POUR_WEIGHTS_FLOAT_REFERENCE")
         a = {"line": line, "dims": [], "rows": [], "values": []}
         self.arrays[ai] = a
-        while self.next_code().kind == "punct" and self.tok.text == b"[":
+        while self.next_code() and self.punct(b"["):
             if len(a["dims"]) == nd:
                 raise self.fail(line, f"{name} has more than {nd} dimension{'s' if nd > 1 else ''}")
             d = self.next_code()
             dim = -1
-            if d.kind == "punct" and d.text == b"]":
+            if self.punct(b"]"):
                 if a["dims"]:
                     raise self.fail(line, f"{name}: only the first dimension may be empty")
             else:
