@@ -40,10 +40,15 @@ const Field kFields[] = {
     F(pivot_height, Double, 0.1, 5.0),
     F(target_dx, Double, -2.0, 2.0),
     F(bucket_mass, Double, 0.01, 100.0),
-    F(liquid_mass, Double, 0.01, 100.0),
-    F(n_particles, Int, 1, POURSIM_MAX_PARTICLES),
-    F(radius_min, Double, 0.001, 0.05),
-    F(radius_max, Double, 0.001, 0.05),
+    F(fill_depth, Double, 0.01, 1.0),
+    F(liquid_density, Double, 500.0, 2000.0),
+    F(n_particles, Int, 2, POURSIM_MAX_PARTICLES),
+    F(fluid, Int, 0, 1),
+    F(fluid_smoothing, Double, 1.2, 3.0),
+    F(fluid_contact_radius, Double, 0.1, 0.5),
+    F(fluid_stiffness, Double, 10.0, 1e5),
+    F(fluid_viscosity, Double, 0.0, 1e3),
+    F(fluid_agitation, Double, 0.0, 5.0),
     F(restitution_liquid, Double, 0.0, 1.0),
     F(restitution_wall, Double, 0.0, 1.0),
     F(friction, Double, 0.0, 2.0),
@@ -117,10 +122,15 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.pivot_height = 0.56;
   c.target_dx = 0.20;
   c.bucket_mass = 2.0;
-  c.liquid_mass = 10.0;
+  c.fill_depth = 0.221;      // 10 L in a round bucket of 24 cm inner diameter
+  c.liquid_density = 1030.0; // soymilk
   c.n_particles = 150;
-  c.radius_min = 0.0075;
-  c.radius_max = 0.0115;
+  c.fluid = 1;
+  c.fluid_smoothing = 1.8;
+  c.fluid_contact_radius = 0.5;
+  c.fluid_stiffness = 10000.0;
+  c.fluid_viscosity = 5.0;
+  c.fluid_agitation = 0.6;
   c.restitution_liquid = 0.5;
   c.restitution_wall = 0.1;
   c.friction = 0.03; // low: the pile levels closer to a liquid (onset 60° vs 65° at 0.1)
@@ -148,12 +158,21 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
                        f.min, f.max);
     }
   }
-  if (c->radius_min > c->radius_max)
-    return set_error(err, err_len, POURSIM_EINVAL, "config radius_min (%g) > radius_max (%g)", c->radius_min,
-                     c->radius_max);
-  if (2.0 * c->radius_max >= c->bucket_inner_width)
-    return set_error(err, err_len, POURSIM_EINVAL, "config radius_max %g does not fit the bucket width %g",
-                     c->radius_max, c->bucket_inner_width);
+  const double inner_depth = c->bucket_height - c->bucket_wall;
+  if (c->fill_depth > 0.95 * inner_depth)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config fill_depth %g m overflows the bucket (inner depth %g m; at most 95 %% of it)",
+                     c->fill_depth, inner_depth);
+  // At least two particles across the bottom, and a lattice that fits the bucket's width.
+  const double spacing = poursim::particle_spacing(c);
+  if (spacing < 0.003)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config n_particles %d: too many for fill_depth %g m (spacing %.4f m < 3 mm: contacts would tunnel)",
+                     c->n_particles, c->fill_depth, spacing);
+  if (2.0 * spacing > c->bucket_inner_width)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config n_particles %d: too few for fill_depth %g m (spacing %.3f m > half the bucket width)",
+                     c->n_particles, c->fill_depth, spacing);
   if (c->obs_theta_max <= c->obs_theta_min)
     return set_error(err, err_len, POURSIM_EINVAL, "config obs_theta_max must be > obs_theta_min");
   if (c->bucket_height <= 2.0 * c->bucket_wall)
@@ -172,17 +191,6 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
     return set_error(err, err_len, POURSIM_EINVAL,
                      "config target_dx %g / pivot_height %g: the rotating bucket would hit the target bucket",
                      c->target_dx, c->pivot_height);
-  // The liquid must fit: total circle area below ~90 % of the bucket's inner area.
-  double n = c->n_particles, r2 = 0.0;
-  for (int i = 0; i < c->n_particles; ++i) {
-    double r = poursim::particle_radius(c, i);
-    r2 += r * r;
-  }
-  double inner = c->bucket_inner_width * (c->bucket_height - c->bucket_wall);
-  if (M_PI * r2 / 0.80 > inner)
-    return set_error(err, err_len, POURSIM_EINVAL,
-                     "config: %g circles of radius %g..%g m do not fit in the bucket", n, c->radius_min,
-                     c->radius_max);
   return POURSIM_OK;
 }
 

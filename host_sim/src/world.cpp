@@ -28,6 +28,9 @@ float restitution_min(float a, int, float b, int) { return a < b ? a : b; }
 
 constexpr double kWorldHalfWidth = 1.5; // the floor's extent; side walls stop anything rolling off
 constexpr double kWorldHeight = 3.0;
+constexpr uint64_t kLiquidCategory = 0x2;
+constexpr double kGravity = 9.81;     // [m/s²]
+constexpr double kRunawaySpeed = 50.0; // [m/s]: no particle of a pour gets near this; beyond it the step failed
 
 double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
@@ -66,11 +69,11 @@ using poursim::set_error;
 static void build_scene(poursim_world_t *w, uint32_t seed) {
   const poursim_config_t &c = w->cfg;
   b2WorldDef wd = b2DefaultWorldDef();
-  wd.gravity = {0.0f, -9.81f};
+  wd.gravity = {0.0f, static_cast<float>(-kGravity)};
   wd.restitutionThreshold = static_cast<float>(c.restitution_threshold);
   wd.contactHertz = static_cast<float>(c.contact_hertz);
   wd.restitutionCallback = restitution_min;
-  wd.enableSleep = true;
+  wd.enableSleep = c.fluid == 0; // the fluid layer moves every particle every step
   {
     std::lock_guard<std::mutex> lock(g_world_table);
     w->world = b2CreateWorld(&wd);
@@ -134,46 +137,47 @@ static void build_scene(poursim_world_t *w, uint32_t seed) {
   jd.maxMotorTorque = 1e4f;
   w->joint = b2CreateRevoluteJoint(w->world, &jd);
 
-  // Liquid: the same radii every seed (so the fill is the same), placed in a shuffled jittered grid.
-  int n = c.n_particles;
+  // Liquid: a jittered lattice of the rest spacing filling the bucket from the bottom; the seed moves
+  // every circle by up to 10 % of the lattice step, so no two seeds pour alike.
+  const int n = c.n_particles;
+  const double s = poursim::particle_spacing(&c), r = poursim::particle_radius(&c);
+  const int cols = std::max(1, static_cast<int>(std::floor(c.bucket_inner_width / s)));
+  const double dx = c.bucket_inner_width / cols;
+  // A rigid pile cannot start compressed; a fluid starts at its rest spacing (area s² a particle).
+  const double dy = c.fluid ? s * s / dx : std::max(s * s / dx, 2.0 * r + 1e-3);
+  const double bottom = c.pivot_height - 0.5 * c.bucket_height + c.bucket_wall;
   poursim::Rng rng(0x5eedULL ^ (static_cast<unsigned long long>(seed) << 20));
-  std::vector<int> order(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
-  for (int i = n - 1; i > 0; --i) {
-    int j = static_cast<int>(rng.next() % static_cast<unsigned long long>(i + 1));
-    std::swap(order[static_cast<size_t>(i)], order[static_cast<size_t>(j)]);
-  }
-  double area = 0.0;
-  for (int i = 0; i < n; ++i) area += M_PI * poursim::particle_radius(&c, i) * poursim::particle_radius(&c, i);
-  double density = c.liquid_mass / area;
-  double cell = 2.0 * c.radius_max + 0.001;
-  int per_row = std::max(1, static_cast<int>(std::floor(c.bucket_inner_width / cell)));
-  double x0 = -0.5 * per_row * cell + 0.5 * cell;
-  double y0 = -0.5 * c.bucket_height + c.bucket_wall + 0.5 * cell;
-  double slack = 0.5 * (cell - 2.0 * c.radius_max);
   b2SurfaceMaterial liquid_mat = b2DefaultSurfaceMaterial();
   liquid_mat.friction = static_cast<float>(c.friction);
   liquid_mat.restitution = static_cast<float>(c.restitution_liquid);
+  const double density = poursim::liquid_mass(&c) / (n * M_PI * r * r);
   w->circles.assign(static_cast<size_t>(n), b2BodyId{});
-  w->radii.assign(static_cast<size_t>(n), 0.0f);
+  w->radii.assign(static_cast<size_t>(n), static_cast<float>(r));
   for (int k = 0; k < n; ++k) {
-    int i = order[static_cast<size_t>(k)];
-    double r = poursim::particle_radius(&c, i);
-    double jx = (rng.uniform() - 0.5) * 2.0 * slack, jy = (rng.uniform() - 0.5) * 2.0 * slack;
+    double jx = (rng.uniform() - 0.5) * 0.2 * dx, jy = (rng.uniform() - 0.5) * 0.2 * dy;
     b2BodyDef cd = b2DefaultBodyDef();
     cd.type = b2_dynamicBody;
-    cd.position = {static_cast<float>(x0 + (k % per_row) * cell + jx),
-                   static_cast<float>(c.pivot_height + y0 + (k / per_row) * cell + jy)};
+    cd.position = {static_cast<float>(-0.5 * c.bucket_inner_width + (k % cols + 0.5) * dx + jx),
+                   static_cast<float>(bottom + (k / cols + 0.5) * dy + jy)};
     b2BodyId body = b2CreateBody(w->world, &cd);
     b2ShapeDef csd = b2DefaultShapeDef();
     csd.material = liquid_mat;
     csd.density = static_cast<float>(density);
+    // With the fluid layer on, circles meet each other only through it.
+    csd.filter.categoryBits = kLiquidCategory;
+    if (c.fluid) csd.filter.maskBits = ~kLiquidCategory;
     b2Circle circle = {{0.0f, 0.0f}, static_cast<float>(r)};
     b2CreateCircleShape(body, &csd, &circle);
     w->circles[static_cast<size_t>(k)] = body;
-    w->radii[static_cast<size_t>(k)] = static_cast<float>(r);
   }
-  w->bucket_inertia = b2Body_GetRotationalInertia(w->bucket);
+  poursim::FluidParams fp;
+  fp.h = c.fluid_smoothing * s;
+  fp.rho0 = poursim::fluid_rest_density(s, fp.h);
+  fp.k = c.fluid_stiffness;
+  fp.sigma = c.fluid_viscosity;
+  fp.agitation = c.fluid_agitation;
+  w->fluid.configure(fp, n, 0xF1D5EEDULL ^ (static_cast<uint64_t>(seed) << 17));
+  for (std::vector<double> *v : {&w->fx, &w->fy, &w->fvx, &w->fvy}) v->assign(static_cast<size_t>(n), 0.0);
 }
 
 static void destroy_scene(poursim_world_t *w) {
@@ -247,6 +251,43 @@ static void measure(poursim_world_t *w) {
   w->hash = fnv_mix(h, scalars, sizeof scalars);
 }
 
+// One dt: the fluid layer changes the circles' velocities, then Box2D moves everything and resolves the
+// contacts with the buckets.
+static void advance(poursim_world_t *w) {
+  const poursim_config_t &c = w->cfg;
+  if (c.fluid) {
+    const size_t n = w->circles.size();
+    for (size_t i = 0; i < n; ++i) {
+      b2Vec2 p = b2Body_GetPosition(w->circles[i]), v = b2Body_GetLinearVelocity(w->circles[i]);
+      w->fx[i] = p.x, w->fy[i] = p.y, w->fvx[i] = v.x, w->fvy[i] = v.y;
+    }
+    w->fluid.step(c.dt, -kGravity, w->fx.data(), w->fy.data(), w->fvx.data(), w->fvy.data());
+    for (size_t i = 0; i < n; ++i)
+      b2Body_SetLinearVelocity(w->circles[i], {static_cast<float>(w->fvx[i]), static_cast<float>(w->fvy[i])});
+  }
+  b2World_Step(w->world, static_cast<float>(c.dt), c.substeps);
+}
+
+// A liquid that blew up shows as a particle that is not finite, has left the world, or moves faster
+// than anything in a pour can; found at the step where it happens, never carried on.
+static int check_numerics(poursim_world_t *w) {
+  for (size_t i = 0; i < w->circles.size(); ++i) {
+    b2Vec2 pf = b2Body_GetPosition(w->circles[i]), vf = b2Body_GetLinearVelocity(w->circles[i]);
+    const double px = pf.x, py = pf.y, vx = vf.x, vy = vf.y;
+    bool inside = std::fabs(px) <= kWorldHalfWidth + 0.5 && py >= -0.5 && py <= kWorldHeight + 0.5;
+    double speed = std::sqrt(vx * vx + vy * vy);
+    if (!std::isfinite(px) || !std::isfinite(py) || !inside || !(speed <= kRunawaySpeed)) {
+      std::snprintf(w->error, sizeof w->error,
+                    "step %u: the liquid blew up: particle %zu at (%g, %g) m moving at %g m/s (fluid_stiffness or dt "
+                    "too large for the particle spacing?)",
+                    w->step, i, px, py, speed);
+      destroy_scene(w);
+      return POURSIM_ENUMERIC;
+    }
+  }
+  return POURSIM_OK;
+}
+
 extern "C" {
 
 poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
@@ -261,7 +302,7 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
   w->cfg = *config;
   int rc = poursim_reset(w, config->seed);
   if (rc != POURSIM_OK) {
-    set_error(err, err_len, rc, "reset failed");
+    set_error(err, err_len, rc, "while the liquid settled: %s", w->error);
     poursim_destroy(w);
     return nullptr;
   }
@@ -278,11 +319,13 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   w->region.assign(n, 0);
   // Settle with the bucket held by the joint motor, then release it at rest.
   int settle_steps = static_cast<int>(std::lround(c.settle_s / c.dt));
-  float dt = static_cast<float>(c.dt);
-  for (int i = 0; i < settle_steps; ++i) b2World_Step(w->world, dt, c.substeps);
+  w->step = 0;
+  w->error[0] = '\0';
+  for (int i = 0; i < settle_steps; ++i) advance(w);
+  int rc = check_numerics(w);
+  if (rc != POURSIM_OK) return rc;
   b2RevoluteJoint_EnableMotor(w->joint, false);
   b2Body_SetAngularVelocity(w->bucket, 0.0f);
-  w->step = 0;
   w->hash = 14695981039346656037ULL;
   w->max_wall_pen = 0.0;
   std::memset(&w->obs, 0, sizeof w->obs);
@@ -296,13 +339,39 @@ int poursim_step(poursim_world_t *w, double action, poursim_obs_t *out) {
   if (!std::isfinite(action)) return POURSIM_EINVAL;
   double a = std::max(-1.0, std::min(1.0, action));
   double tau = a * w->cfg.tau_max;
+  b2RevoluteJoint_EnableMotor(w->joint, false);
   b2Body_ApplyTorque(w->bucket, static_cast<float>(-tau), true);
-  b2World_Step(w->world, static_cast<float>(w->cfg.dt), w->cfg.substeps);
+  advance(w);
   w->step++;
+  int rc = check_numerics(w);
+  if (rc != POURSIM_OK) return rc;
   w->obs.torque = tau;
   measure(w);
   if (out != nullptr) *out = w->obs;
   return POURSIM_OK;
+}
+
+int poursim_step_servo(poursim_world_t *w, double theta_ref, poursim_obs_t *out) {
+  if (w == nullptr || !w->has_world) return POURSIM_EINVAL;
+  if (!std::isfinite(theta_ref)) return POURSIM_EINVAL;
+  // The motor reaches the speed that closes the error in one step, with torque to spare.
+  b2RevoluteJoint_EnableMotor(w->joint, true);
+  b2RevoluteJoint_SetMaxMotorTorque(w->joint, 1e4f);
+  b2RevoluteJoint_SetMotorSpeed(w->joint, static_cast<float>(-(theta_ref - w->obs.theta) / w->cfg.dt));
+  advance(w);
+  w->step++;
+  int rc = check_numerics(w);
+  if (rc != POURSIM_OK) return rc;
+  w->obs.torque = -static_cast<double>(b2RevoluteJoint_GetMotorTorque(w->joint));
+  measure(w);
+  if (out != nullptr) *out = w->obs;
+  return POURSIM_OK;
+}
+
+const char *poursim_world_error(const poursim_world_t *w) { return w ? w->error : "world is NULL"; }
+
+double poursim_max_density_ratio(const poursim_world_t *w) {
+  return w != nullptr && w->cfg.fluid ? w->fluid.max_density_ratio() : 0.0;
 }
 
 void poursim_observe(const poursim_world_t *w, poursim_obs_t *out) {
@@ -345,7 +414,8 @@ double poursim_max_overlap(const poursim_world_t *w) {
   const poursim_config_t &c = w->cfg;
   size_t n = w->circles.size();
   double worst = 0.0;
-  for (size_t i = 0; i < n; ++i) {
+  // Circles of the fluid meet through pressure, not contact: only the pile's circle pairs overlap.
+  for (size_t i = 0; i < n && !c.fluid; ++i) {
     Eigen::Vector2d pi(w->pos[2 * i], w->pos[2 * i + 1]);
     for (size_t j = i + 1; j < n; ++j) {
       Eigen::Vector2d pj(w->pos[2 * j], w->pos[2 * j + 1]);
@@ -372,8 +442,6 @@ double poursim_max_overlap(const poursim_world_t *w) {
 }
 
 double poursim_max_wall_penetration(const poursim_world_t *w) { return w ? w->max_wall_pen : 0.0; }
-
-double poursim_bucket_inertia(const poursim_world_t *w) { return w ? w->bucket_inertia : 0.0; }
 
 uint64_t poursim_trajectory_hash(const poursim_world_t *w) { return w ? w->hash : 0; }
 

@@ -24,7 +24,8 @@ typedef enum {
   POURSIM_EINVAL = -1, /* an argument or config value out of range */
   POURSIM_EIO = -2,    /* a file could not be read */
   POURSIM_EPARSE = -3, /* a file could not be parsed */
-  POURSIM_ESTATE = -4  /* call out of order (e.g. step after the episode ended) */
+  POURSIM_ESTATE = -4, /* call out of order (e.g. step after the episode ended) */
+  POURSIM_ENUMERIC = -5 /* the simulation blew up numerically (poursim_world_error says where) */
 } poursim_status_t;
 
 /* The whole configuration. poursim_default_config() documents each default (docs/simulator.md). */
@@ -40,14 +41,20 @@ typedef struct {
   double bucket_wall;        /* wall and bottom thickness [m] */
   double pivot_height;       /* rotating bucket's centre (pivot) above the ground [m] */
   double target_dx;          /* target bucket's centre x minus pivot x [m] (> 0: the pouring side) */
-  /* masses and liquid */
+  /* masses */
   double bucket_mass;     /* rotating bucket (steel) [kg] */
-  double liquid_mass;     /* all the liquid [kg] */
-  int n_particles;        /* circles, 1..POURSIM_MAX_PARTICLES */
-  double radius_min;      /* radii evenly spread over [radius_min, radius_max] [m] */
-  double radius_max;
+  /* liquid: n_particles circles share the fill's cross-section, spacing s = √(width·fill_depth/n) */
+  double fill_depth;      /* depth of the liquid at rest in the upright bucket [m] */
+  double liquid_density;  /* [kg/m³]; mass = density·fill_depth·π·(width/2)² (a round bucket) */
+  int n_particles;        /* circles, 2..POURSIM_MAX_PARTICLES */
+  int fluid;              /* 1: particle fluid (pressure, viscosity); 0: rigid circle pile, no fluid layer */
+  double fluid_smoothing;      /* interaction radius h / spacing s [-] */
+  double fluid_contact_radius; /* Box2D circle radius / spacing s (contacts with the buckets) [-] */
+  double fluid_stiffness;      /* pressure stiffness k [m/s²] */
+  double fluid_viscosity;      /* pair viscosity σ [1/s] */
+  double fluid_agitation;      /* thermal speed v_T of the pairs [m/s]: keeps 150 particles liquid */
   /* contact model */
-  double restitution_liquid; /* circle–circle */
+  double restitution_liquid; /* circle–circle, the pile only (fluid = 0) */
   double restitution_wall;   /* circle–wall (mixed with min, so it wins) */
   double friction;
   double restitution_threshold; /* collisions slower than this do not bounce [m/s] */
@@ -107,8 +114,20 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
 /* Rebuilds the scene: new liquid arrangement from seed, settled, bucket upright at rest, t = 0. */
 int poursim_reset(poursim_world_t *world, uint32_t seed);
 
-/* One dt step with torque a·tau_max, a in [-1, 1] (clamped); fills *out (may be NULL). */
+/* One dt step with torque a·tau_max, a in [-1, 1] (clamped); fills *out (may be NULL).
+ * POURSIM_ENUMERIC if the liquid blew up in this step (a non-finite or runaway particle): the world is
+ * then unusable until reset, and poursim_world_error() says which particle and where. */
 int poursim_step(poursim_world_t *world, double action, poursim_obs_t *out);
+
+/* One dt step with the bucket driven toward theta_ref [rad] by a stiff servo (the joint's motor) instead
+ * of a torque: for measurements that need a prescribed tilt (retention curve, sloshing). */
+int poursim_step_servo(poursim_world_t *world, double theta_ref, poursim_obs_t *out);
+
+/* The reason of the last failed step, "" if none. */
+const char *poursim_world_error(const poursim_world_t *world);
+
+/* The liquid's state right now: largest density over rest density (compression, fluid only) [-]. */
+double poursim_max_density_ratio(const poursim_world_t *world);
 
 /* The state after the last step (or reset). */
 void poursim_observe(const poursim_world_t *world, poursim_obs_t *out);
@@ -126,15 +145,13 @@ int poursim_particles(const poursim_world_t *world, float *xy, float *radius, in
 /* Where each circle is: 0 rotating, 1 target, 2 spilled, 3 in flight. Returns count. */
 int poursim_particle_regions(const poursim_world_t *world, uint8_t *region, int capacity);
 
-/* Deepest circle–circle or circle–wall overlap right now [m] (contact quality). */
+/* Deepest circle–wall (and, for the pile, circle–circle) overlap right now [m] (contact quality). */
 double poursim_max_overlap(const poursim_world_t *world);
 
 /* Deepest any circle sank into a wall of either bucket since reset [m]: a contact sinks a fraction of a
  * millimetre; a circle that tunnels through a wall shows up as more than its radius. */
 double poursim_max_wall_penetration(const poursim_world_t *world);
 
-/* Rotating bucket's moment of inertia about its pivot, bucket only (liquid comes from contacts) [kg·m²]. */
-double poursim_bucket_inertia(const poursim_world_t *world);
 
 /* Running FNV-1a 64 over the bits of every observation and circle position so far (determinism). */
 uint64_t poursim_trajectory_hash(const poursim_world_t *world);

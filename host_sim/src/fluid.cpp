@@ -1,0 +1,155 @@
+// SPDX-License-Identifier: MIT
+// Per step, in velocity form so that Box2D integrates the result and resolves the walls: a prediction
+// of the positions under gravity, viscosity and agitation on each pair's relative normal velocity, the
+// density measured on the prediction, and a push of each compressed pair apart as a velocity change.
+// Loops run in a fixed order and the agitation draws from a seeded stream: a step is deterministic.
+#include "fluid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace poursim {
+
+namespace {
+
+// xorshift64*, uniform in [-√3, √3): unit variance, bounded (a kick can never be huge).
+double unit_noise(uint64_t &s) {
+  s ^= s >> 12, s ^= s << 25, s ^= s >> 27;
+  uint64_t r = s * 2685821657736338717ULL;
+  return (static_cast<double>(r >> 11) * (1.0 / 9007199254740992.0) - 0.5) * 3.4641016151377544;
+}
+
+} // namespace
+
+double fluid_rest_density(double spacing, double h) {
+  // A liquid at rest packs like a triangular lattice: nearest distance a with a²·√3/2 = spacing².
+  const double a = spacing * std::sqrt(2.0 / std::sqrt(3.0));
+  double rho = 0.0;
+  const int reach = static_cast<int>(std::ceil(h / a)) + 1;
+  for (int i = -reach; i <= reach; ++i) {
+    for (int j = -reach; j <= reach; ++j) {
+      if (i == 0 && j == 0) continue;
+      const double x = a * (i + 0.5 * j), y = a * (std::sqrt(3.0) / 2.0) * j;
+      const double w = 1.0 - std::sqrt(x * x + y * y) / h;
+      if (w > 0.0) rho += w * w;
+    }
+  }
+  return rho;
+}
+
+void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
+  p_ = p;
+  n_ = n;
+  rng_ = seed | 1u; // xorshift must not start at 0
+  const size_t un = static_cast<size_t>(n);
+  for (std::vector<double> *v : {&px_, &py_, &rho_}) v->assign(un, 0.0);
+  cell_of_.assign(un, 0);
+  sorted_.assign(un, 0);
+  pairs_.clear();
+  pairs_.reserve(un * 8);
+  max_ratio_ = 0.0;
+}
+
+void Fluid::predict(double dt, double gy, const double *x, const double *y, const double *vx, const double *vy) {
+  for (size_t i = 0; i < static_cast<size_t>(n_); ++i) {
+    px_[i] = x[i] + dt * vx[i];
+    py_[i] = y[i] + dt * (vy[i] + gy * dt);
+  }
+}
+
+// Counting sort of the particles into cells of size h over their bounding box, then each particle
+// against its own cell and four forward neighbours: every pair closer than h exactly once.
+void Fluid::find_pairs() {
+  pairs_.clear();
+  if (n_ < 2) return;
+  const auto [x0, x1] = std::minmax_element(px_.begin(), px_.end());
+  const auto [y0, y1] = std::minmax_element(py_.begin(), py_.end());
+  const double inv = 1.0 / p_.h, ox = *x0, oy = *y0;
+  // The world keeps every position finite and inside it, so the grid stays small (< 10^4 cells).
+  const int nx = static_cast<int>((*x1 - ox) * inv) + 1, ny = static_cast<int>((*y1 - oy) * inv) + 1;
+  cell_start_.assign(static_cast<size_t>(nx) * static_cast<size_t>(ny) + 1, 0);
+  for (size_t i = 0; i < static_cast<size_t>(n_); ++i) {
+    int cx = std::min(nx - 1, static_cast<int>((px_[i] - ox) * inv));
+    int cy = std::min(ny - 1, static_cast<int>((py_[i] - oy) * inv));
+    cell_of_[i] = cy * nx + cx;
+    cell_start_[static_cast<size_t>(cell_of_[i]) + 1]++;
+  }
+  for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+  fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  for (int i = 0; i < n_; ++i) sorted_[static_cast<size_t>(fill_[static_cast<size_t>(cell_of_[static_cast<size_t>(i)])]++)] = i;
+
+  const double h2 = p_.h * p_.h;
+  auto scan = [&](int i, int b0, int b1) {
+    const double xi = px_[static_cast<size_t>(i)], yi = py_[static_cast<size_t>(i)];
+    for (int b = b0; b < b1; ++b) {
+      const int j = sorted_[static_cast<size_t>(b)];
+      const double ex = px_[static_cast<size_t>(j)] - xi, ey = py_[static_cast<size_t>(j)] - yi;
+      const double r2 = ex * ex + ey * ey;
+      if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
+      const double r = std::sqrt(r2);
+      pairs_.push_back({i, j, ex / r, ey / r, 1.0 - r * inv});
+    }
+  };
+  static const int kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+  for (int cy = 0; cy < ny; ++cy) {
+    for (int cx = 0; cx < nx; ++cx) {
+      const size_t c = static_cast<size_t>(cy * nx + cx);
+      for (int a = cell_start_[c]; a < cell_start_[c + 1]; ++a) {
+        const int i = sorted_[static_cast<size_t>(a)];
+        scan(i, a + 1, cell_start_[c + 1]);
+        for (const auto &f : kForward) {
+          const int fx = cx + f[0], fy = cy + f[1];
+          if (fx < 0 || fx >= nx || fy >= ny) continue;
+          const size_t o = static_cast<size_t>(fy * nx + fx);
+          scan(i, cell_start_[o], cell_start_[o + 1]);
+        }
+      }
+    }
+  }
+}
+
+void Fluid::step(double dt, double gy, const double *x, const double *y, double *vx, double *vy) {
+  const size_t n = static_cast<size_t>(n_);
+  // One neighbour search and one pair geometry a step, on the positions predicted under gravity: what
+  // the viscosity changes moves a particle by dt·Δv, a small fraction of h.
+  predict(dt, gy, x, y, vx, vy);
+  find_pairs();
+
+  // Viscosity and agitation on the relative normal velocity u of each pair, weights (1 − q)² and
+  // (1 − q): du = −σ(1 − q)²·u·dt + √(2σ·dt)·v_T·(1 − q)·ξ, half to each particle. For one pair this
+  // settles at ⟨u²⟩ = v_T² (fluctuation–dissipation).
+  if (p_.sigma > 0.0) {
+    const double kick = std::sqrt(2.0 * p_.sigma * dt) * p_.agitation;
+    for (const Pair &pr : pairs_) {
+      const size_t i = static_cast<size_t>(pr.i), j = static_cast<size_t>(pr.j);
+      const double u = (vx[j] - vx[i]) * pr.ex + (vy[j] - vy[i]) * pr.ey;
+      const double du = -p_.sigma * pr.w * pr.w * u * dt + kick * pr.w * unit_noise(rng_);
+      vx[i] -= 0.5 * du * pr.ex, vy[i] -= 0.5 * du * pr.ey;
+      vx[j] += 0.5 * du * pr.ex, vy[j] += 0.5 * du * pr.ey;
+    }
+  }
+
+  // Density; pressure k(ρ − ρ0), never a pull.
+  std::fill(rho_.begin(), rho_.end(), 0.0);
+  for (const Pair &pr : pairs_) {
+    rho_[static_cast<size_t>(pr.i)] += pr.w * pr.w;
+    rho_[static_cast<size_t>(pr.j)] += pr.w * pr.w;
+  }
+  max_ratio_ = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    max_ratio_ = std::max(max_ratio_, rho_[i] / p_.rho0);
+    rho_[i] = std::max(0.0, p_.k * (rho_[i] - p_.rho0)); // from here on: pressure [m/s²]
+  }
+
+  // Relaxation, Clavet's displacement summed over both ends of a pair: each end moves dt²·P̄·(1 − q)
+  // along the pair's axis, P̄ the pair's mean pressure; the move, over dt, is a velocity change.
+  const double half_dt = 0.5 * dt;
+  for (const Pair &pr : pairs_) {
+    const size_t i = static_cast<size_t>(pr.i), j = static_cast<size_t>(pr.j);
+    const double d = half_dt * (rho_[i] + rho_[j]) * pr.w;
+    vx[i] -= d * pr.ex, vy[i] -= d * pr.ey;
+    vx[j] += d * pr.ex, vy[j] += d * pr.ey;
+  }
+}
+
+} // namespace poursim
