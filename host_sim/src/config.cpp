@@ -120,7 +120,7 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.bucket_height = 0.33;
   c.bucket_wall = 0.005;
   c.pivot_height = 0.56;
-  c.target_dx = 0.20;
+  c.target_dx = 0.28; // under the stream of a slow pour (docs/simulator.md)
   c.bucket_mass = 2.0;
   c.fill_depth = 0.221;      // 10 L in a round bucket of 24 cm inner diameter
   c.liquid_density = 1030.0; // soymilk

@@ -119,9 +119,10 @@ class HandController : public EnvelopedController {
 
  protected:
   double request(const poursim_obs_t &o) override {
-    // Fast to just before the liquid reaches the lip, then slowly on to the stop, so the stream stays
-    // thin and lands in the target; the last stretch empties the bucket.
-    const double fast = 2.0, slow = 0.45, knee = 0.95; // [rad/s], [rad/s], [rad]
+    // Fast to just before the liquid reaches the lip (an ideal liquid's onset at this fill is 41°), then
+    // slowly on to the stop, so the stream stays thin and is not thrown past the target; the last
+    // stretch empties the bucket.
+    const double fast = 2.0, slow = 0.3, knee = 0.6; // [rad/s], [rad/s], [rad]
     double t_knee = knee / fast;
     double ref = t_ < t_knee ? fast * t_ : knee + slow * (t_ - t_knee);
     return pd(o, std::min(ref, cfg_.theta_max + 0.1), cfg_.tau_max);
