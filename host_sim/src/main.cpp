@@ -7,17 +7,16 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "bench.hpp"
 #include "controllers.hpp"
 #include "lcm_link.hpp"
 #include "outputs.hpp"
@@ -40,7 +39,8 @@ const char *kUsage =
     "  --baseline NAME     rate  : tilt at a constant rate to the stop (--rate, default 1.5 rad/s)\n"
     "                      full  : full torque all the way\n"
     "                      hand  : hand-written good pour (fast to the lip, then slowly)\n"
-    "  --bench             measure speed, contact quality, episodes/s and the pour onset angle\n"
+    "  --bench             measure speed, contact quality, episodes/s, and the liquid against physics:\n"
+    "                      retention curve vs an ideal liquid, sloshing vs linear theory (~2 min)\n"
     "                      (with --policy: the rollouts run that policy, else a uniform random one)\n"
     "  --lcm [URL]         pour_controller, a separate process, over LCM (POUR_STATE out, POUR_TORQUE in,\n"
     "                      POUR_PARTICLES for viewers); lockstep unless --realtime. With --policy, the\n"
@@ -189,17 +189,10 @@ int parse_args(int argc, char **argv, Options &o) {
   return -1;
 }
 
-// CPU time of this thread [s]: unlike wall time, it does not count the time other processes took.
-double thread_cpu_s() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 struct Episode {
   uint32_t seed = 0;
-  double poured = 0, spilled = 0, remaining = 0, finish = -1, ret = 0, wall = 0, cpu = 0;
-  double max_overlap_end = 0;
+  double poured = 0, spilled = 0, remaining = 0, finish = -1, ret = 0;
+  std::string error; // why the world stopped, if it did
 };
 
 // One step of history for CSV and rendering.
@@ -228,8 +221,6 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   poursim_observe(world, &o);
   std::vector<double> settled;
   double disc = 1.0;
-  auto t0 = std::chrono::steady_clock::now();
-  double cpu0 = thread_cpu_s();
   auto keep_frame = [&](const poursim_obs_t &ob) {
     std::vector<float> xy(static_cast<size_t>(2 * n));
     poursim_particles(world, xy.data(), nullptr, n);
@@ -244,7 +235,10 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   }
   while (!o.done) {
     double a = ctl.command(o);
-    poursim_step(world, a, &o);
+    if (poursim_step(world, a, &o) != POURSIM_OK) {
+      e.error = poursim_world_error(world);
+      return e;
+    }
     e.ret += disc * o.reward;
     disc *= cfg->gamma;
     settled.push_back(o.v_target + o.v_spill);
@@ -253,8 +247,6 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
       if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
     }
   }
-  e.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  e.cpu = thread_cpu_s() - cpu0;
   e.poured = o.v_target;
   e.spilled = o.v_spill;
   e.remaining = o.v_rotating;
@@ -266,7 +258,6 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
         break;
       }
   }
-  e.max_overlap_end = poursim_max_overlap(world);
   return e;
 }
 
@@ -358,128 +349,6 @@ double stdev(const std::vector<double> &v) {
   return std::sqrt(s / static_cast<double>(v.size() - 1));
 }
 
-// Ideal liquid in a rectangle (2D), fill height h in depth H, width w: the free surface stays level
-// and pivots about the centre of the liquid column; it reaches the lip when tan θ = 2(H − h)/w while
-// it still covers the bottom (h ≥ H/2), else when tan θ = H²/(2 w h) (triangle).
-double ideal_onset(double h, double H, double w) {
-  return h >= 0.5 * H ? std::atan(2.0 * (H - h) / w) : std::atan(H * H / (2.0 * w * h));
-}
-
-int run_bench(const Options &o, const poursim_config_t &cfg) {
-  char err[POURSIM_ERR_LEN];
-  double load[3] = {0, 0, 0};
-  if (std::FILE *f = std::fopen("/proc/loadavg", "r")) {
-    if (std::fscanf(f, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3) load[0] = -1;
-    std::fclose(f);
-  }
-  std::printf("host_sim bench: %d circles, dt %.4f s, %d substeps, contact %.0f Hz; load average %.2f %.2f %.2f\n",
-              cfg.n_particles, cfg.dt, cfg.substeps, cfg.contact_hertz, load[0], load[1], load[2]);
-  poursim_world_t *w = poursim_create(&cfg, err, sizeof err);
-  if (w == nullptr) {
-    std::fprintf(stderr, "host_sim: %s\n", err);
-    return 1;
-  }
-  // 1. One episode on one core, hand-written pour (the liquid moves all episode long).
-  auto hand = poursim::make_hand_controller(cfg);
-  std::vector<double> rtf, rtf_cpu, overlap_rest, overlap_end;
-  int n = std::max(3, std::min(o.episodes, 10));
-  for (int k = 0; k < n; ++k) {
-    uint32_t seed = static_cast<uint32_t>(k + 1);
-    poursim_reset(w, seed);
-    overlap_rest.push_back(poursim_max_overlap(w));
-    Episode e = run_episode(w, *hand, seed, nullptr);
-    rtf.push_back(cfg.episode_s / e.wall);
-    rtf_cpu.push_back(cfg.episode_s / e.cpu);
-    overlap_end.push_back(e.max_overlap_end);
-  }
-  std::printf("real-time factor, one core: %.1fx by CPU time (min %.1fx), %.1fx by wall time, over %d episodes "
-              "of %.0f s\n", mean(rtf_cpu), *std::min_element(rtf_cpu.begin(), rtf_cpu.end()), mean(rtf), n,
-              cfg.episode_s);
-  std::printf("max resting overlap: %.3f mm settled in the bucket, %.3f mm at episode end (worst of %d)\n",
-              1e3 * *std::max_element(overlap_rest.begin(), overlap_rest.end()),
-              1e3 * *std::max_element(overlap_end.begin(), overlap_end.end()), n);
-  // 2. Episodes per second with the C rollout (float policy), 1 and 2 threads.
-  std::vector<double> wbuf(POURSIM_N_FEATURES * POURSIM_MAX_ACTIONS), lbuf(POURSIM_MAX_ACTIONS);
-  poursim_policy_t pol{};
-  poursim_weights_file_t wf;
-  if (!o.policy.empty()) {
-    if (poursim_weights_load(o.policy.c_str(), &wf, err, sizeof err) != POURSIM_OK) {
-      std::fprintf(stderr, "host_sim: %s\n", err);
-      poursim_destroy(w);
-      return 1;
-    }
-    poursim_weights_float_policy(&wf, wbuf.data(), lbuf.data(), &pol);
-    pol.greedy = 0;
-  } else {
-    // Uniform random policy over 11 levels: sampled actions, as in training.
-    pol.n_actions = 11;
-    pol.decision_period = 10;
-    for (int i = 0; i < 11; ++i) lbuf[static_cast<size_t>(i)] = -1.0 + 2.0 * i / 10.0;
-    pol.w = wbuf.data();
-    pol.levels = lbuf.data();
-    pol.theta_min = cfg.obs_theta_min;
-    pol.theta_max = cfg.obs_theta_max;
-    pol.omega_max = cfg.obs_omega_max;
-    pol.greedy = 0;
-  }
-  const int batch = 8;
-  std::vector<uint32_t> seeds(batch);
-  for (int i = 0; i < batch; ++i) seeds[static_cast<size_t>(i)] = static_cast<uint32_t>(100 + i);
-  std::vector<poursim_episode_t> eps(batch);
-  for (int threads = 1; threads <= 2; ++threads) {
-    timespec c0, c1;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
-    auto t0 = std::chrono::steady_clock::now();
-    int rc = poursim_rollout_batch(&cfg, &pol, seeds.data(), batch, threads, nullptr, eps.data(), err, sizeof err);
-    double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
-    double cpu = static_cast<double>(c1.tv_sec - c0.tv_sec) + 1e-9 * static_cast<double>(c1.tv_nsec - c0.tv_nsec);
-    if (rc != POURSIM_OK) {
-      std::fprintf(stderr, "host_sim: %s\n", err);
-      poursim_destroy(w);
-      return 1;
-    }
-    std::printf("rollouts (C, %s policy): %d episodes on %d thread%s in %.2f s wall = %.2f episodes/s "
-                "(%.2f s CPU, %.2f episodes per CPU-second)\n",
-                o.policy.empty() ? "random" : "given", batch, threads, threads > 1 ? "s" : "", s, batch / s, cpu,
-                batch / cpu);
-  }
-  // 3. Pour onset: tilt slowly (0.2 rad/s); the first circle out of the bucket gives the angle.
-  auto slow = poursim::make_rate_controller(0.2, cfg);
-  std::vector<double> onset, ideal;
-  for (int k = 0; k < 3; ++k) {
-    uint32_t seed = static_cast<uint32_t>(k + 1);
-    poursim_reset(w, seed);
-    slow->reset(seed);
-    int np = poursim_particle_count(w);
-    std::vector<float> xy(static_cast<size_t>(2 * np)), r(static_cast<size_t>(np));
-    poursim_particles(w, xy.data(), r.data(), np);
-    // Fill height: the liquid's area spread over the width, at the packing the pile actually has
-    // (judged from the top of the pile: mean of its 10 highest circle tops).
-    std::vector<double> tops;
-    for (int i = 0; i < np; ++i) tops.push_back(xy[static_cast<size_t>(2 * i + 1)] + r[static_cast<size_t>(i)]);
-    std::sort(tops.rbegin(), tops.rend());
-    double top = 0;
-    for (int i = 0; i < 10 && i < np; ++i) top += tops[static_cast<size_t>(i)] / std::min(10, np);
-    double bottom = cfg.pivot_height - 0.5 * cfg.bucket_height + cfg.bucket_wall;
-    double depth = cfg.bucket_height - cfg.bucket_wall;
-    ideal.push_back(ideal_onset(top - bottom, depth, cfg.bucket_inner_width));
-    poursim_obs_t ob;
-    poursim_observe(w, &ob);
-    double first = -1;
-    while (!ob.done && first < 0) {
-      poursim_step(w, slow->command(ob), &ob);
-      if (ob.v_rotating < 1.0) first = ob.theta;
-    }
-    onset.push_back(first);
-  }
-  const double deg = 180.0 / M_PI;
-  std::printf("pour onset: %.1f deg (seeds 1-3: %.1f %.1f %.1f) vs ideal liquid %.1f deg for the same fill\n",
-              mean(onset) * deg, onset[0] * deg, onset[1] * deg, onset[2] * deg, mean(ideal) * deg);
-  poursim_destroy(w);
-  return 0;
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
@@ -522,7 +391,7 @@ int main(int argc, char **argv) {
                  o.policy.c_str(), tau_policy, cfg.tau_max);
     return 2;
   }
-  if (o.bench) return run_bench(o, cfg);
+  if (o.bench) return poursim::run_bench(cfg, o.policy, o.episodes);
 
   // Every output checked before any work: none may name an input or another output, all must be writable.
   std::string render_base, render_json;
@@ -600,6 +469,12 @@ int main(int argc, char **argv) {
     rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
     rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
     Episode e = run_episode(world, *ctl, seed, &rec);
+    if (!e.error.empty()) {
+      std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      if (csv != nullptr) std::fclose(csv);
+      poursim_destroy(world);
+      return 1;
+    }
     eps.push_back(e);
     if (!o.quiet)
       std::fprintf(per, "episode %d seed %u: poured %5.1f %%  spilled %4.1f %%  left %4.1f %%  finish %s  return %.1f\n",

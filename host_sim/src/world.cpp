@@ -195,7 +195,7 @@ static void measure(poursim_world_t *w) {
   b2Transform xf = b2Body_GetTransform(w->bucket);
   Eigen::Vector2d pivot(xf.p.x, xf.p.y);
   // World → bucket frame: undo the bucket's counter-clockwise rotation.
-  Eigen::Rotation2Dd to_bucket(-static_cast<double>(b2Rot_GetAngle(xf.q)));
+  const Eigen::Matrix2d to_bucket = Eigen::Rotation2Dd(-static_cast<double>(b2Rot_GetAngle(xf.q))).toRotationMatrix();
   double wi = 0.5 * c.bucket_inner_width, hh = 0.5 * c.bucket_height;
   double tx0 = c.target_dx - wi, tx1 = c.target_dx + wi, rim = c.bucket_height;
   const Eigen::Vector2d target_centre(c.target_dx, 0.5 * c.bucket_height);
@@ -425,7 +425,7 @@ double poursim_max_overlap(const poursim_world_t *w) {
   }
   b2Transform xf = b2Body_GetTransform(w->bucket);
   Eigen::Vector2d pivot(xf.p.x, xf.p.y), target_centre(c.target_dx, 0.5 * c.bucket_height);
-  Eigen::Rotation2Dd to_bucket(-static_cast<double>(b2Rot_GetAngle(xf.q)));
+  const Eigen::Matrix2d to_bucket = Eigen::Rotation2Dd(-static_cast<double>(b2Rot_GetAngle(xf.q))).toRotationMatrix();
   Eigen::Vector2d lo[3], hi[3];
   poursim::bucket_walls(c, lo, hi);
   for (size_t i = 0; i < n; ++i) {

@@ -4,6 +4,8 @@
   reward curve  -- per-iteration mean episode return, mean and spread over seeds, one band per method
   angle         -- tilt angle over time of the best training episode of a run (Figs. 4 and 6)
   volumes       -- V_rotating, V_target, V_spill over time of an episode
+  --liquid      -- the simulated liquid against physics: retention curves against an ideal liquid at three
+                   fills (and the rigid pile of the first wave), and the slosh after a 12 deg tilt
 """
 from __future__ import annotations
 
@@ -125,16 +127,74 @@ def best_episode(run_dir: Path) -> np.ndarray:
         return np.array(z["best_ep_x"])
 
 
+def liquid(out_dir: Path, prefix: str = "") -> list[Path]:
+    """liquid_retention.png and liquid_slosh.png: the measurements host_sim --bench prints."""
+    from pour import sim
+
+    base = sim.default_config()
+    depth = base["bucket_height"] - base["bucket_wall"]
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for share, colour in ((0.60, "tab:blue"), (0.70, "tab:green"), (0.85, "tab:red")):
+        r = sim.retention({"fill_depth": share * depth})
+        deg = np.degrees(r.theta)
+        ax.plot(deg, 100 * r.ideal, "--", color=colour, lw=1)
+        ax.plot(deg, 100 * r.kept, color=colour,
+                label=f"fill {100 * share:.0f} %: onset {np.degrees(r.onset):.0f} deg "
+                      f"(ideal {np.degrees(r.ideal_onset):.0f}), RMS gap {100 * r.rms_gap:.1f} %")
+    pile = sim.retention({"fill_depth": 0.70 * depth, "fluid": 0}, n_seeds=1)
+    ax.plot(np.degrees(pile.theta), 100 * pile.kept, ":", color="0.3",
+            label=f"rigid pile (fluid = 0), fill 70 %: RMS gap {100 * pile.rms_gap:.0f} %")
+    ax.set(xlabel="tilt [deg] (servo, 0.02 rad/s)", ylabel="liquid left in the bucket [%]", xlim=(0, 125),
+           title="Retention: simulated liquid (solid) against an ideal liquid (dashed)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths = [out_dir / f"{prefix}liquid_retention.png"]
+    fig.savefig(paths[0], dpi=110)
+    plt.close(fig)
+
+    s = sim.slosh()
+    t = np.arange(len(s.trace)) * base["dt"]
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.plot(t, 1e3 * s.trace, lw=1, label="centre of mass across the bucket, mean of 16 seeds")
+    env = 1e3 * s.amplitude * np.exp(-s.damping * 2 * np.pi * s.freq * t)
+    ax.plot(t, env, "k--", lw=0.8, label=f"fit: {s.freq:.2f} Hz (theory {s.freq_theory:.2f} Hz), "
+                                         f"damping ratio {s.damping:.2f}")
+    ax.plot(t, -env, "k--", lw=0.8)
+    ax.set(xlabel="time after the 12 deg tilt [s]", ylabel="[mm]", title="Sloshing after a tilt", xlim=(0, t[-1]))
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    fig.tight_layout()
+    paths.append(out_dir / f"{prefix}liquid_slosh.png")
+    fig.savefig(paths[1], dpi=110)
+    plt.close(fig)
+    return paths
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
-    ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), required=True,
+    ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"),
                     help="a label and its run directories (repeat per method)")
+    ap.add_argument("--liquid", action="store_true",
+                    help="plot the liquid against physics instead (retention, sloshing; ~1 min)")
     ap.add_argument("--out", required=True, help="output folder for the PNGs")
     ap.add_argument("--prefix", default="", help="file name prefix")
     ap.add_argument("--period-ms", type=int, default=10)
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.liquid:
+        from pour.sim import SimError
+        try:
+            for p in liquid(out, args.prefix):
+                print(f"pour-plots: wrote {p}")
+        except SimError as exc:
+            print(f"pour-plots: error: {exc}", file=sys.stderr)
+            return 2
+        return 0
+    if not args.group:
+        print("pour-plots: error: give --group LABEL RUN_DIR... or --liquid", file=sys.stderr)
+        return 2
     groups = {}
     for g in args.group:
         if len(g) < 2:

@@ -89,6 +89,24 @@ class EpisodeStruct(C.Structure):
     ]
 
 
+RETENTION_MAX = 181
+
+
+class RetentionStruct(C.Structure):
+    _fields_ = [
+        ("n", C.c_int), ("theta", C.c_double * RETENTION_MAX), ("kept", C.c_double * RETENTION_MAX),
+        ("ideal", C.c_double * RETENTION_MAX), ("onset", C.c_double), ("ideal_onset", C.c_double),
+        ("rms_gap", C.c_double),
+    ]
+
+
+class SloshStruct(C.Structure):
+    _fields_ = [
+        ("freq", C.c_double), ("freq_theory", C.c_double), ("damping", C.c_double), ("amplitude", C.c_double),
+        ("noise", C.c_double), ("n", C.c_int),
+    ]
+
+
 CONFIG_KEYS: tuple[str, ...] = tuple(name for name, _ in ConfigStruct._fields_)
 
 _lib: C.CDLL | None = None
@@ -140,6 +158,13 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_create": ([P(ConfigStruct)] + err, C.c_void_p),
         "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
         "poursim_step": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_step_servo": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_world_error": ([C.c_void_p], C.c_char_p),
+        "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
+        "poursim_measure_retention": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double,
+                                       P(RetentionStruct)] + err, C.c_int),
+        "poursim_measure_slosh": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
+                                   P(C.c_double), C.c_int, P(SloshStruct)] + err, C.c_int),
         "poursim_observe": ([C.c_void_p, P(ObsStruct)], None),
         "poursim_destroy": ([C.c_void_p], None),
         "poursim_particle_count": ([C.c_void_p], C.c_int),
@@ -327,6 +352,8 @@ class World:
     def step(self, action: float) -> Obs:
         o = ObsStruct()
         if self._lib.poursim_step(self._check(), float(action), C.byref(o)) != 0:
+            if self._lib.poursim_world_error(self._check()):
+                raise SimError(self._lib.poursim_world_error(self._check()).decode(errors="replace"))
             raise SimError(f"step refused action {action!r} (must be a finite number)")
         return Obs.from_struct(o)
 
@@ -400,6 +427,55 @@ def rollout_batch(config: ConfigStruct | Mapping[str, float] | None, policy: Pol
     return [bufs[i].result(seeds[i], arr_e[i]) for i in range(n)]
 
 
+@dataclass
+class Retention:
+    """What the bucket keeps as it tilts (poursim_measure_retention), against an ideal liquid."""
+    theta: np.ndarray   # [rad], one per degree
+    kept: np.ndarray    # V_rotating, mean over the seeds
+    ideal: np.ndarray   # a level liquid's share below the lower lip
+    onset: float        # [rad], first <= 99.5 %
+    ideal_onset: float  # [rad]
+    rms_gap: float
+
+
+def retention(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 3,
+              rate: float = 0.02, theta_end: float = np.radians(125)) -> Retention:
+    """Servo-tilts the bucket at rate [rad/s] to theta_end [rad] once per seed; docs/simulator.md."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    r, e = RetentionStruct(), _err()
+    if lib.poursim_measure_retention(C.byref(cfg), int(seed), int(n_seeds), float(rate), float(theta_end),
+                                     C.byref(r), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    n = r.n
+    return Retention(np.array(r.theta[:n]), np.array(r.kept[:n]), np.array(r.ideal[:n]), r.onset, r.ideal_onset,
+                     r.rms_gap)
+
+
+@dataclass
+class Slosh:
+    """The liquid's centre of mass across the bucket after a tilt (poursim_measure_slosh)."""
+    freq: float          # [Hz]
+    freq_theory: float   # [Hz], first mode of a rectangular tank
+    damping: float
+    amplitude: float     # [m]
+    noise: float         # [m]
+    trace: np.ndarray    # [m], one sample a step, the oscillation about its equilibrium
+
+
+def slosh(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 16,
+          tilt: float = np.radians(12), ramp_s: float = 0.3, hold_s: float = 4.0) -> Slosh:
+    """Tilts to tilt [rad] in ramp_s, holds hold_s, averages n_seeds; docs/simulator.md."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cap = int(round(hold_s / cfg.dt)) + 1
+    trace, out, e = (C.c_double * cap)(), SloshStruct(), _err()
+    if lib.poursim_measure_slosh(C.byref(cfg), int(seed), int(n_seeds), float(tilt), float(ramp_s), float(hold_s),
+                                 trace, cap, C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return Slosh(out.freq, out.freq_theory, out.damping, out.amplitude, out.noise, np.array(trace[:out.n]))
+
+
 def version() -> str:
     return load_library().poursim_version().decode()
 
@@ -409,5 +485,6 @@ def uniform_levels(n_actions: int) -> np.ndarray:
     return np.linspace(-1.0, 1.0, n_actions)
 
 
-__all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "default_config", "make_config",
-                          "rollout_batch", "load_library", "uniform_levels", "CONFIG_KEYS", "REGIONS", "version")
+__all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
+                          "make_config", "rollout_batch", "retention", "slosh", "load_library", "uniform_levels",
+                          "CONFIG_KEYS", "REGIONS", "version")
