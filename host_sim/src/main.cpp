@@ -471,7 +471,6 @@ int main(int argc, char **argv) {
     Episode e = run_episode(world, *ctl, seed, &rec);
     if (!e.error.empty()) {
       std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
-      if (csv != nullptr) std::fclose(csv);
       poursim_destroy(world);
       return 1;
     }
