@@ -57,6 +57,7 @@ const Field kFields[] = {
     F(tau_max, Double, 0.01, 1000.0),
     F(theta_min, Double, -1.0, 0.0),
     F(theta_max, Double, 0.1, 3.1),
+    F(brake_torque, Double, 0.0, 1000.0),
     F(obs_theta_min, Double, -3.2, 3.2),
     F(obs_theta_max, Double, -3.2, 3.2),
     F(obs_omega_max, Double, 1e-3, 1000.0),
@@ -139,6 +140,7 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.tau_max = 20.0;
   c.theta_min = -0.0872664626; // -5°
   c.theta_max = 2.35619449;    // 135°
+  c.brake_torque = 40.0;       // twice the drive's peak: holds the full bucket at any tilt (~15 N·m worst)
   c.obs_theta_min = 0.0;
   c.obs_theta_max = 2.356194;
   c.obs_omega_max = 4.0;

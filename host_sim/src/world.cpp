@@ -320,6 +320,7 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   // Settle with the bucket held by the joint motor, then release it at rest.
   int settle_steps = static_cast<int>(std::lround(c.settle_s / c.dt));
   w->step = 0;
+  w->brake = false;
   w->error[0] = '\0';
   for (int i = 0; i < settle_steps; ++i) advance(w);
   int rc = check_numerics(w);
@@ -339,7 +340,12 @@ int poursim_step(poursim_world_t *w, double action, poursim_obs_t *out) {
   if (!std::isfinite(action)) return POURSIM_EINVAL;
   double a = std::max(-1.0, std::min(1.0, action));
   double tau = a * w->cfg.tau_max;
-  b2RevoluteJoint_EnableMotor(w->joint, false);
+  // The joint's motor is the brake when engaged: zero speed, up to the brake's rating.
+  b2RevoluteJoint_EnableMotor(w->joint, w->brake);
+  if (w->brake) {
+    b2RevoluteJoint_SetMotorSpeed(w->joint, 0.0f);
+    b2RevoluteJoint_SetMaxMotorTorque(w->joint, static_cast<float>(w->cfg.brake_torque));
+  }
   b2Body_ApplyTorque(w->bucket, static_cast<float>(-tau), true);
   advance(w);
   w->step++;
@@ -365,6 +371,12 @@ int poursim_step_servo(poursim_world_t *w, double theta_ref, poursim_obs_t *out)
   w->obs.torque = -static_cast<double>(b2RevoluteJoint_GetMotorTorque(w->joint));
   measure(w);
   if (out != nullptr) *out = w->obs;
+  return POURSIM_OK;
+}
+
+int poursim_set_brake(poursim_world_t *w, int engaged) {
+  if (w == nullptr || !w->has_world) return POURSIM_EINVAL;
+  w->brake = engaged != 0;
   return POURSIM_OK;
 }
 

@@ -27,6 +27,7 @@ struct poursim_world {
   uint32_t step = 0;
   uint64_t hash = 0;
   double max_wall_pen = 0.0;   // [m]
+  bool brake = false;          // holding brake engaged
   char error[POURSIM_ERR_LEN] = ""; // why the last step failed
 };
 

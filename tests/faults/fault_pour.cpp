@@ -8,9 +8,8 @@
 // the slew limit except to zero, at rest without passing θmax + 10°. Prints one table row per scenario
 // (docs/hazards.md carries the table); exits 1 if a bar is missed, 2 on bad arguments.
 //
-// The brake is not part of the simulator: while the core asks for it, this driver applies a holding
-// brake model, the torque that would stop the bucket's own inertia within the step, saturated at the
-// brake's rating (tau_max). With the power cut, the motor's torque is zero.
+// While the core asks for the brake, the simulator's holding brake clamps the axis (poursim_set_brake:
+// a friction brake rated brake_torque). With the power cut, the motor's torque is zero.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -111,7 +110,6 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
   }
   CanPath can;
   can.init();
-  const double inertia = poursim_bucket_inertia(world);
   poursim_obs_t obs{};
   poursim_observe(world, &obs);
   pour_control_output_t out{};
@@ -189,10 +187,7 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
       r.faults = out.faults;
       r.onset_ms = onset;
     }
-    if (out.brake) {
-      // Stops this step's motion of the bucket itself, up to the brake's rating (tau_max).
-      applied += std::max(-1.0, std::min(1.0, -inertia * obs.omega / cfg.dt / cfg.tau_max));
-    }
+    poursim_set_brake(world, out.brake ? 1 : 0); // the simulator's friction brake, rated brake_torque
     if (poursim_step(world, applied, &obs) != POURSIM_OK) break;
     if (k >= sc.inject_ms) {
       const double deg = obs.theta * 180.0 / M_PI;

@@ -54,6 +54,7 @@ class ConfigStruct(C.Structure):
         ("fluid_agitation", C.c_double), ("restitution_liquid", C.c_double), ("restitution_wall", C.c_double), ("friction", C.c_double),
         ("restitution_threshold", C.c_double), ("contact_hertz", C.c_double),
         ("tau_max", C.c_double), ("theta_min", C.c_double), ("theta_max", C.c_double),
+        ("brake_torque", C.c_double),
         ("obs_theta_min", C.c_double), ("obs_theta_max", C.c_double), ("obs_omega_max", C.c_double),
         ("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double), ("seed", C.c_uint32),
     ]

@@ -63,6 +63,7 @@ typedef struct {
   double tau_max;         /* torque of action level 1.0 [N·m] */
   double theta_min;       /* lower hard stop [rad] */
   double theta_max;       /* upper hard stop [rad] */
+  double brake_torque;    /* holding brake's rating [N·m] (poursim_set_brake) */
   /* observation normalisation (must match the policy's weights.h) */
   double obs_theta_min;   /* [rad] */
   double obs_theta_max;   /* [rad] */
@@ -118,6 +119,11 @@ int poursim_reset(poursim_world_t *world, uint32_t seed);
  * POURSIM_ENUMERIC if the liquid blew up in this step (a non-finite or runaway particle): the world is
  * then unusable until reset, and poursim_world_error() says which particle and where. */
 int poursim_step(poursim_world_t *world, double action, poursim_obs_t *out);
+
+/* Engages (1) or releases (0) the holding brake on the bucket's axis, for the steps that follow: a
+ * friction brake that stops the axis and holds it against up to brake_torque, as the joint's motor at
+ * zero speed with that torque limit. Torque from poursim_step still acts on top. */
+int poursim_set_brake(poursim_world_t *world, int engaged);
 
 /* One dt step with the bucket driven toward theta_ref [rad] by a stiff servo (the joint's motor) instead
  * of a torque: for measurements that need a prescribed tilt (retention curve, sloshing). */
