@@ -128,12 +128,14 @@ bench_lcm() {
 # --- section: sim — the Box2D pouring world (libpoursim, host_sim --bench) --------------------------
 # Real-time factor of one 10 s episode on one core (hand-written pour; by thread CPU time, which the
 # other processes on a shared machine do not distort, and by wall time), the deepest resting overlap
-# (contact quality), C rollouts per second on 1 and 2 threads with the shipped policy, and the pour
-# onset angle against an ideal liquid of the same fill. Bars: >= 15x real time, <= 1 mm overlap.
+# (contact quality) and the liquid's compression, C rollouts per second on 1 and 2 threads with the
+# shipped policy, and the liquid against physics: retention curves against an ideal liquid at three fills,
+# sloshing against the first mode of a rectangular tank (docs/simulator.md). Bars: >= 20x real time,
+# >= 4 episodes/s on both cores, <= 1 mm overlap, onset within 5 deg, RMS gap <= 5 %, slosh within 15 %.
 bench_sim() {
   local log
   log=$(mktemp)
-  echo "== sim: libpoursim (Box2D 3.1, 150 circles, 1 ms steps) =="
+  echo "== sim: libpoursim (Box2D 3.1, 150 particles of liquid, 1 ms steps) =="
   if ! { cmake --preset host && cmake --build --preset host -j2 --target host_sim; } >"$log" 2>&1; then
     cat "$log"
     rm -f "$log"
