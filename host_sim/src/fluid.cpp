@@ -42,7 +42,7 @@ void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
   n_ = n;
   rng_ = seed | 1u; // xorshift must not start at 0
   const size_t un = static_cast<size_t>(n);
-  for (std::vector<double> *v : {&px_, &py_, &rho_}) v->assign(un, 0.0);
+  for (std::vector<double> *v : {&px_, &py_, &sx_, &sy_, &rho_}) v->assign(un, 0.0);
   cell_of_.assign(un, 0);
   sorted_.assign(un, 0);
   pairs_.clear();
@@ -76,18 +76,22 @@ void Fluid::find_pairs() {
   }
   for (size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
-  for (int i = 0; i < n_; ++i) sorted_[static_cast<size_t>(fill_[static_cast<size_t>(cell_of_[static_cast<size_t>(i)])]++)] = i;
+  for (int i = 0; i < n_; ++i) {
+    const size_t slot = static_cast<size_t>(fill_[static_cast<size_t>(cell_of_[static_cast<size_t>(i)])]++);
+    sorted_[slot] = i;
+    sx_[slot] = px_[static_cast<size_t>(i)], sy_[slot] = py_[static_cast<size_t>(i)]; // cell order: contiguous scans
+  }
 
   const double h2 = p_.h * p_.h;
-  auto scan = [&](int i, int b0, int b1) {
-    const double xi = px_[static_cast<size_t>(i)], yi = py_[static_cast<size_t>(i)];
+  auto scan = [&](int a, int b0, int b1) {
+    const int i = sorted_[static_cast<size_t>(a)];
+    const double xi = sx_[static_cast<size_t>(a)], yi = sy_[static_cast<size_t>(a)];
     for (int b = b0; b < b1; ++b) {
-      const int j = sorted_[static_cast<size_t>(b)];
-      const double ex = px_[static_cast<size_t>(j)] - xi, ey = py_[static_cast<size_t>(j)] - yi;
+      const double ex = sx_[static_cast<size_t>(b)] - xi, ey = sy_[static_cast<size_t>(b)] - yi;
       const double r2 = ex * ex + ey * ey;
       if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
       const double r = std::sqrt(r2);
-      pairs_.push_back({i, j, ex / r, ey / r, 1.0 - r * inv});
+      pairs_.push_back({i, sorted_[static_cast<size_t>(b)], ex / r, ey / r, 1.0 - r * inv});
     }
   };
   static const int kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
@@ -95,13 +99,12 @@ void Fluid::find_pairs() {
     for (int cx = 0; cx < nx; ++cx) {
       const size_t c = static_cast<size_t>(cy * nx + cx);
       for (int a = cell_start_[c]; a < cell_start_[c + 1]; ++a) {
-        const int i = sorted_[static_cast<size_t>(a)];
-        scan(i, a + 1, cell_start_[c + 1]);
+        scan(a, a + 1, cell_start_[c + 1]);
         for (const auto &f : kForward) {
           const int fx = cx + f[0], fy = cy + f[1];
           if (fx < 0 || fx >= nx || fy >= ny) continue;
           const size_t o = static_cast<size_t>(fy * nx + fx);
-          scan(i, cell_start_[o], cell_start_[o + 1]);
+          scan(a, cell_start_[o], cell_start_[o + 1]);
         }
       }
     }

@@ -50,7 +50,7 @@ class Fluid {
   FluidParams p_{};
   int n_ = 0;
   uint64_t rng_ = 1;
-  std::vector<double> px_, py_, rho_;
+  std::vector<double> px_, py_, sx_, sy_, rho_; // predicted positions; the same in cell order
   std::vector<int32_t> cell_of_, cell_start_, fill_, sorted_;
   std::vector<Pair> pairs_;
   double max_ratio_ = 0.0;

@@ -224,6 +224,8 @@ static void measure(poursim_world_t *w) {
     // How deep any circle sinks into a wall of either bucket (more than its radius = passed through).
     const Eigen::Vector2d in_target = Eigen::Vector2d(px, py) - target_centre;
     for (const Eigen::Vector2d &q : {local, in_target}) {
+      // Only a circle within reach of a wall can sink into it.
+      if (std::fabs(q.x()) < wi - 2.0 * static_cast<double>(w->radii[i]) && std::fabs(q.y()) < hh - 2.0 * c.bucket_wall - 2.0 * static_cast<double>(w->radii[i])) continue;
       if (q.norm() > hh + wi + 0.05) continue;
       for (int k = 0; k < 3; ++k) {
         double pen = static_cast<double>(w->radii[i]) - box_sdf(q, lo[k], hi[k]);
