@@ -29,6 +29,7 @@ namespace {
 
 constexpr double kRestOmega = 0.05;   // [rad/s]
 constexpr int kRestHoldTicks = 100;   // at rest this long to count
+constexpr uint32_t kLossSeeds = 10;    // pours the 10 % loss bar is judged over
 constexpr int kDetectBarMs = 50;
 
 enum class Fault {
@@ -264,11 +265,29 @@ int main(int argc, char **argv) {
       }
     } else {
       if (r.detect_ms >= 0) { r.ok = false; r.why += " a fault on a fault-free run"; }
-      // The nominal bar (>= 95 % poured, <= 3 % spilled) holds with 10 % loss wherever the policy meets it.
-      const bool ref_meets = ref.poured >= 95.0 && ref.spilled <= 3.0;
-      if (sc.fault == Fault::kLoss10 && ref_meets && (r.poured < 95.0 || r.spilled > 3.0)) {
-        r.ok = false;
-        r.why += " misses the nominal bar";
+      // 10 % loss is not a fault: over the same seeds it must not make the pour worse than it is without
+      // loss, beyond the pours' own scatter (a paired comparison: one pour's spill is chaotic, a particle
+      // is 0.7 %), and it must keep the nominal bar (mean >= 95 % poured, <= 3 % spilled) wherever the
+      // policy keeps it without loss by more than that scatter.
+      if (sc.fault == Fault::kLoss10) {
+        double d_sum = 0, d_sq = 0, nominal_spilled = 0, loss_spilled = 0, loss_poured = 0;
+        for (uint32_t k = 0; k < kLossSeeds; ++k) {
+          const Result a = run(nominal, seed + k, base), b = run(sc, seed + k, base);
+          const double d = b.spilled - a.spilled;
+          d_sum += d, d_sq += d * d;
+          nominal_spilled += a.spilled / kLossSeeds, loss_spilled += b.spilled / kLossSeeds;
+          loss_poured += b.poured / kLossSeeds;
+        }
+        const double n = kLossSeeds, d_mean = d_sum / n;
+        const double se = std::sqrt(std::max(0.0, (d_sq - n * d_mean * d_mean) / (n - 1.0)) / n);
+        std::printf("10 %% loss over %u seeds: spilled %.1f %% against %.1f %% without loss (paired difference "
+                    "%+.2f %%, standard error %.2f %%)\n", kLossSeeds, loss_spilled, nominal_spilled, d_mean, se);
+        const bool worse = d_mean > 2.0 * se;
+        const bool bar_lost = nominal_spilled + 2.0 * se <= 3.0 && (loss_spilled > 3.0 || loss_poured < 95.0);
+        if (worse || bar_lost) {
+          r.ok = false;
+          r.why += worse ? " loss makes the pour worse" : " misses the nominal bar";
+        }
       }
     }
     char detect[32], rest[32];
