@@ -30,7 +30,7 @@ namespace {
 const char *kUsage =
     "usage: host_sim (--policy WEIGHTS_H | --baseline NAME | --bench) [options]\n"
     "\n"
-    "Pours a bucket of simulated liquid (150 circles, Box2D) into a second bucket and reports how\n"
+    "Pours a bucket of simulated liquid (150 particles of a fluid, Box2D) into a second bucket and reports how\n"
     "much landed in the target, how much was spilled, how long the pour took and the return.\n"
     "\n"
     "What drives the bucket (one of):\n"

@@ -65,8 +65,8 @@ static void test_config_load_NamesFileAndLineInEveryError(void) {
   static const char bad_value[] = "# c\nfriction = 1e999\n";
   expect_error(load_text("value.cfg", bad_value, sizeof bad_value - 1), "value.cfg:2:", "friction");
   /* A rule across keys: the line of the key the rule names first. */
-  static const char cross[] = "seed = 3\nradius_min = 0.02\n";
-  expect_error(load_text("cross.cfg", cross, sizeof cross - 1), "cross.cfg:2:", "radius_min");
+  static const char cross[] = "seed = 3\nfill_depth = 0.32\n"; /* overflows the 32.5 cm bucket */
+  expect_error(load_text("cross.cfg", cross, sizeof cross - 1), "cross.cfg:2:", "fill_depth");
   expect_error(poursim_config_load("/nonexistent/x.cfg", &cfg, err, sizeof err), "/nonexistent/x.cfg", "cannot read");
 }
 
