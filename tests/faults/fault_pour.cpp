@@ -177,7 +177,7 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
     if (cmd != 0 && (step > ccfg.safety.slew_per_tick || step < -ccfg.safety.slew_per_tick)) r.slew_violations++;
     if (cmd > ccfg.safety.tau_limit || cmd < -ccfg.safety.tau_limit) r.clamp_violations++;
     last = cmd;
-    // The actuator: motor torque through the injected faults, or the brake model.
+    // The actuator: motor torque through the injected faults; the brake is the simulator's (below).
     const double commanded = out.power ? cmd / 32768.0 : 0.0;
     double applied = commanded;
     if (injected && sc.fault == Fault::kMotorReversed) applied = -applied;

@@ -87,6 +87,9 @@ static void test_liquid_ABlownUpFluidStopsTheStepWithAClearError(void) {
   TEST_ASSERT_NOT_NULL(strstr(poursim_world_error(w), "particle"));
   /* The world refuses to go on until it is reset; a reset brings it back. */
   TEST_ASSERT_NOT_EQUAL(POURSIM_OK, poursim_step(w, 0.0, NULL));
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_reset(w, 1));
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_step(w, 0.0, NULL));
+  TEST_ASSERT_EQUAL_STRING("", poursim_world_error(w));
   poursim_destroy(w);
 }
 
