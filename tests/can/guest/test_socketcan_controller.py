@@ -93,14 +93,16 @@ def test_silent_bus_trips_the_watchdog(bus):
         answer = run_states(bus, 40, 3)[-1]
         assert answer["Torque"] == 0 and answer["Mode"] == MODE["FAULT"]
         # ClearErrors clears it through the core: fresh states bring RUN back, the torque ramping up from zero
-        # through the slew limit (3277 per 1 ms tick; a real-time answer comes every few ticks), never jumping
-        # to the command the policy had before the trip.
+        # through the slew limit (3277 per 1 ms tick), never jumping to the command the policy had before the
+        # trip. How many ticks pass between two answers depends on the guest's scheduling (a loaded host let
+        # ten pass), so only the first answer and the monotone ramp are asserted here; the slew limit's exact
+        # steps are pinned tick by tick in the unit tests.
         bus.send("ClearErrors")
         answers = run_states(bus, 43, 20)
         assert answers[-1]["Mode"] == MODE["RUN"]
         torques = [a["Torque"] for a in answers]
         assert 0 < torques[0] <= 2 * 3277, torques
-        assert sum(1 for t in torques if 0 < t < 32767) >= 2, torques  # on its way up, not there at once
+        assert torques == sorted(torques), torques
         hb = bus.wait_for("Heartbeat", timeout=1.0)
         assert hb["Fault_CanWatchdog"] == 0
     finally:
