@@ -49,12 +49,12 @@ bench_core() {
     read -r t d b < <(arm-none-eabi-size "$o" | awk 'NR == 2 {print $1, $2, $3}')
     all_text=$((all_text + t + d))
     case "$(basename "$o")" in
-      fixed.c.obj|obs.c.obj|policy.c.obj|safety.c.obj|supervisor.c.obj|control.c.obj)
+      fixed.c.obj|obs.c.obj|policy.c.obj|safety.c.obj|sensors.c.obj|supervisor.c.obj|control.c.obj)
         core_text=$((core_text + t + d)); core_ram=$((core_ram + d + b))
         printf '   %-18s %5d B flash\n' "$(basename "$o" .c.obj).c" $((t + d)) ;;
     esac
   done
-  printf '   control core (fixed, obs, policy, safety, supervisor, control): %d B flash, %d B static RAM;\n' \
+  printf '   control core (fixed, obs, policy, safety, sensors, supervisor, control): %d B flash, %d B static RAM;\n' \
     "$core_text" "$core_ram"
   printf '   one controller instance (pour_control_t): %s B RAM\n' "${state:-?}"
   # Deepest stack of one step: pour_control_step -> pour_policy_eval -> its deepest kernel (gcc -fstack-usage).
@@ -83,7 +83,7 @@ bench_core() {
 }
 
 # --- section: lcm — host_sim and pour_controller as two processes over LCM (udpm, loopback) ------------
-# Lockstep: loop rate and round trip POUR_STATE -> POUR_TORQUE (median, p99) over 20,000 exchanges with
+# Lockstep: loop rate and round trip POUR_SENSORS -> POUR_TORQUE (median, p99) over 20,000 exchanges with
 # synthetic states (the transport and the controller alone), then a 10 s pour (10,000 steps, Box2D
 # included) next to the same pour in-process. Real time: a 60 s pour at 1 kHz wall clock against the
 # controller's own 1 kHz loop: late and missing answers, safe-torque ticks and overruns on both sides.
@@ -248,11 +248,11 @@ fuzz_sources() {
   case $1 in
     fuzz_weights_h) echo host_sim/src/weights_file.cpp ;;
     fuzz_config) echo host_sim/src/config.cpp ;;
-    fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/supervisor.c firmware/src/policy.c firmware/src/obs.c ;;
+    fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/sensors.c firmware/src/supervisor.c firmware/src/policy.c firmware/src/obs.c ;;
     fuzz_can_node) echo firmware/can/src/can_node.c firmware/can/src/can_codec.c firmware/src/control.c firmware/src/safety.c ;;
-    fuzz_lcm_decode) echo build/host-fuzz-cov/lcmtypes/c/pour_plant_state_t.c build/host-fuzz-cov/lcmtypes/c/pour_command_t.c \
+    fuzz_lcm_decode) echo build/host-fuzz-cov/lcmtypes/c/pour_sensor_sample_t.c build/host-fuzz-cov/lcmtypes/c/pour_command_t.c \
                           build/host-fuzz-cov/lcmtypes/c/pour_torque_t.c ;;
-    fuzz_lcm_port) echo firmware/ports/linux/io_lcm.c firmware/ports/linux/state_si.c ;;
+    fuzz_lcm_port) echo firmware/ports/linux/io_lcm.c ;;
   esac
 }
 bench_fuzz() {

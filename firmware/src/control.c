@@ -8,7 +8,7 @@
 #define DEFAULT_SEED 1u
 #define DEFAULT_PLAUSIBLE_THETA_URAD 3141593   /* π: the tilt cannot pass half a turn */
 #define DEFAULT_PLAUSIBLE_OMEGA_URAD_S 50000000 /* 50 rad/s, ~8 turns/s */
-#define DEFAULT_PLAUSIBLE_VOLUME_SUM 32896      /* 1.0 + 128 LSB (0.4 %) of slack for rounding */
+#define DEFAULT_PLAUSIBLE_VOLUME_SUM 65536      /* off: load-cell volumes pass 1 under impact and slosh */
 #define DEFAULT_STOP_TORQUE_MAX 16384            /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s */
 #define DEFAULT_STOP_RETURN_SPEED_URAD_S 1000000 /* 1 rad/s back toward upright: no slosh over the lip */
 #define DEFAULT_STOP_RETURN_GAIN_PER_S 2u
@@ -20,6 +20,7 @@
 pour_control_config_t pour_control_default_config(void) {
   pour_control_config_t config;
   config.safety = pour_safety_default_config();
+  config.sensors = pour_sensors_default_config();
   config.input_timeout_ms = DEFAULT_INPUT_TIMEOUT_MS;
   config.safe_torque = 0;
   config.policy_mode = POUR_POLICY_GREEDY;
@@ -60,6 +61,7 @@ static void start_afresh(pour_control_t *ctl) {
   ctl->eval.action = 0u;
   ctl->probs_pending = false;
   pour_supervisor_restart(&ctl->supervisor);
+  pour_estimator_reset(&ctl->estimator);
   ctl->stop_ms = 0u;
   ctl->stopped = false;
 }
@@ -80,6 +82,7 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
     return POUR_EINVAL;
   }
   if (pour_safety_init(&ctl->safety, &c->safety) != POUR_OK || !stop_config_ok(&c->stop) ||
+      pour_estimator_init(&ctl->estimator, &c->sensors) != POUR_OK ||
       pour_supervisor_init(&ctl->supervisor, &c->supervisor, c->safety.theta_min_urad, c->safety.theta_max_urad) !=
           POUR_OK) {
     return POUR_EINVAL;
@@ -155,7 +158,8 @@ static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
       ctl->stop_ms++;
       *active = true;
       /* Through the envelope: the stop never steps the torque by more than the slew limit. */
-      return pour_safety_apply(&ctl->safety, stop_request(c, &ctl->state), ctl->state.theta_urad);
+      return pour_safety_apply(&ctl->safety, stop_request(c, &ctl->state), ctl->state.theta_urad,
+                               ctl->state.omega_urad_s);
     }
   }
   return force_safe(ctl);
@@ -216,21 +220,29 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
   }
 
   bool fresh = false;
-  if (in->state_fresh && !plausible(&ctl->config, &in->state)) {
-    ctl->faults |= POUR_FAULT_BAD_INPUT;
-    ctl->mode = POUR_MODE_FAULT;
-  } else if (in->state_fresh && pour_supervisor_accept(&ctl->supervisor, &in->state)) {
-    ctl->state = in->state;
-    ctl->ms_since_fresh = 0u;
-    fresh = true;
-  } else {
+  if (in->sensors_fresh && ctl->mode == POUR_MODE_IDLE) {
+    /* A run's estimate starts from its own first sample: θ̇ from rest, m0 from the liquid as it is now. */
+    pour_estimator_reset(&ctl->estimator);
+  }
+  if (in->sensors_fresh && pour_supervisor_accept(&ctl->supervisor, in->sensors.seq)) {
+    pour_state_t state;
+    if (!pour_estimator_update(&ctl->estimator, &in->sensors, &state) || !plausible(&ctl->config, &state)) {
+      ctl->faults |= POUR_FAULT_BAD_INPUT;
+      ctl->mode = POUR_MODE_FAULT;
+    } else {
+      ctl->state = state;
+      ctl->ms_since_fresh = 0u;
+      fresh = true;
+    }
+  }
+  if (!fresh) {
     if (ctl->ms_since_fresh != UINT32_MAX) {
       ctl->ms_since_fresh++;
     }
     if (ctl->mode == POUR_MODE_RUN && ctl->ms_since_fresh > ctl->config.input_timeout_ms) {
       ctl->faults |= POUR_FAULT_STALE_INPUT;
       if (ctl->supervisor.seq_repeats > 0u) {
-        ctl->faults |= POUR_FAULT_SEQ; /* states came, but the same one again: a frozen sender */
+        ctl->faults |= POUR_FAULT_SEQ; /* samples came, but the same one again: a frozen sender */
       }
       ctl->mode = POUR_MODE_FAULT;
     }
@@ -268,7 +280,8 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
       ctl->probs_pending = false;
     }
     ctl->ms_to_decision--;
-    torque = pour_safety_apply(&ctl->safety, w->action_levels[ctl->eval.action], ctl->state.theta_urad);
+    torque = pour_safety_apply(&ctl->safety, w->action_levels[ctl->eval.action], ctl->state.theta_urad,
+                               ctl->state.omega_urad_s);
     pour_supervisor_record(&ctl->supervisor, &ctl->state, torque);
     fill_output(ctl, torque, out);
   } else if (ctl->mode == POUR_MODE_FAULT) {

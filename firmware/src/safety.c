@@ -7,6 +7,10 @@
 #define DEFAULT_SLEW_PER_TICK 3277        /* a full -1 -> +1 swing (65535 LSB) in 20 ticks */
 #define DEFAULT_THETA_MIN_URAD (-87266)   /* -5 deg: a little past upright, never backwards over */
 #define DEFAULT_THETA_MAX_URAD 2356194    /* 135 deg: the hard stop of the bucket's tilt */
+#define DEFAULT_OMEGA_MAX_URAD_S 2000000  /* 2 rad/s: 93 °C liquid stays in the bucket (docs/safety.md) */
+#define DEFAULT_ALPHA_MAX_URAD_S2 3400000 /* 3.4 rad/s²: ω_max reached in one 1.7 Hz slosh period */
+#define DEFAULT_OMEGA_SLACK_URAD_S 800000 /* 0.8 rad/s: K · slack = 0.4 τ_max holds the full bucket */
+#define DEFAULT_TORQUE_PER_RAD_S 16384    /* 0.5 τ_max per rad/s: stable with 2 ticks of latency */
 
 pour_safety_config_t pour_safety_default_config(void) {
   pour_safety_config_t config;
@@ -14,6 +18,10 @@ pour_safety_config_t pour_safety_default_config(void) {
   config.slew_per_tick = DEFAULT_SLEW_PER_TICK;
   config.theta_min_urad = DEFAULT_THETA_MIN_URAD;
   config.theta_max_urad = DEFAULT_THETA_MAX_URAD;
+  config.omega_max_urad_s = DEFAULT_OMEGA_MAX_URAD_S;
+  config.alpha_max_urad_s2 = DEFAULT_ALPHA_MAX_URAD_S2;
+  config.omega_slack_urad_s = DEFAULT_OMEGA_SLACK_URAD_S;
+  config.torque_per_rad_s = DEFAULT_TORQUE_PER_RAD_S;
   return config;
 }
 
@@ -21,12 +29,19 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   if (safety == NULL || config == NULL) {
     return POUR_EINVAL;
   }
-  if (config->tau_limit <= 0 || config->slew_per_tick <= 0 || config->theta_max_urad <= config->theta_min_urad) {
+  const pour_safety_config_t *c = config;
+  if (c->tau_limit <= 0 || c->slew_per_tick <= 0 || c->theta_max_urad <= c->theta_min_urad ||
+      c->omega_max_urad_s <= 0 || c->omega_max_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->alpha_max_urad_s2 < 1000 ||
+      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->torque_per_rad_s <= 0) {
     return POUR_EINVAL;
   }
-  safety->config = *config;
+  safety->config = *c;
   safety->torque = 0;
   safety->active = 0u;
+  safety->alpha_step_urad_s = (int32_t)(((int64_t)c->alpha_max_urad_s2 + 500) / 1000);
+  safety->gain_q32 = (int32_t)(((int64_t)c->torque_per_rad_s * ((int64_t)1 << 32) + 500000) / 1000000);
+  safety->ceiling_urad_s = c->omega_slack_urad_s;
+  safety->floor_urad_s = -c->omega_slack_urad_s;
   return POUR_OK;
 }
 
@@ -43,7 +58,39 @@ static q15_t angle_cut(const pour_safety_config_t *c, q15_t torque, int32_t thet
   return torque;
 }
 
-q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_urad) {
+static int32_t min3(int32_t a, int32_t b, int32_t c) { return a < b ? (a < c ? a : c) : (b < c ? b : c); }
+static int32_t max3(int32_t a, int32_t b, int32_t c) { return a > b ? (a > c ? a : c) : (b > c ? b : c); }
+
+/* Torque bound for a speed margin [µrad/s]: K · margin, Q15, rounded half up, within ±tau_limit.
+ * |margin| <= 2 · 10^8 < 2^28 and gain < 2^28: the product fits int64 (one 32x32 -> 64 multiply); the
+ * result before the clamp < 2^24, so the int32 cast is exact. */
+static int32_t band_torque(const pour_safety_t *s, int32_t margin_urad_s) {
+  const int32_t t = (int32_t)(((int64_t)margin_urad_s * s->gain_q32 + ((int64_t)1 << 31)) >> 32);
+  const int32_t lim = s->config.tau_limit;
+  return t > lim ? lim : (t < -lim ? -lim : t);
+}
+
+/* Moves the band one tick on from the speed θ̇ [µrad/s]; returns the torque bounds it implies, Q15. */
+static void band_bounds(pour_safety_t *s, int32_t omega_urad_s, int32_t *lo, int32_t *hi) {
+  const pour_safety_config_t *c = &s->config;
+  /* Speeds saturate at ±100 rad/s (twice the plausible), which keeps every sum below in int32. */
+  const int32_t w = omega_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S
+                        ? POUR_SAFETY_OMEGA_MAX_URAD_S
+                        : (omega_urad_s < -POUR_SAFETY_OMEGA_MAX_URAD_S ? -POUR_SAFETY_OMEGA_MAX_URAD_S : omega_urad_s);
+  s->ceiling_urad_s = min3(c->omega_max_urad_s, s->ceiling_urad_s + s->alpha_step_urad_s,
+                           (w > 0 ? w : 0) + c->omega_slack_urad_s);
+  s->floor_urad_s = max3(-c->omega_max_urad_s, s->floor_urad_s - s->alpha_step_urad_s,
+                         (w < 0 ? w : 0) - c->omega_slack_urad_s);
+  *hi = band_torque(s, s->ceiling_urad_s - w);
+  *lo = band_torque(s, s->floor_urad_s - w);
+}
+
+/* The limit bit for a cut at the ceiling (or floor): the speed limit itself, or the band still ramping. */
+static uint8_t band_bit(int32_t edge_urad_s, int32_t limit_urad_s) {
+  return edge_urad_s == limit_urad_s ? POUR_LIMIT_SPEED : POUR_LIMIT_ACCEL;
+}
+
+q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_urad, int32_t omega_urad_s) {
   const pour_safety_config_t *c = &safety->config;
   uint8_t active = 0u;
   int32_t cmd = angle_cut(c, requested, theta_urad, &active);
@@ -54,6 +101,21 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
     cmd = -(int32_t)c->tau_limit;
     active |= POUR_LIMIT_CLAMP;
   }
+  /* The speed band: the band follows the speed from within slack and widens by at most one alpha step a
+   * tick, so |θ̇| can grow only as fast as the band does; the torque is kept within K (edge - θ̇), which
+   * turns into a brake beyond an edge. Braking, toward either edge, is never limited. */
+  int32_t lo;
+  int32_t hi;
+  band_bounds(safety, omega_urad_s, &lo, &hi);
+  const uint8_t hi_bit = band_bit(safety->ceiling_urad_s, c->omega_max_urad_s);
+  const uint8_t lo_bit = band_bit(safety->floor_urad_s, -c->omega_max_urad_s);
+  if (cmd > hi) {
+    cmd = hi;
+    active |= hi_bit;
+  } else if (cmd < lo) {
+    cmd = lo;
+    active |= lo_bit;
+  }
   const int32_t delta = cmd - (int32_t)safety->torque; /* |delta| < 2^16: no overflow */
   if (delta > c->slew_per_tick) {
     cmd = safety->torque + c->slew_per_tick;
@@ -62,8 +124,18 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
     cmd = safety->torque - c->slew_per_tick;
     active |= POUR_LIMIT_SLEW;
   }
-  /* A slewed command can still carry the old sign past a limit: cut it now, since dropping to zero
-   * torque never has to wait for the slew. */
+  /* A slewed command can still push beyond the band, or carry the old sign past an angle limit: cut it
+   * now, toward zero, since less torque never has to wait for the slew (a brake that needs the other sign
+   * builds up through the slew from zero). */
+  const int32_t hi_cut = hi > 0 ? hi : 0;
+  const int32_t lo_cut = lo < 0 ? lo : 0;
+  if (cmd > hi_cut) {
+    cmd = hi_cut;
+    active |= hi_bit;
+  } else if (cmd < lo_cut) {
+    cmd = lo_cut;
+    active |= lo_bit;
+  }
   cmd = angle_cut(c, (q15_t)cmd, theta_urad, &active);
   safety->torque = (q15_t)cmd;
   safety->active = active;

@@ -6,19 +6,23 @@
 #include "pour/control.h"
 
 /* docs/safety.md gives the reason for each default; the figures come from 20 held-out pours of the shipped
- * policy and 5 of the hand-written baseline in the simulator (tau_max 20 N·m, 10 kg of liquid). */
+ * policy and 5 of the hand-written baseline in the simulator (tau_max 20 N·m, 10 kg of liquid), re-tuned for
+ * the estimated θ̇, the motion envelope and the 80 Hz load cells (firmware 3). */
 #define DEFAULT_THETA_MARGIN_URAD 87266     /* 5 deg past the envelope's limits */
-#define DEFAULT_OMEGA_MAX_URAD_S 22000000   /* 22 rad/s: nominal peak 16.0 rad/s + 35 % */
+#define DEFAULT_OMEGA_MAX_URAD_S 4000000    /* 4 rad/s: twice the envelope's speed limit */
 #define DEFAULT_WINDOW_MS 10u
-#define DEFAULT_TORQUE_MIN 16384            /* 0.5 tau_max = 10 N·m, twice the liquid's worst gravity torque */
+#define DEFAULT_TORQUE_MIN 11469            /* 0.35 tau_max = 7 N·m, 30 % above the liquid's worst gravity torque */
 #define DEFAULT_OMEGA_AGAINST_URAD_S 300000 /* 0.3 rad/s */
 #define DEFAULT_AGAINST_MS 3u
-#define DEFAULT_ENCODER_MOVE_URAD 500       /* 10 ms at >= 0.5 tau_max move the full bucket >= 1,800 urad */
-#define DEFAULT_VOLUME_STEP_MAX 2621        /* 8 % of the liquid per tick; nominal worst 2.7 % */
+#define DEFAULT_ENCODER_MOVE_URAD 200       /* 4 counts of 17 bits: above a count's jitter */
+#define DEFAULT_ENCODER_MS 30u              /* 30 ms at >= 0.35 tau_max move even a turning bucket further */
+#define DEFAULT_VOLUME_STEP_MAX 1966        /* 6 % of the liquid per tick since the reading last changed */
 #define DEFAULT_ACCEL_FULL_URAD_S2 350000000    /* 350 rad/s²: 20 N·m on the empty bucket measured 335 */
 #define DEFAULT_ACCEL_PASSIVE_URAD_S2 150000000 /* 150 rad/s²: nominal never beyond it 2 ticks in a row */
 #define SEQ_ADVANCE_MAX 32767u              /* a forward gap larger than this is a jump back, not a gap */
-#define VOLUME_GAP_MAX 32u                  /* missed ticks credited to a volume change, at most */
+#define DW_UNIT_URAD_S 32                   /* the ring keeps |Δθ̇| per tick in these units (uint16) */
+#define VOLUME_GAP_MAX 16u                  /* ticks credited to a volume change, at most: an 80 Hz load cell
+                                             * holds its reading 12.5 ms, 16 leave room for its jitter */
 
 pour_supervisor_config_t pour_supervisor_default_config(void) {
   pour_supervisor_config_t c;
@@ -30,6 +34,7 @@ pour_supervisor_config_t pour_supervisor_default_config(void) {
   c.omega_against_urad_s = DEFAULT_OMEGA_AGAINST_URAD_S;
   c.against_ms = DEFAULT_AGAINST_MS;
   c.encoder_move_urad = DEFAULT_ENCODER_MOVE_URAD;
+  c.encoder_ms = DEFAULT_ENCODER_MS;
   c.volume_step_max = DEFAULT_VOLUME_STEP_MAX;
   c.accel_full_urad_s2 = DEFAULT_ACCEL_FULL_URAD_S2;
   c.accel_passive_urad_s2 = DEFAULT_ACCEL_PASSIVE_URAD_S2;
@@ -44,7 +49,8 @@ pour_status_t pour_supervisor_init(pour_supervisor_t *sup, const pour_supervisor
   const pour_supervisor_config_t *c = config;
   if ((c->checks & ~POUR_CHECK_ALL) != 0u || c->theta_margin_urad <= 0 || c->omega_max_urad_s <= 0 ||
       c->window_ms < 2u || c->window_ms > POUR_SUPERVISOR_WINDOW_MAX || c->torque_min <= 0 ||
-      c->omega_against_urad_s <= 0 || c->against_ms < 1u || c->encoder_move_urad <= 0 || c->volume_step_max <= 0 ||
+      c->omega_against_urad_s <= 0 || c->against_ms < 1u || c->encoder_move_urad <= 0 || c->encoder_ms < 1u ||
+      c->volume_step_max <= 0 ||
       c->accel_full_urad_s2 <= 0 || c->accel_passive_urad_s2 <= 0 ||
       theta_max_urad <= theta_min_urad) {
     return POUR_EINVAL;
@@ -62,20 +68,24 @@ void pour_supervisor_restart(pour_supervisor_t *sup) {
   sup->filled = 0u;
   sup->sum = 0;
   sup->sum_abs = 0;
+  sup->sum_dw = 0;
   sup->against = 0u;
   sup->over = 0u;
+  sup->still_ticks = 0u;
+  sup->push_ticks = 0u;
+  sup->push_dir = 0;
   sup->have_state = false;
-  sup->ticks_since_state = 0u;
+  sup->ticks_since_volume = 0u;
   sup->seq_repeats = 0u;
 }
 
-bool pour_supervisor_accept(pour_supervisor_t *sup, const pour_state_t *state) {
+bool pour_supervisor_accept(pour_supervisor_t *sup, uint32_t seq) {
   if (!sup->have_state || (sup->config.checks & POUR_CHECK_SEQ) == 0u) {
     return true;
   }
-  const uint32_t advance = state->seq - sup->last.seq; /* unsigned: wraps by definition */
+  const uint32_t advance = seq - sup->last_seq; /* unsigned: wraps by definition */
   if (advance >= 1u && advance <= SEQ_ADVANCE_MAX) {
-    sup->last.seq = state->seq; /* also outside RUN (no step there): a long FAULT must not lose the count */
+    sup->last_seq = seq; /* also outside RUN (no step there): a long FAULT must not lose the count */
     return true;
   }
   if (sup->seq_repeats != UINT32_MAX) {
@@ -89,24 +99,30 @@ static int32_t abs_q15_diff(q15_t a, q15_t b) {
   return d < 0 ? -d : d;
 }
 
+/* The load cells update at their own rate (80 Hz) and hold in between: a volume moves in steps. Each step is
+ * judged against the time since the reading last changed, so a held reading does not look like a jump. */
 static bool volume_jumped(const pour_supervisor_t *sup, const pour_state_t *s) {
-  const uint32_t gap = sup->ticks_since_state < VOLUME_GAP_MAX ? sup->ticks_since_state : VOLUME_GAP_MAX;
+  const uint32_t gap = sup->ticks_since_volume < VOLUME_GAP_MAX ? sup->ticks_since_volume : VOLUME_GAP_MAX;
   const int32_t allowed = (int32_t)sup->config.volume_step_max * (int32_t)(gap > 0u ? gap : 1u);
-  const pour_state_t *l = &sup->last;
-  return abs_q15_diff(s->v_rotating, l->v_rotating) > allowed || abs_q15_diff(s->v_target, l->v_target) > allowed ||
-         abs_q15_diff(s->v_spill, l->v_spill) > allowed;
+  return abs_q15_diff(s->v_rotating, sup->volume[0]) > allowed || abs_q15_diff(s->v_target, sup->volume[1]) > allowed ||
+         abs_q15_diff(s->v_spill, sup->volume[2]) > allowed;
+}
+
+static bool volume_changed(const pour_supervisor_t *sup, const pour_state_t *s) {
+  return s->v_rotating != sup->volume[0] || s->v_target != sup->volume[1] || s->v_spill != sup->volume[2];
 }
 
 static uint8_t count_up(uint8_t n, bool yes) { return yes ? (n < UINT8_MAX ? (uint8_t)(n + 1u) : n) : 0u; }
 
+static uint16_t count_up16(uint16_t n) { return n < UINT16_MAX ? (uint16_t)(n + 1u) : n; }
+
 static int32_t abs32(int32_t x) { return x < 0 ? -x : x; } /* callers pass differences of checked states */
 
-/* TORQUE_SIGN, SCALE and ENCODER from the last W commands, in O(1): the ring's sums are kept as entries come
- * and go. Under a mean torque beyond what gravity can resist, the bucket cannot move against it and speed
- * up that way (a motor or encoder of the wrong sign); no speed change can exceed what the commands give the
- * lightest load plus what gravity and the liquid add (a scale stuck high); a bucket under that torque one
- * way for the whole window cannot keep its encoder reading (a frozen encoder). States reaching here passed
- * the core's plausibility check (|θ| <= π, |θ̇| <= 50 rad/s): their differences fit in int32. */
+/* TORQUE_SIGN and SCALE from the last W commands, in O(1): the ring's sums are kept as entries come and go.
+ * Under a mean torque beyond what gravity can resist, the bucket cannot move against it and speed up that
+ * way (a motor or encoder of the wrong sign); no speed change can exceed what the commands give the
+ * lightest load plus what gravity and the liquid add (a scale stuck high). States reaching here passed the
+ * core's plausibility check (|θ| <= π, |θ̇| <= 50 rad/s): their differences fit in int32. */
 static uint16_t window_faults(pour_supervisor_t *sup, const pour_state_t *s) {
   const pour_supervisor_config_t *c = &sup->config;
   const uint8_t w = c->window_ms;
@@ -126,26 +142,42 @@ static uint16_t window_faults(pour_supervisor_t *sup, const pour_state_t *s) {
     }
   }
   if ((c->checks & POUR_CHECK_SCALE) != 0u) {
-    /* |Δθ̇| [µrad/s] > (a_full · Σ|τ|/32768 + a_passive · W) / 1000, multiplied out (no division):
-     * 32768000 · 5e7 and 3.5e8 · 10 · 32768 both fit int64. */
-    const int64_t lhs = (int64_t)abs32(d_omega) * 32768000;
+    /* The path of θ̇ over the window, Σ|Δθ̇| [µrad/s], not only its net change: under the speed band a torque
+     * scale stuck high shows as a chatter whose swings cancel over the window (fault_pour, firmware 3).
+     * Path > (a_full · Σ|τ|/32768 + a_passive · W) / 1000, multiplied out (no division): a path < 10^9
+     * (|θ̇| <= 50 rad/s) times 32768000, and 3.5e8 · 10 · 32768, both fit int64. */
+    const uint8_t newest = (uint8_t)(o == 0u ? w - 1u : o - 1u);
+    const int32_t path =
+        sup->sum_dw - (int32_t)sup->dw[o] * DW_UNIT_URAD_S + abs32(s->omega_urad_s - sup->omega[newest]);
+    const int64_t lhs = (int64_t)path * 32768000;
     const int64_t rhs = (int64_t)c->accel_full_urad_s2 * sup->sum_abs + sup->passive_term;
     sup->over = count_up(sup->over, lhs > rhs);
     if (sup->over >= c->against_ms) {
       faults |= POUR_FAULT_SCALE;
     }
   }
-  /* One direction for the whole window (|Σ| = Σ|τ|) with a mean beyond what gravity resists. */
-  if ((c->checks & POUR_CHECK_ENCODER) != 0u && (mean >= c->torque_min || mean <= -c->torque_min) &&
-      abs32(sup->sum) == sup->sum_abs && abs32(s->theta_urad - sup->theta[o]) <= c->encoder_move_urad) {
-    faults |= POUR_FAULT_ENCODER;
-  }
   return faults;
 }
 
+/* ENCODER: θ has stayed within ±encoder_move of where it last was for encoder_ms samples while every
+ * command of as many ticks was beyond what gravity can resist, one way. A window on the end-to-end
+ * displacement would not do: a bucket turning round under such a torque comes back to where it was 10 ms
+ * before, but it does not stay within a few counts for 30 ms (docs/safety.md). */
+static bool encoder_frozen(pour_supervisor_t *sup, const pour_state_t *s) {
+  const pour_supervisor_config_t *c = &sup->config;
+  if (!sup->have_state || abs32(s->theta_urad - sup->still_theta_urad) > c->encoder_move_urad) {
+    sup->still_theta_urad = s->theta_urad;
+    sup->still_ticks = 0u;
+  } else {
+    sup->still_ticks = count_up16(sup->still_ticks);
+  }
+  return (c->checks & POUR_CHECK_ENCODER) != 0u && sup->still_ticks >= c->encoder_ms &&
+         sup->push_ticks >= c->encoder_ms;
+}
+
 uint16_t pour_supervisor_step(pour_supervisor_t *sup, const pour_state_t *state, bool fresh) {
-  if (sup->ticks_since_state != UINT32_MAX) {
-    sup->ticks_since_state++;
+  if (sup->ticks_since_volume != UINT32_MAX) {
+    sup->ticks_since_volume++;
   }
   if (!fresh) {
     return 0u; /* a repeated state is no new evidence */
@@ -163,9 +195,17 @@ uint16_t pour_supervisor_step(pour_supervisor_t *sup, const pour_state_t *state,
     faults |= POUR_FAULT_VOLUME;
   }
   faults |= window_faults(sup, state);
-  sup->last = *state;
+  if (encoder_frozen(sup, state)) {
+    faults |= POUR_FAULT_ENCODER;
+  }
+  if (!sup->have_state || volume_changed(sup, state)) {
+    sup->volume[0] = state->v_rotating;
+    sup->volume[1] = state->v_target;
+    sup->volume[2] = state->v_spill;
+    sup->ticks_since_volume = 0u;
+  }
+  sup->last_seq = state->seq;
   sup->have_state = true;
-  sup->ticks_since_state = 0u;
   sup->seq_repeats = 0u;
   return faults;
 }
@@ -177,11 +217,22 @@ void pour_supervisor_record(pour_supervisor_t *sup, const pour_state_t *state, q
     sup->sum -= old;
     sup->sum_abs -= old < 0 ? -old : old;
   }
+  if (sup->filled == w) {
+    sup->sum_dw -= (int32_t)sup->dw[sup->head] * DW_UNIT_URAD_S;
+  }
+  const uint8_t prev = (uint8_t)(sup->head == 0u ? w - 1u : sup->head - 1u);
+  int32_t dw = sup->filled > 0u ? abs32(state->omega_urad_s - sup->omega[prev]) / DW_UNIT_URAD_S : 0;
+  dw = dw > UINT16_MAX ? UINT16_MAX : dw; /* 2.1 rad/s in a tick: beyond that the path saturates */
   sup->sum += torque;
   sup->sum_abs += torque < 0 ? -(int32_t)torque : torque;
+  sup->sum_dw += dw * DW_UNIT_URAD_S;
   sup->torque[sup->head] = torque;
-  sup->theta[sup->head] = state->theta_urad;
   sup->omega[sup->head] = state->omega_urad_s;
+  sup->dw[sup->head] = (uint16_t)dw;
+  const int32_t tmin = sup->config.torque_min;
+  const int8_t dir = (int8_t)(torque >= tmin ? 1 : (torque <= -tmin ? -1 : 0));
+  sup->push_ticks = dir == 0 ? 0u : (dir == sup->push_dir ? count_up16(sup->push_ticks) : 1u);
+  sup->push_dir = dir;
   sup->head = (uint8_t)(sup->head + 1u == w ? 0u : sup->head + 1u);
   if (sup->filled < w) {
     sup->filled++;

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "pour/control.h"
-#include "state_si.h"
 
 pour_bridge_config_t pour_bridge_default_config(void) {
   pour_bridge_config_t c;
@@ -25,25 +24,35 @@ pour_status_t pour_bridge_init(pour_bridge_t *b, const pour_bridge_config_t *con
   return POUR_OK;
 }
 
-int pour_bridge_from_state(pour_bridge_t *b, const pour_plant_state_t *msg, pour_can_frame_t frames[2]) {
-  /* The very conversion the in-process simulator and the LCM controller use: same bits reach the core. */
-  pour_state_t s;
-  pour_state_from_si(&s, msg->seq, msg->theta, msg->omega, msg->v_rotating, msg->v_target, msg->v_spill);
-  const uint16_t seq16 = (uint16_t)((uint64_t)msg->seq & 0xFFFFu);
-  const pour_can_state_a_t a = {s.theta_urad, s.omega_urad_s, (uint8_t)(seq16 & 0xFFu)};
-  const pour_can_state_b_t sb = {seq16, s.v_rotating, s.v_target, s.v_spill};
-  if (pour_can_pack_state_a(b->config.node_id, &a, &frames[0]) != POUR_OK ||
-      pour_can_pack_state_b(b->config.node_id, &sb, &frames[1]) != POUR_OK) {
+int pour_bridge_from_sensors(pour_bridge_t *b, const pour_sensor_sample_t *msg, pour_can_frame_t frame[1],
+                             const char **why) {
+  /* The readings cross as they are, so the controller's estimator gets the bits the in-process simulator
+   * hands its core; only what the frame cannot hold is refused (the frame would carry another value). */
+  const char *bad = NULL;
+  if (msg->encoder < 0 || (uint32_t)msg->encoder > POUR_CAN_ENCODER_MAX) {
+    bad = "encoder count outside 0 .. 2^24 - 1";
+  } else if (msg->scale_rotating_g < -POUR_CAN_SCALE_MAX_G || msg->scale_rotating_g > POUR_CAN_SCALE_MAX_G) {
+    bad = "scale_rotating_g outside -32767 .. 32767 g";
+  } else if (msg->scale_target_g < -POUR_CAN_SCALE_MAX_G || msg->scale_target_g > POUR_CAN_SCALE_MAX_G) {
+    bad = "scale_target_g outside -32767 .. 32767 g";
+  }
+  const uint8_t seq8 = (uint8_t)((uint64_t)msg->seq & 0xFFu);
+  const pour_can_sensors_t m = {seq8, (uint32_t)msg->encoder, (int16_t)msg->scale_rotating_g,
+                                (int16_t)msg->scale_target_g};
+  if (bad != NULL || pour_can_pack_sensors(b->config.node_id, &m, &frame[0]) != POUR_OK) {
+    if (why != NULL) {
+      *why = bad != NULL ? bad : "not packable";
+    }
     b->counters.states_refused++;
     return 0;
   }
-  pour_bridge_sent_t *slot = &b->sent[seq16 % POUR_BRIDGE_RING];
+  pour_bridge_sent_t *slot = &b->sent[seq8];
   slot->seq = msg->seq;
   slot->utime = msg->utime;
   slot->episode = msg->episode;
   slot->used = true;
   b->counters.states_sent++;
-  return 2;
+  return 1;
 }
 
 int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[4]) {
@@ -75,8 +84,10 @@ static pour_bridge_out_t torque_of(pour_bridge_t *b, const pour_can_frame_t *fra
     b->counters.frames_dropped++;
     return POUR_BRIDGE_DROPPED;
   }
-  const pour_bridge_sent_t *slot = &b->sent[t.seq % POUR_BRIDGE_RING];
-  if (!slot->used || (uint16_t)((uint64_t)slot->seq & 0xFFFFu) != t.seq) {
+  /* The controller counts from the first Sensors.Seq it saw (8 bits), so only the low 8 bits of its echo are
+   * the host's: they pick the latest sample sent with them, whatever the controller's count started at. */
+  const pour_bridge_sent_t *slot = &b->sent[t.seq & 0xFFu];
+  if (!slot->used) {
     b->counters.torques_unmatched++;
     return POUR_BRIDGE_DROPPED;
   }

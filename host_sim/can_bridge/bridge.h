@@ -1,12 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /* can_bridge's logic, no I/O: LCM messages <-> pour CAN frames (can/pour.dbc).
- *   POUR_STATE (pour_plant_state_t)   -> StateA + StateB  (the SI -> fixed-point conversion of the firmware)
+ *   POUR_SENSORS (pour_sensor_sample_t) -> Sensors        (the raw readings as they are: no conversion)
  *   POUR_COMMAND (pour_command_t)     -> Estop (+ Stop, ClearErrors, Reset)
  *   Torque frame                      -> POUR_TORQUE (pour_torque_t; seq, episode and utime restored)
  *   Heartbeat frame                   -> POUR_STATUS (pour_controller_status_t)
  *   Identity frame                    -> the torque scale and the policy hash of the POUR_TORQUE it makes
- * CAN carries 16 bits of seq and no episode or time stamp: the bridge remembers the states it sent, by
- * seq, and answers torque frames only for states it sent. The torque scale comes from the controller's
+ * CAN carries 8 bits of seq (the controller extends them to its own count, whose low 16 bits its Torque
+ * frames echo) and no episode or time stamp: the bridge remembers the last 256 samples it sent, by the low
+ * 8 bits of seq, and answers torque frames only for those. The torque scale comes from the controller's
  * Identity frame, never from the bridge's own build or a default. */
 #ifndef POUR_CAN_BRIDGE_H
 #define POUR_CAN_BRIDGE_H
@@ -17,10 +18,10 @@
 #include "pour/can_codec.h"
 #include "pour_command_t.h"
 #include "pour_controller_status_t.h"
-#include "pour_plant_state_t.h"
+#include "pour_sensor_sample_t.h"
 #include "pour_torque_t.h"
 
-#define POUR_BRIDGE_RING 256u /* states remembered for matching answers (a power of two) */
+#define POUR_BRIDGE_RING 256u /* samples remembered for matching answers: one per value of Sensors.Seq */
 
 typedef struct {
   uint8_t node_id;     /* controller node id, 0 .. 63 */
@@ -35,10 +36,10 @@ typedef struct {
 } pour_bridge_sent_t;
 
 typedef struct {
-  int64_t states_sent;
-  int64_t states_refused;   /* POUR_STATE values outside the CAN signal ranges: not sent */
+  int64_t states_sent;      /* sensor samples sent */
+  int64_t states_refused;   /* POUR_SENSORS readings outside the Sensors frame's ranges: not sent */
   int64_t torques;          /* torque frames turned into POUR_TORQUE */
-  int64_t torques_unmatched; /* torque frames answering no state we sent (dropped) */
+  int64_t torques_unmatched; /* torque frames answering no sample we sent (dropped) */
   int64_t heartbeats;
   int64_t identities;       /* Identity frames seen */
   int64_t frames_dropped;   /* malformed or unknown frames of the controller's node */
@@ -47,7 +48,7 @@ typedef struct {
 
 typedef struct {
   pour_bridge_config_t config;
-  pour_bridge_sent_t sent[POUR_BRIDGE_RING];
+  pour_bridge_sent_t sent[POUR_BRIDGE_RING]; /* by the low 8 bits of seq */
   pour_bridge_counters_t counters;
   uint8_t mode;            /* from the latest heartbeat or torque frame */
   uint16_t faults;
@@ -62,8 +63,11 @@ pour_bridge_config_t pour_bridge_default_config(void);
 /* POUR_EINVAL for a node id > 63 or n_actions outside 2 .. 16. */
 pour_status_t pour_bridge_init(pour_bridge_t *b, const pour_bridge_config_t *config);
 
-/* StateA and StateB for one POUR_STATE: returns 2, or 0 if a value is outside its CAN range (counted). */
-int pour_bridge_from_state(pour_bridge_t *b, const pour_plant_state_t *msg, pour_can_frame_t frames[2]);
+/* The Sensors frame of one POUR_SENSORS sample: returns 1, or 0 if a reading is outside what the frame
+ * carries (an encoder count outside 0 .. 2^24 - 1, a scale outside ±32767 g): counted, and *why (if not
+ * NULL) names the reading. */
+int pour_bridge_from_sensors(pour_bridge_t *b, const pour_sensor_sample_t *msg, pour_can_frame_t frame[1],
+                             const char **why);
 
 /* Estop (always, as the level), then Stop, ClearErrors and Reset (those asked for): returns the count, 1..4. */
 int pour_bridge_from_command(pour_bridge_t *b, const pour_command_t *msg, pour_can_frame_t frames[4]);
@@ -72,7 +76,7 @@ typedef enum {
   POUR_BRIDGE_NONE = 0,   /* not the controller's, or a frame the host itself sends: ignored */
   POUR_BRIDGE_TORQUE = 1, /* *torque filled: publish on POUR_TORQUE */
   POUR_BRIDGE_STATUS = 2, /* *status filled: publish on POUR_STATUS */
-  POUR_BRIDGE_DROPPED = -1 /* the controller's, but malformed, or a torque that answers no sent state */
+  POUR_BRIDGE_DROPPED = -1 /* the controller's, but malformed, or a torque that answers no sent sample */
 } pour_bridge_out_t;
 
 /* One frame from the bus. utime [µs] stamps the message published. Until the controller's Identity frame

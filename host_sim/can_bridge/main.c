@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* can_bridge: joins LCM and a SocketCAN bus, so that host_sim (and lcm-spy) see a controller that sits on
- * CAN as if it spoke LCM. POUR_STATE/POUR_COMMAND go out as frames; Torque and Heartbeat frames come back
+ * CAN as if it spoke LCM. POUR_SENSORS/POUR_COMMAND go out as frames; Torque and Heartbeat frames come back
  * as POUR_TORQUE and POUR_STATUS. The mapping is bridge.c; this file only moves bytes. */
 #include <errno.h>
 #include <linux/can.h>
@@ -54,17 +54,27 @@ static void send_frames(app_t *app, const pour_can_frame_t *frames, int n) {
   }
 }
 
-static void on_state(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
+static void on_sensors(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
   (void)channel;
   app_t *app = user;
-  pour_plant_state_t msg;
-  if (pour_plant_state_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) < 0) {
+  pour_sensor_sample_t msg;
+  const int n = pour_sensor_sample_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg);
+  if (n < 0 || (uint32_t)n != rbuf->data_size) {
     app->lcm_dropped++;
     return;
   }
-  pour_can_frame_t frames[2];
-  send_frames(app, frames, pour_bridge_from_state(&app->bridge, &msg, frames));
-  pour_plant_state_t_decode_cleanup(&msg);
+  pour_can_frame_t frame[1];
+  const char *why = NULL;
+  const int k = pour_bridge_from_sensors(&app->bridge, &msg, frame, &why);
+  if (k == 0 && app->bridge.counters.states_refused == 1) {
+    /* Once: a sender that gets one reading wrong usually gets them all wrong. */
+    fprintf(stderr,
+            "can_bridge: " POUR_LCM_CHANNEL_SENSORS " seq %lld not sent: %s (encoder %ld, scales %ld g, %ld g); "
+            "further refusals are only counted\n",
+            (long long)msg.seq, why, (long)msg.encoder, (long)msg.scale_rotating_g, (long)msg.scale_target_g);
+  }
+  send_frames(app, frame, k);
+  pour_sensor_sample_t_decode_cleanup(&msg);
 }
 
 static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
@@ -138,7 +148,7 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 
 static void usage(FILE *f) {
   fprintf(f, "usage: can_bridge --iface IFACE [--lcm URL] [--node N] [--n-actions A] [--duration S]\n"
-             "  POUR_STATE, POUR_COMMAND (LCM) -> StateA/StateB, Estop, Stop, ClearErrors, Reset (CAN, can/pour.dbc)\n"
+             "  POUR_SENSORS, POUR_COMMAND (LCM) -> Sensors, Estop, Stop, ClearErrors, Reset (CAN, can/pour.dbc)\n"
              "  Torque, Heartbeat (CAN)        -> POUR_TORQUE, POUR_STATUS (LCM)\n"
              "  the torque scale [N.m] and policy hash come from the controller's Identity frame\n"
              "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n"
@@ -197,7 +207,7 @@ int main(int argc, char **argv) {
     close(app.fd);
     return 1;
   }
-  lcm_subscribe(app.lcm, POUR_LCM_CHANNEL_STATE, on_state, &app);
+  lcm_subscribe(app.lcm, POUR_LCM_CHANNEL_SENSORS, on_sensors, &app);
   lcm_subscribe(app.lcm, POUR_LCM_CHANNEL_COMMAND, on_command, &app);
 
   struct sigaction sa;

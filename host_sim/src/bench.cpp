@@ -12,6 +12,7 @@
 
 #include "controllers.hpp"
 #include "poursim/checks.h"
+#include "poursim/poursim.h"
 #include "poursim/weights_file.h"
 
 namespace poursim {
@@ -169,6 +170,48 @@ int bench_physics(const poursim_config_t &cfg) {
   return 0;
 }
 
+// 4. The rig: the drive against Newton and its datasheet line, the sensors against mass, momentum and
+// their config (the same C functions as tests/sim/test_rig.c).
+int bench_rig(const poursim_config_t &cfg) {
+  char err[POURSIM_ERR_LEN];
+  poursim_drive_check_t d;
+  if (poursim_measure_drive(&cfg, &d, err, sizeof err) != POURSIM_OK) {
+    std::fprintf(stderr, "host_sim: %s\n", err);
+    return 1;
+  }
+  std::printf("drive, empty bucket: latency %d tick(s) (config %d); inertia %.5f kg m^2 by spin-up against %.5f "
+              "(U by hand %.5f + rotor J N^2 %.5f, %+.2f %%); Coulomb breakaway at %.3f N m (config %.3f)\n",
+              d.latency_ticks, cfg.command_latency_ticks, d.inertia_measured, d.inertia_expected, d.inertia_bucket,
+              d.inertia_expected - d.inertia_bucket, 100 * (d.inertia_measured / d.inertia_expected - 1),
+              d.breakaway_torque, cfg.friction_coulomb);
+  for (int r = 0; r < 2; ++r)
+    std::printf("  full command, Coulomb %.1f N m: terminal speed %.3f rad/s, datasheet line %.3f rad/s (%+.2f %%)\n",
+                d.terminal_load[r], d.terminal_speed[r], d.terminal_expected[r],
+                100 * (d.terminal_speed[r] / d.terminal_expected[r] - 1));
+  poursim_sensor_check_t s;
+  if (poursim_measure_sensors(&cfg, 1, &s, err, sizeof err) != POURSIM_OK) {
+    std::fprintf(stderr, "host_sim: %s\n", err);
+    return 1;
+  }
+  std::printf("encoder (%d bits): largest error %.4f counts over -5..125 deg; at the lower stop %u (2^%d - %u)\n",
+              cfg.encoder_bits, s.encoder_max_error, s.encoder_at_stop, cfg.encoder_bits,
+              (1u << cfg.encoder_bits) - s.encoder_at_stop);
+  std::printf("scales, servo pour (upright 1 s, 0.5 rad/s to 125 deg, 3 s): at rest the rotating cell reads %.1f g "
+              "of %.1f g of liquid (%+.2f %%), the target %.1f g of the %.1f g inside it (%+.2f %%)\n",
+              s.rest_rotating_g, s.liquid_g, 100 * (s.rest_rotating_g / s.liquid_g - 1), s.rest_target_g,
+              s.target_liquid_g, 100 * (s.rest_target_g / s.target_liquid_g - 1));
+  std::printf("  %.2f conversions/s (config %.0f Hz), lag %.4f s (config %.4f s; %.1f %% of the conversions equal "
+              "the undelayed reading then), noise %.3f g RMS against %.3f g (%.2f g quantised to %.0f g)\n",
+              s.update_rate_hz, cfg.scale_rate_hz, s.delay_s, cfg.scale_delay_s, 100 * s.delay_match, s.noise_rms_g,
+              s.noise_expected_g, cfg.scale_noise_g, cfg.scale_resolution_g);
+  std::printf("  impact: the target reads %.1f g s beyond the liquid inside it over the pour, the stream's momentum "
+              "is %.1f g s (%+.1f %%); at its peak the impact is %.0f g on a reading of %.0f g; trajectory hash "
+              "%s by the scales' noise, lag and rate\n",
+              s.impact_impulse_gs, s.impact_expected_gs, 100 * (s.impact_impulse_gs / s.impact_expected_gs - 1),
+              s.impact_peak_g, s.impact_peak_reading_g, s.hash_unchanged ? "unchanged" : "CHANGED");
+  return 0;
+}
+
 } // namespace
 
 int run_bench(const poursim_config_t &cfg, const std::string &policy_path, int episodes) {
@@ -187,6 +230,8 @@ int run_bench(const poursim_config_t &cfg, const std::string &policy_path, int e
   if (rc == 0) rc = bench_rollouts(cfg, policy_path);
   std::fflush(stdout);
   if (rc == 0) rc = bench_physics(cfg);
+  std::fflush(stdout);
+  if (rc == 0) rc = bench_rig(cfg);
   return rc;
 }
 

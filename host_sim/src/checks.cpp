@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "poursim_internal.hpp"
+#include "world.hpp"
 
 using poursim::set_error;
 
@@ -215,5 +216,260 @@ extern "C" int poursim_measure_slosh(const poursim_config_t *cfg, uint32_t seed,
   out->noise = noise;
   out->n = 0;
   for (size_t i = 0; trace != nullptr && i < m && static_cast<int>(i) < trace_cap; ++i) trace[out->n++] = osc[i];
+  return POURSIM_OK;
+}
+
+// ---- The rig ----
+
+namespace {
+
+struct WorldGuard { // destroys a world on every path out
+  poursim_world_t *w = nullptr;
+  ~WorldGuard() { poursim_destroy(w); }
+};
+
+// The empty U about the pivot, by hand: its mass spread over the three boxes by area; each box's inertia
+// about its own centre (w² + h²)/12 plus the parallel-axis term. com_y: its centre of mass below the pivot.
+double u_inertia(const poursim_config_t &c, double *com_y) {
+  const double wi = 0.5 * c.bucket_inner_width, t = c.bucket_wall, hh = 0.5 * c.bucket_height;
+  struct Box {
+    double w, h, x, y;
+  } boxes[3] = {{2 * wi + 2 * t, t, 0.0, -hh + 0.5 * t}, {t, 2 * hh, -wi - 0.5 * t, 0.0}, {t, 2 * hh, wi + 0.5 * t, 0.0}};
+  double area = 0, inertia = 0, my = 0;
+  for (const Box &b : boxes) area += b.w * b.h;
+  for (const Box &b : boxes) {
+    const double m = c.bucket_mass * b.w * b.h / area;
+    inertia += m * ((b.w * b.w + b.h * b.h) / 12.0 + b.x * b.x + b.y * b.y);
+    my += m * b.y;
+  }
+  *com_y = my / c.bucket_mass;
+  return inertia;
+}
+
+// A world of c with the liquid taken out (and the stops too with free_spin). The joint was holding the
+// liquid's weight when it went: 0.2 s at rest lets that warm-started impulse die out.
+poursim_world_t *empty_world(const poursim_config_t &c, bool free_spin, char *err, size_t err_len) {
+  poursim_world_t *w = poursim_create(&c, err, err_len);
+  if (w == nullptr) return nullptr;
+  poursim::empty_bucket(w, free_spin);
+  for (int k = 0; k < static_cast<int>(std::lround(0.2 / c.dt)); ++k) poursim_step_servo(w, 0.0, nullptr);
+  return w;
+}
+
+} // namespace
+
+extern "C" int poursim_measure_drive(const poursim_config_t *cfg, poursim_drive_check_t *out, char *err,
+                                     size_t err_len) {
+  if (cfg == nullptr || out == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "measure_drive: NULL argument");
+  *out = poursim_drive_check_t{};
+  const poursim_config_t &c = *cfg;
+  poursim_obs_t o;
+  double com_y;
+  out->inertia_bucket = u_inertia(c, &com_y);
+  out->inertia_expected = out->inertia_bucket + c.motor_rotor_inertia * c.gear_ratio * c.gear_ratio;
+  // Latency: torque well above the friction is commanded at call 10; the bucket moves in the step that
+  // the drive delivers it.
+  {
+    WorldGuard g{empty_world(c, false, err, err_len)};
+    if (g.w == nullptr) return POURSIM_EINVAL;
+    const double a = std::min(1.0, (c.friction_coulomb + 0.2 * c.motor_peak_torque) / c.tau_max);
+    out->latency_ticks = -1;
+    for (int k = 0; k < 10 + 200 && out->latency_ticks < 0; ++k) {
+      poursim_step(g.w, k >= 10 ? a : 0.0, &o);
+      if (k >= 10 && o.omega > 1e-5) out->latency_ticks = k - 10;
+    }
+  }
+  // Reflected inertia: spin up from rest at upright with half the command for 20 steps; each step's
+  // angular acceleration against its net torque (delivered − Coulomb − viscous − the U's gravity).
+  {
+    WorldGuard g{empty_world(c, false, err, err_len)};
+    if (g.w == nullptr) return POURSIM_EINVAL;
+    poursim_observe(g.w, &o);
+    double sum_tau = 0, sum_alpha = 0, omega0 = o.omega, theta0 = o.theta;
+    for (int k = 0; k < c.command_latency_ticks + 20; ++k) {
+      poursim_step(g.w, 0.5, &o);
+      if (o.motor_torque <= c.friction_coulomb) {
+        omega0 = o.omega, theta0 = o.theta;
+        continue;
+      }
+      const double gravity = c.bucket_mass * kG * com_y * std::sin(theta0); // com_y < 0: pulls back to upright
+      sum_tau += o.motor_torque - c.friction_coulomb - c.friction_viscous * omega0 + gravity;
+      sum_alpha += (o.omega - omega0) / c.dt;
+      omega0 = o.omega, theta0 = o.theta;
+    }
+    out->inertia_measured = sum_alpha > 0 ? sum_tau / sum_alpha : -1.0;
+  }
+  // Coulomb breakaway: the command ramps at 1 N·m/s from 0; the bucket at upright (no gravity torque)
+  // stays put until the delivered torque passes the friction.
+  {
+    WorldGuard g{empty_world(c, false, err, err_len)};
+    if (g.w == nullptr) return POURSIM_EINVAL;
+    out->breakaway_torque = -1.0;
+    const int n = static_cast<int>(std::lround((c.friction_coulomb + 1.0) / c.dt));
+    for (int k = 0; k < n && out->breakaway_torque < 0; ++k) {
+      poursim_step(g.w, (k * c.dt) / c.tau_max, &o);
+      if (std::fabs(o.omega) > 1e-5) out->breakaway_torque = o.motor_torque;
+    }
+  }
+  // Terminal speed on the torque–speed line: full command, no stops, two Coulomb loads. Gravity on the
+  // U's offset centre of mass averages out over the ~3 turns a second.
+  for (int r = 0; r < 2; ++r) {
+    poursim_config_t cr = c;
+    if (r == 1) cr.friction_coulomb = 10.0;
+    WorldGuard g{empty_world(cr, true, err, err_len)};
+    if (g.w == nullptr) return POURSIM_EINVAL;
+    const int n = static_cast<int>(std::lround(1.5 / c.dt)), tail = static_cast<int>(std::lround(1.0 / c.dt));
+    double sum = 0;
+    for (int k = 0; k < n; ++k) {
+      poursim_step(g.w, 1.0, &o);
+      if (k >= n - tail) sum += o.omega;
+    }
+    const double P = cr.motor_peak_torque;
+    out->terminal_load[r] = cr.friction_coulomb;
+    out->terminal_speed[r] = sum / tail;
+    // ω = ω₀(1 − (τ_c + bω)/P) → ω = ω₀(1 − τ_c/P)/(1 + ω₀b/P); valid where the line is below the command.
+    out->terminal_expected[r] = cr.motor_no_load_speed * (1.0 - cr.friction_coulomb / P) /
+                                (1.0 + cr.motor_no_load_speed * cr.friction_viscous / P);
+  }
+  return POURSIM_OK;
+}
+
+namespace {
+
+// E[(q(x + n) − q(x))²]^½ for n ~ N(0, σ²), q rounding to multiples of res, x spread evenly over a step.
+double quantised_noise_rms(double sigma, double res) {
+  if (sigma <= 0) return 0.0;
+  const int kU = 400, kK = static_cast<int>(std::ceil(8.0 * sigma / res)) + 2;
+  auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  double e = 0;
+  for (int i = 0; i < kU; ++i) {
+    const double u = -0.5 + (i + 0.5) / kU; // x's offset from its level [steps]
+    for (int k = -kK; k <= kK; ++k) {
+      const double p = phi((k + 0.5 - u) * res / sigma) - phi((k - 0.5 - u) * res / sigma);
+      e += p * (k * res) * (k * res);
+    }
+  }
+  return std::sqrt(e / kU);
+}
+
+} // namespace
+
+extern "C" int poursim_measure_sensors(const poursim_config_t *cfg, uint32_t seed, poursim_sensor_check_t *out,
+                                       char *err, size_t err_len) {
+  if (cfg == nullptr || out == nullptr)
+    return set_error(err, err_len, POURSIM_EINVAL, "measure_sensors: NULL argument");
+  *out = poursim_sensor_check_t{};
+  const poursim_config_t &c = *cfg;
+  // 0: the config's sensors; 1: the same without noise; 2: every step, no lag, no noise (the reference).
+  poursim_config_t cs[3] = {c, c, c};
+  cs[1].scale_noise_g = 0.0;
+  cs[2].scale_noise_g = 0.0;
+  cs[2].scale_delay_s = 0.0;
+  cs[2].scale_rate_hz = 1.0 / c.dt;
+  WorldGuard g[3];
+  for (int i = 0; i < 3; ++i) {
+    g[i].w = poursim_create(&cs[i], err, err_len);
+    if (g[i].w == nullptr) return POURSIM_EINVAL;
+    if (poursim_reset(g[i].w, seed) != POURSIM_OK)
+      return set_error(err, err_len, POURSIM_ENUMERIC, "measure_sensors: %s", poursim_world_error(g[i].w));
+  }
+  const poursim_config_t &ep = *poursim_episode_config(g[0].w);
+  const int n = poursim_particle_count(g[2].w);
+  const double particle_g = 1000.0 * poursim::liquid_mass(&ep) / n;
+  out->liquid_g = particle_g * n;
+  // Held upright 1 s, tilted at 0.5 rad/s to 125°, held 3 s for the target's liquid to settle.
+  const double rate = 0.5, theta_end = 125 * kDeg;
+  const int k_tilt = static_cast<int>(std::lround(1.0 / c.dt));
+  const int k_tilted = k_tilt + static_cast<int>(std::lround(theta_end / rate / c.dt));
+  const int n_steps = k_tilted + static_cast<int>(std::lround(3.0 / c.dt));
+  const int k_last_s = n_steps - static_cast<int>(std::lround(1.0 / c.dt));
+  const int k_rest = static_cast<int>(std::lround(0.2 / c.dt)), avg = std::max(1, static_cast<int>(std::lround(0.05 / c.dt)));
+  std::vector<int32_t> ref(static_cast<size_t>(n_steps)), quiet(static_cast<size_t>(n_steps));
+  std::vector<uint8_t> before(static_cast<size_t>(n), 0), reg(static_cast<size_t>(n), 0);
+  std::vector<double> impact(static_cast<size_t>(n_steps), 0.0), reading(static_cast<size_t>(n_steps), 0.0);
+  std::vector<int> conv; // steps at which the noise-free reading changed (a conversion)
+  const double counts = std::ldexp(1.0, ep.encoder_bits);
+  double rest_rot = 0, rest_tgt = 0, inside_last = 0, momentum = 0, impulse = 0, noise_sq = 0, enc_err = 0;
+  poursim_particle_regions(g[2].w, before.data(), n);
+  poursim_obs_t o[3];
+  for (int k = 0; k < n_steps; ++k) {
+    const double theta_ref = k < k_tilt ? 0.0 : std::min(theta_end, rate * (k - k_tilt) * c.dt);
+    for (int i = 0; i < 3; ++i)
+      if (poursim_step_servo(g[i].w, theta_ref, &o[i]) != POURSIM_OK)
+        return set_error(err, err_len, POURSIM_ENUMERIC, "measure_sensors: %s", poursim_world_error(g[i].w));
+    const poursim_obs_t &r = o[2];
+    const double e = std::fabs(o[0].encoder - r.theta * counts / (2.0 * M_PI));
+    enc_err = std::max(enc_err, std::min(e, std::fabs(e - counts))); // wrapped below upright
+    const size_t ks = static_cast<size_t>(k);
+    ref[ks] = r.scale_rotating_g;
+    quiet[ks] = o[1].scale_rotating_g;
+    if (k >= k_rest && k < k_tilt) rest_rot += r.scale_rotating_g;
+    // The noise-free reading changes at every conversion while the bucket tilts (the load moves each step).
+    if (k >= k_tilt && k < k_tilted && quiet[ks] != quiet[ks - 1]) {
+      conv.push_back(k);
+      const double d = static_cast<double>(o[0].scale_rotating_g) - quiet[ks];
+      noise_sq += d * d;
+    }
+    // Momentum carried into the target's interior (and out of it) by the particles crossing its bounds.
+    poursim_particle_regions(g[2].w, reg.data(), n);
+    int inside = 0;
+    for (int i = 0; i < n; ++i) {
+      const size_t is = static_cast<size_t>(i);
+      inside += reg[is] == 1;
+      if ((reg[is] == 1) != (before[is] == 1)) {
+        const double v_down = -static_cast<double>(b2Body_GetLinearVelocity(g[2].w->circles[is]).y);
+        momentum += (reg[is] == 1 ? 1.0 : -1.0) * particle_g * v_down;
+      }
+      before[is] = reg[is];
+    }
+    impact[ks] = r.scale_target_g - particle_g * inside;
+    reading[ks] = r.scale_target_g;
+    impulse += impact[ks] * c.dt;
+    if (k >= k_last_s) {
+      rest_tgt += r.scale_target_g;
+      inside_last += particle_g * inside;
+    }
+  }
+  out->hash_unchanged = poursim_trajectory_hash(g[0].w) == poursim_trajectory_hash(g[2].w) &&
+                        poursim_trajectory_hash(g[1].w) == poursim_trajectory_hash(g[2].w);
+  out->rest_rotating_g = rest_rot / (k_tilt - k_rest);
+  out->rest_target_g = rest_tgt / (n_steps - k_last_s);
+  out->target_liquid_g = inside_last / (n_steps - k_last_s);
+  out->impact_impulse_gs = impulse;
+  out->impact_expected_gs = momentum / kG;
+  // The impact term's largest 50 ms mean while the liquid arrives.
+  double window = 0;
+  out->impact_peak_g = -1e300;
+  for (int k = 0; k < k_last_s; ++k) {
+    window += impact[static_cast<size_t>(k)];
+    if (k >= avg) window -= impact[static_cast<size_t>(k - avg)];
+    if (k >= avg && window / avg > out->impact_peak_g) {
+      out->impact_peak_g = window / avg;
+      out->impact_peak_reading_g = reading[static_cast<size_t>(k)];
+    }
+  }
+  // Rate and lag: conversions per second, and the lag at which they equal the every-step reference.
+  const double tilt_s = (k_tilted - k_tilt) * c.dt;
+  out->update_rate_hz = static_cast<double>(conv.size()) / tilt_s;
+  const int max_lag = static_cast<int>(std::lround(std::min(1.0, 2.0 * c.scale_delay_s + 0.05) / c.dt));
+  int best = 0, best_lag = 0;
+  for (int lag = 0; lag <= max_lag; ++lag) {
+    int hits = 0;
+    for (int k : conv) hits += k - lag >= 0 && quiet[static_cast<size_t>(k)] == ref[static_cast<size_t>(k - lag)];
+    if (hits > best) best = hits, best_lag = lag;
+  }
+  out->delay_s = best_lag * c.dt;
+  out->delay_match = conv.empty() ? 0.0 : static_cast<double>(best) / static_cast<double>(conv.size());
+  out->noise_rms_g = conv.empty() ? 0.0 : std::sqrt(noise_sq / static_cast<double>(conv.size()));
+  out->noise_expected_g = quantised_noise_rms(ep.scale_noise_g, ep.scale_resolution_g);
+  // Below upright: to the lower stop and held there.
+  poursim_reset(g[0].w, seed);
+  for (int k = 0; k < 300; ++k) {
+    poursim_step_servo(g[0].w, c.theta_min, &o[0]);
+    const double e = std::fabs(o[0].encoder - o[0].theta * counts / (2.0 * M_PI));
+    enc_err = std::max(enc_err, std::min(e, std::fabs(e - counts)));
+  }
+  out->encoder_at_stop = o[0].encoder;
+  out->encoder_max_error = enc_err;
   return POURSIM_OK;
 }

@@ -25,46 +25,66 @@ struct Field {
   size_t offset;
   Kind kind;
   double min, max; // inclusive range
+  const char *unit;
 };
 
-#define F(name, kind, lo, hi) {#name, offsetof(poursim_config_t, name), Kind::kind, lo, hi}
+#define F(name, kind, lo, hi, unit) {#name, offsetof(poursim_config_t, name), Kind::kind, lo, hi, unit}
 // Ranges: wide enough for experiments, narrow enough that the physics stays meaningful.
 const Field kFields[] = {
-    F(dt, Double, 1e-4, 0.01),
-    F(substeps, Int, 1, 16),
-    F(episode_s, Double, 0.01, 600.0),
-    F(settle_s, Double, 0.0, 10.0),
-    F(bucket_inner_width, Double, 0.05, 1.0),
-    F(bucket_height, Double, 0.05, 1.0),
-    F(bucket_wall, Double, 0.001, 0.05),
-    F(pivot_height, Double, 0.1, 5.0),
-    F(target_dx, Double, -2.0, 2.0),
-    F(bucket_mass, Double, 0.01, 100.0),
-    F(fill_depth, Double, 0.01, 1.0),
-    F(liquid_density, Double, 500.0, 2000.0),
-    F(n_particles, Int, 2, POURSIM_MAX_PARTICLES),
-    F(fluid, Int, 0, 1),
-    F(fluid_smoothing, Double, 1.2, 3.0),
-    F(fluid_contact_radius, Double, 0.1, 0.5),
-    F(fluid_stiffness, Double, 10.0, 1e5),
-    F(fluid_viscosity, Double, 0.0, 1e3),
-    F(fluid_agitation, Double, 0.0, 5.0),
-    F(restitution_liquid, Double, 0.0, 1.0),
-    F(restitution_wall, Double, 0.0, 1.0),
-    F(friction, Double, 0.0, 2.0),
-    F(restitution_threshold, Double, 0.0, 100.0),
-    F(contact_hertz, Double, 1.0, 10000.0),
-    F(tau_max, Double, 0.01, 1000.0),
-    F(theta_min, Double, -1.0, 0.0),
-    F(theta_max, Double, 0.1, 3.1),
-    F(brake_torque, Double, 0.0, 1000.0),
-    F(obs_theta_min, Double, -3.2, 3.2),
-    F(obs_theta_max, Double, -3.2, 3.2),
-    F(obs_omega_max, Double, 1e-3, 1000.0),
-    F(k_target, Double, 0.0, 1e6),
-    F(k_spill, Double, 0.0, 1e6),
-    F(gamma, Double, 0.0, 1.0),
-    F(seed, U32, 0, 4294967295.0),
+    F(dt, Double, 1e-4, 0.01, "s"),
+    F(substeps, Int, 1, 16, "-"),
+    F(episode_s, Double, 0.01, 600.0, "s"),
+    F(settle_s, Double, 0.0, 10.0, "s"),
+    F(bucket_inner_width, Double, 0.05, 1.0, "m"),
+    F(bucket_height, Double, 0.05, 1.0, "m"),
+    F(bucket_wall, Double, 0.001, 0.05, "m"),
+    F(pivot_height, Double, 0.1, 5.0, "m"),
+    F(target_dx, Double, -2.0, 2.0, "m"),
+    F(bucket_mass, Double, 0.01, 100.0, "kg"),
+    F(fill_depth, Double, 0.01, 1.0, "m"),
+    F(liquid_density, Double, 500.0, 2000.0, "kg/m^3"),
+    F(n_particles, Int, 2, POURSIM_MAX_PARTICLES, "-"),
+    F(fluid, Int, 0, 1, "0/1"),
+    F(fluid_smoothing, Double, 1.2, 3.0, "-"),
+    F(fluid_contact_radius, Double, 0.1, 0.5, "-"),
+    F(fluid_stiffness, Double, 10.0, 1e5, "m/s^2"),
+    F(fluid_viscosity, Double, 0.0, 1e3, "1/s"),
+    F(fluid_agitation, Double, 0.0, 5.0, "m/s"),
+    F(restitution_liquid, Double, 0.0, 1.0, "-"),
+    F(restitution_wall, Double, 0.0, 1.0, "-"),
+    F(friction, Double, 0.0, 2.0, "-"),
+    F(restitution_threshold, Double, 0.0, 100.0, "m/s"),
+    F(contact_hertz, Double, 1.0, 10000.0, "Hz"),
+    F(tau_max, Double, 0.01, 1000.0, "N m"),
+    F(theta_min, Double, -1.0, 0.0, "rad"),
+    F(theta_max, Double, 0.1, 3.1, "rad"),
+    F(brake_torque, Double, 0.0, 1000.0, "N m"),
+    F(motor_peak_torque, Double, 0.1, 1000.0, "N m at the output"),
+    F(motor_no_load_speed, Double, 0.1, 1000.0, "rad/s at the output"),
+    F(motor_rotor_inertia, Double, 0.0, 0.1, "kg m^2 at the motor"),
+    F(gear_ratio, Double, 1.0, 1000.0, "-"),
+    F(friction_coulomb, Double, 0.0, 100.0, "N m"),
+    F(friction_viscous, Double, 0.0, 100.0, "N m s/rad"),
+    F(command_latency_ticks, Int, 1, 100, "steps"),
+    F(encoder_bits, Int, 8, 24, "bits"),
+    F(scale_rate_hz, Double, 1.0, 10000.0, "Hz"),
+    F(scale_delay_s, Double, 0.0, 1.0, "s"),
+    F(scale_noise_g, Double, 0.0, 1000.0, "g"),
+    F(scale_resolution_g, Double, 1.0, 1000.0, "g"),
+    F(rand_fill, Double, 0.0, 0.5, "relative"),
+    F(rand_target_dx, Double, 0.0, 0.1, "m"),
+    F(rand_pivot_height, Double, 0.0, 0.1, "m"),
+    F(rand_motor, Double, 0.0, 0.5, "relative"),
+    F(rand_bucket_mass, Double, 0.0, 0.5, "relative"),
+    F(rand_liquid, Double, 0.0, 0.5, "relative"),
+    F(rand_sensor, Double, 0.0, 0.9, "relative"),
+    F(obs_theta_min, Double, -3.2, 3.2, "rad"),
+    F(obs_theta_max, Double, -3.2, 3.2, "rad"),
+    F(obs_omega_max, Double, 1e-3, 1000.0, "rad/s"),
+    F(k_target, Double, 0.0, 1e6, "-"),
+    F(k_spill, Double, 0.0, 1e6, "-"),
+    F(gamma, Double, 0.0, 1.0, "-"),
+    F(seed, U32, 0, 4294967295.0, "-"),
 };
 #undef F
 
@@ -141,6 +161,20 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.theta_min = -0.0872664626; // -5°
   c.theta_max = 2.35619449;    // 135°
   c.brake_torque = 40.0;       // twice the drive's peak: holds the full bucket at any tilt (~15 N·m worst)
+  // A 48 V BLDC of the 57 mm (NEMA 23) class on a 2-stage 1:20 planetary gearhead; docs/simulator.md
+  // ("The rig") derives each number.
+  c.motor_peak_torque = 25.0;       // 1.35 N·m peak at the motor × 20 × 0.93 gearhead efficiency
+  c.motor_no_load_speed = 21.0;     // 4,000 rpm at 48 V / 20
+  c.motor_rotor_inertia = 2.4e-5;   // 240 g·cm² (a 57 mm rotor); × 20² = 0.0096 kg·m² at the output
+  c.gear_ratio = 20.0;
+  c.friction_coulomb = 0.6;         // the no-load loss split into Coulomb and viscous parts
+  c.friction_viscous = 0.02;        // 0.4 N·m at the no-load speed
+  c.command_latency_ticks = 1;      // one CAN frame: the torque of tick k acts in tick k + 1
+  c.encoder_bits = 17;
+  c.scale_rate_hz = 80.0;           // HX711 with RATE high: 80 samples/s
+  c.scale_delay_s = 0.05;           // HX711 output settling time at 80 samples/s
+  c.scale_noise_g = 0.5;
+  c.scale_resolution_g = 1.0;       // whole grams on the wire
   c.obs_theta_min = 0.0;
   c.obs_theta_max = 2.356194;
   c.obs_omega_max = 4.0;
@@ -179,6 +213,10 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
     return set_error(err, err_len, POURSIM_EINVAL, "config obs_theta_max must be > obs_theta_min");
   if (c->bucket_height <= 2.0 * c->bucket_wall)
     return set_error(err, err_len, POURSIM_EINVAL, "config bucket_height must exceed twice bucket_wall");
+  if (c->scale_rate_hz * c->dt > 1.0 + 1e-9)
+    return set_error(err, err_len, POURSIM_EINVAL,
+                     "config scale_rate_hz %g Hz: faster than the step (at most 1/dt = %g Hz)", c->scale_rate_hz,
+                     1.0 / c->dt);
   // The rotating bucket must swing clear of the ground.
   double hw = 0.5 * c->bucket_inner_width + c->bucket_wall, hh = 0.5 * c->bucket_height;
   double sweep = std::sqrt(hw * hw + hh * hh);
@@ -195,6 +233,45 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
                      c->target_dx, c->pivot_height);
   return POURSIM_OK;
 }
+
+namespace poursim {
+
+poursim_config_t draw_episode_config(const poursim_config_t &c, uint32_t seed) {
+  if (c.rand_fill == 0 && c.rand_target_dx == 0 && c.rand_pivot_height == 0 && c.rand_motor == 0 &&
+      c.rand_bucket_mass == 0 && c.rand_liquid == 0 && c.rand_sensor == 0)
+    return c;
+  // Its own stream: the liquid's arrangement and agitation of a seed stay what they are without it.
+  Rng rng(0xD0A1D0A1ULL ^ (static_cast<unsigned long long>(seed) << 24));
+  constexpr int kAttempts = 64;
+  for (int attempt = 0; attempt < kAttempts; ++attempt) {
+    // Every draw is taken whichever keys are on, so that turning one key on leaves the others' draws.
+    double d[16];
+    for (double &x : d) x = 2.0 * rng.uniform() - 1.0; // [-1, 1)
+    poursim_config_t e = c;
+    e.fill_depth *= 1.0 + c.rand_fill * d[0];
+    e.target_dx += c.rand_target_dx * d[1];
+    e.pivot_height += c.rand_pivot_height * d[2];
+    e.motor_peak_torque *= 1.0 + c.rand_motor * d[3];
+    e.motor_no_load_speed *= 1.0 + c.rand_motor * d[4];
+    e.friction_coulomb *= 1.0 + c.rand_motor * d[5];
+    e.friction_viscous *= 1.0 + c.rand_motor * d[6];
+    e.motor_rotor_inertia *= 1.0 + c.rand_motor * d[7];
+    e.bucket_mass *= 1.0 + c.rand_bucket_mass * d[8];
+    e.fluid_viscosity *= 1.0 + c.rand_liquid * d[9];
+    e.fluid_stiffness *= 1.0 + c.rand_liquid * d[10];
+    e.fluid_agitation *= 1.0 + c.rand_liquid * d[11];
+    e.liquid_density *= 1.0 + c.rand_liquid * d[12];
+    e.scale_delay_s *= 1.0 + c.rand_sensor * d[13];
+    e.scale_noise_g *= 1.0 + c.rand_sensor * d[14];
+    if (c.rand_sensor > 0 && d[15] >= 0.0) e.command_latency_ticks += 1;
+    // A draw that makes no valid world (the bucket hits the target, the fill overflows, ...) is drawn
+    // again from the same stream; the nominal config if none of kAttempts draws is valid.
+    if (poursim_config_validate(&e, nullptr, 0) == POURSIM_OK) return e;
+  }
+  return c;
+}
+
+} // namespace poursim
 
 extern "C" int poursim_config_set(poursim_config_t *c, const char *key, const char *value, char *err,
                                   size_t err_len) {
@@ -301,6 +378,20 @@ extern "C" int poursim_config_load(const char *path, poursim_config_t *c, char *
   return POURSIM_OK;
 }
 
+extern "C" int poursim_config_describe(char *buf, size_t len) {
+  if (buf == nullptr || len == 0) return POURSIM_EINVAL;
+  const poursim_config_t d = poursim_default_config();
+  size_t used = 0;
+  buf[0] = '\0';
+  for (const Field &f : kFields) {
+    int n = std::snprintf(buf + used, len - used, "  %-22s [%s] %g..%g%s, default %.6g\n", f.name, f.unit, f.min,
+                          f.max, f.kind == Kind::Double ? "" : " (integer)", get_value(&d, f));
+    if (n < 0 || static_cast<size_t>(n) >= len - used) return POURSIM_EINVAL;
+    used += static_cast<size_t>(n);
+  }
+  return POURSIM_OK;
+}
+
 extern "C" int poursim_config_write(const poursim_config_t *c, const char *path, char *err, size_t err_len) {
   std::ofstream out(path);
   if (!out) return set_error(err, err_len, POURSIM_EIO, "cannot write config file '%s'", path);
@@ -312,7 +403,7 @@ extern "C" int poursim_config_write(const poursim_config_t *c, const char *path,
       std::snprintf(buf, sizeof buf, "%.17g", v);
     else
       std::snprintf(buf, sizeof buf, "%.0f", v);
-    out << f.name << " = " << buf << "\n";
+    out << f.name << " = " << buf << "  # [" << f.unit << "]\n";
   }
   return out ? POURSIM_OK : set_error(err, err_len, POURSIM_EIO, "error writing '%s'", path);
 }

@@ -11,6 +11,7 @@
 extern "C" {
 #include "pour/control.h"
 #include "pour/safety.h"
+#include "pour/sensors.h"
 }
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
@@ -30,20 +31,22 @@ class Controller {
   virtual int action() const { return -1; }
 };
 
-// The firmware core (pour_control_step) with a weights.h loaded at run time. The state crosses as it
-// would over the wire: θ, θ̇ in µrad(/s) by lround, volumes Q15 rounded and saturated.
-std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &weights, bool sampled);
+// The firmware core (pour_control_step) with a weights.h loaded at run time, fed the rig's sensor sample
+// as it would cross the wire; its encoder resolution is the simulator's.
+std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &weights, bool sampled,
+                                                     const poursim_config_t &config);
 
-// Baselines, all through the firmware's safety envelope (pour_safety_apply, default config).
+// Baselines, all seeing the rig through the firmware's estimator and commanding through its safety
+// envelope (default config).
 // Tilt at a constant rate [rad/s] to the stop, tracked by a PD loop (the paper's best binary policy).
 std::unique_ptr<Controller> make_rate_controller(double rate, const poursim_config_t &config);
 // +tau_max from start to end.
-std::unique_ptr<Controller> make_full_torque_controller();
+std::unique_ptr<Controller> make_full_torque_controller(const poursim_config_t &config);
 // A hand-written good pour: quickly to just before the onset angle, then slowly on to the stop.
 std::unique_ptr<Controller> make_hand_controller(const poursim_config_t &config);
 
-// State as the firmware receives it (rounding rules of the wire).
-pour_state_t to_firmware_state(const poursim_obs_t &obs, uint32_t seq);
+// The sensor sample the firmware receives after a step (seq = the step).
+pour_sensors_t to_sensor_sample(const poursim_obs_t &obs, uint32_t seq);
 
 } // namespace poursim
 

@@ -14,7 +14,8 @@
 
 #include "pour/command_t.hpp"
 #include "pour/particles_t.hpp"
-#include "pour/plant_state_t.hpp"
+#include "pour/plant_truth_t.hpp"
+#include "pour/sensor_sample_t.hpp"
 #include "pour/torque_t.hpp"
 #include "pour_lcm/channels.h"
 
@@ -52,7 +53,7 @@ int publish(lcm_t *lcm, const char *channel, const Msg &msg) {
   const int n = msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
   return n < 0 ? n : lcm_publish(lcm, channel, buf.data(), static_cast<unsigned>(n));
 }
-constexpr size_t kRing = 4096; // send times of recent states, by seq modulo the ring size
+constexpr size_t kRing = 4096; // send times of recent samples, by seq modulo the ring size
 
 } // namespace
 
@@ -63,7 +64,7 @@ struct LcmLink::Impl {
   std::array<int64_t, kRing> sent_ns{};  // publish time of seq % kRing
   std::array<int64_t, kRing> sent_seq{}; // which seq the slot holds
   int episode = 0;
-  int64_t waiting_seq = -1;   // the state whose answer the current tick waits for
+  int64_t waiting_seq = -1;   // the sample whose answer the current tick waits for
   bool got_waited = false;
   int16_t answer_q15 = 0;     // torque of the latest accepted answer
   int answer_action = -1;     // its action index
@@ -71,7 +72,7 @@ struct LcmLink::Impl {
   bool have_answer = false;
   int64_t t0_ns = 0;          // real time: slot of tick 0
   int64_t next_particles_step = 0;
-  pour::plant_state_t last_state{};
+  pour::sensor_sample_t last_sample{};
 
   explicit Impl(const LcmLinkDef &d) : def(d), lcm(lcm_create(d.url.empty() ? POUR_LCM_DEFAULT_URL : d.url.c_str())) {}
   ~Impl() {
@@ -185,11 +186,13 @@ struct LcmLink::Impl {
     return false;
   }
 
-  void publish_state(int64_t seq) {
+  // The truth first, for the bench's tools only; then the sample the controller answers.
+  void publish_sample(int64_t seq, const pour::plant_truth_t &truth) {
+    publish(lcm, POUR_LCM_CHANNEL_TRUTH, truth);
     const size_t slot = static_cast<size_t>(seq) % kRing;
     sent_seq[slot] = seq;
     sent_ns[slot] = mono_ns();
-    publish(lcm, POUR_LCM_CHANNEL_STATE, last_state);
+    publish(lcm, POUR_LCM_CHANNEL_SENSORS, last_sample);
   }
 };
 
@@ -236,24 +239,33 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
       s.t0_ns = 0;
     }
   }
-  pour::plant_state_t &m = s.last_state;
+  // What the rig's sensors read, exactly as the in-process controller is handed them (seq = step); the
+  // counts fit int32 (encoder_bits <= 24).
+  pour::sensor_sample_t &m = s.last_sample;
   m.seq = seq;
   m.episode = episode;
-  m.theta = obs.theta;
-  m.omega = obs.omega;
-  m.v_rotating = obs.v_rotating;
-  m.v_target = obs.v_target;
-  m.v_spill = obs.v_spill;
+  m.encoder = static_cast<int32_t>(obs.encoder);
+  m.scale_rotating_g = obs.scale_rotating_g;
+  m.scale_target_g = obs.scale_target_g;
+  pour::plant_truth_t truth;
+  truth.seq = seq;
+  truth.episode = episode;
+  truth.theta = obs.theta;
+  truth.omega = obs.omega;
+  truth.v_rotating = obs.v_rotating;
+  truth.v_target = obs.v_target;
+  truth.v_spill = obs.v_spill;
+  truth.motor_torque = obs.motor_torque;
   for (int i = 0; i < 5; i++) {
-    m.obs[i] = static_cast<float>(obs.obs[i]);
+    truth.obs[i] = static_cast<float>(obs.obs[i]);
   }
   s.waiting_seq = seq;
   s.got_waited = false;
 
   if (s.def.lockstep) {
-    m.utime = std::llround(obs.t * 1e6);
+    m.utime = truth.utime = std::llround(obs.t * 1e6);
     s.stats.states_sent++;
-    s.publish_state(seq);
+    s.publish_sample(seq, truth);
     const int64_t start = mono_ns();
     const int64_t give_up = start + static_cast<int64_t>(s.def.answer_timeout_ms) * 1000000LL;
     int64_t resend_at = start + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
@@ -264,7 +276,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
           std::snprintf(buf, sizeof buf,
                         "no answer on %s to %s seq %lld (episode %d) within %d ms: is pour_controller "
                         "running (--lockstep) on the same LCM URL?",
-                        POUR_LCM_CHANNEL_TORQUE, POUR_LCM_CHANNEL_STATE, static_cast<long long>(seq), episode,
+                        POUR_LCM_CHANNEL_TORQUE, POUR_LCM_CHANNEL_SENSORS, static_cast<long long>(seq), episode,
                         s.def.answer_timeout_ms);
           *err = buf;
         }
@@ -274,7 +286,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
       s.stats.resends++;
       const size_t slot = static_cast<size_t>(seq) % kRing;
       const int64_t first = s.sent_ns[slot];
-      publish(s.lcm, POUR_LCM_CHANNEL_STATE, m);
+      publish(s.lcm, POUR_LCM_CHANNEL_SENSORS, m);
       s.sent_ns[slot] = first; // the round trip counts from the first publish
       resend_at = mono_ns() + static_cast<int64_t>(s.def.resend_ms) * 1000000LL;
     }
@@ -295,9 +307,9 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
   if (late_ns > kPeriodNs) {
     s.stats.overruns++;
   }
-  m.utime = wall_us();
+  m.utime = truth.utime = wall_us();
   s.stats.states_sent++;
-  s.publish_state(seq);
+  s.publish_sample(seq, truth);
   s.poll_all();
   s.pump_until(slot_ns + static_cast<int64_t>(s.def.rt_budget_us) * 1000);
   const int64_t now = mono_ns();
@@ -354,6 +366,7 @@ void LcmLink::drain(int wait_ms) {
 void LcmLink::request_new_run() {
   pour::command_t m{};
   m.utime = wall_us();
+  m.clear_faults = 1;
   m.stop = 1;
   m.reset = 1;
   publish(impl_->lcm, POUR_LCM_CHANNEL_COMMAND, m);

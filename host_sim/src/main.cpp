@@ -19,6 +19,7 @@
 #include "bench.hpp"
 #include "controllers.hpp"
 #include "lcm_link.hpp"
+#include "metrics.hpp"
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
@@ -42,10 +43,10 @@ const char *kUsage =
     "  --bench             measure speed, contact quality, episodes/s, and the liquid against physics:\n"
     "                      retention curve vs an ideal liquid, sloshing vs linear theory (~2 min)\n"
     "                      (with --policy: the rollouts run that policy, else a uniform random one)\n"
-    "  --lcm [URL]         pour_controller, a separate process, over LCM (POUR_STATE out, POUR_TORQUE in,\n"
-    "                      POUR_PARTICLES for viewers); lockstep unless --realtime. With --policy, the\n"
-    "                      file sets tau_max and the controller must run that policy. Exit status 3\n"
-    "                      if the controller does not answer, 4 if it runs other weights.\n"
+    "  --lcm [URL]         pour_controller, a separate process, over LCM (POUR_SENSORS out, POUR_TORQUE in,\n"
+    "                      POUR_TRUTH, POUR_PARTICLES for viewers); lockstep unless --realtime. With\n"
+    "                      --policy, the file sets tau_max and the controller must run that policy.\n"
+    "                      Exit status 3 if the controller does not answer, 4 if it runs other weights.\n"
     "\n"
     "Options:\n"
     "  --episodes N        episodes to run (default 1), seeds S, S+1, ...\n"
@@ -192,6 +193,8 @@ int parse_args(int argc, char **argv, Options &o) {
 struct Episode {
   uint32_t seed = 0;
   double poured = 0, spilled = 0, remaining = 0, finish = -1, ret = 0;
+  double litres = 0, peak_omega = 0, peak_alpha = 0; // fill [L], max |θ̇| [rad/s], max |θ̈| [rad/s²]
+  int reversals = 0;
   std::string error; // why the world stopped, if it did
 };
 
@@ -219,8 +222,8 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   int n = poursim_particle_count(world);
   poursim_obs_t o;
   poursim_observe(world, &o);
-  std::vector<double> settled;
-  double disc = 1.0;
+  poursim::EpisodeMeter meter;
+  meter.reset(*poursim_episode_config(world), o);
   auto keep_frame = [&](const poursim_obs_t &ob) {
     std::vector<float> xy(static_cast<size_t>(2 * n));
     poursim_particles(world, xy.data(), nullptr, n);
@@ -239,25 +242,22 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
       e.error = poursim_world_error(world);
       return e;
     }
-    e.ret += disc * o.reward;
-    disc *= cfg->gamma;
-    settled.push_back(o.v_target + o.v_spill);
+    meter.add(o, a * cfg->tau_max);
     if (rec != nullptr) {
       if (rec->steps) rec->samples.push_back({o, ctl.action()});
       if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
     }
   }
-  e.poured = o.v_target;
-  e.spilled = o.v_spill;
-  e.remaining = o.v_rotating;
-  double fin = settled.empty() ? 0.0 : settled.back();
-  if (fin >= 0.01) {
-    for (size_t t = 0; t < settled.size(); ++t)
-      if (settled[t] >= 0.99 * fin) {
-        e.finish = static_cast<double>(t + 1) * cfg->dt;
-        break;
-      }
-  }
+  const poursim_episode_t m = meter.result();
+  e.poured = m.poured;
+  e.spilled = m.spilled;
+  e.remaining = m.remaining;
+  e.finish = m.finish_time;
+  e.ret = m.ret;
+  e.litres = m.liquid_l;
+  e.peak_omega = m.peak_omega;
+  e.peak_alpha = m.peak_alpha;
+  e.reversals = m.reversals;
   return e;
 }
 
@@ -433,9 +433,9 @@ int main(int argc, char **argv) {
     }
     lcm_ctl = lc.get();
     ctl = std::move(lc);
-  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled);
+  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled, cfg);
   else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, cfg);
-  else if (o.baseline == "full") ctl = poursim::make_full_torque_controller();
+  else if (o.baseline == "full") ctl = poursim::make_full_torque_controller(cfg);
   else ctl = poursim::make_hand_controller(cfg);
 
   poursim_world_t *world = poursim_create(&cfg, err, sizeof err);
@@ -476,35 +476,58 @@ int main(int argc, char **argv) {
     }
     eps.push_back(e);
     if (!o.quiet)
-      std::fprintf(per, "episode %d seed %u: poured %5.1f %%  spilled %4.1f %%  left %4.1f %%  finish %s  return %.1f\n",
-                   k + 1, seed, 100 * e.poured, 100 * e.spilled, 100 * e.remaining,
-                   e.finish < 0 ? "  -   " : (std::to_string(e.finish).substr(0, 5) + " s").c_str(), e.ret);
+      std::fprintf(per,
+                   "episode %d seed %u: poured %5.1f %% (%5.2f L)  spilled %4.1f %% (%4.2f L)  left %4.1f %%  finish %s"
+                   "  peak %.2f rad/s %.0f rad/s²  reversals %d  return %.1f\n",
+                   k + 1, seed, 100 * e.poured, e.poured * e.litres, 100 * e.spilled, e.spilled * e.litres,
+                   100 * e.remaining, e.finish < 0 ? "  -   " : (std::to_string(e.finish).substr(0, 5) + " s").c_str(),
+                   e.peak_omega, e.peak_alpha, e.reversals, e.ret);
     if (k == 0 && !o.render.empty()) first = rec;
     if (csv != nullptr) write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
-  std::vector<double> poured, spilled, finish, ret;
+  std::vector<double> poured, spilled, poured_l, spilled_l, finish, ret, peak_omega, peak_alpha, reversals;
   int unfinished = 0;
   for (const Episode &e : eps) {
     poured.push_back(100 * e.poured);
     spilled.push_back(100 * e.spilled);
+    poured_l.push_back(e.poured * e.litres);
+    spilled_l.push_back(e.spilled * e.litres);
     ret.push_back(e.ret);
+    peak_omega.push_back(e.peak_omega);
+    peak_alpha.push_back(e.peak_alpha);
+    reversals.push_back(e.reversals);
     if (e.finish >= 0) finish.push_back(e.finish);
     else ++unfinished;
   }
+  const double max_finish = finish.empty() ? -1.0 : *std::max_element(finish.begin(), finish.end());
+  const double max_peak = *std::max_element(peak_omega.begin(), peak_omega.end());
   if (o.json) {
     std::printf("{\"controller\": \"%s\", \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
                 "\"poured_pct\": %.3f, \"poured_pct_std\": %.3f, \"spilled_pct\": %.3f, \"spilled_pct_std\": %.3f, "
-                "\"finish_s\": %.4f, \"unfinished\": %d, \"return\": %.4f, \"return_std\": %.4f, \"per_episode\": [",
+                "\"poured_l\": %.4f, \"spilled_l\": %.4f, \"finish_s\": %.4f, \"finish_max_s\": %.4f, "
+                "\"unfinished\": %d, \"peak_omega_rad_s\": %.4f, \"peak_omega_max_rad_s\": %.4f, "
+                "\"peak_alpha_rad_s2\": %.3f, \"reversals\": %.2f, \"return\": %.4f, \"return_std\": %.4f, "
+                "\"per_episode\": [",
                 ctl->name().c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
-                stdev(spilled), finish.empty() ? -1.0 : mean(finish), unfinished, mean(ret), stdev(ret));
-    for (size_t k = 0; k < eps.size(); ++k)
-      std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"finish_s\": %.4f, \"return\": %.4f}",
-                  k ? ", " : "", eps[k].seed, 100 * eps[k].poured, 100 * eps[k].spilled, eps[k].finish, eps[k].ret);
+                stdev(spilled), mean(poured_l), mean(spilled_l), finish.empty() ? -1.0 : mean(finish), max_finish,
+                unfinished, mean(peak_omega), max_peak, mean(peak_alpha), mean(reversals), mean(ret), stdev(ret));
+    for (size_t k = 0; k < eps.size(); ++k) {
+      const Episode &e = eps[k];
+      std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"liquid_l\": %.4f, "
+                  "\"finish_s\": %.4f, \"peak_omega_rad_s\": %.4f, \"peak_alpha_rad_s2\": %.3f, \"reversals\": %d, "
+                  "\"return\": %.4f}",
+                  k ? ", " : "", e.seed, 100 * e.poured, 100 * e.spilled, e.litres, e.finish, e.peak_omega,
+                  e.peak_alpha, e.reversals, e.ret);
+    }
     std::printf("]}\n");
   } else {
-    std::printf("summary (%d episode%s): poured %.1f %% (sd %.1f)  spilled %.1f %% (sd %.1f)  finish %s  return %.1f\n",
-                o.episodes, o.episodes > 1 ? "s" : "", mean(poured), stdev(poured), mean(spilled), stdev(spilled),
-                finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(), mean(ret));
+    std::printf("summary (%d episode%s): poured %.1f %% (%.2f L, sd %.1f %%)  spilled %.1f %% (%.2f L, sd %.1f %%)  "
+                "finish %s (max %s)  peak %.2f rad/s (max %.2f)  %.0f rad/s²  reversals %.1f  return %.1f\n",
+                o.episodes, o.episodes > 1 ? "s" : "", mean(poured), mean(poured_l), stdev(poured), mean(spilled),
+                mean(spilled_l), stdev(spilled),
+                finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(),
+                finish.empty() ? "-" : (std::to_string(max_finish).substr(0, 5) + " s").c_str(), mean(peak_omega),
+                max_peak, mean(peak_alpha), mean(reversals), mean(ret));
   }
   if (lcm_ctl != nullptr) {
     lcm_ctl->link().drain(50);

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 
 #include "poursim/poursim.h"
 
@@ -31,6 +32,10 @@ inline double particle_radius(const poursim_config_t *c) { return c->fluid_conta
 inline double liquid_mass(const poursim_config_t *c) {
   return c->liquid_density * c->fill_depth * M_PI * 0.25 * c->bucket_inner_width * c->bucket_inner_width;
 }
+
+// The config of the episode of seed: each rand_* key draws its parameters uniformly in ± its value
+// around c's (relative or absolute, as poursim.h says); c itself when every rand_* key is 0.
+poursim_config_t draw_episode_config(const poursim_config_t &c, uint32_t seed);
 
 // Deterministic PRNG (splitmix64): the same stream on every platform.
 struct Rng {

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Whole episodes in C for the trainer: a float softmax-linear policy decides every P steps, its torque
-// passes through the firmware's own safety envelope, and the arrays Python asked for are filled.
+// Whole episodes in C for the trainer: a float softmax-linear policy decides every P steps on the state the
+// firmware's own estimator makes of the rig's sensors, its torque passes through the firmware's own safety
+// envelope (the motion envelope included), and the arrays Python asked for are filled.
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
@@ -11,8 +12,11 @@
 #include <vector>
 
 extern "C" {
+#include "pour/control.h"
 #include "pour/safety.h"
+#include "pour/sensors.h"
 }
+#include "metrics.hpp"
 #include "poursim/poursim.h"
 #include "poursim_internal.hpp"
 
@@ -44,12 +48,13 @@ int validate_policy(const poursim_policy_t *p, char *err, size_t err_len) {
 
 double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
-// The features of the weights.h spec, from the physical state (not the world's own normalisation).
-Features features_of(const poursim_policy_t *p, const poursim_obs_t &o) {
+// The features of the weights.h spec, from the state the firmware's estimator makes of the sensors.
+Features features_of(const poursim_policy_t *p, const pour_state_t &s) {
+  const double theta = s.theta_urad * 1e-6, omega = s.omega_urad_s * 1e-6;
   Features x;
-  x << clamp01((o.theta - p->theta_min) / (p->theta_max - p->theta_min)),
-      clamp01((o.omega + p->omega_max) / (2.0 * p->omega_max)), clamp01(o.v_rotating), clamp01(o.v_target),
-      clamp01(o.v_spill), 1.0;
+  x << clamp01((theta - p->theta_min) / (p->theta_max - p->theta_min)),
+      clamp01((omega + p->omega_max) / (2.0 * p->omega_max)), clamp01(s.v_rotating / 32768.0),
+      clamp01(s.v_target / 32768.0), clamp01(s.v_spill / 32768.0), 1.0;
   return x;
 }
 
@@ -70,27 +75,34 @@ extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *p
   rc = poursim_reset(world, seed);
   if (rc != POURSIM_OK) return rc;
 
-  pour_safety_config_t scfg = pour_safety_default_config();
+  // The firmware's defaults, as the shipped controller runs them; the encoder as the rig has it.
+  pour_control_config_t fw = pour_control_default_config();
+  fw.sensors.encoder_bits = static_cast<uint8_t>(cfg->encoder_bits);
   pour_safety_t safety;
-  if (pour_safety_init(&safety, &scfg) != POUR_OK) return POURSIM_ESTATE;
+  pour_estimator_t est;
+  if (pour_safety_init(&safety, &fw.safety) != POUR_OK || pour_estimator_init(&est, &fw.sensors) != POUR_OK)
+    return POURSIM_ESTATE;
 
   const int n_act = policy->n_actions;
   Eigen::Map<const RowMatrix> W(policy->w, POURSIM_N_FEATURES, n_act);
   // Sampling draws from its own stream so that greedy and sampled runs share the liquid of a seed.
   poursim::Rng rng(0xA5A5A5A5ULL ^ (static_cast<unsigned long long>(seed) * 0x100000001B3ULL));
   const int n_steps = static_cast<int>(std::lround(cfg->episode_s / cfg->dt));
-  std::vector<double> settled(static_cast<size_t>(n_steps));
 
-  std::memset(ep, 0, sizeof *ep);
   poursim_obs_t o;
   poursim_observe(world, &o);
-  int action = 0, decision = -1;
-  double disc = 1.0, ret = 0.0, sum = 0.0, max_theta = o.theta;
+  poursim::EpisodeMeter meter;
+  meter.reset(*poursim_episode_config(world), o);
+  pour_state_t state{};
+  int action = 0, decision = -1, reversals = 0;
   Eigen::VectorXd probs(n_act);
   for (int t = 0; t < n_steps; ++t) {
+    // A sample the estimator refuses (the firmware would fault) leaves the last state in place.
+    const pour_sensors_t sample = {static_cast<uint32_t>(t), o.encoder, o.scale_rotating_g, o.scale_target_g};
+    pour_estimator_update(&est, &sample, &state);
     if (t % policy->decision_period == 0) {
       ++decision;
-      Features x = features_of(policy, o);
+      Features x = features_of(policy, state);
       Eigen::VectorXd logits = (x * W).transpose();
       probs = (logits.array() - logits.maxCoeff()).exp();
       probs /= probs.sum();
@@ -119,41 +131,24 @@ extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *p
           for (int k = 0; k < n_act; ++k) buf->probs[d * static_cast<size_t>(n_act) + static_cast<size_t>(k)] = probs(k);
       }
     }
-    int32_t theta_urad = static_cast<int32_t>(std::max(-2.0e9, std::min(2.0e9, std::round(o.theta * 1e6))));
-    q15_t cmd = pour_safety_apply(&safety, to_q15(policy->levels[action]), theta_urad);
+    q15_t cmd = pour_safety_apply(&safety, to_q15(policy->levels[action]), state.theta_urad, state.omega_urad_s);
     rc = poursim_step(world, cmd / 32768.0, &o);
     if (rc != POURSIM_OK) return rc;
-    ret += disc * o.reward;
-    disc *= cfg->gamma;
-    sum += o.reward;
-    max_theta = std::max(max_theta, o.theta);
-    settled[static_cast<size_t>(t)] = o.v_target + o.v_spill;
+    meter.add(o, cmd / 32768.0 * cfg->tau_max);
+    // Training's reward shaping: each torque reversal costs k_reversal (0: the world's reward as it is).
+    const int new_reversals = meter.reversals() - reversals;
+    reversals += new_reversals;
+    const double r = o.reward - policy->k_reversal * new_reversals;
     if (buf != nullptr) {
-      if (decision < buf->capacity && buf->rewards != nullptr) buf->rewards[decision] += o.reward;
+      if (decision < buf->capacity && buf->rewards != nullptr) buf->rewards[decision] += r;
       if (t < buf->step_capacity) {
-        if (buf->step_rewards != nullptr) buf->step_rewards[t] = o.reward;
+        if (buf->step_rewards != nullptr) buf->step_rewards[t] = r;
         if (buf->step_theta != nullptr) buf->step_theta[t] = o.theta;
       }
     }
   }
-  ep->n_steps = n_steps;
+  *ep = meter.result();
   ep->n_decisions = decision + 1;
-  ep->poured = o.v_target;
-  ep->spilled = o.v_spill;
-  ep->remaining = o.v_rotating;
-  ep->ret = ret;
-  ep->reward_sum = sum;
-  ep->max_theta = max_theta;
-  ep->finish_time = -1.0;
-  double final_settled = n_steps > 0 ? settled.back() : 0.0;
-  if (final_settled >= 0.01) {
-    for (int t = 0; t < n_steps; ++t) {
-      if (settled[static_cast<size_t>(t)] >= 0.99 * final_settled) {
-        ep->finish_time = (t + 1) * cfg->dt;
-        break;
-      }
-    }
-  }
   return POURSIM_OK;
 }
 

@@ -67,7 +67,7 @@ void bucket_walls(const poursim_config_t &c, Eigen::Vector2d lo[3], Eigen::Vecto
 using poursim::set_error;
 
 static void build_scene(poursim_world_t *w, uint32_t seed) {
-  const poursim_config_t &c = w->cfg;
+  const poursim_config_t &c = w->ep;
   b2WorldDef wd = b2DefaultWorldDef();
   wd.gravity = {0.0f, static_cast<float>(-kGravity)};
   wd.restitutionThreshold = static_cast<float>(c.restitution_threshold);
@@ -101,11 +101,13 @@ static void build_scene(poursim_world_t *w, uint32_t seed) {
   Eigen::Vector2d lo[3], hi[3];
   poursim::bucket_walls(c, lo, hi);
   Eigen::Vector2d target_centre(c.target_dx, 0.5 * c.bucket_height);
+  // The target bucket stands on its load cell: a static body of its own, so its contacts are its load.
+  w->target = b2CreateBody(w->world, &gd);
   for (int i = 0; i < 3; ++i) {
     Eigen::Vector2d mid = 0.5 * (lo[i] + hi[i]) + target_centre, half = 0.5 * (hi[i] - lo[i]);
     b2Polygon box = b2MakeOffsetBox(static_cast<float>(half.x()), static_cast<float>(half.y()),
                                     {static_cast<float>(mid.x()), static_cast<float>(mid.y())}, b2Rot_identity);
-    b2CreatePolygonShape(w->ground, &sd, &box);
+    b2CreatePolygonShape(w->target, &sd, &box);
   }
 
   // The rotating bucket: a dynamic body whose origin is the pivot (the bucket's centre).
@@ -124,6 +126,11 @@ static void build_scene(poursim_world_t *w, uint32_t seed) {
                                     {static_cast<float>(mid.x()), static_cast<float>(mid.y())}, b2Rot_identity);
     b2CreatePolygonShape(w->bucket, &bsd, &box);
   }
+  // The motor's rotor turns N times as fast as the bucket: its inertia counts N² times at the output.
+  b2MassData md = b2Body_GetMassData(w->bucket);
+  w->bucket_mass_kg = md.mass;
+  md.rotationalInertia += static_cast<float>(poursim::reflected_inertia(c));
+  b2Body_SetMassData(w->bucket, md);
   b2RevoluteJointDef jd = b2DefaultRevoluteJointDef();
   jd.bodyIdA = w->ground;
   jd.bodyIdB = w->bucket;
@@ -189,7 +196,7 @@ static void destroy_scene(poursim_world_t *w) {
 
 // Positions, regions, volumes, normalised observation, reward; updates the hash and wall penetration.
 static void measure(poursim_world_t *w) {
-  const poursim_config_t &c = w->cfg;
+  const poursim_config_t &c = w->ep;
   poursim_obs_t &o = w->obs;
   size_t n = w->circles.size();
   b2Transform xf = b2Body_GetTransform(w->bucket);
@@ -249,15 +256,72 @@ static void measure(poursim_world_t *w) {
   o.obs[4] = clamp01(o.v_spill);
   o.reward = c.k_target * o.v_target - c.k_spill * o.v_spill;
   o.done = (o.t >= c.episode_s - 0.5 * c.dt) ? 1 : 0;
-  double scalars[8] = {o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight, o.reward, o.torque};
+  // Physics only: the sensors' noise, lag and rate leave the hash as it is (docs/simulator.md).
+  double scalars[9] = {o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight, o.reward, o.torque,
+                       o.motor_torque};
   w->hash = fnv_mix(h, scalars, sizeof scalars);
+}
+
+// The loads on the two cells now [g]. The rotating bucket hangs on its pivot, which stands on a load
+// cell: the cell carries the joint's reaction (the bucket and whatever the liquid does to it, weight and
+// inertia alike), tared by the empty bucket's weight. The target bucket stands on the other: it carries
+// every contact force on the target body, so liquid landing in it weighs its momentum too (ṁ·v).
+static void cell_loads(poursim_world_t *w, double *rotating_g, double *target_g) {
+  const double to_g = 1000.0 / kGravity;
+  const b2Vec2 f = b2Joint_GetConstraintForce(w->joint); // on the bucket (body B), over the last sub-step
+  *rotating_g = static_cast<double>(f.y) * to_g - 1000.0 * w->bucket_mass_kg;
+  const int cap = b2Body_GetContactCapacity(w->target);
+  if (static_cast<size_t>(cap) > w->contacts.size()) w->contacts.resize(static_cast<size_t>(cap));
+  const int n = b2Body_GetContactData(w->target, w->contacts.data(), cap);
+  double fy = 0.0; // on the target [N·s over a sub-step]
+  for (int k = 0; k < n; ++k) {
+    const b2ContactData &cd = w->contacts[static_cast<size_t>(k)];
+    const b2Manifold &m = cd.manifold;
+    // The solver pushes shape B along +normal (and +tangent = right perpendicular) and A the other way.
+    const bool target_is_a = B2_ID_EQUALS(b2Shape_GetBody(cd.shapeIdA), w->target);
+    const double normal_y = m.normal.y, tangent_y = -static_cast<double>(m.normal.x);
+    double py = 0.0;
+    for (int j = 0; j < m.pointCount; ++j)
+      py += static_cast<double>(m.points[j].normalImpulse) * normal_y +
+            static_cast<double>(m.points[j].tangentImpulse) * tangent_y;
+    fy += target_is_a ? -py : py;
+  }
+  const double inv_h = w->ep.substeps / w->ep.dt;
+  *target_g = -fy * inv_h * to_g; // pushed down = a positive load
+}
+
+// The sensors after a step (or, with initial, at reset: the liquid has rested on both cells since before
+// the delay reaches back).
+static void sense(poursim_world_t *w, bool initial) {
+  poursim_obs_t &o = w->obs;
+  o.encoder = poursim::encoder_count(o.theta, w->ep.encoder_bits);
+  double rot_g, tgt_g;
+  cell_loads(w, &rot_g, &tgt_g);
+  if (initial) {
+    w->scale_rotating.reset(w->ep, rot_g, w->sensor_noise);
+    w->scale_target.reset(w->ep, tgt_g, w->sensor_noise);
+  } else {
+    w->scale_rotating.update(w->step, rot_g, w->sensor_noise);
+    w->scale_target.update(w->step, tgt_g, w->sensor_noise);
+  }
+  o.scale_rotating_g = w->scale_rotating.reading();
+  o.scale_target_g = w->scale_target.reading();
+}
+
+// The drive's Coulomb friction (and the brake when engaged) as the joint's motor held at zero speed: it
+// stops the axis against up to that torque, and slips at exactly that torque beyond.
+static void set_joint_friction(poursim_world_t *w) {
+  const double hold = w->ep.friction_coulomb + (w->brake ? w->ep.brake_torque : 0.0);
+  b2RevoluteJoint_EnableMotor(w->joint, hold > 0.0);
+  b2RevoluteJoint_SetMotorSpeed(w->joint, 0.0f);
+  b2RevoluteJoint_SetMaxMotorTorque(w->joint, static_cast<float>(hold));
 }
 
 // One dt: the fluid layer changes the circles' velocities, then Box2D moves everything and resolves the
 // contacts with the buckets.
 static void advance(poursim_world_t *w) {
-  const poursim_config_t &c = w->cfg;
-  if (c.fluid) {
+  const poursim_config_t &c = w->ep;
+  if (c.fluid && !w->circles.empty()) {
     const size_t n = w->circles.size();
     for (size_t i = 0; i < n; ++i) {
       b2Vec2 p = b2Body_GetPosition(w->circles[i]), v = b2Body_GetLinearVelocity(w->circles[i]);
@@ -290,6 +354,20 @@ static int check_numerics(poursim_world_t *w) {
   return POURSIM_OK;
 }
 
+namespace poursim {
+
+void empty_bucket(poursim_world_t *w, bool free_spin) {
+  if (!w->has_world) return;
+  for (b2BodyId b : w->circles) b2DestroyBody(b);
+  w->circles.clear();
+  w->radii.clear();
+  w->pos.clear();
+  w->region.clear();
+  if (free_spin) b2RevoluteJoint_EnableLimit(w->joint, false);
+}
+
+} // namespace poursim
+
 extern "C" {
 
 poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
@@ -302,6 +380,7 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
     return nullptr;
   }
   w->cfg = *config;
+  w->ep = *config;
   int rc = poursim_reset(w, config->seed);
   if (rc != POURSIM_OK) {
     set_error(err, err_len, rc, "while the liquid settled: %s", w->error);
@@ -314,8 +393,11 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
 int poursim_reset(poursim_world_t *w, uint32_t seed) {
   if (w == nullptr) return POURSIM_EINVAL;
   destroy_scene(w);
+  w->ep = poursim::draw_episode_config(w->cfg, seed);
   build_scene(w, seed);
-  const poursim_config_t &c = w->cfg;
+  const poursim_config_t &c = w->ep;
+  w->drive.reset(c);
+  w->sensor_noise = poursim::Gauss(0x5E4507ULL ^ (static_cast<uint64_t>(seed) << 28));
   size_t n = w->circles.size();
   w->pos.assign(2 * n, 0.0f);
   w->region.assign(n, 0);
@@ -327,12 +409,13 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   for (int i = 0; i < settle_steps; ++i) advance(w);
   int rc = check_numerics(w);
   if (rc != POURSIM_OK) return rc;
-  b2RevoluteJoint_EnableMotor(w->joint, false);
+  set_joint_friction(w);
   b2Body_SetAngularVelocity(w->bucket, 0.0f);
   w->hash = 14695981039346656037ULL;
   w->max_wall_pen = 0.0;
   std::memset(&w->obs, 0, sizeof w->obs);
   measure(w);
+  sense(w, true);
   w->max_wall_pen = 0.0; // count excursions from t = 0 on
   return POURSIM_OK;
 }
@@ -340,21 +423,23 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
 int poursim_step(poursim_world_t *w, double action, poursim_obs_t *out) {
   if (w == nullptr || !w->has_world) return POURSIM_EINVAL;
   if (!std::isfinite(action)) return POURSIM_EINVAL;
-  double a = std::max(-1.0, std::min(1.0, action));
-  double tau = a * w->cfg.tau_max;
-  // The joint's motor is the brake when engaged: zero speed, up to the brake's rating.
-  b2RevoluteJoint_EnableMotor(w->joint, w->brake);
-  if (w->brake) {
-    b2RevoluteJoint_SetMotorSpeed(w->joint, 0.0f);
-    b2RevoluteJoint_SetMaxMotorTorque(w->joint, static_cast<float>(w->cfg.brake_torque));
-  }
-  b2Body_ApplyTorque(w->bucket, static_cast<float>(-tau), true);
+  const double a = std::max(-1.0, std::min(1.0, action));
+  const double tau_cmd = a * w->ep.tau_max;
+  // The drive delivers the command of command_latency_ticks steps ago, within its torque–speed
+  // envelope at the speed the step starts from; viscous friction opposes that speed (explicit: b·dt/J is
+  // ~1e-4). Coulomb friction and the brake are the joint's motor.
+  const double omega = -static_cast<double>(b2Body_GetAngularVelocity(w->bucket));
+  const double tau_motor = w->drive.step(tau_cmd, omega);
+  set_joint_friction(w);
+  b2Body_ApplyTorque(w->bucket, static_cast<float>(-(tau_motor - w->ep.friction_viscous * omega)), true);
   advance(w);
   w->step++;
   int rc = check_numerics(w);
   if (rc != POURSIM_OK) return rc;
-  w->obs.torque = tau;
+  w->obs.torque = tau_cmd;
+  w->obs.motor_torque = tau_motor;
   measure(w);
+  sense(w, false);
   if (out != nullptr) *out = w->obs;
   return POURSIM_OK;
 }
@@ -365,13 +450,15 @@ int poursim_step_servo(poursim_world_t *w, double theta_ref, poursim_obs_t *out)
   // The motor reaches the speed that closes the error in one step, with torque to spare.
   b2RevoluteJoint_EnableMotor(w->joint, true);
   b2RevoluteJoint_SetMaxMotorTorque(w->joint, 1e4f);
-  b2RevoluteJoint_SetMotorSpeed(w->joint, static_cast<float>(-(theta_ref - w->obs.theta) / w->cfg.dt));
+  b2RevoluteJoint_SetMotorSpeed(w->joint, static_cast<float>(-(theta_ref - w->obs.theta) / w->ep.dt));
   advance(w);
   w->step++;
   int rc = check_numerics(w);
   if (rc != POURSIM_OK) return rc;
   w->obs.torque = -static_cast<double>(b2RevoluteJoint_GetMotorTorque(w->joint));
+  w->obs.motor_torque = w->obs.torque;
   measure(w);
+  sense(w, false);
   if (out != nullptr) *out = w->obs;
   return POURSIM_OK;
 }
@@ -385,7 +472,7 @@ int poursim_set_brake(poursim_world_t *w, int engaged) {
 const char *poursim_world_error(const poursim_world_t *w) { return w ? w->error : "world is NULL"; }
 
 double poursim_max_density_ratio(const poursim_world_t *w) {
-  return w != nullptr && w->cfg.fluid ? w->fluid.max_density_ratio() : 0.0;
+  return w != nullptr && w->ep.fluid ? w->fluid.max_density_ratio() : 0.0;
 }
 
 void poursim_observe(const poursim_world_t *w, poursim_obs_t *out) {
@@ -399,6 +486,8 @@ void poursim_destroy(poursim_world_t *w) {
 }
 
 const poursim_config_t *poursim_world_config(const poursim_world_t *w) { return w ? &w->cfg : nullptr; }
+
+const poursim_config_t *poursim_episode_config(const poursim_world_t *w) { return w ? &w->ep : nullptr; }
 
 int poursim_particle_count(const poursim_world_t *w) { return w ? static_cast<int>(w->circles.size()) : 0; }
 
@@ -425,7 +514,7 @@ int poursim_particle_regions(const poursim_world_t *w, uint8_t *region, int capa
 
 double poursim_max_overlap(const poursim_world_t *w) {
   if (w == nullptr) return 0.0;
-  const poursim_config_t &c = w->cfg;
+  const poursim_config_t &c = w->ep;
   size_t n = w->circles.size();
   double worst = 0.0;
   // Circles of the fluid meet through pressure, not contact: only the pile's circle pairs overlap.

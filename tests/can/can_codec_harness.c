@@ -3,7 +3,7 @@
  * (through cantools) bit for bit. One request per line on stdin, one answer per line on stdout:
  *   pack <msg> <node> <raw fields...>   -> "ok <id> <dlc> <hex>" | "einval"
  *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
- * msg: state_a (theta omega seq_low), state_b (seq vr vt vs), torque (seq torque action mode limits),
+ * msg: sensors (seq_low encoder scale_rotating scale_target), torque (seq torque action mode limits),
  * heartbeat (mode faults rx_dropped overruns counter), estop (assert), identity (hash tau_max fw init),
  * clear_errors, stop and reset (no fields).
  * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
@@ -64,12 +64,9 @@ static void do_pack(const char *msg, long *v, int n) {
     return;
   }
   uint8_t node = (uint8_t)v[0];
-  if (strcmp(msg, "state_a") == 0 && n == 4) {
-    pour_can_state_a_t m = {(int32_t)v[1], (int32_t)v[2], (uint8_t)v[3]};
-    print_frame(pour_can_pack_state_a(node, &m, &f), &f);
-  } else if (strcmp(msg, "state_b") == 0 && n == 5) {
-    pour_can_state_b_t m = {(uint16_t)v[1], (q15_t)v[2], (q15_t)v[3], (q15_t)v[4]};
-    print_frame(pour_can_pack_state_b(node, &m, &f), &f);
+  if (strcmp(msg, "sensors") == 0 && n == 5) {
+    pour_can_sensors_t m = {(uint8_t)v[1], (uint32_t)v[2], (int16_t)v[3], (int16_t)v[4]};
+    print_frame(pour_can_pack_sensors(node, &m, &f), &f);
   } else if (strcmp(msg, "torque") == 0 && n == 6) {
     pour_can_torque_t m = {(uint16_t)v[1], (q15_t)v[2], (uint8_t)v[3], (uint8_t)v[4], (uint8_t)v[5]};
     print_frame(pour_can_pack_torque(node, &m, &f), &f);
@@ -127,14 +124,11 @@ static void do_unpack(const char *msg, char *rest) {
   f.dlc = (uint8_t)dlc;
   pour_can_rx_t rc;
   char out[128];
-  if (strcmp(msg, "state_a") == 0) {
-    pour_can_state_a_t m = {0};
-    rc = pour_can_unpack_state_a(&f, &m);
-    snprintf(out, sizeof out, "%ld %ld %u", (long)m.theta_urad, (long)m.omega_urad_s, (unsigned)m.seq_low);
-  } else if (strcmp(msg, "state_b") == 0) {
-    pour_can_state_b_t m = {0};
-    rc = pour_can_unpack_state_b(&f, &m);
-    snprintf(out, sizeof out, "%u %d %d %d", (unsigned)m.seq, m.v_rotating, m.v_target, m.v_spill);
+  if (strcmp(msg, "sensors") == 0) {
+    pour_can_sensors_t m = {0};
+    rc = pour_can_unpack_sensors(&f, &m);
+    snprintf(out, sizeof out, "%u %lu %d %d", (unsigned)m.seq_low, (unsigned long)m.encoder, m.scale_rotating_g,
+             m.scale_target_g);
   } else if (strcmp(msg, "torque") == 0) {
     pour_can_torque_t m = {0};
     rc = pour_can_unpack_torque(&f, &m);

@@ -16,17 +16,15 @@ void setUp(void) {
 
 void tearDown(void) {}
 
-static pour_plant_state_t state(int64_t seq, double theta) {
-  pour_plant_state_t m;
+static pour_sensor_sample_t sample(int64_t seq, int32_t encoder) {
+  pour_sensor_sample_t m;
   memset(&m, 0, sizeof m);
   m.utime = 1000 * seq + 7;
   m.seq = seq;
   m.episode = 3;
-  m.theta = theta;
-  m.omega = -0.25;
-  m.v_rotating = 0.75;
-  m.v_target = 0.2;
-  m.v_spill = 0.05;
+  m.encoder = encoder;
+  m.scale_rotating_g = 7725;
+  m.scale_target_g = -12;
   return m;
 }
 
@@ -39,28 +37,38 @@ static void test_bridge_init_RejectsBadConfig(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_bridge_init(&b, &c));
 }
 
-static void test_bridge_StateBecomesTwoFramesInFixedPoint(void) {
-  pour_can_frame_t f[2];
-  const pour_plant_state_t m = state(70000, 1.25);
-  TEST_ASSERT_EQUAL_INT(2, pour_bridge_from_state(&b, &m, f));
-  pour_can_state_a_t a;
-  pour_can_state_b_t sb;
-  TEST_ASSERT_EQUAL_HEX16(pour_can_id(2, POUR_CAN_CMD_STATE_A), f[0].id);
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_a(&f[0], &a));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_b(&f[1], &sb));
-  TEST_ASSERT_EQUAL_INT32(1250000, a.theta_urad);
-  TEST_ASSERT_EQUAL_INT32(-250000, a.omega_urad_s);
-  TEST_ASSERT_EQUAL_UINT16(70000 & 0xFFFF, sb.seq);
-  TEST_ASSERT_EQUAL_UINT8(70000 & 0xFF, a.seq_low);
-  TEST_ASSERT_EQUAL_INT16(24576, sb.v_rotating);
-  TEST_ASSERT_EQUAL_INT16(6554, sb.v_target); /* round(0.2 * 32768) */
+static void test_bridge_SampleBecomesOneFrameWithTheReadingsAsTheyAre(void) {
+  pour_can_frame_t f[1];
+  const pour_sensor_sample_t m = sample(70000, 130000);
+  TEST_ASSERT_EQUAL_INT(1, pour_bridge_from_sensors(&b, &m, f, NULL));
+  pour_can_sensors_t s;
+  TEST_ASSERT_EQUAL_HEX16(pour_can_id(2, POUR_CAN_CMD_SENSORS), f[0].id);
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_sensors(&f[0], &s));
+  TEST_ASSERT_EQUAL_UINT8(70000 & 0xFF, s.seq_low);
+  TEST_ASSERT_EQUAL_UINT32(130000u, s.encoder);
+  TEST_ASSERT_EQUAL_INT16(7725, s.scale_rotating_g);
+  TEST_ASSERT_EQUAL_INT16(-12, s.scale_target_g);
+  TEST_ASSERT_EQUAL_INT64(1, b.counters.states_sent);
 }
 
-static void test_bridge_RefusesStatesOutsideTheCanRange(void) {
-  pour_can_frame_t f[2];
-  const pour_plant_state_t m = state(1, 3.5); /* > 3.2 rad */
-  TEST_ASSERT_EQUAL_INT(0, pour_bridge_from_state(&b, &m, f));
-  TEST_ASSERT_EQUAL_INT64(1, b.counters.states_refused);
+/* What the frame cannot carry is refused with the reading named, not wrapped into another value. */
+static void test_bridge_RefusesReadingsTheFrameCannotCarry(void) {
+  pour_can_frame_t f[1];
+  const char *why = NULL;
+  pour_sensor_sample_t m = sample(1, -1); /* a negative count */
+  TEST_ASSERT_EQUAL_INT(0, pour_bridge_from_sensors(&b, &m, f, &why));
+  TEST_ASSERT_NOT_NULL(strstr(why, "encoder"));
+  m = sample(1, 1 << 24);
+  TEST_ASSERT_EQUAL_INT(0, pour_bridge_from_sensors(&b, &m, f, &why));
+  m = sample(1, 0);
+  m.scale_rotating_g = 40000;
+  TEST_ASSERT_EQUAL_INT(0, pour_bridge_from_sensors(&b, &m, f, &why));
+  TEST_ASSERT_NOT_NULL(strstr(why, "scale_rotating_g"));
+  m = sample(1, 0);
+  m.scale_target_g = -32768; /* the frame's overload code is not a reading */
+  TEST_ASSERT_EQUAL_INT(0, pour_bridge_from_sensors(&b, &m, f, &why));
+  TEST_ASSERT_NOT_NULL(strstr(why, "scale_target_g"));
+  TEST_ASSERT_EQUAL_INT64(4, b.counters.states_refused);
   TEST_ASSERT_EQUAL_INT64(0, b.counters.states_sent);
 }
 
@@ -81,11 +89,11 @@ static void receive_identity(uint16_t tau_max_cnm, uint32_t hash) {
   TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_NONE, pour_bridge_from_frame(&b, &f, 0, &tq, &st));
 }
 
-static void test_bridge_TorqueAnswersTheStateItMatches(void) {
+static void test_bridge_TorqueAnswersTheSampleItMatches(void) {
   receive_identity(4000u, 0x12345678u); /* 40 N·m */
-  pour_can_frame_t f[2];
-  const pour_plant_state_t m = state(70000, 0.5);
-  pour_bridge_from_state(&b, &m, f);
+  pour_can_frame_t f[1];
+  const pour_sensor_sample_t m = sample(70000, 5000);
+  pour_bridge_from_sensors(&b, &m, f, NULL);
   pour_torque_t tq;
   pour_controller_status_t st;
   const pour_can_frame_t tf = torque_frame(2, 70000 & 0xFFFF, -16384);
@@ -102,11 +110,25 @@ static void test_bridge_TorqueAnswersTheStateItMatches(void) {
   TEST_ASSERT_EQUAL_INT32(0x12345678, tq.weights_hash);
 }
 
+/* A controller that joined mid-run counts from the first Sensors.Seq it saw: only the low 8 bits of its
+ * echo are the host's, and they find the sample. */
+static void test_bridge_MatchesTheEchoByTheFramesSeqBitsOnly(void) {
+  pour_can_frame_t f[1];
+  const pour_sensor_sample_t m = sample(300, 5000); /* 300 = 0x12C: Sensors.Seq 0x2C */
+  pour_bridge_from_sensors(&b, &m, f, NULL);
+  pour_torque_t tq;
+  pour_controller_status_t st;
+  const pour_can_frame_t tf = torque_frame(2, 0x002C, 100); /* its count began at 0x2C */
+  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_TORQUE, pour_bridge_from_frame(&b, &tf, 0, &tq, &st));
+  TEST_ASSERT_EQUAL_INT64(300, tq.seq);
+  TEST_ASSERT_EQUAL_INT64(m.utime, tq.state_utime);
+}
+
 /* No scale is guessed: before the controller's Identity frame the torque in N·m is unknown (NaN). */
 static void test_bridge_TorqueScaleComesFromTheBusOnly(void) {
-  pour_can_frame_t f[2];
-  const pour_plant_state_t m = state(5, 0.5);
-  pour_bridge_from_state(&b, &m, f);
+  pour_can_frame_t f[1];
+  const pour_sensor_sample_t m = sample(5, 5000);
+  pour_bridge_from_sensors(&b, &m, f, NULL);
   pour_torque_t tq;
   pour_controller_status_t st;
   const pour_can_frame_t tf = torque_frame(2, 5, 16384);
@@ -119,7 +141,7 @@ static void test_bridge_TorqueScaleComesFromTheBusOnly(void) {
   TEST_ASSERT_EQUAL_INT32(7, tq.weights_hash);
 }
 
-static void test_bridge_DropsTorqueForAStateNeverSent(void) {
+static void test_bridge_DropsTorqueForASampleNeverSent(void) {
   pour_torque_t tq;
   pour_controller_status_t st;
   const pour_can_frame_t tf = torque_frame(2, 9, 100);
@@ -147,10 +169,10 @@ static void test_bridge_IgnoresOtherNodesAndHostFramesButDropsMalformed(void) {
   pour_controller_status_t st;
   pour_can_frame_t f = torque_frame(3, 0, 0); /* node 3 */
   TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_NONE, pour_bridge_from_frame(&b, &f, 0, &tq, &st));
-  pour_can_frame_t two[2];
-  const pour_plant_state_t m = state(1, 0.0);
-  pour_bridge_from_state(&b, &m, two); /* our own StateA, seen on the bus */
-  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_NONE, pour_bridge_from_frame(&b, &two[0], 0, &tq, &st));
+  pour_can_frame_t own[1];
+  const pour_sensor_sample_t m = sample(1, 0);
+  pour_bridge_from_sensors(&b, &m, own, NULL); /* our own Sensors frame, seen on the bus */
+  TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_NONE, pour_bridge_from_frame(&b, &own[0], 0, &tq, &st));
   f = torque_frame(2, 1, 0);
   f.dlc = 6;
   TEST_ASSERT_EQUAL_INT(POUR_BRIDGE_DROPPED, pour_bridge_from_frame(&b, &f, 0, &tq, &st));
@@ -185,11 +207,12 @@ static void test_bridge_CommandBecomesEstopAndClear(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_bridge_init_RejectsBadConfig);
-  RUN_TEST(test_bridge_StateBecomesTwoFramesInFixedPoint);
-  RUN_TEST(test_bridge_RefusesStatesOutsideTheCanRange);
-  RUN_TEST(test_bridge_TorqueAnswersTheStateItMatches);
+  RUN_TEST(test_bridge_SampleBecomesOneFrameWithTheReadingsAsTheyAre);
+  RUN_TEST(test_bridge_RefusesReadingsTheFrameCannotCarry);
+  RUN_TEST(test_bridge_TorqueAnswersTheSampleItMatches);
+  RUN_TEST(test_bridge_MatchesTheEchoByTheFramesSeqBitsOnly);
   RUN_TEST(test_bridge_TorqueScaleComesFromTheBusOnly);
-  RUN_TEST(test_bridge_DropsTorqueForAStateNeverSent);
+  RUN_TEST(test_bridge_DropsTorqueForASampleNeverSent);
   RUN_TEST(test_bridge_HeartbeatBecomesStatus);
   RUN_TEST(test_bridge_IgnoresOtherNodesAndHostFramesButDropsMalformed);
   RUN_TEST(test_bridge_CommandBecomesEstopAndClear);

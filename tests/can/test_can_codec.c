@@ -11,50 +11,56 @@ void tearDown(void) {}
 
 static void test_can_id_PlacesNodeAboveCmd(void) {
   TEST_ASSERT_EQUAL_HEX16(0x012, pour_can_id(0, POUR_CAN_CMD_TORQUE));
-  TEST_ASSERT_EQUAL_HEX16((5u << 5) | 0x10u, pour_can_id(5, POUR_CAN_CMD_STATE_A));
+  TEST_ASSERT_EQUAL_HEX16((5u << 5) | 0x10u, pour_can_id(5, POUR_CAN_CMD_SENSORS));
   TEST_ASSERT_EQUAL_HEX16(0x7FF, pour_can_id(63, 31));
 }
 
-static void test_can_pack_state_a_IsLittleEndianWithSignedTheta(void) {
-  pour_can_state_a_t a = {.theta_urad = -2, .omega_urad_s = 0x01020304, .seq_low = 0xAB};
+static void test_can_pack_sensors_IsLittleEndianWithSignedScales(void) {
+  pour_can_sensors_t m = {.seq_low = 0xAB, .encoder = 0x01FFFFu, .scale_rotating_g = -2, .scale_target_g = 12345};
   pour_can_frame_t f;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(1, &a, &f));
-  const uint8_t want[8] = {0xFE, 0xFF, 0xFF, 0x04, 0x03, 0x02, 0x01, 0xAB};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(1, &m, &f));
+  const uint8_t want[8] = {0xAB, 0xFF, 0xFF, 0x01, 0xFE, 0xFF, 0x39, 0x30};
   TEST_ASSERT_EQUAL_HEX16(0x030, f.id);
   TEST_ASSERT_EQUAL_UINT8(8, f.dlc);
   TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
-  pour_can_state_a_t back;
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_a(&f, &back));
-  TEST_ASSERT_EQUAL_INT32(-2, back.theta_urad);
-  TEST_ASSERT_EQUAL_INT32(0x01020304, back.omega_urad_s);
+  pour_can_sensors_t back;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_sensors(&f, &back));
   TEST_ASSERT_EQUAL_UINT8(0xAB, back.seq_low);
+  TEST_ASSERT_EQUAL_HEX32(0x01FFFFu, back.encoder);
+  TEST_ASSERT_EQUAL_INT16(-2, back.scale_rotating_g);
+  TEST_ASSERT_EQUAL_INT16(12345, back.scale_target_g);
 }
 
-static void test_can_state_a_RoundTripsRangeEdges(void) {
-  const int32_t thetas[] = {-POUR_CAN_THETA_MAX_URAD, -1, 0, 1, POUR_CAN_THETA_MAX_URAD};
-  const int32_t omegas[] = {-POUR_CAN_OMEGA_MAX_URAD_S, -1, 0, 1, POUR_CAN_OMEGA_MAX_URAD_S};
+static void test_can_sensors_RoundTripRangeEdges(void) {
+  const uint32_t encoders[] = {0u, 1u, 0x1FFFFu, 0x20000u, POUR_CAN_ENCODER_MAX};
+  const int16_t scales[] = {-POUR_CAN_SCALE_MAX_G, -1, 0, 1, POUR_CAN_SCALE_MAX_G};
   for (unsigned i = 0; i < 5; ++i) {
-    pour_can_state_a_t a = {.theta_urad = thetas[i], .omega_urad_s = omegas[4 - i], .seq_low = (uint8_t)i};
+    pour_can_sensors_t m = {.seq_low = (uint8_t)(250u + i), .encoder = encoders[i], .scale_rotating_g = scales[i],
+                            .scale_target_g = scales[4 - i]};
     pour_can_frame_t f;
-    pour_can_state_a_t b;
-    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(0, &a, &f));
-    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_a(&f, &b));
-    TEST_ASSERT_EQUAL_INT32(a.theta_urad, b.theta_urad);
-    TEST_ASSERT_EQUAL_INT32(a.omega_urad_s, b.omega_urad_s);
+    pour_can_sensors_t b;
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(0, &m, &f));
+    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_sensors(&f, &b));
+    TEST_ASSERT_EQUAL_UINT8(m.seq_low, b.seq_low);
+    TEST_ASSERT_EQUAL_UINT32(m.encoder, b.encoder);
+    TEST_ASSERT_EQUAL_INT16(m.scale_rotating_g, b.scale_rotating_g);
+    TEST_ASSERT_EQUAL_INT16(m.scale_target_g, b.scale_target_g);
   }
 }
 
 static void test_can_pack_RefusesOutOfRangeAndLeavesFrame(void) {
   pour_can_frame_t f;
   memset(&f, 0x5A, sizeof f);
-  pour_can_state_a_t a = {.theta_urad = POUR_CAN_THETA_MAX_URAD + 1, .omega_urad_s = 0, .seq_low = 0};
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_state_a(0, &a, &f));
+  pour_can_sensors_t m = {.seq_low = 0, .encoder = POUR_CAN_ENCODER_MAX + 1u, .scale_rotating_g = 0,
+                          .scale_target_g = 0};
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_sensors(0, &m, &f)); /* does not fit 24 bits */
   TEST_ASSERT_EQUAL_HEX8(0x5A, f.data[0]);
-  a.theta_urad = 0;
-  a.omega_urad_s = -POUR_CAN_OMEGA_MAX_URAD_S - 1;
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_state_a(0, &a, &f));
-  pour_can_state_b_t b = {.seq = 1, .v_rotating = -1, .v_target = 0, .v_spill = 0};
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_state_b(0, &b, &f));
+  m.encoder = 0u;
+  m.scale_rotating_g = INT16_MIN; /* the overload code */
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_sensors(0, &m, &f));
+  m.scale_rotating_g = 0;
+  m.scale_target_g = INT16_MIN;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_sensors(0, &m, &f));
   pour_can_torque_t t = {.seq = 0, .torque = 0, .action = 16, .mode = 0, .limits = 0};
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_torque(0, &t, &f));
   pour_can_heartbeat_t hb = {.mode = 4};
@@ -69,33 +75,18 @@ static void test_can_pack_RefusesOutOfRangeAndLeavesFrame(void) {
   TEST_ASSERT_EQUAL_HEX8(0x5A, f.data[0]);
 }
 
-static void test_can_unpack_state_a_RejectsThetaPastRange(void) {
-  pour_can_frame_t f = {.id = POUR_CAN_CMD_STATE_A, .dlc = 8, .data = {0}};
-  /* 3,200,001 µrad = 0x30D401 */
-  f.data[0] = 0x01;
-  f.data[1] = 0xD4;
-  f.data[2] = 0x30;
-  pour_can_state_a_t a = {.theta_urad = 7, .omega_urad_s = 7, .seq_low = 7};
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_state_a(&f, &a));
-  TEST_ASSERT_EQUAL_INT32(7, a.theta_urad);
-  f.data[0] = 0x00; /* 3,200,000: the edge itself is in range */
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_a(&f, &a));
-  TEST_ASSERT_EQUAL_INT32(POUR_CAN_THETA_MAX_URAD, a.theta_urad);
-}
-
-static void test_can_state_b_RoundTripsAndRejectsNegativeVolume(void) {
-  pour_can_state_b_t b = {.seq = 0xBEEF, .v_rotating = 32767, .v_target = 0, .v_spill = 1};
-  pour_can_frame_t f;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_b(2, &b, &f));
-  const uint8_t want[8] = {0xEF, 0xBE, 0xFF, 0x7F, 0x00, 0x00, 0x01, 0x00};
-  TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
-  pour_can_state_b_t back;
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_state_b(&f, &back));
-  TEST_ASSERT_EQUAL_UINT16(0xBEEF, back.seq);
-  TEST_ASSERT_EQUAL_INT16(32767, back.v_rotating);
-  TEST_ASSERT_EQUAL_INT16(1, back.v_spill);
-  f.data[5] = 0x80; /* v_target = -32768 */
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_state_b(&f, &back));
+static void test_can_unpack_sensors_RejectsTheScaleOverloadCode(void) {
+  pour_can_frame_t f = {.id = POUR_CAN_CMD_SENSORS, .dlc = 8, .data = {7, 1, 0, 0, 0x00, 0x80, 0, 0}};
+  pour_can_sensors_t m = {.seq_low = 9, .encoder = 9, .scale_rotating_g = 9, .scale_target_g = 9};
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_sensors(&f, &m)); /* rotating -32768 */
+  TEST_ASSERT_EQUAL_UINT8(9, m.seq_low);                                           /* untouched */
+  f.data[5] = 0x00;
+  f.data[7] = 0x80; /* target -32768 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_sensors(&f, &m));
+  f.data[6] = 0x01; /* -32767: the edge itself is in range */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_sensors(&f, &m));
+  TEST_ASSERT_EQUAL_INT16(-POUR_CAN_SCALE_MAX_G, m.scale_target_g);
+  TEST_ASSERT_EQUAL_UINT32(1u, m.encoder);
 }
 
 static void test_can_torque_RoundTripsFullQ15Range(void) {
@@ -137,8 +128,8 @@ static void test_can_unpack_RejectsWrongDlcAndWrongCmd(void) {
   f.dlc = 1;
   f.data[0] = 2;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_estop(&f, &e));
-  pour_can_state_b_t b;
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_state_b(&f, &b));
+  pour_can_sensors_t m;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_sensors(&f, &m));
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(3, POUR_CAN_CMD_CLEAR_ERRORS, &f));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f, POUR_CAN_CMD_CLEAR_ERRORS));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_unpack_command(&f, POUR_CAN_CMD_RESET));
@@ -164,11 +155,11 @@ static void test_can_identity_RoundTripsHashScaleVersionAndNegativeStatus(void) 
 }
 
 static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {
-  const uint32_t accept = 1u << POUR_CAN_CMD_STATE_A;
-  pour_can_frame_t f = {.id = pour_can_id(4, POUR_CAN_CMD_STATE_A), .dlc = 8, .data = {0}};
+  const uint32_t accept = 1u << POUR_CAN_CMD_SENSORS;
+  pour_can_frame_t f = {.id = pour_can_id(4, POUR_CAN_CMD_SENSORS), .dlc = 8, .data = {0}};
   uint8_t cmd = 0xFF;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_classify(&f, 4, accept, &cmd));
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CMD_STATE_A, cmd);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CMD_SENSORS, cmd);
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OTHER_NODE, pour_can_classify(&f, 5, accept, &cmd));
   f.dlc = 7;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_DLC, pour_can_classify(&f, 4, accept, &cmd));
@@ -185,11 +176,10 @@ static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_id_PlacesNodeAboveCmd);
-  RUN_TEST(test_can_pack_state_a_IsLittleEndianWithSignedTheta);
-  RUN_TEST(test_can_state_a_RoundTripsRangeEdges);
+  RUN_TEST(test_can_pack_sensors_IsLittleEndianWithSignedScales);
+  RUN_TEST(test_can_sensors_RoundTripRangeEdges);
   RUN_TEST(test_can_pack_RefusesOutOfRangeAndLeavesFrame);
-  RUN_TEST(test_can_unpack_state_a_RejectsThetaPastRange);
-  RUN_TEST(test_can_state_b_RoundTripsAndRejectsNegativeVolume);
+  RUN_TEST(test_can_unpack_sensors_RejectsTheScaleOverloadCode);
   RUN_TEST(test_can_torque_RoundTripsFullQ15Range);
   RUN_TEST(test_can_heartbeat_CarriesOnlyNamedFaultBits);
   RUN_TEST(test_can_unpack_RejectsWrongDlcAndWrongCmd);

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* CAN node: frames -> control input, watchdog, heartbeat schedule, dropped-frame accounting; and the node
- * with the real control core behind it, as both ports run them (one state for node and core). */
+ * with the real control core behind it, as both ports run them (one sensor sample for node and core). */
 #include <string.h>
 
 #include "pour/can_node.h"
@@ -21,19 +21,18 @@ void setUp(void) {
   cfg.identity.tau_max_cnm = 2000u;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
   ccfg = pour_control_default_config();
-  ccfg.supervisor.checks = POUR_CHECK_ALL & ~(POUR_CHECK_ENCODER | POUR_CHECK_TORQUE_SIGN); /* scripted states */
+  ccfg.supervisor.checks = POUR_CHECK_ALL & ~(POUR_CHECK_ENCODER | POUR_CHECK_TORQUE_SIGN); /* scripted samples */
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
 }
 
 void tearDown(void) {}
 
-static void send_state(uint16_t seq, int32_t theta) {
-  pour_can_state_a_t a = {.theta_urad = theta, .omega_urad_s = -5, .seq_low = (uint8_t)(seq & 0xFFu)};
-  pour_can_state_b_t b = {.seq = seq, .v_rotating = 30000, .v_target = 100, .v_spill = 7};
+/* One Sensors frame: the encoder at count, 10 kg of liquid in the rotating bucket, 300 g in the target. */
+static void send_sample(uint32_t seq, uint32_t encoder) {
+  const pour_can_sensors_t m = {.seq_low = (uint8_t)(seq & 0xFFu), .encoder = encoder, .scale_rotating_g = 10000,
+                                .scale_target_g = 300};
   pour_can_frame_t f;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(cfg.node_id, &a, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_b(cfg.node_id, &b, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(cfg.node_id, &m, &f));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
 }
 
@@ -61,23 +60,22 @@ static void test_can_node_init_RejectsBadConfig(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_node_init(NULL, &cfg));
 }
 
-static void test_can_node_StatePairBecomesOneFreshInput(void) {
-  send_state(0x1234, 1500000);
+static void test_can_node_SensorsFrameBecomesOneFreshRawSample(void) {
+  send_sample(0x34, 0x1FFFFu);
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   tick(100, &in, tx);
-  TEST_ASSERT_TRUE(in.state_fresh);
-  TEST_ASSERT_EQUAL_UINT32(0x1234, in.state.seq);
-  TEST_ASSERT_EQUAL_INT32(1500000, in.state.theta_urad);
-  TEST_ASSERT_EQUAL_INT32(-5, in.state.omega_urad_s);
-  TEST_ASSERT_EQUAL_INT16(30000, in.state.v_rotating);
-  TEST_ASSERT_EQUAL_INT16(7, in.state.v_spill);
+  TEST_ASSERT_TRUE(in.sensors_fresh);
+  TEST_ASSERT_EQUAL_UINT32(0x34, in.sensors.seq);
+  TEST_ASSERT_EQUAL_UINT32(0x1FFFFu, in.sensors.encoder); /* as read: the core's estimator converts it */
+  TEST_ASSERT_EQUAL_INT32(10000, in.sensors.scale_rotating_g);
+  TEST_ASSERT_EQUAL_INT32(300, in.sensors.scale_target_g);
   tick(100, &in, tx);
-  TEST_ASSERT_FALSE(in.state_fresh);
+  TEST_ASSERT_FALSE(in.sensors_fresh);
 }
 
 static void test_can_node_TorqueFrameEchoesSeqEveryTick(void) {
-  send_state(77, 0);
+  send_sample(77, 0);
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   uint8_t n = tick(-1234, &in, tx);
@@ -97,7 +95,7 @@ static void test_can_node_HeartbeatAtConfiguredPeriod(void) {
   unsigned heartbeats = 0;
   uint8_t last_counter = 0;
   for (unsigned t = 0; t < 12; ++t) {
-    send_state((uint16_t)t, 0);
+    send_sample(t, 0);
     uint8_t n = tick(0, &in, tx);
     if (n == 3) {
       pour_can_heartbeat_t hb;
@@ -126,14 +124,14 @@ static void test_can_node_SilenceTripsWatchdogAfterTimeout(void) {
     tick(1000, &in, tx);
     TEST_ASSERT_FALSE(in.link_fault);
   }
-  send_state(1, 0);
+  send_sample(1, 0);
   for (unsigned t = 0; t < 6; ++t) {
     tick(1000, &in, tx);
     TEST_ASSERT_FALSE(in.link_fault);
   }
   tick(1000, &in, tx); /* 6 ms without a valid frame > 5 ms */
   TEST_ASSERT_TRUE(in.link_fault);
-  send_state(2, 0); /* a valid frame ends the trip; the core keeps it latched until a clear */
+  send_sample(2, 0); /* a valid frame ends the trip; the core keeps it latched until a clear */
   tick(1000, &in, tx);
   TEST_ASSERT_FALSE(in.link_fault);
 }
@@ -157,15 +155,15 @@ static void receive_command(uint8_t cmd) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
 }
 
-/* The Linux port's watchdog runs on the wall clock: it can trip while states still arrive (a slow guest in
+/* The Linux port's watchdog runs on the wall clock: it can trip while samples still arrive (a slow guest in
  * lockstep). Then the core itself goes to FAULT, and ClearErrors lets the torque back only through the slew
  * limit (it used to jump from 0 to the core's hidden command, 32767, in one tick). */
 static void test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew(void) {
   pour_control_output_t out;
-  uint16_t seq = 0;
+  uint32_t seq = 0;
   q15_t peak = 0;
   for (unsigned t = 0; t < 40u; ++t) {
-    send_state(seq++, 0);
+    send_sample(seq++, 0);
     peak = core_tick(&out).torque > peak ? out.torque : peak;
   }
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
@@ -181,7 +179,7 @@ static void test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew(void) {
   receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
   q15_t last = 0;
   for (unsigned t = 0; t < 40u; ++t) {
-    send_state(seq++, 0);
+    send_sample(seq++, 0);
     pour_can_torque_t tq = core_tick(&out);
     const int32_t step = (int32_t)tq.torque - last;
     TEST_ASSERT_TRUE(step <= ccfg.safety.slew_per_tick && step >= -ccfg.safety.slew_per_tick);
@@ -196,7 +194,7 @@ static void test_can_node_EstopWinsOverWatchdogSafeTorque(void) {
   ccfg.safe_torque = 3000;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
   pour_control_output_t out;
-  send_state(1, 0);
+  send_sample(1, 0);
   core_tick(&out);
   pour_can_frame_t f;
   const pour_can_estop_t e = {.assert_estop = 1};
@@ -210,37 +208,73 @@ static void test_can_node_EstopWinsOverWatchdogSafeTorque(void) {
   }
 }
 
-/* StateB's seq wraps every 65,536 samples (65.5 s at 1 kHz): a wrap is the next sample, not a new run. */
+/* The frame's seq wraps every 256 samples (256 ms at 1 kHz): a wrap is the next sample, not a new run, and
+ * the 32-bit count the core sees (its estimator's gap, the torque frame's 16-bit echo) runs on through it;
+ * lost frames advance it by the forward distance. */
 static void test_can_node_SeqWrapIsTheNextSampleNotANewRun(void) {
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
-  for (uint32_t k = 0; k < 70000u; ++k) {
-    send_state((uint16_t)(k & 0xFFFFu), 0);
+  for (uint32_t k = 0; k < 70000u; k += (k % 1000u == 999u) ? 3u : 1u) { /* now and then 2 frames lost */
+    send_sample(k, 0);
     pour_can_node_begin_tick(&node, &in);
-    TEST_ASSERT_TRUE(in.state_fresh);
-    TEST_ASSERT_EQUAL_UINT32(k, in.state.seq);
+    TEST_ASSERT_TRUE(in.sensors_fresh);
+    TEST_ASSERT_EQUAL_UINT32(k, in.sensors.seq);
     TEST_ASSERT_FALSE(in.reset);
   }
   (void)tx;
   /* Only a Reset frame starts the count again (and asks the core for a new run). */
   receive_command(POUR_CAN_CMD_RESET);
-  send_state(0, 0);
+  send_sample(0, 0);
   pour_can_node_begin_tick(&node, &in);
   TEST_ASSERT_TRUE(in.reset);
-  TEST_ASSERT_EQUAL_UINT32(0, in.state.seq);
+  TEST_ASSERT_EQUAL_UINT32(0, in.sensors.seq);
+}
+
+/* A Sensors frame may carry what no sensor of the rig can read (a count past the encoder's 2^17, a scale past
+ * its limits): the node passes it on as it came, and the core refuses it as BAD_INPUT, a latched fault the
+ * heartbeat carries; the bus never sees torque from it. */
+static void test_can_node_ImpossibleSampleLatchesBadInputInTheCore(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  for (unsigned t = 0; t < 20u; ++t) {
+    send_sample(seq++, 0);
+    core_tick(&out);
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  send_sample(seq++, 1u << 17); /* the default encoder has 17 bits: counts 0 .. 2^17 - 1 */
+  pour_can_torque_t tq = core_tick(&out);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_BAD_INPUT, out.faults);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, tq.mode);
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  TEST_ASSERT_EQUAL_UINT8(2, pour_can_node_status_frames(&node, &out, 0, tx));
+  pour_can_heartbeat_t hb;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[0], &hb));
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_BAD_INPUT, hb.faults);
+
+  /* The same for a scale reading past the load cell's limit (30 kg by default), on a fresh core. */
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
+  send_sample(seq++, 0);
+  core_tick(&out);
+  const pour_can_sensors_t heavy = {.seq_low = (uint8_t)(seq & 0xFFu), .encoder = 0, .scale_rotating_g = 10000,
+                                    .scale_target_g = (int16_t)(ccfg.sensors.scale_max_g + 1)};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(cfg.node_id, &heavy, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+  core_tick(&out);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_BAD_INPUT, out.faults);
 }
 
 /* A reset is refused while the core runs; Stop first ends the run. */
 static void test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop(void) {
   pour_control_output_t out;
-  uint16_t seq = 0;
+  uint32_t seq = 0;
   for (unsigned t = 0; t < 30u; ++t) {
-    send_state(seq++, 0);
+    send_sample(seq++, 0);
     core_tick(&out);
   }
   const q15_t running = out.torque;
   receive_command(POUR_CAN_CMD_RESET);
-  send_state(seq++, 0);
+  send_sample(seq++, 0);
   core_tick(&out);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_EQUAL_UINT32(1, ctl.resets_refused);
@@ -255,7 +289,7 @@ static void test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop(void) {
 static void test_can_node_EstopLevelReachesTheNextTick(void) {
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
-  send_state(1, 0);
+  send_sample(1, 0);
   tick(5000, &in, tx);
   pour_can_frame_t f;
   pour_can_estop_t e = {.assert_estop = 1};
@@ -278,12 +312,12 @@ static void test_can_node_EstopLevelReachesTheNextTick(void) {
 static void test_can_node_MalformedFramesAreDroppedAndCounted(void) {
   pour_control_input_t in;
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
-  send_state(1, 42);
+  send_sample(1, 42);
   tick(0, &in, tx);
   pour_can_frame_t f;
   /* wrong DLC */
-  pour_can_state_a_t a = {.theta_urad = 999, .omega_urad_s = 0, .seq_low = 2};
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(cfg.node_id, &a, &f));
+  const pour_can_sensors_t m = {.seq_low = 2, .encoder = 999, .scale_rotating_g = 1, .scale_target_g = 1};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(cfg.node_id, &m, &f));
   f.dlc = 6;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_DLC, pour_can_node_receive(&node, &f));
   /* unknown cmd, and a cmd only the controller sends */
@@ -292,39 +326,41 @@ static void test_can_node_MalformedFramesAreDroppedAndCounted(void) {
   pour_can_torque_t t = {0};
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_torque(cfg.node_id, &t, &f));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_node_receive(&node, &f));
-  /* out-of-range theta */
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(cfg.node_id, &a, &f));
-  f.data[2] = 0x7F;
+  /* a scale reading of -32768 g: the load cell amplifier's overload code */
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(cfg.node_id, &m, &f));
+  f.data[6] = 0x00;
+  f.data[7] = 0x80;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_node_receive(&node, &f));
-  /* StateB without its StateA */
-  pour_can_state_b_t b = {.seq = 2, .v_rotating = 1, .v_target = 1, .v_spill = 1};
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_b(cfg.node_id, &b, &f));
-  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_UNPAIRED, pour_can_node_receive(&node, &f));
-  /* another node's state: ignored, not an error */
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_state_a(7, &a, &f));
+  /* the retired StateB id of protocol 2 (0x11) is no command any more */
+  f.id = pour_can_id(cfg.node_id, 0x11);
+  f.dlc = 8;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_node_receive(&node, &f));
+  /* another node's sample: ignored, not an error */
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_sensors(7, &m, &f));
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OTHER_NODE, pour_can_node_receive(&node, &f));
 
   TEST_ASSERT_EQUAL_UINT32(1, node.counters.bad_dlc);
-  TEST_ASSERT_EQUAL_UINT32(2, node.counters.bad_id);
+  TEST_ASSERT_EQUAL_UINT32(3, node.counters.bad_id);
   TEST_ASSERT_EQUAL_UINT32(1, node.counters.out_of_range);
-  TEST_ASSERT_EQUAL_UINT32(1, node.counters.unpaired);
   TEST_ASSERT_EQUAL_UINT32(1, node.counters.other_node);
   TEST_ASSERT_EQUAL_UINT32(5, pour_can_node_dropped(&node));
   tick(0, &in, tx);
-  TEST_ASSERT_FALSE(in.state_fresh);
-  TEST_ASSERT_EQUAL_INT32(42, in.state.theta_urad); /* nothing of the bad frames got through */
+  TEST_ASSERT_FALSE(in.sensors_fresh);
+  TEST_ASSERT_EQUAL_UINT32(42, in.sensors.encoder); /* nothing of the bad frames got through */
+  TEST_ASSERT_EQUAL_INT32(10000, in.sensors.scale_rotating_g);
 }
 
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_node_init_RejectsBadConfig);
-  RUN_TEST(test_can_node_StatePairBecomesOneFreshInput);
+  RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);
   RUN_TEST(test_can_node_SilenceTripsWatchdogAfterTimeout);
   RUN_TEST(test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew);
   RUN_TEST(test_can_node_EstopWinsOverWatchdogSafeTorque);
   RUN_TEST(test_can_node_SeqWrapIsTheNextSampleNotANewRun);
+  RUN_TEST(test_can_node_ImpossibleSampleLatchesBadInputInTheCore);
   RUN_TEST(test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop);
   RUN_TEST(test_can_node_EstopLevelReachesTheNextTick);
   RUN_TEST(test_can_node_MalformedFramesAreDroppedAndCounted);

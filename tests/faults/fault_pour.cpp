@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Closed-loop fault injection, in process: the shipped policy (policy/weights.h, compiled in) runs in the
 // firmware core against the Box2D world, and each scenario injects one fault mid-pour between the two.
-// The CAN scenarios (seq wrap, watchdog + clear) pass every state and every torque through pour::can's
-// codec and node, as the ports do. For each scenario it measures the time to detection, the time to rest
+// The core sees what the rig's sensors read (the simulator's 17-bit encoder count and two load cells, as
+// pour_sensors_t) and estimates the state itself. The CAN scenarios (seq wrap, watchdog + clear) pass every
+// sample and every torque through pour::can's codec and node, as the ports do. For each scenario it measures the time to detection, the time to rest
 // (|θ̇| < 0.05 rad/s, held 100 ms), the angle range and the extra liquid spilled, and checks the bars of
 // docs/hazards.md: detected within 50 ms, the torque inside the envelope and never stepping by more than
 // the slew limit except to zero, at rest without passing θmax + 10°. Prints one table row per scenario
@@ -21,7 +22,6 @@ extern "C" {
 #include "pour/can_node.h"
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
-#include "state_si.h"
 }
 #include "poursim/poursim.h"
 
@@ -34,7 +34,7 @@ constexpr int kDetectBarMs = 50;
 
 enum class Fault {
   kNone, kMotorReversed, kEncoderReversed, kEncoderFrozen, kSenderFrozen, kScaleStuckFull, kBusSilent,
-  kLoss10, kClearAfterWatchdog, kSeqWrap, kEstopWorstAngle
+  kLoss10, kClearAfterWatchdog, kSeqWrap, kEstopWorstAngle, kLoadCellJump, kLoadCellOverRange, kEncoderGarbage
 };
 
 struct Scenario {
@@ -52,7 +52,8 @@ struct Result {
   double theta_min_deg = 1e9, theta_max_deg = -1e9;  // after injection
   double spilled = 0.0, poured = 0.0, finish_s = 0.0;
   uint16_t faults = 0;
-  int slew_violations = 0, clamp_violations = 0;
+  int slew_violations = 0, clamp_violations = 0, band_violations = 0;
+  double peak_omega = 0.0;  // max |θ̇| of the bucket [rad/s]
   bool ok = true;
   std::string why;
 };
@@ -65,13 +66,11 @@ struct CanPath {
     c.identity.weights_hash = pour_weights_compiled.content_hash;
     (void)pour_can_node_init(&node, &c);
   }
-  void send_state(const pour_state_t &s) {
-    const uint16_t seq16 = static_cast<uint16_t>(s.seq & 0xFFFFu);
-    const pour_can_state_a_t a = {s.theta_urad, s.omega_urad_s, static_cast<uint8_t>(seq16 & 0xFFu)};
-    const pour_can_state_b_t b = {seq16, s.v_rotating, s.v_target, s.v_spill};
+  void send_sample(const pour_sensors_t &s) {
+    const pour_can_sensors_t m = {static_cast<uint8_t>(s.seq & 0xFFu), s.encoder,
+                                  static_cast<int16_t>(s.scale_rotating_g), static_cast<int16_t>(s.scale_target_g)};
     pour_can_frame_t f;
-    if (pour_can_pack_state_a(0, &a, &f) == POUR_OK) (void)pour_can_node_receive(&node, &f);
-    if (pour_can_pack_state_b(0, &b, &f) == POUR_OK) (void)pour_can_node_receive(&node, &f);
+    if (pour_can_pack_sensors(0, &m, &f) == POUR_OK) (void)pour_can_node_receive(&node, &f);
   }
   void send_command(uint8_t cmd) {
     pour_can_frame_t f;
@@ -114,7 +113,7 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
   poursim_obs_t obs{};
   poursim_observe(world, &obs);
   pour_control_output_t out{};
-  pour_state_t frozen{};
+  pour_sensors_t frozen{};
   uint32_t rng = seed * 2654435761u + 1u;
   q15_t last = 0;
   int rest_run = 0;
@@ -122,40 +121,38 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
   const int steps = static_cast<int>(std::lround(sc.episode_s / cfg.dt));
   for (int k = 0; k < steps; ++k) {
     const bool injected = sc.fault != Fault::kNone && k >= sc.inject_ms;
-    pour_state_t s;
-    pour_state_from_si(&s, k, obs.theta, obs.omega, obs.v_rotating, obs.v_target, obs.v_spill);
+    const pour_sensors_t s = {static_cast<uint32_t>(k), obs.encoder, obs.scale_rotating_g, obs.scale_target_g};
     if (k == sc.inject_ms) frozen = s;
     pour_control_input_t in{};
-    in.state_fresh = true;
-    in.state = s;
+    in.sensors_fresh = true;
+    in.sensors = s;
     if (injected) {
+      const uint32_t turn = 1u << cfg.encoder_bits;
       switch (sc.fault) {
-        case Fault::kEncoderReversed:
-          in.state.theta_urad = -s.theta_urad;
-          in.state.omega_urad_s = -s.omega_urad_s;
-          break;
-        case Fault::kEncoderFrozen:
-          in.state.theta_urad = frozen.theta_urad;
-          in.state.omega_urad_s = frozen.omega_urad_s;
-          break;
-        case Fault::kSenderFrozen: in.state = frozen; break;
-        case Fault::kBusSilent: in.state_fresh = false; break;
+        case Fault::kEncoderReversed: in.sensors.encoder = (turn - s.encoder) & (turn - 1u); break;
+        case Fault::kEncoderFrozen: in.sensors.encoder = frozen.encoder; break;
+        case Fault::kSenderFrozen: in.sensors = frozen; break;
+        case Fault::kBusSilent: in.sensors_fresh = false; break;
         case Fault::kEstopWorstAngle: in.estop = true; break;
+        // The rotating bucket's cell drops by the whole liquid at once (a tare step, a cable pulled).
+        case Fault::kLoadCellJump: in.sensors.scale_rotating_g -= frozen.scale_rotating_g; break;
+        case Fault::kLoadCellOverRange: in.sensors.scale_target_g = 32767; break;  // amplifier saturated
+        case Fault::kEncoderGarbage: in.sensors.encoder = turn | s.encoder; break;   // a bit beyond the count
         default: break;
       }
     }
     if (sc.fault == Fault::kLoss10) {
       rng ^= rng << 13; rng ^= rng >> 17; rng ^= rng << 5;  // xorshift32: seeded, deterministic
-      in.state_fresh = (rng % 10u) != 0u;
+      in.sensors_fresh = (rng % 10u) != 0u;
     }
     if (injected && onset < 0 &&
-        (in.state_fresh != true || in.estop || std::memcmp(&in.state, &s, sizeof s) != 0 ||
+        (in.sensors_fresh != true || in.estop || std::memcmp(&in.sensors, &s, sizeof s) != 0 ||
          sc.fault == Fault::kClearAfterWatchdog)) {
       onset = k;
     }
     q15_t cmd;
     if (sc.via_can) {
-      if (in.state_fresh) can.send_state(in.state);
+      if (in.sensors_fresh) can.send_sample(in.sensors);
       uint32_t extra = 0;
       if (sc.fault == Fault::kClearAfterWatchdog && k >= sc.inject_ms && k < sc.inject_ms + 60) {
         extra = 60;  // a wall-clock watchdog trip (a slow host) while states still arrive
@@ -172,11 +169,18 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
       pour_control_step(&ctl, &in, &out);
       cmd = out.torque;
     }
-    // Envelope bars on the command.
+    // Envelope bars on the command: a step beyond the slew only toward zero; within ±tau_limit; no torque
+    // that speeds the bucket up beyond ±omega_max, judged on the speed the core estimated (all it has).
     const int32_t step = static_cast<int32_t>(cmd) - last;
-    if (cmd != 0 && (step > ccfg.safety.slew_per_tick || step < -ccfg.safety.slew_per_tick)) r.slew_violations++;
+    const bool toward_zero = (last >= 0 && cmd >= 0 && cmd <= last) || (last <= 0 && cmd <= 0 && cmd >= last);
+    if (!toward_zero && (step > ccfg.safety.slew_per_tick || step < -ccfg.safety.slew_per_tick)) r.slew_violations++;
     if (cmd > ccfg.safety.tau_limit || cmd < -ccfg.safety.tau_limit) r.clamp_violations++;
+    const int64_t w = ctl.state.omega_urad_s, k_gain = ccfg.safety.torque_per_rad_s;
+    const int64_t hi = std::max<int64_t>((ccfg.safety.omega_max_urad_s - w) * k_gain / 1000000, 0);
+    const int64_t lo = std::min<int64_t>((-ccfg.safety.omega_max_urad_s - w) * k_gain / 1000000, 0);
+    if (out.power && (cmd > hi + 1 || cmd < lo - 1)) r.band_violations++;
     last = cmd;
+    r.peak_omega = std::max(r.peak_omega, std::fabs(obs.omega));
     // The actuator: motor torque through the injected faults; the brake is the simulator's (below).
     const double commanded = out.power ? cmd / 32768.0 : 0.0;
     double applied = commanded;
@@ -229,6 +233,9 @@ int main(int argc, char **argv) {
   // The nominal pour, for the extra spill and the worst angle of the e-stop (its fastest tick).
   const Scenario nominal = {"nominal", Fault::kNone, 0, 3.0, false};
   const Result ref = run(nominal, seed, base);
+  std::printf("nominal pour (seed %u): poured %.1f %%, spilled %.1f %%, peak |θ̇| %.2f rad/s, faults 0x%04x\n",
+              static_cast<unsigned>(seed), ref.poured, ref.spilled, ref.peak_omega, static_cast<unsigned>(ref.faults));
+  int failures = ref.detect_ms >= 0 || ref.band_violations > 0 ? 1 : 0;  // a nominal pour must not trip
   const std::vector<Scenario> scenarios = {
       {"reversed motor sign", Fault::kMotorReversed, 30, 3.0, false},
       {"reversed encoder sign", Fault::kEncoderReversed, 30, 3.0, false},
@@ -240,14 +247,16 @@ int main(int argc, char **argv) {
       {"ClearErrors right after a watchdog trip (CAN node)", Fault::kClearAfterWatchdog, 60, 3.0, true},
       {"seq wrap, 70 s of running (CAN node)", Fault::kSeqWrap, 0, 70.0, true},
       {"e-stop at the fastest tilt", Fault::kEstopWorstAngle, 100, 3.0, false},
+      {"load cell drops by the whole liquid at once", Fault::kLoadCellJump, 400, 3.0, false},
+      {"load cell over range (amplifier saturated)", Fault::kLoadCellOverRange, 400, 3.0, false},
+      {"encoder count out of range", Fault::kEncoderGarbage, 400, 3.0, false},
   };
   std::printf("| fault | injected at | first acts at | detected after | faults | time to rest | angle range | "
               "spilled (nominal %.1f %%) | bars |\n|---|---|---|---|---|---|---|---|---|\n", ref.spilled);
-  int failures = 0;
   for (const Scenario &sc : scenarios) {
     Result r = run(sc, seed, base);
     const bool expect_fault = sc.fault != Fault::kLoss10 && sc.fault != Fault::kSeqWrap;
-    if (r.slew_violations > 0 || r.clamp_violations > 0) {
+    if (r.slew_violations > 0 || r.clamp_violations > 0 || r.band_violations > 0) {
       r.ok = false;
       r.why += " torque left the envelope or stepped past the slew limit";
     }

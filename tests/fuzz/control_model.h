@@ -1,12 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /* The safety rules of docs/safety.md and of pour_control_step's contract (control.h), checked after every
  * tick (fuzz_control_step, fuzz_can_node). Written from the documents, not from control.c: it tracks only
- * what the rules name (the ticks without a state, the latched faults, the last command). What the
+ * what the rules name (the ticks without a sample, the latched faults, the last command, the speed band). What the
  * supervisor proves and how the controlled stop steers are for their own tests; here they must stay
  * inside the envelope like everything else. */
 #ifndef POUR_FUZZ_CONTROL_MODEL_H
 #define POUR_FUZZ_CONTROL_MODEL_H
 
+#include <algorithm>
+#include <climits>
 #include <cstdint>
 #include <cstdlib>
 
@@ -22,16 +24,19 @@ class ControlModel {
   explicit ControlModel(const pour_control_config_t &c, uint8_t n_actions)
       : c_(c), n_actions_(n_actions), torque_(c.safe_torque) {}
 
-  // Rule 3: what a state must satisfy to be used.
-  bool plausible(const pour_state_t &s) const {
-    return std::llabs(s.theta_urad) <= c_.plausible_theta_urad && std::llabs(s.omega_urad_s) <= c_.plausible_omega_urad_s &&
-           s.v_rotating >= 0 && s.v_target >= 0 && s.v_spill >= 0 &&
-           static_cast<int32_t>(s.v_rotating) + s.v_target + s.v_spill <= c_.plausible_volume_sum;
+  // Rule 5: a raw sample no sensor can give (a count beyond the encoder's bits, a scale beyond its range).
+  bool raw_plausible(const pour_sensors_t &s) const {
+    const pour_sensors_config_t &k = c_.sensors;
+    return s.encoder < (1u << k.encoder_bits) && s.scale_rotating_g >= k.scale_min_g &&
+           s.scale_rotating_g <= k.scale_max_g && s.scale_target_g >= k.scale_min_g && s.scale_target_g <= k.scale_max_g;
   }
 
-  // theta: the tilt of the state the core steers by (its latest accepted state): the angle limits are
-  // about that state, and which states the supervisor accepts (seq advancing) is its business.
-  void check(const pour_control_input_t &in, const pour_control_output_t &out, int32_t theta) {
+  // theta, omega: the state the core steers by (its latest estimate): the angle limits and the speed band
+  // are about that state, and which samples the supervisor accepts (seq advancing) is its business.
+  // new_seq: this tick's sample carries a seq the core has not seen (the fuzzer repeats inputs verbatim).
+  // omega INT32_MIN: not known to the caller, the band is not checked.
+  void check(const pour_control_input_t &in, const pour_control_output_t &out, int32_t theta,
+             int32_t omega = INT32_MIN, bool new_seq = false) {
     const pour_safety_config_t &s = c_.safety;
     ++ticks_;
     FUZZ_CHECK(out.tick == ticks_, "tick %u after %u steps", out.tick, ticks_);
@@ -58,9 +63,9 @@ class ControlModel {
       via_safe = true;
     }
     if (in.reset && (mode == POUR_MODE_IDLE || mode == POUR_MODE_FAULT)) via_safe = true;
-    stale_ = in.state_fresh ? 0u : stale_ + 1u;
-    if (in.state_fresh && !plausible(in.state))
-      FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible state did not latch BAD_INPUT");
+    stale_ = in.sensors_fresh ? 0u : stale_ + 1u;
+    if (in.sensors_fresh && new_seq && !raw_plausible(in.sensors))
+      FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible sample did not latch BAD_INPUT");
     if (in.link_fault && !in.clear_faults) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
     const uint16_t new_bits = static_cast<uint16_t>(out.faults & ~kept);
@@ -70,7 +75,7 @@ class ControlModel {
     FUZZ_CHECK(out.brake == !out.power, "brake %d and power %d together", out.brake, out.power);
     FUZZ_CHECK(std::abs(out.torque) <= s.tau_limit, "|torque| %d > tau_limit %d", out.torque, s.tau_limit);
     if (out.mode == POUR_MODE_RUN) { // RUN is entered on a fresh state only, and never outlives the input timeout
-      FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && in.state_fresh), "RUN from mode %u", mode);
+      FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && in.sensors_fresh), "RUN from mode %u", mode);
       FUZZ_CHECK(stale_ <= c_.input_timeout_ms, "RUN after %u ticks without a state", stale_);
       FUZZ_CHECK(out.action < n_actions_ && out.power, "action %u power %d", out.action, out.power);
     } else if (out.mode == POUR_MODE_IDLE) {
@@ -78,12 +83,24 @@ class ControlModel {
     } else {
       FUZZ_CHECK(out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
     }
-    // The envelope in RUN and in the active stop: the slew limit from the last command (a drop to zero or,
-    // through IDLE or FAULT, the safe torque never waits for it).
+    // The envelope in RUN and in the active stop: the slew limit from the last command (less torque, toward
+    // zero, or through IDLE or FAULT the safe torque, never waits for it) ...
+    const auto toward_zero = [&out](int32_t from) {
+      return (from >= 0 && out.torque >= 0 && out.torque <= from) || (from <= 0 && out.torque <= 0 && out.torque >= from);
+    };
     if (out.power)
-      FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || out.torque == 0 ||
-                     (via_safe && std::abs(out.torque - c_.safe_torque) <= s.slew_per_tick),
+      FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || toward_zero(torque_) ||
+                     (via_safe && (std::abs(out.torque - c_.safe_torque) <= s.slew_per_tick || toward_zero(c_.safe_torque))),
                  "torque %d -> %d breaks the slew limit %d", torque_, out.torque, s.slew_per_tick);
+    // ... and no torque that speeds the bucket beyond ±omega_max: τ <= max(K (ω_max - θ̇), 0) and
+    // τ >= min(-K (ω_max + θ̇), 0), K = torque_per_rad_s per rad/s, 1 LSB for rounding.
+    if (out.power && omega != INT32_MIN) {
+      const int64_t w = std::clamp<int64_t>(omega, -POUR_SAFETY_OMEGA_MAX_URAD_S, POUR_SAFETY_OMEGA_MAX_URAD_S);
+      const int64_t hi = (static_cast<int64_t>(s.omega_max_urad_s) - w) * s.torque_per_rad_s / 1000000;
+      const int64_t lo = (-static_cast<int64_t>(s.omega_max_urad_s) - w) * s.torque_per_rad_s / 1000000;
+      FUZZ_CHECK(out.torque <= std::max<int64_t>(hi, 0) + 1 && out.torque >= std::min<int64_t>(lo, 0) - 1,
+                 "torque %d speeds the bucket beyond the band at %d urad/s", out.torque, omega);
+    }
     // Angle limits, in every mode: no torque that tilts further past a limit.
     FUZZ_CHECK(!(theta >= s.theta_max_urad && out.torque > 0), "tilting further at theta %d", theta);
     FUZZ_CHECK(!(theta <= s.theta_min_urad && out.torque < 0), "tilting back further at theta %d", theta);
@@ -115,6 +132,16 @@ pour_control_config_t fuzz_control_config(Provider &fdp) {
   c.safety.slew_per_tick = fdp.template ConsumeIntegralInRange<q15_t>(1, 32767);
   c.safety.theta_min_urad = fdp.template ConsumeIntegralInRange<int32_t>(-200000, 0);
   c.safety.theta_max_urad = fdp.template ConsumeIntegralInRange<int32_t>(1, 3000000);
+  c.safety.omega_max_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
+  c.safety.alpha_max_urad_s2 = fdp.template ConsumeIntegralInRange<int32_t>(1000, INT32_MAX);
+  c.safety.omega_slack_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
+  c.safety.torque_per_rad_s = fdp.template ConsumeIntegralInRange<q15_t>(1, 32767);
+  c.sensors.encoder_bits = fdp.template ConsumeIntegralInRange<uint8_t>(POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX);
+  c.sensors.bandwidth_rad_s = fdp.template ConsumeIntegralInRange<uint16_t>(1, 1000);
+  c.sensors.scale_min_g = fdp.template ConsumeIntegralInRange<int32_t>(-POUR_SCALE_LIMIT_G, 0);
+  c.sensors.scale_max_g = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SCALE_LIMIT_G);
+  c.sensors.mass_min_g = fdp.template ConsumeIntegralInRange<int32_t>(1, 20000);
+  c.sensors.jump_max_urad = fdp.template ConsumeIntegralInRange<int32_t>(1, 1000000);
   c.input_timeout_ms = fdp.template ConsumeIntegralInRange<uint16_t>(1, 60);
   c.safe_torque = fdp.template ConsumeIntegralInRange<q15_t>(static_cast<q15_t>(-c.safety.tau_limit), c.safety.tau_limit);
   c.policy_mode = fdp.ConsumeBool() ? POUR_POLICY_SAMPLED : POUR_POLICY_GREEDY;

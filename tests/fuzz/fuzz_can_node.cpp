@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The controller's CAN node with the control step behind it, as the MCU port runs them: frames in (well
 // formed for our node, other nodes', or raw garbage), one tick, frames out. After every tick: the rules of
-// docs/safety.md on the control step, slew limit included (control_model.h); on the bus, the torque frame
-// decodes, carries exactly the core's command and mode, stays within tau_limit, and is zero while the
-// e-stop is asserted; the heartbeat and identity frames decode.
+// docs/safety.md on the control step, slew limit included (control_model.h); the sample the core got is the
+// last Sensors frame the node accepted, reading for reading; on the bus, the torque frame decodes, carries
+// exactly the core's command and mode, stays within tau_limit, and is zero while the e-stop is asserted;
+// the heartbeat and identity frames decode.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstring>
@@ -27,20 +28,14 @@ pour_can_frame_t fuzz_frame(FuzzedDataProvider &fdp, uint8_t node_id) {
     return f;
   }
   pour_status_t st = POUR_OK;
-  switch (fdp.ConsumeIntegralInRange<int>(0, 3)) { // a well-formed frame of ours (the codec refuses bad values)
-    case 0: {
-      pour_can_state_a_t a{fdp.ConsumeIntegralInRange<int32_t>(-4000000, 4000000),
-                           fdp.ConsumeIntegralInRange<int32_t>(-60000000, 60000000), fdp.ConsumeIntegral<uint8_t>()};
-      st = pour_can_pack_state_a(node_id, &a, &f);
+  switch (fdp.ConsumeIntegralInRange<int>(0, 2)) { // a well-formed frame of ours (the codec refuses bad values)
+    case 0: {                                           // any sample the frame can carry, sensible or not
+      pour_can_sensors_t m{fdp.ConsumeIntegral<uint8_t>(), fdp.ConsumeIntegralInRange<uint32_t>(0, 0xFFFFFFu),
+                           fdp.ConsumeIntegral<int16_t>(), fdp.ConsumeIntegral<int16_t>()};
+      st = pour_can_pack_sensors(node_id, &m, &f);
       break;
     }
     case 1: {
-      pour_can_state_b_t b{fdp.ConsumeIntegral<uint16_t>(), fdp.ConsumeIntegralInRange<q15_t>(0, 32767),
-                           fdp.ConsumeIntegralInRange<q15_t>(0, 32767), fdp.ConsumeIntegralInRange<q15_t>(0, 32767)};
-      st = pour_can_pack_state_b(node_id, &b, &f);
-      break;
-    }
-    case 2: {
       pour_can_estop_t e{static_cast<uint8_t>(fdp.ConsumeBool())};
       st = pour_can_pack_estop(node_id, &e, &f);
       break;
@@ -71,24 +66,42 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   ControlModel model(cfg, pour_weights_compiled.n_actions);
   static const bool trace = std::getenv("POUR_FUZZ_TRACE") != nullptr; // replaying a crash: one line per tick
   for (uint32_t tick = 0; tick < 4000 && fdp.remaining_bytes() > 0; ++tick) {
-    if (fdp.ConsumeBool()) { // a complete state: StateA, then the StateB of the same sample
-      pour_can_state_a_t a{fdp.ConsumeIntegralInRange<int32_t>(-4000000, 4000000),
-                           fdp.ConsumeIntegralInRange<int32_t>(-60000000, 60000000), static_cast<uint8_t>(tick)};
-      pour_can_state_b_t b{static_cast<uint16_t>(tick), fdp.ConsumeIntegralInRange<q15_t>(0, 16384),
-                           fdp.ConsumeIntegralInRange<q15_t>(0, 16383), fdp.ConsumeIntegralInRange<q15_t>(0, 200)};
-      pour_can_frame_t fa, fb;
-      if (pour_can_pack_state_a(ncfg.node_id, &a, &fa) == POUR_OK && pour_can_pack_state_b(ncfg.node_id, &b, &fb) == POUR_OK) {
-        pour_can_node_receive(&node, &fa);
-        pour_can_node_receive(&node, &fb);
+    bool sampled = false;
+    pour_can_sensors_t last{}; // the last Sensors frame the node accepted this tick
+    if (fdp.ConsumeBool()) { // this tick's sample: mostly what the rig reads (a 17-bit encoder between a
+                             // little below upright and the stop, scales within their limits), now and then not
+      const bool sane = fdp.ConsumeIntegralInRange<int>(0, 7) != 0;
+      const uint32_t below = (1u << 17) - fdp.ConsumeIntegralInRange<uint32_t>(1, 6000);
+      const uint32_t enc = sane ? (fdp.ConsumeBool() ? fdp.ConsumeIntegralInRange<uint32_t>(0, 60000) : below)
+                                : fdp.ConsumeIntegralInRange<uint32_t>(0, 0xFFFFFFu);
+      const int16_t rot = sane ? fdp.ConsumeIntegralInRange<int16_t>(-50, 12000) : fdp.ConsumeIntegral<int16_t>();
+      const int16_t tgt = sane ? fdp.ConsumeIntegralInRange<int16_t>(-50, 12000) : fdp.ConsumeIntegral<int16_t>();
+      pour_can_sensors_t m{static_cast<uint8_t>(tick), enc, rot, tgt};
+      pour_can_frame_t f;
+      if (pour_can_pack_sensors(ncfg.node_id, &m, &f) == POUR_OK && pour_can_node_receive(&node, &f) == POUR_CAN_RX_OK) {
+        sampled = true;
+        last = m;
       }
     }
     const int n_rx = fdp.ConsumeIntegralInRange<int>(0, 3);
     for (int k = 0; k < n_rx; ++k) {
       const pour_can_frame_t f = fuzz_frame(fdp, ncfg.node_id);
-      pour_can_node_receive(&node, &f);
+      pour_can_sensors_t m{};
+      if (pour_can_node_receive(&node, &f) == POUR_CAN_RX_OK && pour_can_unpack_sensors(&f, &m) == POUR_CAN_RX_OK) {
+        sampled = true;
+        last = m;
+      }
     }
     pour_control_input_t in{};
     pour_can_node_begin_tick(&node, &in);
+    FUZZ_CHECK(in.sensors_fresh == sampled, "fresh %d after %s", in.sensors_fresh, sampled ? "a sample" : "none");
+    if (sampled)
+      FUZZ_CHECK((in.sensors.seq & 0xFFu) == last.seq_low && in.sensors.encoder == last.encoder &&
+                     in.sensors.scale_rotating_g == last.scale_rotating_g &&
+                     in.sensors.scale_target_g == last.scale_target_g,
+                 "the core got seq %u encoder %u scales %d/%d, the frame said %u %u %d/%d", in.sensors.seq,
+                 in.sensors.encoder, in.sensors.scale_rotating_g, in.sensors.scale_target_g, last.seq_low, last.encoder,
+                 last.scale_rotating_g, last.scale_target_g);
     pour_control_output_t out{};
     pour_control_step(&ctl, &in, &out);
     model.check(in, out, ctl.state.theta_urad);
@@ -108,7 +121,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     if (trace)
       std::fprintf(stderr, "tick %u: fresh %d estop %d clear %d | core mode %u faults %x torque %d | link fault %d since_valid %u | bus %d\n",
-                   tick, in.state_fresh, in.estop, in.clear_faults, ctl.mode, ctl.faults, ctl.safety.torque,
+                   tick, in.sensors_fresh, in.estop, in.clear_faults, ctl.mode, ctl.faults, ctl.safety.torque,
                    in.link_fault, node.ms_since_valid, t.torque);
     if (in.estop) FUZZ_CHECK(t.torque == 0, "torque %d on the bus during e-stop", t.torque);
     FUZZ_CHECK(std::abs(t.torque) <= cfg.safety.tau_limit, "bus torque %d > tau_limit %d", t.torque, cfg.safety.tau_limit);

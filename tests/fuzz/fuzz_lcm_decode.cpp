@@ -1,21 +1,21 @@
 // SPDX-License-Identifier: MIT
-// The LCM message types our C and C++ programs decode (plant_state_t and command_t: the controller and the
+// The LCM message types our C and C++ programs decode (sensor_sample_t and command_t: the controller and the
 // CAN bridge, in C; torque_t: host_sim, in C++), decoded from arbitrary bytes by the generated C and C++
 // code: no crash, no out-of-bounds read; both decoders agree on what they consume; and a buffer decoded
-// exactly re-encodes to the same bytes in both languages. particles_t and controller_status_t are decoded
-// only by the Python and Java tools; the generated C and C++ decoders of particles_t allocate whatever
+// exactly re-encodes to the same bytes in both languages. particles_t, plant_truth_t and controller_status_t
+// are decoded only by the Python and Java tools; the generated C and C++ decoders of particles_t allocate whatever
 // length a message claims (a negative n asks for ~16 GB), which is why no C or C++ code may decode it.
 #include <cstring>
 #include <vector>
 
 #include "fuzz_check.h"
 #include "pour/command_t.hpp"
-#include "pour/plant_state_t.hpp"
+#include "pour/sensor_sample_t.hpp"
 #include "pour/torque_t.hpp"
 
 extern "C" {
 #include "pour_command_t.h"
-#include "pour_plant_state_t.h"
+#include "pour_sensor_sample_t.h"
 #include "pour_torque_t.h"
 }
 
@@ -45,8 +45,8 @@ void check(const uint8_t *data, int size, int (*c_decode)(const void *, int, int
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   if (size > (1u << 16)) return 0;
   const int n = static_cast<int>(size);
-  check<pour_plant_state_t, pour::plant_state_t>(data, n, pour_plant_state_t_decode, pour_plant_state_t_encode,
-                                                 pour_plant_state_t_decode_cleanup, "plant_state_t");
+  check<pour_sensor_sample_t, pour::sensor_sample_t>(data, n, pour_sensor_sample_t_decode, pour_sensor_sample_t_encode,
+                                                     pour_sensor_sample_t_decode_cleanup, "sensor_sample_t");
   check<pour_torque_t, pour::torque_t>(data, n, pour_torque_t_decode, pour_torque_t_encode,
                                        pour_torque_t_decode_cleanup, "torque_t");
   check<pour_command_t, pour::command_t>(data, n, pour_command_t_decode, pour_command_t_encode,

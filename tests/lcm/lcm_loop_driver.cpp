@@ -16,7 +16,6 @@
 
 extern "C" {
 #include "pour/control.h"
-#include "state_si.h"
 #include "pour/weights_compiled.h"
 }
 
@@ -26,7 +25,7 @@ void usage(FILE *f) {
   std::fprintf(f,
                "usage: lcm_loop_driver --mode inproc|lcm [--url URL] [--realtime] [--steps N] [--episodes E]\n"
                "                       [--seed S] [--answer-timeout-ms T] [--particles-ms P] [--trace FILE] [--no-sim]\n"
-               "  --no-sim   synthetic states instead of the Box2D world: the loop's own rate (benchmark)\n");
+               "  --no-sim   synthetic sensor samples instead of the Box2D world: the loop's own rate (benchmark)\n");
 }
 
 bool parse_long(const char *opt, const char *s, long lo, long hi, long *out) {
@@ -146,23 +145,27 @@ int main(int argc, char **argv) {
         }
         link->maybe_publish_particles(world, obs);
       } else {
+        // The sample as host_sim's in-process controller takes it (seq = step); over LCM the same integers.
         pour_control_input_t in;
         std::memset(&in, 0, sizeof in);
-        in.state_fresh = true;
-        pour_state_from_si(&in.state, obs.step, obs.theta, obs.omega, obs.v_rotating, obs.v_target, obs.v_spill);
+        in.sensors_fresh = true;
+        in.sensors = pour_sensors_t{obs.step, obs.encoder, obs.scale_rotating_g, obs.scale_target_g};
         pour_control_output_t out;
         pour_control_step(&ctl, &in, &out);
         q15 = out.torque;
       }
       if (trace != nullptr) {
-        std::fprintf(trace, "%ld %u %.17g %.17g %d\n", ep, obs.step, obs.theta, obs.omega, q15);
+        std::fprintf(trace, "%ld %u %u %d %d %.17g %.17g %d\n", ep, obs.step, obs.encoder, obs.scale_rotating_g,
+                     obs.scale_target_g, obs.theta, obs.omega, q15);
       }
       if (no_sim) {
-        // A plausible state that changes every tick, at no physics cost.
+        // A plausible sample that changes every tick, at no physics cost: the encoder sweeps 0 .. 1.9 rad
+        // at 0.1 rad/s, and liquid moves from one scale to the other at 0.1 kg/s (5 kg every 50 s).
         obs.step = static_cast<uint32_t>(k + 1);
         obs.t = static_cast<double>(k + 1) * 1e-3;
-        obs.theta = 1e-4 * static_cast<double>(k % 20000);
-        obs.omega = static_cast<double>(q15) / 32768.0;
+        obs.encoder = static_cast<uint32_t>((k % 20000) * 2);
+        obs.scale_rotating_g = static_cast<int32_t>(10000 - (k / 10) % 5000);
+        obs.scale_target_g = static_cast<int32_t>((k / 10) % 5000);
       } else if (poursim_step(world, static_cast<double>(q15) / 32768.0, &obs) != POURSIM_OK) {
         break;
       }

@@ -11,9 +11,12 @@ from typing import Callable
 
 import lcm
 
-from pour import channels, lcm_types
+from pour import channels, lcm_sensors, lcm_types
 
 msgs = lcm_types.load()
+
+LIQUID_G = 10300
+"""Scripted samples weigh 10 L of soymilk (1.03 kg/L) in all."""
 
 
 def url(offset: int) -> str:
@@ -68,8 +71,8 @@ class Proc:
 
 
 class Plant:
-    """A damped bucket that moves with the controller's torque, so that scripted states are physical (the
-    controller's supervisor calls a bucket that never moves under torque a frozen encoder). Per asked state:
+    """A damped bucket that moves with the controller's torque, so that scripted samples are physical (the
+    controller's supervisor calls a bucket that never moves under torque a frozen encoder). Per asked sample:
     θ̇ ← 0.9 θ̇ + 6e-6 rad/s per Q15 LSB of the last answer's torque (≤ 2 rad/s), θ += θ̇ · 1 ms; added to
     what a test asks with."""
 
@@ -110,20 +113,24 @@ class Bus:
             self.lc.handle_timeout(max(1, min(50, int(left * 1000))))
         return True
 
-    def state(self, seq: int, episode: int = 0, theta: float = 0.1, omega: float = 0.0,
-              v: tuple[float, float, float] = (1.0, 0.0, 0.0)) -> bytes:
-        m = msgs.plant_state_t()
+    def state(self, seq: int, episode: int = 0, theta: float = 0.1, v: tuple[float, float] = (1.0, 0.0),
+              **raw: int) -> bytes:
+        """A POUR_SENSORS sample of a bucket at tilt theta [rad] holding the fractions v (rotating, target) of
+        LIQUID_G; raw= encoder, scale_rotating_g, scale_target_g override the readings as given (bad input)."""
+        m = msgs.sensor_sample_t()
         m.utime, m.seq, m.episode = seq * 1000, seq, episode
-        m.theta, m.omega = theta, omega
-        m.v_rotating, m.v_target, m.v_spill = v
+        m.encoder = lcm_sensors.encoder_count(theta)
+        m.scale_rotating_g, m.scale_target_g = round(v[0] * LIQUID_G), round(v[1] * LIQUID_G)
+        for k, value in raw.items():
+            setattr(m, k, value)
         return m.encode()
 
     def ask(self, seq: int, seconds: float = 5.0, **kw) -> "msgs.torque_t":
-        """Publishes a state (again every 100 ms, as host_sim does) and waits for the torque answering it."""
+        """Publishes a sample (again every 100 ms, as host_sim does) and waits for the torque answering it."""
         if channels.TORQUE not in self.got:
             self.watch(channels.TORQUE)
-        dtheta, domega = self.plant.advance()
-        kw = dict(kw, theta=kw.get("theta", 0.1) + dtheta, omega=kw.get("omega", 0.0) + domega)
+        dtheta, _ = self.plant.advance()
+        kw = dict(kw, theta=kw.get("theta", 0.1) + dtheta)
         data = self.state(seq, **kw)
         episode = kw.get("episode", 0)
 
@@ -133,7 +140,7 @@ class Bus:
 
         end = time.monotonic() + seconds
         while time.monotonic() < end:
-            self.lc.publish(channels.STATE, data)
+            self.lc.publish(channels.SENSORS, data)
             if self.wait_for(lambda: bool(answers()), min(0.1, end - time.monotonic())):
                 self.plant.torque_q15 = answers()[-1].torque_q15
                 return answers()[-1]

@@ -41,13 +41,14 @@ def test_real_frames_never_exceed_the_worst_case_bound():
 
 def test_protocol_load_at_1khz_is_under_half_the_bus():
     rows = {r.name: r for r in bl.cyclic_messages()}
-    assert set(rows) == {"StateA", "StateB", "Torque", "Heartbeat", "Identity"}
-    assert rows["StateA"].rate_hz == rows["Torque"].rate_hz == 1000.0
+    # One 8-byte Sensors frame per tick carries the whole sample (no longer two state frames).
+    assert set(rows) == {"Sensors", "Torque", "Heartbeat", "Identity"}
+    assert rows["Sensors"].rate_hz == rows["Torque"].rate_hz == 1000.0
     assert rows["Heartbeat"].rate_hz == rows["Identity"].rate_hz == 10.0
     total = sum(r.load for r in rows.values())
-    assert total == pytest.approx(((135 + 135 + 125) * 1000 + 135 * 10 * 2) / 1e6)
+    assert total == pytest.approx(((135 + 125) * 1000 + 135 * 10 * 2) / 1e6)
     assert total < 0.5
-    assert "39.8 % worst case" in bl.report(list(rows.values()))
+    assert "26.3 % worst case" in bl.report(list(rows.values()))
 
 
 def test_cli_reports_and_rejects_bad_input(tmp_path):
@@ -61,10 +62,9 @@ def test_cli_reports_and_rejects_bad_input(tmp_path):
         r = run(*args)
         assert r.returncode == 2 and "pour-can-bus-load: error:" in r.stderr
     dump = tmp_path / "dump.log"
-    dump.write_text("(1.0) vcan0 010#0000000000000000\n(1.0) vcan0 011#0000FF7F00000000\n"
-                    "(1.0) vcan0 012#00000000050100\n")
+    dump.write_text("(1.0) vcan0 010#00FFFF0100003930\n(1.0) vcan0 012#00000000050100\n")
     r = run("--candump", str(dump))
-    assert r.returncode == 0 and "3 frames over 1 ticks" in r.stdout
+    assert r.returncode == 0 and "2 frames over 1 ticks" in r.stdout
     dump.write_text("(1.0) vcan0 010#0000000000000000\n")
     r = run("--candump", str(dump))
     assert r.returncode == 2 and "no Torque frame" in r.stderr

@@ -66,4 +66,4 @@ def test_bridge_without_the_interface_says_so():
 
 def test_bridge_help_names_the_channels():
     r = run(exe("can_bridge"), "--help")
-    assert r.returncode == 0 and "POUR_STATE" in r.stdout and "POUR_TORQUE" in r.stdout
+    assert r.returncode == 0 and "POUR_SENSORS" in r.stdout and "POUR_TORQUE" in r.stdout

@@ -173,25 +173,30 @@ def test_fixed_policy_agrees_with_the_float_policy(source_dir):
 
 
 def test_safety_envelope_mirrors_the_c_rules():
-    env = fp.SafetyEnvelope()
+    env = fp.SafetyEnvelope(fp.SafetyConfig(omega_slack_urad_s=3000000, omega_max_urad_s=3000000))
     env.force(-32768)
     ticks = 0
     while env.torque != 32767:
-        env.apply(32767, 1000000)
+        env.apply(32767, 1000000, 0)  # a band of ±3 rad/s at rest: the governor lets all through
         ticks += 1
     assert ticks == 20
-    assert env.apply(32767, 2356194) == 0 and env.active & fp.LIMIT_ANGLE_MAX
-    assert env.apply(-32768, -87266) == 0 and env.active & fp.LIMIT_ANGLE_MIN
+    assert env.apply(32767, 2356194, 0) == 0 and env.active & fp.LIMIT_ANGLE_MAX
+    assert env.apply(-32768, -87266, 0) == 0 and env.active & fp.LIMIT_ANGLE_MIN
     clamp = fp.SafetyEnvelope(fp.SafetyConfig(tau_limit=1000, slew_per_tick=32767))
-    assert clamp.apply(20000, 0) == 1000 and clamp.active & fp.LIMIT_CLAMP
+    assert clamp.apply(20000, 0, 0) == 1000 and clamp.active & fp.LIMIT_CLAMP
+    gov = fp.SafetyEnvelope(fp.SafetyConfig(slew_per_tick=32767, alpha_max_urad_s2=2000000000))  # no ramp
+    assert gov.apply(32767, 0, 2500000) < 0 and gov.active & fp.LIMIT_SPEED  # above ω_max: it brakes
+    assert gov.apply(32767, 0, 0) == 13107 and gov.active & fp.LIMIT_ACCEL  # at rest: K · slack
 
 
 def test_python_safety_defaults_match_the_c_defaults(source_dir):
     text = (source_dir / "firmware/src/safety.c").read_text()
     c = {m.group(1): int(m.group(2)) for m in re.finditer(r"#define DEFAULT_(\w+) \(?(-?\d+)\)?", text)}
     py = fp.SafetyConfig()
-    assert (py.slew_per_tick, py.theta_min_urad, py.theta_max_urad) == \
-        (c["SLEW_PER_TICK"], c["THETA_MIN_URAD"], c["THETA_MAX_URAD"])
+    assert (py.slew_per_tick, py.theta_min_urad, py.theta_max_urad, py.omega_max_urad_s, py.alpha_max_urad_s2,
+            py.omega_slack_urad_s, py.torque_per_rad_s) == \
+        (c["SLEW_PER_TICK"], c["THETA_MIN_URAD"], c["THETA_MAX_URAD"], c["OMEGA_MAX_URAD_S"], c["ALPHA_MAX_URAD_S2"],
+         c["OMEGA_SLACK_URAD_S"], c["TORQUE_PER_RAD_S"])
     assert py.tau_limit == fp.Q15_MAX
 
 
@@ -205,8 +210,8 @@ def test_controller_decides_at_steps_0_p_2p(source_dir):
     ctl.policy.eval = lambda obs: calls.append(ctl.tick) or real_eval(obs)
     for _ in range(5):
         ctl.step(None)  # IDLE: no state yet
-    for _ in range(3 * ex.decision_period_ms + 1):
-        ctl.step((0, 0, 32767, 0, 0))
+    for k in range(3 * ex.decision_period_ms + 1):
+        ctl.step((k, 0, 5000, 0))
     first = 6
     assert calls == [first + k * ex.decision_period_ms for k in range(4)]
 
@@ -214,12 +219,41 @@ def test_controller_decides_at_steps_0_p_2p(source_dir):
 def test_controller_timeout_and_estop():
     ctl = fp.Controller(np.zeros((6, 2), dtype=np.int16), 11, [-32768, 32767], 10, fp.ObsNorm(0, 2356194, 4000000))
     assert ctl.step(None).mode == fp.MODE_IDLE
-    assert ctl.step((0, 0, 32767, 0, 0)).mode == fp.MODE_RUN
+    assert ctl.step((0, 0, 5000, 0)).mode == fp.MODE_RUN
     outs = [ctl.step(None) for _ in range(21)]
     assert outs[19].mode == fp.MODE_RUN and outs[20].mode == fp.MODE_FAULT
     assert outs[20].faults == fp.FAULT_STALE_INPUT
-    o = ctl.step((0, 0, 32767, 0, 0), estop=True)
+    o = ctl.step((1, 0, 5000, 0), estop=True)
     assert (o.mode, o.torque) == (fp.MODE_ESTOP, 0) and o.faults & fp.FAULT_ESTOP
+
+
+def test_python_sensors_defaults_match_the_c_defaults(source_dir):
+    text = (source_dir / "firmware/src/sensors.c").read_text()
+    c = {m.group(1): int(m.group(2)) for m in re.finditer(r"#define DEFAULT_(\w+) \(?(-?\d+)\)?u?", text)}
+    py = fp.SensorsConfig()
+    assert (py.encoder_bits, py.bandwidth_rad_s, py.scale_min_g, py.scale_max_g, py.mass_min_g) == \
+        (c["ENCODER_BITS"], c["BANDWIDTH_RAD_S"], c["SCALE_MIN_G"], c["SCALE_MAX_G"], c["MASS_MIN_G"])
+    assert f"{fp.TWO_PI_URAD_Q8}u" in text and fp.TWO_PI_URAD_Q8 == round(2 * np.pi * 1e6 * 256)
+
+
+def test_estimator_angle_is_sign_symmetric_and_rounded():
+    assert [fp.encoder_theta_urad(c, 17) for c in (0, 1, 65536, 65537, 131071)] == \
+        [0, 48, 3141593, -3141545, -48]
+    for c in (1, 7, 12345, 65535):
+        assert fp.encoder_theta_urad(c, 17) == -fp.encoder_theta_urad((1 << 17) - c, 17)
+        assert abs(fp.encoder_theta_urad(c, 17) - c * 2 * np.pi * 1e6 / (1 << 17)) <= 0.5 + 1e-3
+
+
+def test_estimator_tracks_a_constant_speed_and_refuses_implausible_samples():
+    est = fp.Estimator()
+    assert est.update(0, 1 << 17, 5000, 0) is None  # count out of range
+    assert est.update(0, 0, 40000, 0) is None       # scale beyond its limit
+    assert est.update(0, 0, 500, 0) is None         # m0 too small to divide by
+    st = None
+    for k in range(400):  # 1 rad/s
+        st = est.update(k, round(k * 1e-3 / (2 * np.pi) * (1 << 17)), 7500, 2500)
+    assert abs(st[2] - 1000000) < 30000  # the 17-bit counts' noise: docs/safety.md
+    assert st[3:] == (24576, 8192, 0)
 
 
 def test_python_control_defaults_match_the_c_defaults(source_dir):

@@ -18,12 +18,12 @@ def header_macros(source_dir) -> dict:
 
 def test_channels_header_and_module_agree(source_dir):
     h = header_macros(source_dir)
-    py = {"CHANNEL_STATE": channels.STATE, "CHANNEL_TORQUE": channels.TORQUE,
+    py = {"CHANNEL_SENSORS": channels.SENSORS, "CHANNEL_TRUTH": channels.TRUTH, "CHANNEL_TORQUE": channels.TORQUE,
           "CHANNEL_STATUS": channels.STATUS, "CHANNEL_PARTICLES": channels.PARTICLES,
           "CHANNEL_COMMAND": channels.COMMAND, "DEFAULT_URL": channels.DEFAULT_URL,
           "STATUS_PERIOD_MS": channels.STATUS_PERIOD_MS, "PARTICLES_PERIOD_MS": channels.PARTICLES_PERIOD_MS}
     assert h == py
-    assert len(set(channels.ALL)) == len(channels.ALL) == 5
+    assert len(set(channels.ALL)) == len(channels.ALL) == 6
 
 
 def test_every_message_starts_with_utime_and_comments_each_field(source_dir):
@@ -43,10 +43,14 @@ def test_every_message_starts_with_utime_and_comments_each_field(source_dir):
 def test_generated_types_round_trip(build_dir, monkeypatch):
     monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
     m = lcm_types.load()
-    s = m.plant_state_t()
-    s.utime, s.seq, s.theta, s.obs = 1000, 1, 0.5, [0.1, 0.2, 0.3, 0.4, 0.5]
-    d = m.plant_state_t.decode(s.encode())
-    assert (d.utime, d.seq, d.theta) == (1000, 1, 0.5)
+    s = m.sensor_sample_t()
+    s.utime, s.seq, s.encoder, s.scale_rotating_g, s.scale_target_g = 1000, 1, 131071, -5, 12345
+    d = m.sensor_sample_t.decode(s.encode())
+    assert (d.utime, d.seq, d.encoder, d.scale_rotating_g, d.scale_target_g) == (1000, 1, 131071, -5, 12345)
+    g = m.plant_truth_t()
+    g.utime, g.seq, g.theta, g.motor_torque, g.obs = 1000, 1, 0.5, -2.5, [0.1, 0.2, 0.3, 0.4, 0.5]
+    d = m.plant_truth_t.decode(g.encode())
+    assert (d.utime, d.seq, d.theta, d.motor_torque) == (1000, 1, 0.5, -2.5)
     t = m.torque_t()
     t.n_actions, t.probs_q15 = 2, [16384, 16384] + [0] * 14
     assert m.torque_t.decode(t.encode()).probs_q15[:2] == (16384, 16384)
@@ -55,11 +59,13 @@ def test_generated_types_round_trip(build_dir, monkeypatch):
 def test_generated_types_refuse_foreign_and_truncated_data(build_dir, monkeypatch):
     monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
     m = lcm_types.load()
-    data = m.plant_state_t().encode()
+    data = m.sensor_sample_t().encode()
     with pytest.raises(ValueError):
         m.torque_t.decode(data)
+    with pytest.raises(ValueError):
+        m.plant_truth_t.decode(data)  # the truth is a type of its own: a sensor sample never passes for it
     with pytest.raises(Exception):
-        m.plant_state_t.decode(data[:-3])
+        m.sensor_sample_t.decode(data[:-3])
 
 
 def test_missing_build_gives_a_clear_message(monkeypatch, tmp_path):

@@ -47,7 +47,7 @@ def test_controller_drops_and_counts_garbage_and_keeps_answering(controller):
     with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]) as c:
         assert bus.ask(0).seq == 0
         for g in garbage:
-            bus.lc.publish(channels.STATE, g)
+            bus.lc.publish(channels.SENSORS, g)
         for g in garbage[:5]:
             bus.lc.publish(channels.COMMAND, g)
         bus.lc.publish(channels.COMMAND, good)  # a state where a command belongs
@@ -87,6 +87,45 @@ def test_controller_input_timeout_latches_fault_until_clear(controller):
         assert a.faults == 0 and a.mode in (0, MODE_RUN)
         assert bus.ask(2, episode=1, theta=0.2).mode == MODE_RUN
         assert c.stop() == 0
+
+
+FAULT_BAD_INPUT = 0x4
+
+
+@pytest.mark.parametrize("raw", [
+    {"encoder": 1 << 17},                      # no count of the default 17-bit encoder
+    {"encoder": -1},                           # a negative count (int32 on the wire)
+    {"encoder": 2**31 - 1},
+    {"scale_rotating_g": 30001},               # past the load cell's 30 kg
+    {"scale_target_g": -2001},                 # a tared cell never reads 2 kg below zero
+    {"scale_rotating_g": -2**31, "scale_target_g": 2**31 - 1},
+])
+def test_controller_latches_bad_input_on_an_impossible_sample(controller, raw):
+    """A sample no sensor of the rig can give reaches the core as sent and is refused there: BAD_INPUT,
+    FAULT, a message on stderr, and never torque from it."""
+    u = url(7)
+    bus = Bus(u)
+    with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]) as c:
+        for k in range(10):
+            assert bus.ask(k, theta=0.2).mode == MODE_RUN
+        a = bus.ask(10, theta=0.2, **raw)
+        assert a.mode == MODE_FAULT and a.faults & FAULT_BAD_INPUT, (raw, a.faults)
+        a = bus.ask(11, theta=0.2)  # good samples again: the fault stays latched until a clear
+        assert a.mode == MODE_FAULT and a.faults & FAULT_BAD_INPUT
+        assert c.stop() == 0
+    assert "fault 0x0004 latched at tick 11" in c.err
+
+
+def test_controller_takes_the_encoder_resolution_it_is_given(controller):
+    """--encoder-bits: a 20-bit encoder's counts are plausible there, and θ is read at that resolution."""
+    u = url(8)
+    bus = Bus(u)
+    with Proc([controller, "--io", f"lcm:{u}", "--lockstep", "--encoder-bits", "20"]) as c:
+        for k in range(5):
+            a = bus.ask(k, theta=0.2, encoder=(1 << 18) + k)  # 1.57 rad at 20 bits; implausible at 17
+            assert a.mode == MODE_RUN and a.faults == 0
+        assert c.stop() == 0
+    assert a.obs_q15[0] > 0
 
 
 def test_controller_estop_zeroes_torque_and_latches(controller):
@@ -132,6 +171,8 @@ def test_controller_real_time_ticks_without_states_and_counts(controller):
     (["--duration"], "--duration needs"),
     (["--input-timeout-ms", "70000"], "--input-timeout-ms needs"),
     (["--seed", "-3"], "--seed needs"),
+    (["--encoder-bits", "7"], "--encoder-bits needs an integer in [8, 24]"),
+    (["--encoder-bits", "25"], "--encoder-bits needs an integer in [8, 24]"),
     (["--frobnicate"], "unknown option"),
 ])
 def test_controller_rejects_bad_arguments(controller, argv, needle):

@@ -156,7 +156,7 @@ def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_d
     host_sim = binary(build_dir, "host_sim")
     r = run([host_sim, *host_sim_args(build_dir, "--lcm", url(17), "--lcm-timeout-ms", "300")])
     assert r.returncode == 3
-    assert "no answer on POUR_TORQUE to POUR_STATE seq 0" in r.stderr
+    assert "no answer on POUR_TORQUE to POUR_SENSORS seq 0" in r.stderr
 
 
 def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build_dir, source_dir):

@@ -10,7 +10,7 @@ import time
 import numpy as np
 from PIL import Image
 
-from lcm_helpers import Bus, Proc, binary, compiled_weights, url
+from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
 from pour import channels
 
 
@@ -134,3 +134,19 @@ def test_live_view_window_under_xvfb(build_dir, source_dir, tmp_path):
     frames = int(out.split("pour-live-view: ")[1].split()[0])
     assert frames > 10
     assert white > 50000  # a white figure covers much of the black root window
+
+
+def test_live_view_shows_the_raw_sample_and_flags_an_impossible_count():
+    from pour import live_view
+
+    view = live_view.LiveView(url(45))
+    assert "no POUR_SENSORS yet" in view.sensors_text()
+    s = msgs.sensor_sample_t()
+    s.encoder, s.scale_rotating_g, s.scale_target_g = 32768, 7725, 2575  # a quarter turn: 90°
+    view._on_sensors(channels.SENSORS, s.encode())
+    assert view.sensors_text() == "sensors: encoder  32768 (  90.0°)  scales   7725 g /   2575 g"
+    s.encoder = 1 << 17  # no count of the 17-bit encoder: the controller latches BAD_INPUT on it
+    view._on_sensors(channels.SENSORS, s.encode())
+    assert "(out of range)" in view.sensors_text()
+    view._on_sensors(channels.SENSORS, b"garbage")
+    assert view.dropped == 1

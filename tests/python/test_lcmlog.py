@@ -3,6 +3,7 @@
 plots and the render are written; bad logs give clear errors."""
 import json
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -15,7 +16,7 @@ import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
 from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
-from pour import channels, lcmlog
+from pour import channels, lcm_sensors, lcmlog
 
 LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
 
@@ -69,15 +70,23 @@ def test_log_summary_matches_the_simulated_pour(recorded):
     s = json.loads(r.stdout)
     (ep,) = s["episodes"]
     # host_sim's summary: poured/spilled after the last step; the log's last state is one step earlier.
-    words = summary_line(host_out).split()
-    poured, spilled = float(words[4]) / 100, float(words[9]) / 100
+    line = summary_line(host_out)
+    poured = float(re.search(r"poured\s+([\d.]+) %", line).group(1)) / 100
+    spilled = float(re.search(r"spilled\s+([\d.]+) %", line).group(1)) / 100
     assert abs(ep["poured"] - poured) <= 1 / 150 + 1e-9 and abs(ep["spilled"] - spilled) <= 1 / 150 + 1e-9
     # UDP multicast to the logger may drop a few datagrams on a loaded machine, anywhere in the stream
     # (the end included), states and answers alike.
     assert ep["first_seq"] <= 100 and ep["last_seq"] >= 1900
     assert s["states"] >= 1900 and s["unanswered"] <= 100
     assert s["latency_us"]["n"] == s["states"] - s["unanswered"] and s["latency_us"]["median"] > 0
-    assert s["particle_frames"] > 0 and s["undecodable"] == {}
+    assert s["particle_frames"] > 0 and s["undecodable"] == {} and s["refused"] == {}
+    assert ep["source"] == channels.TRUTH
+    # The tools read the encoder as the simulator writes it: every logged count is the count of the true
+    # tilt of the same sample (round(θ·2^17/2π) mod 2^17).
+    (e,) = lcmlog.read_log(log).episodes
+    both = [k for k in e.raw if k in e.truth]
+    assert len(both) >= 1900
+    assert all(lcm_sensors.encoder_count(e.truth[k][0]) == e.raw[k][0] for k in both)
     for png in ("traces.png", "latency.png"):
         assert (out / png).stat().st_size > 10000
     assert json.loads((out / "summary.json").read_text())["episodes"] == s["episodes"]
@@ -88,8 +97,9 @@ def test_log_text_output_reads_like_host_sim(recorded):
     r = subprocess.run([sys.executable, "-m", "pour.lcmlog", log], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert summary_line(r.stdout).startswith("summary (1 episode): poured ")
-    assert "latency POUR_STATE -> POUR_TORQUE: median" in r.stdout
+    assert "latency POUR_SENSORS -> POUR_TORQUE: median" in r.stdout
     assert "controller: mode" in r.stdout
+    assert "plant from POUR_TRUTH" in r.stdout  # host_sim publishes the simulated plant's truth
 
 
 def test_log_renders_like_host_sim(recorded):
@@ -109,16 +119,16 @@ def test_log_with_garbage_counts_it_and_still_analyses(tmp_path):
     bus_state = Bus.state  # encode helper without a bus
     rng = random.Random(2)
     for k in range(20):
-        w.write_event(k * 1000, channels.STATE, bus_state(None, k, theta=0.01 * k))
+        w.write_event(k * 1000, channels.SENSORS, bus_state(None, k, theta=0.01 * k))
         t = msgs.torque_t()
         t.seq, t.torque = k, 1.0
         w.write_event(k * 1000 + 80, channels.TORQUE, t.encode())
         w.write_event(k * 1000 + 90, channels.TORQUE, bytes(rng.randrange(256) for _ in range(30)))
-    w.write_event(30000, channels.STATE, msgs.command_t().encode())
+    w.write_event(30000, channels.SENSORS, msgs.command_t().encode())
     w.write_event(30001, "SOMEONE_ELSE", b"ignored")
     w.close()
     s = lcmlog.analyse(path, None)
-    assert s["undecodable"] == {channels.TORQUE: 20, channels.STATE: 1}
+    assert s["undecodable"] == {channels.TORQUE: 20, channels.SENSORS: 1}
     assert s["states"] == 20 and s["unanswered"] == 0
     assert s["latency_us"]["median"] == 80
 
@@ -133,13 +143,13 @@ def test_garbage_file_is_a_clear_error(tmp_path):
     path = tmp_path / "junk.lcmlog"
     path.write_bytes(bytes(random.Random(1).randrange(256) for _ in range(5000)))
     r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
-    assert r.returncode == 1 and "holds no POUR_STATE messages" in r.stderr
+    assert r.returncode == 1 and "holds no usable POUR_SENSORS messages" in r.stderr
 
 
 def test_log_without_particles_cannot_render(tmp_path):
     path = tmp_path / "noparticles.lcmlog"
     w = lcm.EventLog(str(path), "w", overwrite=True)
-    w.write_event(0, channels.STATE, Bus.state(None, 0))
+    w.write_event(0, channels.SENSORS, Bus.state(None, 0))
     w.close()
     r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path, "--render", tmp_path / "x.gif"],
                        capture_output=True, text=True, timeout=60)
@@ -173,5 +183,86 @@ def test_log_replays_onto_the_bus_and_analyses_the_same(recorded, tmp_path):
     (a,), (b,) = first.episodes, second.episodes
     # UDP may drop a few replayed messages, but what arrives is the same pour, state for state.
     assert len(b.seq) >= 0.9 * len(a.seq)
-    va, vb = dict(zip(a.seq, zip(a.theta, a.v))), dict(zip(b.seq, zip(b.theta, b.v)))
+    assert len(b.series_seq) >= 0.9 * len(a.series_seq)
+    va, vb = dict(zip(a.series_seq, zip(a.theta, a.v))), dict(zip(b.series_seq, zip(b.theta, b.v)))
     assert all(vb[k] == va[k] for k in vb)
+    assert {k: b.raw[k] for k in b.raw} == {k: a.raw[k] for k in b.raw}  # the raw samples too
+
+
+def sensor_log(path: Path, samples, truth=()) -> None:
+    """A log of scripted POUR_SENSORS samples (seq, theta, (v_rot, v_tgt), raw overrides) and POUR_TRUTH."""
+    w = lcm.EventLog(str(path), "w", overwrite=True)
+    for seq, theta, v, raw in samples:
+        w.write_event(seq * 1000, channels.SENSORS, Bus.state(None, seq, theta=theta, v=v, **raw))
+    for seq, values in truth:
+        g = msgs.plant_truth_t()
+        g.seq = seq
+        g.theta, g.omega, g.v_rotating, g.v_target, g.v_spill = values
+        w.write_event(seq * 1000 + 1, channels.TRUTH, g.encode())
+    w.close()
+
+
+def test_log_without_truth_reads_the_plant_from_the_sensors(tmp_path):
+    """A rig's log has no POUR_TRUTH: θ from the encoder count, the volumes from the scales (V = m/m0, the
+    rest spilled or in flight), as the firmware's estimator defines them."""
+    path = tmp_path / "rig.lcmlog"
+    # 10 L pour: 60 % moves to the target, 5 % goes missing; the bucket tilts to 100° and back below upright.
+    sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 1.75, (0.5, 0.4), {}), (2, -0.02, (0.35, 0.6), {})])
+    s = lcmlog.analyse(path, None)
+    (ep,) = s["episodes"]
+    assert ep["source"].startswith(channels.SENSORS)
+    assert ep["poured"] == pytest.approx(0.6, abs=1e-4) and ep["spilled"] == pytest.approx(0.05, abs=1e-4)
+    assert ep["left"] == pytest.approx(0.35, abs=1e-4)
+    assert ep["max_theta_deg"] == pytest.approx(100.27, abs=0.01)  # 1.75 rad to one count (47.9 µrad)
+    log = s["_log"]
+    assert log.episodes[0].theta[-1] == pytest.approx(-0.02, abs=5e-5)  # below upright: the count wrapped
+
+
+def test_log_prefers_truth_and_refuses_impossible_values(tmp_path):
+    path = tmp_path / "mixed.lcmlog"
+    sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 0.1, (0.9, 0.1), {}),
+                      (2, 0.2, (0.8, 0.2), {"encoder": 1 << 17}),  # no count of a 17-bit encoder
+                      (3, 0.2, (0.8, 0.2), {"encoder": -1})],
+               truth=[(0, (0.0, 0.0, 1.0, 0.0, 0.0)), (1, (0.1, 1.0, 0.7, 0.25, 0.05)),
+                      (2, (float("nan"), 0.0, 0.5, 0.5, 0.0)), (3, (0.2, float("inf"), 0.5, 0.5, 0.0))])
+    s = lcmlog.analyse(path, None)
+    (ep,) = s["episodes"]
+    assert ep["source"] == channels.TRUTH and ep["states"] == 4
+    assert ep["poured"] == 0.25 and ep["spilled"] == 0.05  # the last plausible truth, not the scales
+    assert s["refused"] == {channels.SENSORS: 2, channels.TRUTH: 2}
+    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and "refused 4" in r.stdout
+    # The same samples read as a 24-bit encoder's: 2^17 is then a count like any other.
+    assert lcmlog.analyse(path, None, encoder_bits=24)["refused"] == {channels.SENSORS: 1, channels.TRUTH: 2}
+
+
+def test_log_without_liquid_on_the_scales_is_a_clear_error(tmp_path):
+    path = tmp_path / "empty.lcmlog"
+    sensor_log(path, [(0, 0.0, (0.0, 0.0), {}), (1, 0.1, (0.0, 0.0), {})])
+    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 1 and "weighs 0 g of liquid" in r.stderr
+
+
+@pytest.mark.parametrize("bits", ["7", "25"])
+def test_bad_encoder_bits_is_a_clear_error(tmp_path, bits):
+    path = tmp_path / "a.lcmlog"
+    path.write_bytes(b"")
+    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path, "--encoder-bits", bits], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "--encoder-bits must be 8 .. 24" in r.stderr
+
+
+def test_sensor_readings_in_physical_units_and_their_bad_input():
+    assert lcm_sensors.encoder_count(0.0) == 0 and lcm_sensors.encoder_count(-1e-4) == (1 << 17) - 2
+    assert lcm_sensors.encoder_angle(1 << 15) == pytest.approx(3.141592653589793 / 2)
+    assert lcm_sensors.encoder_angle((1 << 17) - 2) == pytest.approx(-2 * 2 * 3.141592653589793 / (1 << 17))
+    assert lcm_sensors.volumes(5150, 4120, 10300) == pytest.approx((0.5, 0.4, 0.1))
+    assert lcm_sensors.volumes(9000, 2000, 10300)[2] == 0.0  # more than m0 on the scales: nothing missing
+    with pytest.raises(ValueError, match="outside 0 .. 2"):
+        lcm_sensors.encoder_angle(1 << 17)
+    with pytest.raises(ValueError, match="outside 0 .. 2"):
+        lcm_sensors.encoder_angle(-1)
+    with pytest.raises(ValueError, match="not finite"):
+        lcm_sensors.encoder_count(float("nan"))
+    with pytest.raises(ValueError, match="must be positive"):
+        lcm_sensors.volumes(1, 1, 0)

@@ -30,6 +30,30 @@ def test_default_config_has_the_documented_scene():
     assert c["restitution_liquid"] == 0.5 and c["restitution_wall"] == 0.1
 
 
+def test_rig_keys_and_readings_cross_the_binding_with_the_c_layout():
+    # Values the C side sets land in the right Python fields only if the layouts agree field by field.
+    c = sim.default_config()
+    assert (c["motor_peak_torque"], c["motor_no_load_speed"], c["gear_ratio"]) == (25.0, 21.0, 20.0)
+    assert (c["command_latency_ticks"], c["encoder_bits"], c["scale_rate_hz"]) == (1, 17, 80.0)
+    assert c["rand_sensor"] == 0.0 and c["k_target"] == 1.0 and c["seed"] == 1
+    with sim.World(seed=3) as w:
+        o = w.observe()
+        assert o.encoder in (0, (1 << 17) - 1) or o.encoder < 50 or o.encoder > (1 << 17) - 50
+        assert 7000 < o.scale_rotating_g < 14000 and abs(o.scale_target_g) < 500  # 10.3 kg of agitated liquid
+        w.step(1.0)
+        o = w.step(1.0)
+        assert o.torque == 20.0 and 19.0 < o.motor_torque <= 20.0  # the command of the step before, at speed
+        assert o.encoder == round(o.theta * (1 << 17) / (2 * np.pi))
+    with sim.World({"rand_fill": 0.2, "rand_motor": 0.15}, seed=5) as w:
+        e = w.episode_config()
+        assert e["fill_depth"] != c["fill_depth"] and abs(e["fill_depth"] / c["fill_depth"] - 1) <= 0.2
+        assert abs(e["motor_peak_torque"] / 25.0 - 1) <= 0.15 and e["rand_fill"] == 0.2
+    d = sim.measure_drive()
+    assert d["latency_ticks"] == 1 and d["inertia_measured"] == pytest.approx(d["inertia_expected"], rel=0.01)
+    with pytest.raises(sim.SimError, match="encoder_bits"):
+        sim.make_config({"encoder_bits": 40})
+
+
 def test_bad_config_key_or_value_raises_naming_it():
     with pytest.raises(sim.SimError, match="no_such_key"):
         sim.make_config({"no_such_key": 1})

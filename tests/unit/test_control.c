@@ -8,16 +8,26 @@ static pour_control_t ctl;
 static pour_control_input_t in;
 static pour_control_output_t out;
 
-/* Upright, still, full rotating bucket: the example policy pushes forward. */
-static pour_state_t start_state(void) {
-  pour_state_t s = {0u, 0, 0, 32767, 0, 0};
-  return s;
+#define FULL_G 10000 /* 10 kg of liquid, all in the rotating bucket */
+
+/* The raw count of the default 17-bit encoder at θ [µrad] (0 = upright, below upright wraps). */
+static uint32_t count_at(int32_t theta_urad) {
+  const int64_t c = ((int64_t)theta_urad * 131072 * 1000 + (theta_urad >= 0 ? 3141592654LL : -3141592654LL)) /
+                    6283185307LL;
+  return (uint32_t)((c + 131072) % 131072);
+}
+
+/* What the sensors read: θ [µrad] and the two scales [g]. */
+static void sense(int32_t theta_urad, int32_t m_rot_g, int32_t m_tgt_g) {
+  in.sensors.encoder = count_at(theta_urad);
+  in.sensors.scale_rotating_g = m_rot_g;
+  in.sensors.scale_target_g = m_tgt_g;
 }
 
 static void step(bool fresh) {
-  in.state_fresh = fresh;
+  in.sensors_fresh = fresh;
   if (fresh) {
-    in.state.seq++;
+    in.sensors.seq++;
   }
   pour_control_step(&ctl, &in, &out);
 }
@@ -28,8 +38,9 @@ void setUp(void) {
    * the supervisor's motion and volume checks would rightly object. test_supervisor.c covers them. */
   config.supervisor.checks = POUR_CHECK_POSITION | POUR_CHECK_OVERSPEED | POUR_CHECK_SEQ;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &config, &pour_weights_compiled));
-  in.state_fresh = false;
-  in.state = start_state();
+  in.sensors_fresh = false;
+  in.sensors.seq = 0u;
+  sense(0, FULL_G, 0); /* upright, still, the liquid in the rotating bucket: the example policy pushes */
   in.estop = false;
   in.clear_faults = false;
 }
@@ -51,6 +62,12 @@ static void test_control_init_RefusesBadConfig(void) {
   config = pour_control_default_config();
   config.plausible_volume_sum = 0;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init(&ctl, &config, &pour_weights_compiled));
+  config = pour_control_default_config();
+  config.sensors.encoder_bits = 30u;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init(&ctl, &config, &pour_weights_compiled));
+  config = pour_control_default_config();
+  config.safety.omega_max_urad_s = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init(&ctl, &config, &pour_weights_compiled));
 }
 
 static void test_control_init_PassesOnAWeightsError(void) {
@@ -70,7 +87,7 @@ static void test_control_step_IdleWaitsForFirstStateWithoutTimingOut(void) {
   TEST_ASSERT_EQUAL_UINT32(1000u, out.tick);
 }
 
-static void test_control_step_FirstFreshStateStartsRunAndDecides(void) {
+static void test_control_step_FirstFreshSampleStartsRunAndDecides(void) {
   step(true);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[out.action] > 0);
@@ -102,13 +119,13 @@ static void test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick(void
 
 static void test_control_step_DecidesEveryPeriodAndHoldsBetween(void) {
   const unsigned period = pour_weights_compiled.decision_period_ms;
+  sense(2000000, FULL_G, 0); /* tilted, still full: the policy pushes on */
   step(true);
   const uint8_t first = out.action;
-  /* From now on the state says "poured, tilted": the policy wants to pull back, but only the next
-   * decision tick may change the action. */
-  in.state.theta_urad = 2000000;
-  in.state.v_rotating = 500;
-  in.state.v_target = 32000;
+  TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[first] > 0);
+  /* From now on the scales say "poured": the policy wants to pull back, but only the next decision tick
+   * may change the action. */
+  sense(2000000, 150, 9800);
   for (unsigned k = 1; k < period; ++k) {
     step(true);
     TEST_ASSERT_EQUAL_UINT8(first, out.action);
@@ -178,65 +195,101 @@ static void test_control_step_EstopZeroesTorqueInTheSameTick(void) {
   TEST_ASSERT_EQUAL_INT16(config.safety.slew_per_tick, out.torque);
 }
 
-static void expect_bad_input(pour_state_t s) {
+/* A run, then one sample that cannot be (encoder, scales as given), then plausible samples again: the
+ * fault latches, the torque is the safe one at once, and the bad sample is never used. */
+static void expect_bad_input(uint32_t encoder, int32_t m_rot_g, int32_t m_tgt_g) {
   setUp();
-  step(true);
-  in.state = s;
+  for (unsigned i = 0; i < 30u; ++i) {
+    step(true);
+  }
+  const pour_state_t good = ctl.state;
+  in.sensors.encoder = encoder;
+  in.sensors.scale_rotating_g = m_rot_g;
+  in.sensors.scale_target_g = m_tgt_g;
   step(true);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
   TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_BAD_INPUT, out.faults);
   TEST_ASSERT_EQUAL_INT16(config.safe_torque, out.torque);
+  TEST_ASSERT_EQUAL_INT32(good.theta_urad, ctl.state.theta_urad);
+  TEST_ASSERT_EQUAL_INT16(good.v_rotating, ctl.state.v_rotating);
+  sense(0, FULL_G, 0);
+  for (unsigned i = 0; i < 20u; ++i) {
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  }
 }
 
-static void test_control_step_ImpossibleStatesRaiseBadInput(void) {
-  pour_state_t s = start_state();
-  s.v_rotating = -1;
-  expect_bad_input(s);
-  s = start_state();
-  s.v_spill = INT16_MIN;
-  expect_bad_input(s);
-  s = start_state();
-  s.v_target = 32767; /* with v_rotating = 32767: twice the liquid there is */
-  expect_bad_input(s);
-  s = start_state();
-  s.theta_urad = INT32_MIN;
-  expect_bad_input(s);
-  s = start_state();
-  s.theta_urad = 4000000; /* past half a turn */
-  expect_bad_input(s);
-  s = start_state();
-  s.omega_urad_s = INT32_MAX;
-  expect_bad_input(s);
+static void test_control_step_ImplausibleSamplesRaiseBadInput(void) {
+  expect_bad_input(131072u, FULL_G, 0);                     /* a count a 17-bit encoder cannot give */
+  expect_bad_input(UINT32_MAX, FULL_G, 0);
+  expect_bad_input(0u, config.sensors.scale_max_g + 1, 0);  /* a scale beyond its range */
+  expect_bad_input(0u, FULL_G, config.sensors.scale_min_g - 1);
+  expect_bad_input(0u, INT32_MIN, INT32_MAX);
+  expect_bad_input(count_at(3000000), FULL_G, 0);           /* half a turn in 1 ms: a count that jumped */
+  expect_bad_input(count_at(20000), FULL_G, 0);             /* 20 mrad in 1 ms: 40,000 rad/s² */
+}
+
+/* The volume-sum check, off by default (load cells read more than the liquid under impact and slosh), still
+ * refuses what it is set to. */
+static void test_control_step_VolumeSumCheckRefusesWhenArmed(void) {
+  config.plausible_volume_sum = 40000; /* 1.22 */
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &config, &pour_weights_compiled));
+  step(true);
+  sense(0, FULL_G, FULL_G / 2);
+  step(true);
+  TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_BAD_INPUT, out.faults);
+  setUp();
+  step(true);
+  sense(0, FULL_G, FULL_G); /* twice the liquid: each cell clipped at 1, the sum at 2: passes by default */
+  step(true);
+  TEST_ASSERT_EQUAL_HEX16(0u, out.faults);
 }
 
 static void test_control_step_BadInputInIdleAlsoFaults(void) {
-  in.state.v_rotating = -5;
+  sense(0, 300, 200); /* m0 = 0.5 kg: no liquid to measure a pour by */
   step(true);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
   TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_BAD_INPUT, out.faults);
 }
 
+/* Each run's estimate starts from the run's first sample: m0 is the liquid as it is then, θ̇ from rest. */
+static void test_control_step_EachRunStartsTheEstimateAfresh(void) {
+  sense(0, 8000, 0);
+  step(true);
+  TEST_ASSERT_EQUAL_INT16(32767, ctl.state.v_rotating);
+  in.stop = true;
+  step(false);
+  in.stop = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  sense(0, 4000, 0); /* half of it was poured out by hand */
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_INT16(32767, ctl.state.v_rotating);
+  TEST_ASSERT_EQUAL_INT32(4000, ctl.estimator.m0_g);
+}
+
+/* Moving forward slowly (0.3 rad/s) past θ_max: forward torque before it, none from the first sample past it. */
 static void test_control_step_NoForwardTorquePastMaxAngle(void) {
-  for (unsigned i = 0; i < 40u; ++i) {
+  const int32_t start = config.safety.theta_max_urad - 6000;
+  bool pushed = false;
+  for (int32_t i = 0; i < 45; ++i) {
+    sense(start + 300 * i, FULL_G, 0); /* the policy wants to push all the way */
     step(true);
+    if (ctl.state.theta_urad >= config.safety.theta_max_urad) {
+      TEST_ASSERT_TRUE(out.torque <= 0);
+    } else {
+      pushed = pushed || out.torque > 0;
+    }
   }
-  TEST_ASSERT_TRUE(out.torque > 0);
-  in.state.theta_urad = config.safety.theta_max_urad + 1000;
-  in.state.v_rotating = 32767; /* the policy still wants to push */
-  for (unsigned i = 0; i < 25u; ++i) {
-    step(true);
-    TEST_ASSERT_TRUE(out.torque <= 0);
-  }
+  TEST_ASSERT_TRUE(pushed);
 }
 
 static void test_control_step_IsDeterministic(void) {
   pour_control_t other;
   pour_control_output_t out2;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&other, &config, &pour_weights_compiled));
-  for (unsigned i = 0; i < 500u; ++i) {
-    in.state.theta_urad = (int32_t)(i * 3000u);
-    in.state.v_rotating = (q15_t)(32767 - (int32_t)i * 60);
-    in.state.v_target = (q15_t)(i * 60u);
+  for (int32_t i = 0; i < 500; ++i) {
+    sense(i * 3000, FULL_G - i * 18, i * 18);
     step(true);
     pour_control_step(&other, &in, &out2);
     TEST_ASSERT_EQUAL_INT16(out.torque, out2.torque);
@@ -249,14 +302,16 @@ int main(void) {
   RUN_TEST(test_control_init_RefusesBadConfig);
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);
-  RUN_TEST(test_control_step_FirstFreshStateStartsRunAndDecides);
+  RUN_TEST(test_control_step_FirstFreshSampleStartsRunAndDecides);
   RUN_TEST(test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick);
   RUN_TEST(test_control_step_DecidesEveryPeriodAndHoldsBetween);
   RUN_TEST(test_control_step_StaleInputAfterTimeoutGivesSafeTorqueAndLatches);
   RUN_TEST(test_control_step_ClearReturnsToIdleThenRun);
   RUN_TEST(test_control_step_EstopZeroesTorqueInTheSameTick);
-  RUN_TEST(test_control_step_ImpossibleStatesRaiseBadInput);
+  RUN_TEST(test_control_step_ImplausibleSamplesRaiseBadInput);
   RUN_TEST(test_control_step_BadInputInIdleAlsoFaults);
+  RUN_TEST(test_control_step_VolumeSumCheckRefusesWhenArmed);
+  RUN_TEST(test_control_step_EachRunStartsTheEstimateAfresh);
   RUN_TEST(test_control_step_NoForwardTorquePastMaxAngle);
   RUN_TEST(test_control_step_IsDeterministic);
   return UNITY_END();

@@ -1,5 +1,8 @@
 /* SPDX-License-Identifier: MIT */
+/* The envelope's rules one by one (the torque rules with a speed band too wide to act, then the motion
+ * envelope), and the motion envelope in closed loop with the estimator on a gravity-loaded bucket. */
 #include "pour/safety.h"
+#include "pour/sensors.h"
 #include "unity.h"
 
 static pour_safety_config_t config;
@@ -7,9 +10,20 @@ static pour_safety_t safety;
 
 #define MID_URAD 1000000 /* well inside the angle limits */
 
+/* The torque rules alone: a speed band of ±100 rad/s at rest lets any torque through. */
+static void init_without_band(void) {
+  config.omega_max_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
+  config.omega_slack_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+}
+
+static q15_t apply_at_rest(q15_t requested, int32_t theta_urad) {
+  return pour_safety_apply(&safety, requested, theta_urad, 0);
+}
+
 void setUp(void) {
   config = pour_safety_default_config();
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+  init_without_band();
 }
 
 void tearDown(void) {}
@@ -30,26 +44,40 @@ static void test_safety_init_RefusesBadConfigs(void) {
   config = pour_safety_default_config();
   config.theta_max_urad = config.theta_min_urad;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.omega_max_urad_s = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config.omega_max_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S + 1;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.alpha_max_urad_s2 = 999; /* below one µrad/s per tick */
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.omega_slack_urad_s = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.torque_per_rad_s = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
 }
 
 static void test_safety_default_SwingsFullScaleInAbout20Ticks(void) {
   unsigned ticks = 0;
-  (void)pour_safety_apply(&safety, POUR_Q15_MIN, MID_URAD);
+  (void)apply_at_rest(POUR_Q15_MIN, MID_URAD);
   pour_safety_force(&safety, POUR_Q15_MIN);
   while (safety.torque != POUR_Q15_MAX && ticks < 100u) {
-    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD);
+    (void)apply_at_rest(POUR_Q15_MAX, MID_URAD);
     ++ticks;
   }
   TEST_ASSERT_EQUAL_UINT(20u, ticks);
 }
 
 static void test_safety_apply_SlewLimitsEachStep(void) {
-  const q15_t t1 = pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD);
+  const q15_t t1 = apply_at_rest(POUR_Q15_MAX, MID_URAD);
   TEST_ASSERT_EQUAL_INT16(config.slew_per_tick, t1);
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_SLEW, safety.active);
-  const q15_t t2 = pour_safety_apply(&safety, POUR_Q15_MIN, MID_URAD);
+  const q15_t t2 = apply_at_rest(POUR_Q15_MIN, MID_URAD);
   TEST_ASSERT_EQUAL_INT16(0, t2);
-  const q15_t t3 = pour_safety_apply(&safety, 100, MID_URAD);
+  const q15_t t3 = apply_at_rest(100, MID_URAD);
   TEST_ASSERT_EQUAL_INT16(100, t3);
   TEST_ASSERT_EQUAL_UINT8(0u, safety.active);
 }
@@ -57,52 +85,251 @@ static void test_safety_apply_SlewLimitsEachStep(void) {
 static void test_safety_apply_ClampsToTauLimit(void) {
   config.tau_limit = 10000;
   config.slew_per_tick = POUR_Q15_MAX;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
-  TEST_ASSERT_EQUAL_INT16(10000, pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD));
+  init_without_band();
+  TEST_ASSERT_EQUAL_INT16(10000, apply_at_rest(POUR_Q15_MAX, MID_URAD));
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_CLAMP, safety.active);
-  TEST_ASSERT_EQUAL_INT16(-10000, pour_safety_apply(&safety, POUR_Q15_MIN, MID_URAD));
+  TEST_ASSERT_EQUAL_INT16(-10000, apply_at_rest(POUR_Q15_MIN, MID_URAD));
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_CLAMP, safety.active);
 }
 
 static void test_safety_apply_RefusesForwardTorqueAtMaxAngle(void) {
   config.slew_per_tick = POUR_Q15_MAX;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
-  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, 20000, config.theta_max_urad));
+  init_without_band();
+  TEST_ASSERT_EQUAL_INT16(0, apply_at_rest(20000, config.theta_max_urad));
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_ANGLE_MAX, safety.active);
-  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, 20000, INT32_MAX));
+  TEST_ASSERT_EQUAL_INT16(0, apply_at_rest(20000, INT32_MAX));
   /* pulling back is allowed */
-  TEST_ASSERT_EQUAL_INT16(-20000, pour_safety_apply(&safety, -20000, config.theta_max_urad));
+  TEST_ASSERT_EQUAL_INT16(-20000, apply_at_rest(-20000, config.theta_max_urad));
   TEST_ASSERT_EQUAL_UINT8(0u, safety.active);
 }
 
 static void test_safety_apply_RefusesBackwardTorqueAtMinAngle(void) {
   config.slew_per_tick = POUR_Q15_MAX;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
-  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, -20000, config.theta_min_urad));
+  init_without_band();
+  TEST_ASSERT_EQUAL_INT16(0, apply_at_rest(-20000, config.theta_min_urad));
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_ANGLE_MIN, safety.active);
-  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, -20000, INT32_MIN));
-  TEST_ASSERT_EQUAL_INT16(20000, pour_safety_apply(&safety, 20000, config.theta_min_urad));
+  TEST_ASSERT_EQUAL_INT16(0, apply_at_rest(-20000, INT32_MIN));
+  TEST_ASSERT_EQUAL_INT16(20000, apply_at_rest(20000, config.theta_min_urad));
 }
 
 static void test_safety_apply_DropsTorqueAtLimitWithoutWaitingForSlew(void) {
   for (unsigned i = 0; i < 30u; ++i) {
-    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD);
+    (void)apply_at_rest(POUR_Q15_MAX, MID_URAD);
   }
   TEST_ASSERT_EQUAL_INT16(POUR_Q15_MAX, safety.torque);
   /* reaching the limit: a slewed command would still push forward; it must be zero at once */
-  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, POUR_Q15_MAX, config.theta_max_urad + 1));
+  TEST_ASSERT_EQUAL_INT16(0, apply_at_rest(POUR_Q15_MAX, config.theta_max_urad + 1));
   TEST_ASSERT_BITS_HIGH(POUR_LIMIT_ANGLE_MAX, safety.active);
 }
 
 static void test_safety_force_BypassesSlew(void) {
   for (unsigned i = 0; i < 30u; ++i) {
-    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD);
+    (void)apply_at_rest(POUR_Q15_MAX, MID_URAD);
   }
   pour_safety_force(&safety, 0);
   TEST_ASSERT_EQUAL_INT16(0, safety.torque);
   TEST_ASSERT_EQUAL_UINT8(0u, safety.active);
   /* and the slew continues from the forced value */
-  TEST_ASSERT_EQUAL_INT16(config.slew_per_tick, pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD));
+  TEST_ASSERT_EQUAL_INT16(config.slew_per_tick, apply_at_rest(POUR_Q15_MAX, MID_URAD));
+}
+
+
+/* ---- The motion envelope (default band: ω_max 2 rad/s, α_max 3.4 rad/s², slack 0.8 rad/s, K 0.5 τ_max per
+ * rad/s) ---- */
+
+static void init_default(void) {
+  config = pour_safety_default_config();
+  config.slew_per_tick = POUR_Q15_MAX; /* the band alone */
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+}
+
+static void test_safety_band_AtRestAllowsKTimesSlackEitherWay(void) {
+  init_default();
+  /* K · slack = 0.5 · 0.8 = 0.4 τ_max = 13107 */
+  TEST_ASSERT_EQUAL_INT16(13107, pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, 0));
+  TEST_ASSERT_EQUAL_HEX8(POUR_LIMIT_ACCEL, safety.active);
+  pour_safety_force(&safety, 0);
+  TEST_ASSERT_EQUAL_INT16(-13107, pour_safety_apply(&safety, -POUR_Q15_MAX, MID_URAD, 0));
+  TEST_ASSERT_EQUAL_HEX8(POUR_LIMIT_ACCEL, safety.active);
+  TEST_ASSERT_EQUAL_INT16(5000, pour_safety_apply(&safety, 5000, MID_URAD, 0)); /* inside: untouched */
+  TEST_ASSERT_EQUAL_HEX8(0u, safety.active);
+}
+
+static void test_safety_band_WidensAtMostAlphaPerTick(void) {
+  init_default();
+  /* The bucket follows the ceiling exactly: the ceiling may rise by one alpha step (3,400 µrad/s) a tick
+   * and no faster, however far the slack would let it. */
+  int32_t omega = 0;
+  (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, omega);
+  for (unsigned t = 0; t < 100u; ++t) {
+    const int32_t before = safety.ceiling_urad_s;
+    omega = before;
+    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, omega);
+    TEST_ASSERT_EQUAL_INT32(before + 3400, safety.ceiling_urad_s);
+  }
+  /* The torque that speeds it up is K · (ceiling - θ̇): one alpha step's worth. */
+  TEST_ASSERT_EQUAL_INT16(56, safety.torque); /* 3.4e-3 rad/s · 16384 per rad/s = 55.7 */
+  TEST_ASSERT_EQUAL_HEX8(POUR_LIMIT_ACCEL, safety.active);
+}
+
+static void test_safety_band_AboveTheSpeedLimitItBrakes(void) {
+  init_default();
+  for (int32_t w = 0; w <= 2000000; w += 3000) { /* ramp up along the band to the limit */
+    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, w);
+  }
+  TEST_ASSERT_EQUAL_INT32(config.omega_max_urad_s, safety.ceiling_urad_s);
+  /* 0.2 rad/s above the limit: even a full forward request becomes a brake of K · 0.2 = 0.1 τ_max */
+  TEST_ASSERT_EQUAL_INT16(-3277, pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, 2200000));
+  TEST_ASSERT_EQUAL_HEX8(POUR_LIMIT_SPEED, safety.active);
+  /* the same backwards */
+  init_default();
+  for (int32_t w = 0; w >= -2000000; w -= 3000) {
+    (void)pour_safety_apply(&safety, -POUR_Q15_MAX, MID_URAD, w);
+  }
+  TEST_ASSERT_EQUAL_INT16(3277, pour_safety_apply(&safety, -POUR_Q15_MAX, MID_URAD, -2200000));
+  TEST_ASSERT_EQUAL_HEX8(POUR_LIMIT_SPEED, safety.active);
+}
+
+static void test_safety_band_NeverLimitsBraking(void) {
+  init_default();
+  for (int32_t w = 0; w <= 1500000; w += 3000) {
+    (void)pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, w);
+  }
+  /* moving forward at 1.5 rad/s: a full reverse torque slows the bucket down and passes */
+  pour_safety_force(&safety, 0);
+  TEST_ASSERT_EQUAL_INT16(-POUR_Q15_MAX, pour_safety_apply(&safety, -POUR_Q15_MAX, MID_URAD, 1500000));
+  TEST_ASSERT_EQUAL_HEX8(0u, safety.active);
+}
+
+static void test_safety_band_SaturatesAbsurdSpeeds(void) {
+  init_default();
+  TEST_ASSERT_EQUAL_INT16(-POUR_Q15_MAX, pour_safety_apply(&safety, POUR_Q15_MAX, MID_URAD, INT32_MAX));
+  pour_safety_force(&safety, 0);
+  TEST_ASSERT_EQUAL_INT16(POUR_Q15_MAX, pour_safety_apply(&safety, POUR_Q15_MIN, MID_URAD, INT32_MIN));
+}
+
+/* ---- Closed loop: envelope + estimator on a gravity-loaded inertia, in integers ----
+ * The bucket: inertia J, gravity torque -G sin θ (the liquid's centre of mass below the pivot pulls it
+ * upright), Coulomb friction 0.5 N·m, τ_max 20 N·m delivered after a latency of L ticks, θ read by the
+ * 17-bit encoder. 10 sub-steps of 100 µs per tick. sin by Bhaskara's formula (error < 0.2 %). */
+#define TAU_MAX_MNM 20000
+#define FRICTION_MNM 500
+#define LATENCY_MAX 4u
+
+typedef struct {
+  int64_t theta_nrad;
+  int64_t omega_urad_s;
+  int32_t j_gm2;     /* inertia [g·m²] */
+  int32_t g_mnm;     /* gravity torque at 90 deg [mN·m] */
+  q15_t pipe[LATENCY_MAX];
+  unsigned latency;  /* ticks, 1 .. LATENCY_MAX */
+} bucket_t;
+
+static int64_t sin_ppm(int64_t theta_urad) { /* sin θ · 10^6 for |θ| <= π */
+  const int64_t pi = 3141593;
+  const int64_t x = theta_urad < 0 ? -theta_urad : theta_urad;
+  const int64_t p = x * (pi - x) / 1000;                       /* [µrad² / 1000] */
+  const int64_t s = 16 * p * 1000000 / (5 * pi * pi / 1000 - 4 * p);
+  return theta_urad < 0 ? -s : s;
+}
+
+static void bucket_step(bucket_t *b, q15_t command) {
+  const q15_t applied = b->pipe[0];
+  for (unsigned i = 0; i + 1u < b->latency; ++i) {
+    b->pipe[i] = b->pipe[i + 1u];
+  }
+  b->pipe[b->latency - 1u] = command;
+  for (int k = 0; k < 10; ++k) {
+    int64_t tau = (int64_t)applied * TAU_MAX_MNM / 32768 - (int64_t)b->g_mnm * sin_ppm(b->theta_nrad / 1000) / 1000000;
+    if (b->omega_urad_s != 0) {
+      tau -= b->omega_urad_s > 0 ? FRICTION_MNM : -FRICTION_MNM;
+    }
+    b->omega_urad_s += tau * 1000000 / b->j_gm2 / 10000; /* α [µrad/s²] · 100 µs */
+    b->theta_nrad += b->omega_urad_s / 10;               /* ω [µrad/s] · 100 µs [nrad] */
+  }
+}
+
+static uint32_t encoder_count(int64_t theta_nrad) {
+  const int64_t turn = (int64_t)1 << 17;
+  int64_t c = (theta_nrad * turn + 3141592654LL) / 6283185307LL; /* round to the nearest count */
+  return (uint32_t)(((c % turn) + turn) % turn);
+}
+
+typedef struct {
+  int32_t peak_urad_s;     /* max |θ̇| of the bucket */
+  int32_t over_ramp_urad_s; /* max of |θ̇(t)| - (slack + α_max t) over the run: > 0 = faster than the ramp */
+} run_t;
+
+static bool band_off; /* the same runs without the motion envelope: the tests must fail then */
+
+/* Requests `requested` for `ticks` from rest at theta0, with the estimator closing the loop. */
+static run_t closed_loop(int32_t j_gm2, int32_t g_mnm, unsigned latency, int32_t theta0_urad, q15_t requested,
+                         unsigned ticks) {
+  config = pour_safety_default_config();
+  if (band_off) {
+    config.omega_max_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
+    config.omega_slack_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+  const pour_sensors_config_t sc = pour_sensors_default_config();
+  static pour_estimator_t est;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_estimator_init(&est, &sc));
+  bucket_t b = {(int64_t)theta0_urad * 1000, 0, j_gm2, g_mnm, {0}, latency};
+  run_t r = {0, INT32_MIN};
+  for (uint32_t t = 0; t < ticks; ++t) {
+    const pour_sensors_t sample = {t, encoder_count(b.theta_nrad), 10000, 0};
+    pour_state_t st;
+    const bool ok = pour_estimator_update(&est, &sample, &st);
+    if (band_off && !ok) {
+      break; /* the free bucket has spun past half a turn: the count wrapped, which the estimator refuses */
+    }
+    TEST_ASSERT_TRUE(ok);
+    bucket_step(&b, pour_safety_apply(&safety, requested, st.theta_urad, st.omega_urad_s));
+    const int32_t w = (int32_t)(b.omega_urad_s < 0 ? -b.omega_urad_s : b.omega_urad_s);
+    r.peak_urad_s = w > r.peak_urad_s ? w : r.peak_urad_s;
+    const int32_t ramp = config.omega_slack_urad_s + (int32_t)((int64_t)config.alpha_max_urad_s2 * t / 1000);
+    r.over_ramp_urad_s = w - ramp > r.over_ramp_urad_s ? w - ramp : r.over_ramp_urad_s;
+  }
+  return r;
+}
+
+/* Full forward torque for 1 s from upright, without gravity and with the full bucket's 5.4 N·m against the
+ * motion, from the lightest inertia to twice the full bucket's, latency 1 and 2 ticks: |θ̇| stays below
+ * ω_max + 0.05 rad/s, and never runs ahead of the ramp slack + α_max t by more than 0.15 rad/s (the
+ * lightest bucket with 2 ticks of latency: 0.14). Without gravity the bucket does reach the limit. */
+static void test_safety_closed_loop_FullForwardRequestStaysWithinTheSpeedLimit(void) {
+  const int32_t inertias[] = {40, 60, 150, 300};
+  for (unsigned i = 0; i < 4u; ++i) {
+    for (unsigned lat = 1u; lat <= 2u; ++lat) {
+      for (int32_t g = 0; g <= 5400; g += 5400) {
+        const run_t r = closed_loop(inertias[i], g, lat, 0, POUR_Q15_MAX, 1000u);
+        TEST_ASSERT_LESS_OR_EQUAL_INT32(config.omega_max_urad_s + 50000, r.peak_urad_s);
+        TEST_ASSERT_GREATER_THAN_INT32(g == 0 ? 1950000 : 1500000, r.peak_urad_s);
+        TEST_ASSERT_LESS_OR_EQUAL_INT32(150000, r.over_ramp_urad_s);
+      }
+    }
+  }
+}
+
+/* Full reverse torque from 115 deg back toward upright, gravity pulling the same way: the governor brakes
+ * against gravity; a proportional governor droops by G/(K τ_max) = 5.4 / (0.5 · 20) = 0.54 rad/s at
+ * most, so |θ̇| <= ω_max + 0.54 rad/s (+ 0.05 for the estimate's lag). Without the band the same swing,
+ * and the forward start, pass 10 rad/s. */
+static void test_safety_closed_loop_FullReverseRequestWithGravityStaysWithinTheDroop(void) {
+  const int32_t inertias[] = {40, 60, 150, 300};
+  for (unsigned i = 0; i < 4u; ++i) {
+    for (unsigned lat = 1u; lat <= 2u; ++lat) {
+      const run_t r = closed_loop(inertias[i], 5400, lat, 2000000, POUR_Q15_MIN, 900u);
+      TEST_ASSERT_LESS_OR_EQUAL_INT32(config.omega_max_urad_s + 540000 + 50000, r.peak_urad_s);
+      TEST_ASSERT_GREATER_THAN_INT32(1500000, r.peak_urad_s);
+    }
+  }
+  band_off = true;
+  const run_t free_swing = closed_loop(150, 5400, 1u, 2000000, POUR_Q15_MIN, 900u);
+  const run_t free_start = closed_loop(150, 5400, 1u, 0, POUR_Q15_MAX, 1000u);
+  band_off = false;
+  TEST_ASSERT_GREATER_THAN_INT32(10000000, free_swing.peak_urad_s);
+  TEST_ASSERT_GREATER_THAN_INT32(10000000, free_start.peak_urad_s);
 }
 
 int main(void) {
@@ -116,5 +343,12 @@ int main(void) {
   RUN_TEST(test_safety_apply_RefusesBackwardTorqueAtMinAngle);
   RUN_TEST(test_safety_apply_DropsTorqueAtLimitWithoutWaitingForSlew);
   RUN_TEST(test_safety_force_BypassesSlew);
+  RUN_TEST(test_safety_band_AtRestAllowsKTimesSlackEitherWay);
+  RUN_TEST(test_safety_band_WidensAtMostAlphaPerTick);
+  RUN_TEST(test_safety_band_AboveTheSpeedLimitItBrakes);
+  RUN_TEST(test_safety_band_NeverLimitsBraking);
+  RUN_TEST(test_safety_band_SaturatesAbsurdSpeeds);
+  RUN_TEST(test_safety_closed_loop_FullForwardRequestStaysWithinTheSpeedLimit);
+  RUN_TEST(test_safety_closed_loop_FullReverseRequestWithGravityStaysWithinTheDroop);
   return UNITY_END();
 }

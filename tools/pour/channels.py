@@ -1,10 +1,14 @@
 # SPDX-License-Identifier: MIT
 """LCM channel names and the default URL, the Python twin of lcmtypes/include/pour_lcm/channels.h."""
 
-STATE = "POUR_STATE"
-"""Plant state, host_sim -> controller, every 1 ms tick (pour.plant_state_t)."""
+SENSORS = "POUR_SENSORS"
+"""Raw sensor sample (encoder count, two scales), host_sim or a rig -> controller, every 1 ms tick
+(pour.sensor_sample_t). The only plant input the controller has."""
+TRUTH = "POUR_TRUTH"
+"""Ground truth of the simulated plant, host_sim -> bench tools only, every tick (pour.plant_truth_t);
+no controller subscribes to it."""
 TORQUE = "POUR_TORQUE"
-"""Torque answering one state, controller -> host_sim (pour.torque_t)."""
+"""Torque answering one sensor sample, controller -> host_sim (pour.torque_t)."""
 STATUS = "POUR_STATUS"
 """Controller health at about 10 Hz (pour.controller_status_t)."""
 PARTICLES = "POUR_PARTICLES"
@@ -18,4 +22,4 @@ DEFAULT_URL = "udpm://239.255.76.67:7667?ttl=0"
 STATUS_PERIOD_MS = 100
 PARTICLES_PERIOD_MS = 33
 
-ALL = (STATE, TORQUE, STATUS, PARTICLES, COMMAND)
+ALL = (SENSORS, TRUTH, TORQUE, STATUS, PARTICLES, COMMAND)

@@ -2,7 +2,7 @@
 """pour-eval: held-out evaluation of a policy, and float-vs-fixed-point agreement.
 
   pour-eval agree RUN_DIR --header policy/weights.h   # greedy float vs firmware fixed point on visited states
-  pour-eval heldout --header policy/weights.h         # host_sim with the firmware core, and the baselines
+  pour-eval robust --header policy/weights.h          # nominal and each edge of the rig's uncertainty
 """
 from __future__ import annotations
 
@@ -85,7 +85,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     ag.add_argument("--episodes", type=int, default=20)
     ag.add_argument("--which", default="best", choices=("best", "last"))
     ag.add_argument("--episode-s", type=float, default=10.0, help="held-out episode length [s]")
+    rb = sub.add_parser("robust", help="the robustness table: nominal and each edge of the rig's uncertainty")
+    rb.add_argument("--header", default="policy/weights.h", help="the policy (firmware core in the loop)")
+    rb.add_argument("--out", default="results/robustness", type=Path, help="folder for the table, JSON and plot")
+    rb.add_argument("--nominal-episodes", type=int, default=100)
+    rb.add_argument("--edge-episodes", type=int, default=30)
+    rb.add_argument("--seed", type=int, default=held_out_seeds(2)[1], help="first held-out seed")
+    rb.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
+    rb.add_argument("--workers", type=int, default=2, help="host_sim processes at once")
     args = ap.parse_args(argv)
+    if args.cmd == "robust":
+        return robust(args)
     from pour import export
     try:
         doc = export.load_policy(args.run)
@@ -103,6 +113,24 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     print(json.dumps({"states": int(len(xs)), "agreement": a, "episodes": args.episodes}))
     return 0
+
+
+def robust(args: argparse.Namespace) -> int:
+    from pour import robustness, sim
+    try:
+        for name in ("nominal_episodes", "edge_episodes", "workers"):
+            if not 1 <= getattr(args, name) <= 100000:
+                raise ValueError(f"--{name.replace('_', '-')} wants an integer 1..100000")
+        weights_h.parse_weights_h(args.header)
+        if not args.out.parent.is_dir():
+            raise ValueError(f"--out: folder {args.out.parent} does not exist")
+        rows = robustness.run(args.header, args.out, args.nominal_episodes, args.edge_episodes, args.seed,
+                              lambda a: run_host_sim(a, args.build_dir), sim.default_config(), args.workers)
+    except (OSError, RuntimeError, ValueError, weights_h.WeightsHError, sim.SimError) as exc:
+        print(f"pour-eval: error: {exc}", file=sys.stderr)
+        return 2
+    print((args.out / "robustness.md").read_text(), end="")
+    return 0 if all(r["bar_met"] for r in rows) else 1
 
 
 if __name__ == "__main__":

@@ -213,6 +213,8 @@ def float_policy_probs(w_float: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 # Safety envelope (safety.c), for simulations that want the firmware's torque shaping in Python.
 LIMIT_CLAMP, LIMIT_SLEW, LIMIT_ANGLE_MAX, LIMIT_ANGLE_MIN = 0x01, 0x02, 0x04, 0x08
+LIMIT_SPEED, LIMIT_ACCEL = 0x10, 0x20
+SPEED_BAND_MAX_URAD_S = 100000000  # |θ̇| the speed band works with, saturated: 100 rad/s (2x plausible)
 
 
 @dataclass
@@ -221,15 +223,24 @@ class SafetyConfig:
     slew_per_tick: int = 3277
     theta_min_urad: int = -87266
     theta_max_urad: int = 2356194
+    omega_max_urad_s: int = 2000000
+    alpha_max_urad_s2: int = 3400000
+    torque_per_rad_s: int = 16384
+    omega_slack_urad_s: int = 800000
 
 
 class SafetyEnvelope:
-    """pour_safety_t: angle limits, clamp, slew, then the angle cut again."""
+    """pour_safety_t: angle limits, clamp, the speed band (governor), slew, then the band's and the angle's cuts
+    toward zero again."""
 
     def __init__(self, config: SafetyConfig | None = None):
-        self.config = config or SafetyConfig()
+        self.config = c = config or SafetyConfig()
         self.torque = 0
         self.active = 0
+        self.alpha_step = max((c.alpha_max_urad_s2 + 500) // 1000, 1)
+        self.gain_q32 = (c.torque_per_rad_s * (1 << 32) + 500000) // 1000000
+        self.ceiling = c.omega_slack_urad_s
+        self.floor = -c.omega_slack_urad_s
 
     def _angle_cut(self, torque: int, theta_urad: int) -> int:
         c = self.config
@@ -241,7 +252,11 @@ class SafetyEnvelope:
             return 0
         return torque
 
-    def apply(self, requested: int, theta_urad: int) -> int:
+    def _band_torque(self, margin_urad_s: int) -> int:
+        t = round_half_up_shift(margin_urad_s * self.gain_q32, 32)
+        return sat(t, -self.config.tau_limit, self.config.tau_limit)
+
+    def apply(self, requested: int, theta_urad: int, omega_urad_s: int) -> int:
         c = self.config
         self.active = 0
         cmd = self._angle_cut(int(requested), theta_urad)
@@ -249,11 +264,26 @@ class SafetyEnvelope:
             cmd, self.active = c.tau_limit, self.active | LIMIT_CLAMP
         elif cmd < -c.tau_limit:
             cmd, self.active = -c.tau_limit, self.active | LIMIT_CLAMP
+        w = sat(int(omega_urad_s), -SPEED_BAND_MAX_URAD_S, SPEED_BAND_MAX_URAD_S)
+        self.ceiling = min(c.omega_max_urad_s, self.ceiling + self.alpha_step, max(w, 0) + c.omega_slack_urad_s)
+        self.floor = max(-c.omega_max_urad_s, self.floor - self.alpha_step, min(w, 0) - c.omega_slack_urad_s)
+        hi = self._band_torque(self.ceiling - w)
+        lo = self._band_torque(self.floor - w)
+        hi_bit = LIMIT_SPEED if self.ceiling == c.omega_max_urad_s else LIMIT_ACCEL
+        lo_bit = LIMIT_SPEED if self.floor == -c.omega_max_urad_s else LIMIT_ACCEL
+        if cmd > hi:
+            cmd, self.active = hi, self.active | hi_bit
+        elif cmd < lo:
+            cmd, self.active = lo, self.active | lo_bit
         delta = cmd - self.torque
         if delta > c.slew_per_tick:
             cmd, self.active = self.torque + c.slew_per_tick, self.active | LIMIT_SLEW
         elif delta < -c.slew_per_tick:
             cmd, self.active = self.torque - c.slew_per_tick, self.active | LIMIT_SLEW
+        if cmd > max(hi, 0):
+            cmd, self.active = max(hi, 0), self.active | hi_bit
+        elif cmd < min(lo, 0):
+            cmd, self.active = min(lo, 0), self.active | lo_bit
         cmd = self._angle_cut(cmd, theta_urad)
         self.torque = cmd
         return cmd
@@ -261,6 +291,88 @@ class SafetyEnvelope:
     def force(self, torque: int) -> None:
         self.torque = int(torque)
         self.active = 0
+
+
+# Sensor estimator (sensors.c): raw encoder count and scale readings -> the plant state.
+TWO_PI_URAD_Q8 = 1608495439  # round(2π · 10^6 · 2^8): one turn [µrad] Q8
+ESTIMATOR_GAP_MAX = 32  # ticks a seq gap is credited with, at most
+
+
+@dataclass
+class SensorsConfig:
+    encoder_bits: int = 17
+    bandwidth_rad_s: int = 300
+    scale_min_g: int = -2000
+    scale_max_g: int = 30000
+    mass_min_g: int = 1000
+    jump_max_urad: int = 10000
+
+
+def encoder_theta_urad(count: int, bits: int) -> int:
+    """θ [µrad] of a raw single-turn count: counts above 2^(bits-1) are below upright (negative); the
+    magnitude rounded half up, the sign applied after (θ(-c) = -θ(c))."""
+    c = count - (1 << bits) if count > (1 << (bits - 1)) else count
+    mag = (abs(c) * TWO_PI_URAD_Q8 + (1 << (bits + 7))) >> (bits + 8)
+    return -mag if c < 0 else mag
+
+
+def mass_ratio_q15(num: int, den: int) -> int:
+    """round(32768 num / den) clipped to [0, 32767], for 0 < den < 2^16."""
+    if num <= 0:
+        return 0
+    if num >= den:
+        return Q15_MAX
+    return min((num * Q15_ONE + den // 2) // den, Q15_MAX)
+
+
+class Estimator:
+    """pour_estimator_t: θ from the encoder, θ̇ from a critically damped tracking loop, volumes from the scales."""
+
+    def __init__(self, config: SensorsConfig | None = None):
+        self.config = c = config or SensorsConfig()
+        bw = c.bandwidth_rad_s
+        self.gain_theta_q24 = (2 * bw * (1 << 24) + 500) // 1000
+        self.gain_omega_q24 = (bw * bw * (1 << 24) + 500000) // 1000000
+        self.reset()
+
+    def reset(self) -> None:
+        self.started = False
+        self.last_seq = 0
+        self.theta_q16 = 0
+        self.omega_q16 = 0
+        self.m0_g = 0
+
+    def update(self, seq: int, encoder: int, scale_rotating_g: int, scale_target_g: int) -> tuple | None:
+        """(seq, θ, θ̇, V_rot, V_tgt, V_spill), or None for an implausible sample (nothing changes)."""
+        c = self.config
+        if not 0 <= encoder < (1 << c.encoder_bits):
+            return None
+        for m in (scale_rotating_g, scale_target_g):
+            if not c.scale_min_g <= m <= c.scale_max_g:
+                return None
+        m0 = self.m0_g if self.started else scale_rotating_g + scale_target_g
+        if m0 < c.mass_min_g:
+            return None
+        theta = encoder_theta_urad(encoder, c.encoder_bits)
+        advance = 0  # θ̂'s advance over this tick [µrad/tick] Q16; θ̇ is this, not ω̂ (which lags 2a/ωn)
+        if not self.started:
+            self.started, self.m0_g = True, m0
+            self.theta_q16, self.omega_q16 = theta << 16, 0
+        else:
+            n = sat((seq - self.last_seq) & 0xFFFFFFFF, 1, ESTIMATOR_GAP_MAX)
+            predicted = self.theta_q16 + (n - 1) * self.omega_q16
+            e = sat_i32(theta - round_half_up_shift(predicted, 16))
+            if abs(e) > c.jump_max_urad * n * n:
+                return None  # a count that jumped, not a motion
+            advance = self.omega_q16 + round_half_up_shift(e * self.gain_theta_q24, 8)
+            self.theta_q16 = predicted + advance
+            self.omega_q16 += round_half_up_shift(e * self.gain_omega_q24, 8)
+        self.last_seq = seq & 0xFFFFFFFF
+        omega = sat_i32(round_half_up_shift(advance * 1000, 16))
+        v_rot = mass_ratio_q15(scale_rotating_g, m0)
+        v_tgt = mass_ratio_q15(scale_target_g, m0)
+        v_spill = sat(Q15_ONE - v_rot - v_tgt, 0, Q15_MAX)  # neither cell carries it: spilled or in flight
+        return (seq, theta, omega, v_rot, v_tgt, v_spill)
 
 
 # Control step (control.c): modes, faults and the decision schedule, for bit-exact replays in Python.
@@ -271,13 +383,14 @@ FAULT_STALE_INPUT, FAULT_ESTOP, FAULT_BAD_INPUT = 0x0001, 0x0002, 0x0004
 @dataclass
 class ControlConfig:
     safety: SafetyConfig | None = None
+    sensors: SensorsConfig | None = None
     input_timeout_ms: int = 20
     safe_torque: int = 0
     sampled: bool = False
     seed: int = 1
     plausible_theta_urad: int = 3141593
     plausible_omega_urad_s: int = 50000000
-    plausible_volume_sum: int = 32896
+    plausible_volume_sum: int = 65536
 
 
 @dataclass
@@ -294,25 +407,28 @@ class ControlOutput:
 class Controller:
     """pour_control_t: one call of step() is one 1 ms tick of pour_control_step().
 
-    state is (theta_urad, omega_urad_s, v_rotating, v_target, v_spill) with volumes in Q15.
+    sample is a raw sensor sample (seq, encoder, scale_rotating_g, scale_target_g); the estimator turns it
+    into the state (seq, theta_urad, omega_urad_s, v_rotating, v_target, v_spill), volumes in Q15. The
+    supervisor (its seq check included) is not mirrored: the golden vectors run with its checks disarmed.
     """
 
     def __init__(self, w_q: np.ndarray, frac_bits: int, levels_q15: Sequence[int], decision_period_ms: int,
                  norm: ObsNorm, config: ControlConfig | None = None):
         self.config = config or ControlConfig()
         self.safety = SafetyEnvelope(self.config.safety or SafetyConfig())
+        self.estimator = Estimator(self.config.sensors or SensorsConfig())
         self.policy = FixedPolicy(w_q, frac_bits, sampled=self.config.sampled, seed=self.config.seed)
         self.levels = [int(v) for v in levels_q15]
         self.period = int(decision_period_ms)
         self.norm = norm
         self.mode, self.faults, self.tick = MODE_IDLE, 0, 0
         self.ms_since_fresh, self.ms_to_decision = 0, 0
-        self.state = (0, 0, 0, 0, 0)
+        self.state = (0, 0, 0, 0, 0, 0)
         self.action, self.probs = 0, [0] * MAX_ACTIONS
 
     def _plausible(self, s: Sequence[int]) -> bool:
         c = self.config
-        theta, omega, vr, vt, vs = (int(v) for v in s)
+        _, theta, omega, vr, vt, vs = (int(v) for v in s)
         if abs(theta) > c.plausible_theta_urad or abs(omega) > c.plausible_omega_urad_s:
             return False
         if vr < 0 or vt < 0 or vs < 0:
@@ -321,7 +437,7 @@ class Controller:
 
     def _force_safe(self) -> int:
         sc = self.safety.config
-        theta = self.state[0]
+        theta = self.state[1]
         torque = self.config.safe_torque
         if (torque > 0 and theta >= sc.theta_max_urad) or (torque < 0 and theta <= sc.theta_min_urad):
             torque = 0
@@ -332,8 +448,8 @@ class Controller:
         return ControlOutput(torque, self.action, list(self.probs), self.mode, self.faults, self.safety.active,
                              self.tick)
 
-    def step(self, state: Sequence[int] | None, estop: bool = False, clear_faults: bool = False) -> ControlOutput:
-        """state None means no fresh state this tick."""
+    def step(self, sample: Sequence[int] | None, estop: bool = False, clear_faults: bool = False) -> ControlOutput:
+        """sample None means no fresh sample this tick."""
         self.tick = (self.tick + 1) & 0xFFFFFFFF
         if estop:
             self.mode = MODE_ESTOP
@@ -345,29 +461,30 @@ class Controller:
         if clear_faults and self.mode == MODE_FAULT:
             self.faults, self.mode, self.ms_since_fresh = 0, MODE_IDLE, 0
         fresh = False
-        if state is not None:
-            if self._plausible(state):
-                self.state = tuple(int(v) for v in state)
-                self.ms_since_fresh = 0
-                fresh = True
-            else:
+        if sample is not None and self.mode == MODE_IDLE:
+            self.estimator.reset()
+        if sample is not None:
+            state = self.estimator.update(*(int(v) for v in sample))
+            if state is None or not self._plausible(state):
                 self.faults |= FAULT_BAD_INPUT
                 self.mode = MODE_FAULT
-        elif self.mode == MODE_RUN:
+            else:
+                self.state, self.ms_since_fresh, fresh = state, 0, True
+        if not fresh:
             self.ms_since_fresh += 1
-            if self.ms_since_fresh > self.config.input_timeout_ms:
+            if self.mode == MODE_RUN and self.ms_since_fresh > self.config.input_timeout_ms:
                 self.faults |= FAULT_STALE_INPUT
                 self.mode = MODE_FAULT
         if self.mode == MODE_IDLE and fresh:
             self.mode, self.ms_to_decision = MODE_RUN, 0
         if self.mode == MODE_RUN:
             if self.ms_to_decision == 0:
-                e = self.policy.eval(quantize_obs(self.norm, *self.state))
+                e = self.policy.eval(quantize_obs(self.norm, *self.state[1:]))
                 self.action = e.action
                 self.probs = e.probs + [0] * (MAX_ACTIONS - len(e.probs))
                 self.ms_to_decision = self.period
             self.ms_to_decision -= 1
-            torque = self.safety.apply(self.levels[self.action], self.state[0])
+            torque = self.safety.apply(self.levels[self.action], self.state[1], self.state[2])
         else:
             torque = self._force_safe()
         return self._out(torque)

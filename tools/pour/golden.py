@@ -113,68 +113,143 @@ def _softmax_cases(rng: np.random.Generator) -> list[tuple[list[int], list[int],
     return [(lg, fp.softmax_q15(lg), fp.argmax(lg)) for lg in out]
 
 
-def _control_script(rng: np.random.Generator) -> list[tuple[bool, tuple, bool, bool]]:
-    """Ticks of (fresh, state, estop, clear): idle, a pour with short gaps, a timeout, clear, e-stop,
-    clear, an impossible state, clear, run."""
-    ticks: list[tuple[bool, tuple, bool, bool]] = []
-    theta, omega, vr, vt = 0, 0, 32767, 0
+def _encoder_count(theta_urad: int, bits: int = 17) -> int:
+    """The raw count a single-turn encoder reads at θ (0 = upright, below upright wraps)."""
+    return int(np.floor(theta_urad * 1e-6 / (2 * np.pi) * (1 << bits) + 0.5)) % (1 << bits)
 
-    def state() -> tuple:
-        return (theta, omega, vr, vt, 0)
+
+def _control_script(rng: np.random.Generator) -> list[tuple[bool, tuple, bool, bool]]:
+    """Ticks of (fresh, sample, estop, clear), sample = (seq, encoder, scale_rotating_g, scale_target_g): idle,
+    a pour with short gaps and scales that hold for 12 ticks, a timeout, clear, e-stop, clear, an implausible
+    sample, clear, run."""
+    ticks: list[tuple[bool, tuple, bool, bool]] = []
+    theta, omega, m_rot, m_tgt, seq = 0, 0, 10300, 0, 0
+    held = (m_rot, m_tgt)
+
+    def sample() -> tuple:
+        return (seq, _encoder_count(theta), held[0], held[1])
 
     def run(n: int, gaps: bool = True) -> None:
-        nonlocal theta, omega, vr, vt
+        nonlocal theta, omega, m_rot, m_tgt, seq, held
         for _ in range(n):
+            seq += 1
             omega = int(np.clip(omega + rng.integers(-60000, 90000), -3000000, 3000000))
             theta = int(np.clip(theta + omega // 1000, -50000, 2300000))
-            moved = int(rng.integers(0, 200)) if theta > 1200000 else 0
-            moved = min(moved, vr)
-            vr, vt = vr - moved, vt + moved
+            moved = min(int(rng.integers(0, 60)) if theta > 1200000 else 0, m_rot)
+            m_rot, m_tgt = m_rot - moved, m_tgt + moved - int(rng.integers(0, 2))
+            if seq % 12 == 0:  # an 80 Hz load cell
+                held = (m_rot + int(rng.integers(-5, 6)), m_tgt + int(rng.integers(-5, 6)))
             fresh = not (gaps and rng.random() < 0.1)
-            ticks.append((fresh, state(), False, False))
+            ticks.append((fresh, sample(), False, False))
 
-    ticks += [(False, state(), False, False)] * 15
+    ticks += [(False, sample(), False, False)] * 15
     run(160)
-    ticks += [(False, state(), False, False)] * 25          # stale input: fault
+    ticks += [(False, sample(), False, False)] * 25         # stale input: fault
     run(20, gaps=False)                                     # latched: still FAULT
-    ticks.append((True, state(), False, True))              # clear, and this state restarts RUN
+    seq += 1
+    ticks.append((True, sample(), False, True))             # clear, and this sample restarts RUN
     run(60)
-    ticks += [(True, state(), True, False)] * 4             # e-stop held
-    ticks.append((True, state(), True, True))               # clear ignored while held
-    ticks.append((True, state(), False, False))             # released: FAULT
-    ticks.append((True, state(), False, True))              # clear
+    ticks += [(True, sample(), True, False)] * 4            # e-stop held
+    ticks.append((True, sample(), True, True))              # clear ignored while held
+    seq += 1
+    ticks.append((True, sample(), False, False))            # released: FAULT
+    seq += 1
+    ticks.append((True, sample(), False, True))             # clear
     run(40)
-    ticks.append((True, (theta, omega, -5, vt, 0), False, False))  # impossible: negative volume
+    seq += 1
+    ticks.append((True, (seq, 1 << 17, held[0], held[1]), False, False))  # implausible: count out of range
     run(5, gaps=False)
-    ticks.append((False, state(), False, True))
+    ticks.append((False, sample(), False, True))
     run(60)
     return ticks
 
 
 def _control_lines(ex: weights_h.WeightsH, rng: np.random.Generator) -> list[str]:
     configs = [("greedy, default config", fp.ControlConfig()),
-               ("sampled (seed 7), tighter envelope, 10 ms timeout",
+               ("sampled (seed 7), tighter envelope and motion limits, 10 ms timeout, a slow tracking loop (80 rad/s)",
                 fp.ControlConfig(safety=fp.SafetyConfig(tau_limit=24000, slew_per_tick=2000, theta_min_urad=-20000,
-                                                        theta_max_urad=1900000),
+                                                        theta_max_urad=1900000, omega_max_urad_s=1500000,
+                                                        alpha_max_urad_s2=10000000, omega_slack_urad_s=400000,
+                                                        torque_per_rad_s=30000),
+                                 sensors=fp.SensorsConfig(encoder_bits=17, bandwidth_rad_s=80),
                                  input_timeout_ms=10, safe_torque=-1000, sampled=True, seed=7))]
     lines = ["/* pour_control_step on example_weights.h: per tick the inputs (flags: 1 fresh, 2 e-stop, 4 clear;",
-             " * state θ, θ̇, V_rot, V_tgt, V_spill) and the outputs (torque, action, mode, faults, limits). */",
-             "typedef struct { uint8_t flags; int32_t state[5]; int16_t torque; uint8_t action; uint8_t mode; "
+             " * sample seq, encoder, scale_rotating_g, scale_target_g) and the outputs (torque, action, mode,",
+             " * faults, limits). */",
+             "typedef struct { uint8_t flags; uint32_t sample[4]; int16_t torque; uint8_t action; uint8_t mode; "
              "uint16_t faults; uint8_t limits; } pour_golden_tick_t;"]
     script = _control_script(rng)
     for i, (what, cfg) in enumerate(configs):
         ctl = fp.Controller(ex.w_q, ex.w_frac_bits, ex.levels_q15, ex.decision_period_ms, ex.norm, cfg)
         sc = cfg.safety or fp.SafetyConfig()
+        se = cfg.sensors or fp.SensorsConfig()
         lines += [f"/* {what} */",
-                  f"static const int32_t pour_golden_control_config_{i}[10] = "
-                  f"{_c_array([sc.tau_limit, sc.slew_per_tick, sc.theta_min_urad, sc.theta_max_urad, cfg.input_timeout_ms, cfg.safe_torque, int(cfg.sampled), cfg.seed, 0, 0])};",
+                  f"static const int32_t pour_golden_control_config_{i}[14] = "
+                  f"{_c_array([sc.tau_limit, sc.slew_per_tick, sc.theta_min_urad, sc.theta_max_urad, cfg.input_timeout_ms, cfg.safe_torque, int(cfg.sampled), cfg.seed, sc.omega_max_urad_s, sc.alpha_max_urad_s2, sc.omega_slack_urad_s, sc.torque_per_rad_s, se.encoder_bits, se.bandwidth_rad_s])};",
                   f"static const pour_golden_tick_t pour_golden_control_{i}[] = {{"]
-        for fresh, st, estop, clear in script:
-            o = ctl.step(st if fresh else None, estop=estop, clear_faults=clear)
+        for fresh, smp, estop, clear in script:
+            o = ctl.step(smp if fresh else None, estop=estop, clear_faults=clear)
             flags = int(fresh) | 2 * int(estop) | 4 * int(clear)
-            lines.append(f"    {{{flags}, {_c_array(st)}, {o.torque}, {o.action}, {o.mode}, {o.faults}, {o.limits}}},")
+            lines.append(f"    {{{flags}, {{{smp[0]}u, {smp[1]}u, {smp[2] & 0xFFFFFFFF}u, {smp[3] & 0xFFFFFFFF}u}}, "
+                         f"{o.torque}, {o.action}, {o.mode}, {o.faults}, {o.limits}}},")
         lines.append("};")
     lines += [f"#define POUR_GOLDEN_CONTROL_LEN {len(script)}", ""]
+    return lines
+
+
+ESTIMATOR_LEN = 200
+
+
+def _estimator_lines(rng: np.random.Generator) -> list[str]:
+    """pour_estimator_update over a scripted motion per config: rest, a swing through upright (the wrap),
+    seq gaps, repeats, held scales, and implausible samples (count, scales, m0) in between."""
+    configs = [fp.SensorsConfig(), fp.SensorsConfig(encoder_bits=12, bandwidth_rad_s=40, scale_min_g=-100,
+                                                    scale_max_g=20000, mass_min_g=2000, jump_max_urad=3000),
+               fp.SensorsConfig(encoder_bits=24, bandwidth_rad_s=1000, scale_min_g=-32767, scale_max_g=32767,
+                                mass_min_g=1, jump_max_urad=1000000)]
+    lines = ["/* pour_estimator_update: config (encoder_bits, bandwidth, scale_min, scale_max, mass_min, jump_max), per",
+             " * sample (seq, encoder, scale_rotating_g, scale_target_g) -> ok and the state (θ, θ̇, V_rot, V_tgt,",
+             " * V_spill; the last good one where not ok) */",
+             f"typedef struct {{ int32_t config[6]; uint32_t sample[{ESTIMATOR_LEN}][4]; uint8_t ok[{ESTIMATOR_LEN}]; "
+             f"int32_t state[{ESTIMATOR_LEN}][5]; }} pour_golden_estimator_t;",
+             "static const pour_golden_estimator_t pour_golden_estimator[] = {"]
+    for cfg in configs:
+        est = fp.Estimator(cfg)
+        bits = cfg.encoder_bits
+        theta, omega, seq, m_rot, m_tgt = 300000, 0.0, 7, 9000, 1000
+        samples, oks, states, last = [], [], [], (0, 0, 0, 0, 0)
+        for t in range(ESTIMATOR_LEN):
+            seq = (seq + [1, 1, 1, 3, 0, 40][int(rng.integers(6))]) & 0xFFFFFFFF
+            omega = -3.0 * np.sin(t / 25.0) + float(rng.normal(0, 0.05))
+            theta = int(theta + omega * 1000)
+            if t % 12 == 0:
+                moved = int(rng.integers(0, 300))
+                m_rot, m_tgt = m_rot - moved, m_tgt + moved - int(rng.integers(0, 20))
+            smp = [seq, _encoder_count(theta, bits), m_rot, m_tgt]
+            kind = int(rng.integers(20))
+            if t == 0:
+                smp[2] = cfg.mass_min_g - 1 - smp[3]  # m0 too small: the first good sample comes after
+            elif kind == 0:
+                smp[1] = (1 << bits) + int(rng.integers(0, 5))
+            elif kind == 1:
+                smp[2] = cfg.scale_max_g + 1
+            elif kind == 2:
+                smp[3] = cfg.scale_min_g - 1
+            elif kind == 3:
+                smp[2] = cfg.scale_max_g  # at the limit: plausible
+            elif kind == 4:
+                smp[1] = _encoder_count(theta + int(rng.choice([-1, 1])) * int(rng.integers(2000, 60000)), bits)
+            r = est.update(*smp)
+            oks.append(0 if r is None else 1)
+            if r is not None:
+                last = r[1:]
+            samples.append(smp)
+            states.append(last)
+        lines.append(f"    {{{_c_array([cfg.encoder_bits, cfg.bandwidth_rad_s, cfg.scale_min_g, cfg.scale_max_g, cfg.mass_min_g, cfg.jump_max_urad])}, "
+                     "{" + ", ".join("{" + ", ".join(f"{v & 0xFFFFFFFF}u" for v in sm) + "}" for sm in samples) + "}, "
+                     f"{_c_array(oks)}, " + "{" + ", ".join(_c_array(st) for st in states) + "}},")
+    lines += ["};", f"#define POUR_GOLDEN_N_ESTIMATOR {len(configs)}", f"#define POUR_GOLDEN_ESTIMATOR_LEN {ESTIMATOR_LEN}",
+              ""]
     return lines
 
 
@@ -233,25 +308,35 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
         lines.append(f"    {{{seed_i}u, {_c_array(ob)}, {_c_array(acts)}}},")
     lines += ["};", f"#define POUR_GOLDEN_N_SAMPLED {N_SAMPLED}", f"#define POUR_GOLDEN_SAMPLED_LEN {SAMPLED_LEN}", ""]
     configs = [fp.SafetyConfig(), fp.SafetyConfig(tau_limit=20000, slew_per_tick=3000, theta_min_urad=-1000,
-                                                  theta_max_urad=2000000)]
-    lines += ["/* pour_safety_apply: config (tau_limit, slew_per_tick, theta_min, theta_max), then per tick",
-              " * requested torque and θ -> command and active limits */",
-              f"typedef struct {{ int32_t config[4]; int32_t requested[{SAFETY_LEN}]; int32_t theta[{SAFETY_LEN}]; "
-              f"int16_t torque[{SAFETY_LEN}]; uint8_t active[{SAFETY_LEN}]; }} pour_golden_safety_t;",
+                                                  theta_max_urad=2000000, omega_max_urad_s=3000000,
+                                                  alpha_max_urad_s2=50000000, omega_slack_urad_s=200000,
+                                                  torque_per_rad_s=32767)]
+    lines += ["/* pour_safety_apply: config (tau_limit, slew_per_tick, theta_min, theta_max, omega_max, alpha_max,",
+              " * omega_slack, torque_per_rad_s), then per tick requested torque, θ and θ̇ -> command and active limits */",
+              f"typedef struct {{ int32_t config[8]; int32_t requested[{SAFETY_LEN}]; int32_t theta[{SAFETY_LEN}]; "
+              f"int32_t omega[{SAFETY_LEN}]; int16_t torque[{SAFETY_LEN}]; uint8_t active[{SAFETY_LEN}]; }} "
+              "pour_golden_safety_t;",
               "static const pour_golden_safety_t pour_golden_safety[] = {"]
     for cfg in configs:
         env = fp.SafetyEnvelope(cfg)
-        req, th, tq, act = [], [], [], []
+        req, th, om, tq, act = [], [], [], [], []
+        omega = 0
         for t in range(SAFETY_LEN):
             r = int(rng.choice([-32768, 32767, 0, int(rng.integers(-32768, 32768))]))
             theta = int(rng.choice([cfg.theta_min_urad, cfg.theta_max_urad, int(rng.integers(-200000, 2500000))]))
+            omega = int(rng.choice([omega + int(rng.integers(-300000, 300000)), -cfg.omega_max_urad_s,
+                                    cfg.omega_max_urad_s + 1, int(rng.integers(-8000000, 8000000)),
+                                    fp.INT32_MAX, fp.INT32_MIN], p=[0.7, 0.05, 0.05, 0.1, 0.05, 0.05]))
             req.append(r)
             th.append(theta)
-            tq.append(env.apply(r, theta))
+            om.append(omega)
+            tq.append(env.apply(r, theta, omega))
             act.append(env.active)
-        lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad])}, "
-                     f"{_c_array(req)}, {_c_array(th)}, {_c_array(tq)}, {_c_array(act)}}},")
+            omega = int(np.clip(omega, -4000000, 4000000))
+        lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad, cfg.omega_max_urad_s, cfg.alpha_max_urad_s2, cfg.omega_slack_urad_s, cfg.torque_per_rad_s])}, "
+                     f"{_c_array(req)}, {_c_array(th)}, {_c_array(om)}, {_c_array(tq)}, {_c_array(act)}}},")
     lines += ["};", f"#define POUR_GOLDEN_N_SAFETY {len(configs)}", f"#define POUR_GOLDEN_SAFETY_LEN {SAFETY_LEN}", ""]
+    lines += _estimator_lines(rng)
     lines += _control_lines(ex, rng) + ["#endif", ""]
     return "\n".join(lines)
 

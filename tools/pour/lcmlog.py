@@ -1,13 +1,18 @@
 # SPDX-License-Identifier: MIT
 """pour-lcmlog: an LCM log of a pour (lcm-logger) → the summary and plots of a simulated pour.
 
-    pour-lcmlog pour.lcmlog --out DIR [--render pour.gif] [--json]
+    pour-lcmlog pour.lcmlog --out DIR [--render pour.gif] [--json] [--encoder-bits 17]
 
 Prints one line per episode and a summary in host_sim's words (poured, spilled, left, finish, return),
-the round-trip latency POUR_STATE → POUR_TORQUE as the logger saw it (median, p99, max), answers that
-never came, and messages on our channels that did not decode. Writes DIR/traces.png (θ, torque and
-volumes over time), DIR/latency.png (histogram) and DIR/summary.json. With --render, the logged
-POUR_PARTICLES frames become the same animation and snapshot as host_sim --render.
+the round-trip latency POUR_SENSORS → POUR_TORQUE as the logger saw it (median, p99, max), answers that
+never came, and messages on our channels that did not decode or were refused. Writes DIR/traces.png (θ,
+torque and volumes over time), DIR/latency.png (histogram) and DIR/summary.json. With --render, the
+logged POUR_PARTICLES frames become the same animation and snapshot as host_sim --render.
+
+θ and the volumes come from POUR_TRUTH when the log has it (host_sim publishes the simulated plant's
+ground truth there); a rig's log has none, and then they are read from the raw sensor samples of
+POUR_SENSORS (encoder count → θ with --encoder-bits; the two scales → volumes, as the firmware's estimator
+defines them). Each episode's summary names its source.
 """
 from __future__ import annotations
 
@@ -25,7 +30,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pour import channels, lcm_types  # noqa: E402
+from pour import channels, lcm_sensors, lcm_types  # noqa: E402
 
 
 class LogError(RuntimeError):
@@ -35,15 +40,42 @@ class LogError(RuntimeError):
 @dataclass
 class Episode:
     index: int
-    seq: list[int] = field(default_factory=list)
-    t: list[float] = field(default_factory=list)       # simulated time of each state [s]
-    theta: list[float] = field(default_factory=list)
-    omega: list[float] = field(default_factory=list)
-    v: list[tuple[float, float, float]] = field(default_factory=list)
-    state_ts: dict[int, int] = field(default_factory=dict)   # seq → logger time of its first state [µs]
+    seq: list[int] = field(default_factory=list)             # sensor samples, in the order they were logged
+    state_ts: dict[int, int] = field(default_factory=dict)   # seq → logger time of its first sample [µs]
+    raw: dict[int, tuple[int, int, int]] = field(default_factory=dict)  # seq → (encoder, rotating g, target g)
+    truth: dict[int, tuple[float, ...]] = field(default_factory=dict)   # seq → (θ, θ̇, v_rot, v_tgt, v_spill)
     torque: dict[int, tuple[float, int, int, int]] = field(default_factory=dict)  # seq → (N·m, action, mode, faults)
     torque_ts: dict[int, int] = field(default_factory=dict)  # seq → logger time of its first answer [µs]
     frames: list = field(default_factory=list)               # decoded particles_t
+    # The plant over time, sorted by seq (finish() fills them): from POUR_TRUTH, else from the sensors.
+    source: str = ""
+    series_seq: list[int] = field(default_factory=list)
+    t: list[float] = field(default_factory=list)             # simulated time of each sample [s]
+    theta: list[float] = field(default_factory=list)
+    omega: list[float] = field(default_factory=list)
+    v: list[tuple[float, float, float]] = field(default_factory=list)
+
+    def finish(self, encoder_bits: int) -> None:
+        if self.truth:
+            self.source = channels.TRUTH
+            self.series_seq = sorted(self.truth)
+            rows = [self.truth[k] for k in self.series_seq]
+            self.theta = [r[0] for r in rows]
+            self.omega = [r[1] for r in rows]
+            self.v = [tuple(r[2:5]) for r in rows]
+        else:
+            self.source = f"{channels.SENSORS} (encoder {encoder_bits} bits, scales)"
+            self.series_seq = sorted(self.raw)
+            rows = [self.raw[k] for k in self.series_seq]
+            self.theta = [lcm_sensors.encoder_angle(r[0], encoder_bits) for r in rows]
+            m0 = rows[0][1] + rows[0][2] if rows else 0
+            if m0 <= 0:
+                raise LogError(f"episode {self.index}: the scales' first sample weighs {m0} g of liquid: "
+                               "no volumes without POUR_TRUTH")
+            self.v = [lcm_sensors.volumes(r[1], r[2], m0) for r in rows]
+            th = np.asarray(self.theta)
+            self.omega = list(np.gradient(th, np.asarray(self.series_seq) * 1e-3)) if len(th) > 1 else [0.0] * len(th)
+        self.t = [k * 1e-3 for k in self.series_seq]
 
 
 @dataclass
@@ -51,11 +83,22 @@ class Log:
     episodes: list[Episode]
     status: list = field(default_factory=list)
     undecodable: dict[str, int] = field(default_factory=dict)
+    refused: dict[str, int] = field(default_factory=dict)  # decoded, but values no sensor or plant can have
     events: int = 0
 
 
-def read_log(path: Path) -> Log:
-    """Decodes our channels of an LCM log; undecodable messages are counted, never fatal."""
+def _plausible_sample(msg, encoder_bits: int) -> bool:
+    return 0 <= msg.encoder < (1 << encoder_bits)
+
+
+def _plausible_truth(msg) -> bool:
+    return all(math.isfinite(x) for x in (msg.theta, msg.omega, msg.v_rotating, msg.v_target, msg.v_spill))
+
+
+def read_log(path: Path, encoder_bits: int = lcm_sensors.ENCODER_BITS) -> Log:
+    """Decodes our channels of an LCM log; undecodable messages are counted, never fatal. Sensor samples with
+    an encoder count outside 0 .. 2^encoder_bits - 1 and truth with a non-finite value are counted as
+    refused and left out of the plant's series (a sample still counts for the latency it was answered in)."""
     import lcm
 
     m = lcm_types.load()
@@ -65,9 +108,13 @@ def read_log(path: Path) -> Log:
         raise LogError(f"cannot open LCM log {path}: {e}") from e
     eps: dict[int, Episode] = {}
     out = Log(episodes=[])
-    decoders = {channels.STATE: m.plant_state_t, channels.TORQUE: m.torque_t,
+    decoders = {channels.SENSORS: m.sensor_sample_t, channels.TRUTH: m.plant_truth_t, channels.TORQUE: m.torque_t,
                 channels.STATUS: m.controller_status_t, channels.PARTICLES: m.particles_t,
                 channels.COMMAND: m.command_t}
+
+    def refuse(channel: str) -> None:
+        out.refused[channel] = out.refused.get(channel, 0) + 1
+
     try:
         for ev in ev_log:
             out.events += 1
@@ -79,16 +126,24 @@ def read_log(path: Path) -> Log:
             except Exception:  # wrong fingerprint (ValueError) or truncated (struct.error)
                 out.undecodable[ev.channel] = out.undecodable.get(ev.channel, 0) + 1
                 continue
-            if ev.channel == channels.STATE:
+            if ev.channel == channels.SENSORS:
                 ep = eps.setdefault(msg.episode, Episode(msg.episode))
                 if msg.seq in ep.state_ts:
                     continue  # a resend
                 ep.state_ts[msg.seq] = ev.timestamp
                 ep.seq.append(msg.seq)
-                ep.t.append(msg.seq * 1e-3)
-                ep.theta.append(msg.theta)
-                ep.omega.append(msg.omega)
-                ep.v.append((msg.v_rotating, msg.v_target, msg.v_spill))
+                if _plausible_sample(msg, encoder_bits):
+                    ep.raw[msg.seq] = (msg.encoder, msg.scale_rotating_g, msg.scale_target_g)
+                else:
+                    refuse(ev.channel)
+            elif ev.channel == channels.TRUTH:
+                ep = eps.setdefault(msg.episode, Episode(msg.episode))
+                if msg.seq in ep.truth:
+                    continue
+                if _plausible_truth(msg):
+                    ep.truth[msg.seq] = (msg.theta, msg.omega, msg.v_rotating, msg.v_target, msg.v_spill)
+                else:
+                    refuse(ev.channel)
             elif ev.channel == channels.TORQUE:
                 ep = eps.setdefault(msg.episode, Episode(msg.episode))
                 if msg.seq not in ep.torque_ts:
@@ -101,9 +156,11 @@ def read_log(path: Path) -> Log:
                 out.status.append(msg)
     except (OSError, ValueError) as e:
         raise LogError(f"{path} is not a readable LCM log ({e})") from e
-    out.episodes = [eps[k] for k in sorted(eps) if eps[k].seq]
+    out.episodes = [eps[k] for k in sorted(eps) if eps[k].seq and (eps[k].raw or eps[k].truth)]
     if not out.episodes:
-        raise LogError(f"{path} holds no {channels.STATE} messages: nothing to analyse")
+        raise LogError(f"{path} holds no usable {channels.SENSORS} messages: nothing to analyse")
+    for ep in out.episodes:
+        ep.finish(encoder_bits)
     return out
 
 
@@ -122,19 +179,20 @@ def reward_params(k_target: float | None, k_spill: float | None, gamma: float | 
 
 
 def episode_summary(ep: Episode, reward) -> dict:
-    """Same definitions as host_sim: values of the last state; finish = first time V_target + V_spill
+    """Same definitions as host_sim: values of the last sample; finish = first time V_target + V_spill
     reaches 99 % of its final value (None if under 1 % moved); return = Σ γ^t r(s_{t+1})."""
-    order = np.argsort(ep.seq)
-    seq = np.asarray(ep.seq)[order]
-    v = np.asarray(ep.v)[order]
+    seq = np.asarray(ep.series_seq)
+    v = np.asarray(ep.v)
     moved = v[:, 1] + v[:, 2]
     final = moved[-1]
     finish = None
     if final >= 0.01:
         k = int(np.argmax(moved >= 0.99 * final))
         finish = float(seq[k]) * 1e-3
-    out = {"episode": ep.index, "states": int(len(seq)), "first_seq": int(seq[0]), "last_seq": int(seq[-1]),
-           "gaps": int(seq[-1] - seq[0] + 1 - len(seq)), "poured": float(v[-1, 1]), "spilled": float(v[-1, 2]),
+    states = np.sort(np.asarray(ep.seq))
+    out = {"episode": ep.index, "source": ep.source, "states": int(len(states)), "first_seq": int(states[0]),
+           "last_seq": int(states[-1]), "gaps": int(states[-1] - states[0] + 1 - len(states)),
+           "poured": float(v[-1, 1]), "spilled": float(v[-1, 2]),
            "left": float(v[-1, 0]), "finish_s": finish, "max_theta_deg": float(np.degrees(np.max(ep.theta)))}
     if reward is not None:
         kt, ks, g = reward
@@ -153,14 +211,11 @@ def plot_pour(log: Log, out: Path) -> None:
     """θ, torque and volumes over time, one colour per episode (volumes: first episode)."""
     fig, (a_th, a_tq, a_v) = plt.subplots(3, 1, figsize=(8, 7), dpi=100, sharex=True)
     for ep in log.episodes:
-        order = np.argsort(ep.seq)
-        t = np.asarray(ep.t)[order]
-        a_th.plot(t, np.degrees(np.asarray(ep.theta)[order]), lw=1, label=f"episode {ep.index}")
+        a_th.plot(ep.t, np.degrees(ep.theta), lw=1, label=f"episode {ep.index}")
         ts = sorted(ep.torque)
         a_tq.step(np.asarray(ts) * 1e-3, [ep.torque[s][0] for s in ts], where="post", lw=0.8)
     ep = log.episodes[0]
-    order = np.argsort(ep.seq)
-    t, v = np.asarray(ep.t)[order], np.asarray(ep.v)[order]
+    t, v = np.asarray(ep.t), np.asarray(ep.v)
     a_v.plot(t, v[:, 0], label="in bucket", color="0.4")
     a_v.plot(t, v[:, 1], label="in target", color="tab:green")
     a_v.plot(t, v[:, 2], label="spilled", color="tab:red")
@@ -173,7 +228,7 @@ def plot_pour(log: Log, out: Path) -> None:
         a.grid(alpha=0.3)
     a_th.legend(fontsize=8)
     a_v.legend(fontsize=8, loc="center right")
-    fig.suptitle("Pour from an LCM log")
+    fig.suptitle(f"Pour from an LCM log (plant from {log.episodes[0].source})")
     fig.tight_layout()
     fig.savefig(out)
     plt.close(fig)
@@ -188,7 +243,7 @@ def plot_latency(lat: np.ndarray, out: Path) -> None:
         ax.axvline(med, color="k", lw=1, label=f"median {med:.0f} µs")
         ax.axvline(p99, color="tab:red", lw=1, label=f"p99 {p99:.0f} µs")
         ax.legend()
-    ax.set_xlabel(f"round trip {channels.STATE} → {channels.TORQUE} at the logger [µs]")
+    ax.set_xlabel(f"round trip {channels.SENSORS} → {channels.TORQUE} at the logger [µs]")
     ax.set_ylabel("answers")
     ax.set_yscale("log")
     ax.grid(alpha=0.3)
@@ -203,10 +258,9 @@ def render_json(log: Log, summary: dict) -> dict:
     if not ep.frames:
         raise LogError(f"the log has no {channels.PARTICLES} messages to render")
     f0 = ep.frames[0]
-    order = np.argsort(ep.seq)
-    v = np.asarray(ep.v)[order]
+    v = np.asarray(ep.v)
     pick = slice(None, None, 10)
-    tq = [ep.torque.get(s, (0.0,))[0] for s in np.asarray(ep.seq)[order]]
+    tq = [ep.torque.get(s, (0.0,))[0] for s in ep.series_seq]
     # host_sim renders 12.5 frames/s; keep about that many of the logged snapshots.
     frames, next_t = [], 0.0
     for fr in ep.frames:
@@ -221,7 +275,7 @@ def render_json(log: Log, summary: dict) -> dict:
                       "pivot_x": f0.pivot_x, "pivot_y": f0.pivot_y, "target_x": f0.target_x,
                       "theta_max": f0.theta_max},
             "radius": list(f0.r),
-            "series": {"t": np.asarray(ep.t)[order][pick].tolist(), "theta": np.asarray(ep.theta)[order][pick].tolist(),
+            "series": {"t": np.asarray(ep.t)[pick].tolist(), "theta": np.asarray(ep.theta)[pick].tolist(),
                        "v_rotating": v[pick, 0].tolist(), "v_target": v[pick, 1].tolist(),
                        "v_spill": v[pick, 2].tolist(), "torque": tq[::10]},
             "frames": frames}
@@ -234,8 +288,8 @@ def fmt_episode(s: dict) -> str:
             f"left {100 * s['left']:4.1f} %  finish {fin}{ret}")
 
 
-def analyse(path: Path, out_dir: Path | None, reward=None) -> dict:
-    log = read_log(path)
+def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = lcm_sensors.ENCODER_BITS) -> dict:
+    log = read_log(path, encoder_bits)
     eps = [episode_summary(ep, reward) for ep in log.episodes]
     lat = latencies_us(log)
     answered = sum(len(set(ep.torque_ts) & set(ep.state_ts)) for ep in log.episodes)
@@ -246,7 +300,7 @@ def analyse(path: Path, out_dir: Path | None, reward=None) -> dict:
                        "median": float(np.median(lat)) if len(lat) else None,
                        "p99": float(np.percentile(lat, 99)) if len(lat) else None,
                        "max": float(np.max(lat)) if len(lat) else None},
-        "states": states, "unanswered": states - answered, "undecodable": log.undecodable,
+        "states": states, "unanswered": states - answered, "undecodable": log.undecodable, "refused": log.refused,
         "particle_frames": sum(len(ep.frames) for ep in log.episodes),
     }
     if log.status:
@@ -273,7 +327,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--k-target", type=float)
     ap.add_argument("--k-spill", type=float)
     ap.add_argument("--gamma", type=float)
+    ap.add_argument("--encoder-bits", type=int, default=lcm_sensors.ENCODER_BITS,
+                    help="resolution of the rig's encoder, for a log without POUR_TRUTH (default %(default)s)")
     a = ap.parse_args(argv)
+    if not 8 <= a.encoder_bits <= 24:
+        print(f"pour-lcmlog: error: --encoder-bits must be 8 .. 24 (the CAN Sensors frame's count field), "
+              f"got {a.encoder_bits}", file=sys.stderr)
+        return 2
     if not a.log.is_file():
         print(f"pour-lcmlog: error: no such log file: {a.log}", file=sys.stderr)
         return 2
@@ -281,7 +341,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"pour-lcmlog: error: --render wants a .gif or .mp4 file name, got {a.render}", file=sys.stderr)
         return 2
     try:
-        s = analyse(a.log, a.out, reward_params(a.k_target, a.k_spill, a.gamma))
+        s = analyse(a.log, a.out, reward_params(a.k_target, a.k_spill, a.gamma), a.encoder_bits)
         log = s.pop("_log")
         if a.render is not None:
             from pour import render
@@ -305,10 +365,11 @@ def main(argv: Sequence[str] | None = None) -> int:
           f"  finish {f'{np.mean(fins):.3f} s' if fins else '-'}{ret}")
     L = s["latency_us"]
     if L["n"]:
-        print(f"latency {channels.STATE} -> {channels.TORQUE}: median {L['median']:.0f} us  p99 {L['p99']:.0f} us"
+        print(f"latency {channels.SENSORS} -> {channels.TORQUE}: median {L['median']:.0f} us  p99 {L['p99']:.0f} us"
               f"  max {L['max']:.0f} us over {L['n']} answers")
     print(f"states {s['states']}  unanswered {s['unanswered']}  undecodable {sum(s['undecodable'].values())}"
-          f"  particle frames {s['particle_frames']}")
+          f"  refused {sum(s['refused'].values())}  particle frames {s['particle_frames']}")
+    print(f"plant from {eps[0]['source']}")
     if "controller" in s:
         c = s["controller"]
         print(f"controller: mode {c['mode']}  faults 0x{c['faults']:04x}  overruns {c['overruns']}"

@@ -5,11 +5,13 @@
     pour-live-view --save view.png --frames 30          # headless: the 30th frame as a PNG, then exit
 
 The picture is host_sim's render (tools/pour/render.py): buckets, liquid coloured by where it is,
-θ and the shares in bucket, target and spilled; the controller's last status is shown under it.
+θ and the shares in bucket, target and spilled; under it, the latest raw sensor sample the controller
+was sent (POUR_SENSORS: encoder count, the two scales) and the controller's last status.
 """
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -17,7 +19,7 @@ from pathlib import Path
 
 import matplotlib
 
-from pour import channels, lcm_types
+from pour import channels, lcm_sensors, lcm_types
 
 
 def scene_data(p) -> dict:
@@ -42,10 +44,12 @@ class LiveView:
         self.lc = lcm.LCM(url)
         self.latest = None
         self.status = None
+        self.sample = None
         self.frames = 0
         self.dropped = 0
         self.lc.subscribe(channels.PARTICLES, self._on_particles)
         self.lc.subscribe(channels.STATUS, self._on_status)
+        self.lc.subscribe(channels.SENSORS, self._on_sensors)
 
     def _on_particles(self, channel: str, data: bytes) -> None:
         try:
@@ -64,6 +68,23 @@ class LiveView:
             self.status = self.m.controller_status_t.decode(data)
         except Exception:
             self.dropped += 1
+
+    def _on_sensors(self, channel: str, data: bytes) -> None:
+        try:
+            self.sample = self.m.sensor_sample_t.decode(data)
+        except Exception:
+            self.dropped += 1
+
+    def sensors_text(self) -> str:
+        s = self.sample
+        if s is None:
+            return f"sensors: no {channels.SENSORS} yet"
+        try:
+            angle = f"{math.degrees(lcm_sensors.encoder_angle(s.encoder)):6.1f}°"
+        except ValueError:
+            angle = "out of range"  # the controller latches BAD_INPUT on such a count
+        return (f"sensors: encoder {s.encoder:6d} ({angle})  scales {s.scale_rotating_g:6d} g"
+                f" / {s.scale_target_g:6d} g")
 
     def pump(self, seconds: float) -> None:
         end = time.monotonic() + seconds
@@ -126,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
         shown = view.frames
         scene.data["frames"] = [frame(view.latest)]
         scene.update(0)
-        footer.set_text(view.status_text())
+        footer.set_text(view.sensors_text() + "\n" + view.status_text())
 
     if a.save is not None:
         last = time.monotonic()

@@ -55,6 +55,14 @@ class ConfigStruct(C.Structure):
         ("restitution_threshold", C.c_double), ("contact_hertz", C.c_double),
         ("tau_max", C.c_double), ("theta_min", C.c_double), ("theta_max", C.c_double),
         ("brake_torque", C.c_double),
+        ("motor_peak_torque", C.c_double), ("motor_no_load_speed", C.c_double), ("motor_rotor_inertia", C.c_double),
+        ("gear_ratio", C.c_double), ("friction_coulomb", C.c_double), ("friction_viscous", C.c_double),
+        ("command_latency_ticks", C.c_int),
+        ("encoder_bits", C.c_int), ("scale_rate_hz", C.c_double), ("scale_delay_s", C.c_double),
+        ("scale_noise_g", C.c_double), ("scale_resolution_g", C.c_double),
+        ("rand_fill", C.c_double), ("rand_target_dx", C.c_double), ("rand_pivot_height", C.c_double),
+        ("rand_motor", C.c_double), ("rand_bucket_mass", C.c_double), ("rand_liquid", C.c_double),
+        ("rand_sensor", C.c_double),
         ("obs_theta_min", C.c_double), ("obs_theta_max", C.c_double), ("obs_omega_max", C.c_double),
         ("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double), ("seed", C.c_uint32),
     ]
@@ -65,6 +73,8 @@ class ObsStruct(C.Structure):
         ("step", C.c_uint32), ("t", C.c_double), ("theta", C.c_double), ("omega", C.c_double),
         ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
         ("obs", C.c_double * 5), ("reward", C.c_double), ("torque", C.c_double), ("done", C.c_int),
+        ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
+        ("scale_target_g", C.c_int32),
     ]
 
 
@@ -72,6 +82,7 @@ class PolicyStruct(C.Structure):
     _fields_ = [
         ("n_actions", C.c_int), ("decision_period", C.c_int), ("w", _DP), ("levels", _DP),
         ("theta_min", C.c_double), ("theta_max", C.c_double), ("omega_max", C.c_double), ("greedy", C.c_int),
+        ("k_reversal", C.c_double),
     ]
 
 
@@ -86,7 +97,8 @@ class EpisodeStruct(C.Structure):
     _fields_ = [
         ("n_steps", C.c_int), ("n_decisions", C.c_int), ("poured", C.c_double), ("spilled", C.c_double),
         ("remaining", C.c_double), ("finish_time", C.c_double), ("ret", C.c_double),
-        ("reward_sum", C.c_double), ("max_theta", C.c_double),
+        ("reward_sum", C.c_double), ("max_theta", C.c_double), ("liquid_l", C.c_double),
+        ("peak_omega", C.c_double), ("peak_alpha", C.c_double), ("reversals", C.c_int),
     ]
 
 
@@ -105,6 +117,25 @@ class SloshStruct(C.Structure):
     _fields_ = [
         ("freq", C.c_double), ("freq_theory", C.c_double), ("damping", C.c_double), ("amplitude", C.c_double),
         ("noise", C.c_double), ("n", C.c_int),
+    ]
+
+
+class DriveCheckStruct(C.Structure):
+    _fields_ = [
+        ("latency_ticks", C.c_int), ("inertia_measured", C.c_double), ("inertia_expected", C.c_double),
+        ("inertia_bucket", C.c_double), ("breakaway_torque", C.c_double), ("terminal_load", C.c_double * 2),
+        ("terminal_speed", C.c_double * 2), ("terminal_expected", C.c_double * 2),
+    ]
+
+
+class SensorCheckStruct(C.Structure):
+    _fields_ = [
+        ("encoder_max_error", C.c_double), ("encoder_at_stop", C.c_uint32), ("liquid_g", C.c_double),
+        ("rest_rotating_g", C.c_double), ("target_liquid_g", C.c_double), ("rest_target_g", C.c_double),
+        ("update_rate_hz", C.c_double), ("delay_s", C.c_double), ("delay_match", C.c_double),
+        ("noise_rms_g", C.c_double), ("noise_expected_g", C.c_double), ("impact_impulse_gs", C.c_double),
+        ("impact_expected_gs", C.c_double), ("impact_peak_g", C.c_double), ("impact_peak_reading_g", C.c_double),
+        ("hash_unchanged", C.c_int),
     ]
 
 
@@ -167,6 +198,9 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_measure_slosh": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
                                    P(C.c_double), C.c_int, P(SloshStruct)] + err, C.c_int),
         "poursim_observe": ([C.c_void_p, P(ObsStruct)], None),
+        "poursim_episode_config": ([C.c_void_p], P(ConfigStruct)),
+        "poursim_measure_drive": ([P(ConfigStruct), P(DriveCheckStruct)] + err, C.c_int),
+        "poursim_measure_sensors": ([P(ConfigStruct), C.c_uint32, P(SensorCheckStruct)] + err, C.c_int),
         "poursim_destroy": ([C.c_void_p], None),
         "poursim_particle_count": ([C.c_void_p], C.c_int),
         "poursim_particles": ([C.c_void_p, P(C.c_float), P(C.c_float), C.c_int], C.c_int),
@@ -234,13 +268,18 @@ class Obs:
     v_flight: float
     obs: np.ndarray
     reward: float
-    torque: float
+    torque: float              # commanded in this step [N·m]
     done: bool
+    motor_torque: float = 0.0  # delivered by the drive in this step [N·m]
+    encoder: int = 0           # output-shaft absolute encoder count
+    scale_rotating_g: int = 0  # load cell carrying the rotating bucket [g]
+    scale_target_g: int = 0    # load cell under the target [g]
 
     @staticmethod
     def from_struct(o: ObsStruct) -> "Obs":
         return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
-                   np.array(o.obs[:], dtype=np.float64), o.reward, o.torque, bool(o.done))
+                   np.array(o.obs[:], dtype=np.float64), o.reward, o.torque, bool(o.done), o.motor_torque,
+                   int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g))
 
 
 @dataclass
@@ -253,6 +292,7 @@ class Policy:
     theta_max: float = 2.356194        # [rad]
     omega_max: float = 4.0             # [rad/s]
     greedy: bool = False               # argmax instead of sampling
+    k_reversal: float = 0.0            # training's reward shaping: cost of each torque reversal
 
     def _struct(self) -> tuple[PolicyStruct, tuple[np.ndarray, np.ndarray]]:
         w = np.ascontiguousarray(self.w, dtype=np.float64)
@@ -262,7 +302,8 @@ class Policy:
         if lv.shape != (w.shape[1],):
             raise SimError(f"policy levels has shape {lv.shape}, expected ({w.shape[1]},)")
         s = PolicyStruct(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
-                         self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0)
+                         self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0,
+                         float(self.k_reversal))
         return s, (w, lv)  # the arrays must outlive the call
 
 
@@ -307,7 +348,8 @@ class _Buffers:
     def result(self, seed: int, e: EpisodeStruct) -> Rollout:
         d = e.n_decisions
         m = {"poured": e.poured, "spilled": e.spilled, "remaining": e.remaining, "finish_time": e.finish_time,
-             "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta}
+             "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta, "liquid_l": e.liquid_l,
+             "peak_omega": e.peak_omega, "peak_alpha": e.peak_alpha, "reversals": e.reversals}
         return Rollout(seed, self.features[:d], self.actions[:d], self.rewards[:d], self.probs[:d],
                        self.step_rewards, self.step_theta, e.poured, e.spilled, e.remaining, e.finish_time,
                        e.ret, e.reward_sum, e.max_theta, m)
@@ -362,6 +404,11 @@ class World:
         o = ObsStruct()
         self._lib.poursim_observe(self._check(), C.byref(o))
         return Obs.from_struct(o)
+
+    def episode_config(self) -> dict[str, float]:
+        """This episode's config: the world's with the reset seed's rand_* draws applied."""
+        c = self._lib.poursim_episode_config(self._check()).contents
+        return {k: getattr(c, k) for k in CONFIG_KEYS}
 
     @property
     def n_particles(self) -> int:
@@ -477,6 +524,31 @@ def slosh(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 
     return Slosh(out.freq, out.freq_theory, out.damping, out.amplitude, out.noise, np.array(trace[:out.n]))
 
 
+def _struct_dict(st: C.Structure) -> dict:
+    return {name: (list(getattr(st, name)) if isinstance(getattr(st, name), C.Array) else getattr(st, name))
+            for name, _ in st._fields_}
+
+
+def measure_drive(config: ConfigStruct | Mapping[str, float] | None = None) -> dict:
+    """The drive on the empty bucket against Newton and its datasheet line (poursim_measure_drive)."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    out, e = DriveCheckStruct(), _err()
+    if lib.poursim_measure_drive(C.byref(cfg), C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return _struct_dict(out)
+
+
+def measure_sensors(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1) -> dict:
+    """Encoder and load cells against mass, momentum and their config (poursim_measure_sensors)."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    out, e = SensorCheckStruct(), _err()
+    if lib.poursim_measure_sensors(C.byref(cfg), int(seed), C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return _struct_dict(out)
+
+
 def version() -> str:
     return load_library().poursim_version().decode()
 
@@ -487,5 +559,5 @@ def uniform_levels(n_actions: int) -> np.ndarray:
 
 
 __all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
-                          "make_config", "rollout_batch", "retention", "slosh", "load_library", "uniform_levels",
-                          "CONFIG_KEYS", "REGIONS", "version")
+                          "make_config", "rollout_batch", "retention", "slosh", "measure_drive", "measure_sensors",
+                          "load_library", "uniform_levels", "CONFIG_KEYS", "REGIONS", "version")

@@ -53,6 +53,10 @@ class SimEnv:
                  options: dict[str, Any] | None = None):
         opts = dict(options or {})
         opts.setdefault("episode_s", episode_s)
+        # Reward shaping of training alone (the world's reward stays K_target·V_target − K_spill·V_spill).
+        self.k_reversal = float(opts.pop("k_reversal", 0.0))
+        if not (math.isfinite(self.k_reversal) and self.k_reversal >= 0.0):
+            raise envs.EnvError(f"option k_reversal = {self.k_reversal!r}: want a finite value >= 0")
         self.world = _open_world(opts)
         cfg = self.world.config
         if abs(cfg.dt - 1e-3) > 1e-12:
@@ -67,12 +71,14 @@ class SimEnv:
             raise envs.EnvError(f"W has shape {w.shape}, expected ({sim.N_FEATURES}, {self.n_actions})")
         cfg = self.world.config
         pol = sim.Policy(w, self.levels, self.period, cfg.obs_theta_min, cfg.obs_theta_max, cfg.obs_omega_max,
-                         bool(greedy))
+                         bool(greedy), self.k_reversal)
         with _env_errors(f"poursim_rollout (seed {seed})"):
             ro = self.world.rollout(pol, seed)
         metrics = {"v_target": ro.poured, "v_spill": ro.spilled, "v_rotating": ro.remaining,
                    "finish_s": ro.finish_time, "return": ro.ret, "reward_sum": ro.reward_sum,
-                   "max_theta": ro.max_theta}
+                   "max_theta": ro.max_theta, "liquid_l": ro.metrics["liquid_l"],
+                   "peak_omega": ro.metrics["peak_omega"], "peak_alpha": ro.metrics["peak_alpha"],
+                   "reversals": ro.metrics["reversals"]}
         return envs.Episode(ro.features, ro.actions.astype(np.int64), ro.rewards, metrics, int(seed))
 
 

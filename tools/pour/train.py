@@ -24,7 +24,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from pour import config as cfgmod
-from pour import envs, reinforce
+from pour import envs, executors, reinforce
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
 
@@ -250,8 +250,9 @@ def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode],
 
 
 def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, quiet: bool = False,
-          stop_after: int | None = None) -> RunResult:
-    """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call."""
+          stop_after: int | None = None, make_runner: Any = Runner) -> RunResult:
+    """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call.
+    make_runner: cfg -> the episode runner (Runner, the local pool, or executors.RayRunner): same results."""
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
@@ -299,7 +300,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     valid_seeds = episode_seeds(cfg.seed, STREAM_VALID, 0, cfg.eval.episodes)
     t0 = time.monotonic()
     done = 0
-    with Runner(cfg) as runner:
+    with make_runner(cfg) as runner:
         for it in range(start, cfg.iterations):
             if stop_after is not None and done >= stop_after:
                 break
@@ -382,14 +383,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, help="override the config's workers")
     ap.add_argument("--fresh", action="store_true", help="discard an existing checkpoint in --out")
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--executor", choices=("local", "ray"), default="local",
+                    help="where episodes run: 'local' process pool (default) or Ray tasks (pip install './tools[ray]')")
+    ap.add_argument("--ray-address", default="local", metavar="auto|HOST:PORT",
+                    help="--executor ray: 'local' (a Ray instance of this process), 'auto' (this machine's cluster) "
+                         "or a head's HOST:PORT")
     args = ap.parse_args(argv)
     try:
         cfg = cfgmod.load(args.config)
         over = {k: getattr(args, k) for k in ("seed", "iterations", "workers") if getattr(args, k) is not None}
         if over:
             cfg = cfgmod.with_overrides(cfg, **over)
-        res = train(cfg, args.out, resume=not args.fresh, quiet=args.quiet)
-    except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError) as exc:
+        res = train(cfg, args.out, resume=not args.fresh, quiet=args.quiet,
+                    make_runner=executors.runner_factory(args.executor, args.ray_address))
+    except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError, executors.ExecutorError) as exc:
         print(f"pour-train: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps({"run_dir": str(res.run_dir), "iterations": res.iterations, "wall_s": round(res.wall_s, 1),

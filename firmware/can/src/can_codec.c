@@ -29,16 +29,10 @@ static uint32_t get_u24(const uint8_t *p) {
 
 static uint32_t get_u32(const uint8_t *p) { return (uint32_t)get_u16(p) | ((uint32_t)get_u16(p + 2) << 16); }
 
-static int32_t as_i32(uint32_t v) {
-  /* Two's complement reinterpretation without implementation-defined conversion. */
-  return (v & 0x80000000u) ? -(int32_t)(~v) - 1 : (int32_t)v;
-}
+/* Two's complement reinterpretation without implementation-defined conversion. */
+static int16_t as_i16(uint16_t v) { return (int16_t)((v & 0x8000u) ? -(int32_t)(uint16_t)(~v) - 1 : (int32_t)v); }
 
-static int32_t sext24(uint32_t v) { return as_i32((v & 0x800000u) ? (v | 0xFF000000u) : v); }
-
-static q15_t as_q15(uint16_t v) { return (q15_t)((v & 0x8000u) ? -(int32_t)(uint16_t)(~v) - 1 : (int32_t)v); }
-
-static uint16_t q15_bits(q15_t v) { return (uint16_t)((uint32_t)(int32_t)v & 0xFFFFu); }
+static uint16_t i16_bits(int16_t v) { return (uint16_t)((uint32_t)(int32_t)v & 0xFFFFu); }
 
 static void frame_begin(pour_can_frame_t *frame, uint8_t node_id, uint8_t cmd, uint8_t dlc) {
   frame->id = pour_can_id(node_id, cmd);
@@ -48,34 +42,19 @@ static void frame_begin(pour_can_frame_t *frame, uint8_t node_id, uint8_t cmd, u
   }
 }
 
-static int in_range_i32(int32_t v, int32_t lim) { return v >= -lim && v <= lim; }
+/* int16_t reaches 32767 = POUR_CAN_SCALE_MAX_G: only the overload code -32768 is out of range. */
+static int scale_ok(int16_t g) { return g >= -POUR_CAN_SCALE_MAX_G; }
 
-/* q15_t tops out at 32767 = POUR_CAN_VOLUME_MAX_Q15: only the sign needs checking. */
-static int volume_ok(q15_t v) { return v >= 0; }
-
-pour_status_t pour_can_pack_state_a(uint8_t node_id, const pour_can_state_a_t *msg, pour_can_frame_t *frame) {
-  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX ||
-      !in_range_i32(msg->theta_urad, POUR_CAN_THETA_MAX_URAD) ||
-      !in_range_i32(msg->omega_urad_s, POUR_CAN_OMEGA_MAX_URAD_S)) {
+pour_status_t pour_can_pack_sensors(uint8_t node_id, const pour_can_sensors_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->encoder > POUR_CAN_ENCODER_MAX ||
+      !scale_ok(msg->scale_rotating_g) || !scale_ok(msg->scale_target_g)) {
     return POUR_EINVAL;
   }
-  frame_begin(frame, node_id, POUR_CAN_CMD_STATE_A, POUR_CAN_DLC_STATE_A);
-  put_u24(&frame->data[0], (uint32_t)msg->theta_urad & 0xFFFFFFu);
-  put_u32(&frame->data[3], (uint32_t)msg->omega_urad_s);
-  frame->data[7] = msg->seq_low;
-  return POUR_OK;
-}
-
-pour_status_t pour_can_pack_state_b(uint8_t node_id, const pour_can_state_b_t *msg, pour_can_frame_t *frame) {
-  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !volume_ok(msg->v_rotating) ||
-      !volume_ok(msg->v_target) || !volume_ok(msg->v_spill)) {
-    return POUR_EINVAL;
-  }
-  frame_begin(frame, node_id, POUR_CAN_CMD_STATE_B, POUR_CAN_DLC_STATE_B);
-  put_u16(&frame->data[0], msg->seq);
-  put_u16(&frame->data[2], q15_bits(msg->v_rotating));
-  put_u16(&frame->data[4], q15_bits(msg->v_target));
-  put_u16(&frame->data[6], q15_bits(msg->v_spill));
+  frame_begin(frame, node_id, POUR_CAN_CMD_SENSORS, POUR_CAN_DLC_SENSORS);
+  frame->data[0] = msg->seq_low;
+  put_u24(&frame->data[1], msg->encoder);
+  put_u16(&frame->data[4], i16_bits(msg->scale_rotating_g));
+  put_u16(&frame->data[6], i16_bits(msg->scale_target_g));
   return POUR_OK;
 }
 
@@ -86,7 +65,7 @@ pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_TORQUE, POUR_CAN_DLC_TORQUE);
   put_u16(&frame->data[0], msg->seq);
-  put_u16(&frame->data[2], q15_bits(msg->torque));
+  put_u16(&frame->data[2], i16_bits(msg->torque));
   frame->data[4] = msg->action;
   frame->data[5] = msg->mode;
   frame->data[6] = msg->limits;
@@ -149,8 +128,7 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_STOP: return (int)POUR_CAN_DLC_STOP;
     case POUR_CAN_CMD_IDENTITY: return (int)POUR_CAN_DLC_IDENTITY;
     case POUR_CAN_CMD_RESET: return (int)POUR_CAN_DLC_RESET;
-    case POUR_CAN_CMD_STATE_A: return (int)POUR_CAN_DLC_STATE_A;
-    case POUR_CAN_CMD_STATE_B: return (int)POUR_CAN_DLC_STATE_B;
+    case POUR_CAN_CMD_SENSORS: return (int)POUR_CAN_DLC_SENSORS;
     case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
     case POUR_CAN_CMD_CLEAR_ERRORS: return (int)POUR_CAN_DLC_CLEAR_ERRORS;
     default: return -1;
@@ -168,37 +146,20 @@ static pour_can_rx_t check_header(const pour_can_frame_t *frame, uint8_t cmd) {
   return POUR_CAN_RX_OK;
 }
 
-pour_can_rx_t pour_can_unpack_state_a(const pour_can_frame_t *frame, pour_can_state_a_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_STATE_A);
+pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_sensors_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_SENSORS);
   if (rc != POUR_CAN_RX_OK || msg == NULL) {
     return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
   }
-  int32_t theta = sext24(get_u24(&frame->data[0]));
-  int32_t omega = as_i32(get_u32(&frame->data[3]));
-  if (!in_range_i32(theta, POUR_CAN_THETA_MAX_URAD) || !in_range_i32(omega, POUR_CAN_OMEGA_MAX_URAD_S)) {
+  const int16_t rot = as_i16(get_u16(&frame->data[4]));
+  const int16_t tgt = as_i16(get_u16(&frame->data[6]));
+  if (!scale_ok(rot) || !scale_ok(tgt)) {
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
-  msg->theta_urad = theta;
-  msg->omega_urad_s = omega;
-  msg->seq_low = frame->data[7];
-  return POUR_CAN_RX_OK;
-}
-
-pour_can_rx_t pour_can_unpack_state_b(const pour_can_frame_t *frame, pour_can_state_b_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_STATE_B);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
-  }
-  q15_t vr = as_q15(get_u16(&frame->data[2]));
-  q15_t vt = as_q15(get_u16(&frame->data[4]));
-  q15_t vs = as_q15(get_u16(&frame->data[6]));
-  if (!volume_ok(vr) || !volume_ok(vt) || !volume_ok(vs)) {
-    return POUR_CAN_RX_OUT_OF_RANGE;
-  }
-  msg->seq = get_u16(&frame->data[0]);
-  msg->v_rotating = vr;
-  msg->v_target = vt;
-  msg->v_spill = vs;
+  msg->seq_low = frame->data[0];
+  msg->encoder = get_u24(&frame->data[1]);
+  msg->scale_rotating_g = rot;
+  msg->scale_target_g = tgt;
   return POUR_CAN_RX_OK;
 }
 
@@ -212,7 +173,7 @@ pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_tor
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
   msg->seq = get_u16(&frame->data[0]);
-  msg->torque = as_q15(get_u16(&frame->data[2]));
+  msg->torque = as_i16(get_u16(&frame->data[2]));
   msg->action = frame->data[4];
   msg->mode = frame->data[5];
   msg->limits = frame->data[6];

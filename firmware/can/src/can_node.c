@@ -4,8 +4,8 @@
 #include <stddef.h>
 
 /* Commands a controller accepts; HEARTBEAT, IDENTITY and TORQUE are its own transmissions. */
-#define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_STATE_A) | \
-                     (1u << POUR_CAN_CMD_STATE_B) | (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET))
+#define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_SENSORS) | \
+                     (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET))
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
@@ -37,7 +37,7 @@ static void count(uint32_t *c) {
   }
 }
 
-/* A valid state or command: feeds the watchdog, and arms it on the first one. */
+/* A valid sample or command: feeds the watchdog, and arms it on the first one. */
 static void kick(pour_can_node_t *node) {
   node->armed = true;
   node->ms_since_valid = 0;
@@ -53,18 +53,17 @@ static pour_can_rx_t drop(pour_can_node_t *node, pour_can_rx_t why) {
   return why;
 }
 
-/* Completes a sample: StateB's 16-bit seq continues the 32-bit count by its forward distance (mod 2^16),
- * so a wrap is the next sample and a repeated frame repeats the seq (the core's supervisor sees it). */
-static void complete_state(pour_can_node_t *node, const pour_can_state_b_t *b) {
-  const uint16_t last16 = (uint16_t)(node->state.seq & 0xFFFFu);
-  node->state.seq = node->have_seq ? node->state.seq + (uint16_t)(b->seq - last16) : b->seq;
+/* Takes a sample: the frame's 8-bit seq continues the 32-bit count by its forward distance (mod 2^8), so
+ * a wrap is the next sample and a repeated frame repeats the seq (the core's supervisor sees it). The
+ * readings go to the core as the sensors gave them; the estimator judges them (BAD_INPUT). */
+static void take_sample(pour_can_node_t *node, const pour_can_sensors_t *m) {
+  const uint8_t last8 = (uint8_t)(node->sensors.seq & 0xFFu);
+  node->sensors.seq = node->have_seq ? node->sensors.seq + (uint8_t)(m->seq_low - last8) : m->seq_low;
   node->have_seq = true;
-  node->state.theta_urad = node->pending_a.theta_urad;
-  node->state.omega_urad_s = node->pending_a.omega_urad_s;
-  node->state.v_rotating = b->v_rotating;
-  node->state.v_target = b->v_target;
-  node->state.v_spill = b->v_spill;
-  node->state_fresh = true;
+  node->sensors.encoder = m->encoder;
+  node->sensors.scale_rotating_g = m->scale_rotating_g;
+  node->sensors.scale_target_g = m->scale_target_g;
+  node->sensors_fresh = true;
 }
 
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame) {
@@ -77,29 +76,13 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
     return drop(node, rc);
   }
   switch (cmd) {
-    case POUR_CAN_CMD_STATE_A: {
-      pour_can_state_a_t a;
-      rc = pour_can_unpack_state_a(frame, &a);
+    case POUR_CAN_CMD_SENSORS: {
+      pour_can_sensors_t m;
+      rc = pour_can_unpack_sensors(frame, &m);
       if (rc != POUR_CAN_RX_OK) {
         return drop(node, rc);
       }
-      node->pending_a = a;
-      node->have_a = true;
-      break;
-    }
-    case POUR_CAN_CMD_STATE_B: {
-      pour_can_state_b_t b;
-      rc = pour_can_unpack_state_b(frame, &b);
-      if (rc != POUR_CAN_RX_OK) {
-        return drop(node, rc);
-      }
-      /* A lost or corrupt StateA must not pair its neighbour's angle with these volumes. */
-      if (!node->have_a || node->pending_a.seq_low != (uint8_t)(b.seq & 0xFFu)) {
-        count(&node->counters.unpaired);
-        return POUR_CAN_RX_UNPAIRED;
-      }
-      node->have_a = false;
-      complete_state(node, &b);
+      take_sample(node, &m);
       kick(node);
       break;
     }
@@ -136,14 +119,14 @@ static bool tripped(const pour_can_node_t *node) {
 }
 
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
-  in->state_fresh = node->state_fresh;
-  in->state = node->state;
+  in->sensors_fresh = node->sensors_fresh;
+  in->sensors = node->sensors;
   in->estop = node->estop;
   in->clear_faults = node->clear_request;
   in->stop = node->stop_request;
   in->reset = node->reset_request;
   in->link_fault = tripped(node);
-  node->state_fresh = false;
+  node->sensors_fresh = false;
   node->clear_request = false;
   node->stop_request = false;
   node->reset_request = false;
@@ -159,14 +142,14 @@ bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {
 
 uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
   const pour_can_node_counters_t *c = &node->counters;
-  uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range + c->unpaired;
+  uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range;
   return sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
 }
 
 pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour_control_output_t *out,
                                          pour_can_frame_t *frame) {
   pour_can_torque_t t;
-  t.seq = (uint16_t)(node->state.seq & 0xFFFFu);
+  t.seq = (uint16_t)(node->sensors.seq & 0xFFFFu);
   t.torque = out->torque;
   t.action = (uint8_t)(out->action & POUR_CAN_ACTION_MAX);
   t.mode = (uint8_t)(out->mode & POUR_CAN_MODE_MAX);

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The 1 kHz control step: state in, torque out, inside the safety envelope. Pure: no I/O, no float. */
+/* The 1 kHz control step: raw sensor samples in, torque out, inside the safety envelope. Pure: no I/O, no
+ * float. */
 #ifndef POUR_CONTROL_H
 #define POUR_CONTROL_H
 
@@ -10,11 +11,13 @@
 #include "pour/obs.h"
 #include "pour/policy.h"
 #include "pour/safety.h"
+#include "pour/sensors.h"
 #include "pour/supervisor.h"
 
 /* Version of the firmware as the bus reports it (Identity.FwVersion): +1 with any change in behaviour a
- * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity. */
-#define POUR_FIRMWARE_VERSION 2u
+ * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity.
+ * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp). */
+#define POUR_FIRMWARE_VERSION 3u
 
 typedef enum {
   POUR_MODE_IDLE = 0,  /* no state yet (or faults just cleared): safe torque */
@@ -24,16 +27,16 @@ typedef enum {
 } pour_mode_t;
 
 /* Latched fault bits (pour_control_t.faults); only clear_faults resets them. */
-#define POUR_FAULT_STALE_INPUT 0x0001u /* no fresh state for longer than input_timeout_ms */
+#define POUR_FAULT_STALE_INPUT 0x0001u /* no fresh sample for longer than input_timeout_ms */
 #define POUR_FAULT_ESTOP 0x0002u       /* e-stop was asserted */
-#define POUR_FAULT_BAD_INPUT 0x0004u   /* a state outside its physical range was received */
+#define POUR_FAULT_BAD_INPUT 0x0004u   /* a sensor sample (or the state from it) outside its physical range */
 #define POUR_FAULT_POSITION 0x0008u    /* supervisor: θ outside [θmin - margin, θmax + margin] */
 #define POUR_FAULT_OVERSPEED 0x0010u   /* supervisor: |θ̇| above the overspeed limit */
 #define POUR_FAULT_TORQUE_SIGN 0x0020u /* supervisor: the axis accelerates against the commanded torque */
 #define POUR_FAULT_ENCODER 0x0040u     /* supervisor: the encoder does not move under sustained torque */
-#define POUR_FAULT_VOLUME 0x0080u      /* supervisor: a volume reading jumped faster than liquid can flow */
+#define POUR_FAULT_VOLUME 0x0080u      /* supervisor: a scale reading jumped faster than liquid can flow */
 #define POUR_FAULT_LINK 0x0100u        /* the transport's command watchdog tripped (the CAN node's) */
-#define POUR_FAULT_SEQ 0x0200u         /* supervisor: states keep arriving but their seq does not advance */
+#define POUR_FAULT_SEQ 0x0200u         /* supervisor: samples keep arriving but their seq does not advance */
 #define POUR_FAULT_SCALE 0x0400u       /* supervisor: the axis accelerates more than the command can (scale) */
 #define POUR_FAULT_ALL 0x07FFu
 /* Faults the controlled stop answers actively (the sensors and the motor are still trusted): decelerate,
@@ -53,11 +56,12 @@ typedef struct {
 
 typedef struct {
   pour_safety_config_t safety;
-  uint16_t input_timeout_ms;   /* fresh state required at least this often in RUN, >= 1 */
+  pour_sensors_config_t sensors; /* the estimator: encoder bits, tracking loop, scale limits */
+  uint16_t input_timeout_ms;   /* fresh sample required at least this often in RUN, >= 1 */
   q15_t safe_torque;           /* command in IDLE and FAULT, within the envelope, Q15 */
   pour_policy_mode_t policy_mode;
   uint32_t seed;               /* sampled mode's PRNG seed */
-  /* A fresh state outside these bounds is physically impossible: BAD_INPUT fault. */
+  /* A state estimated from a fresh sample outside these bounds is physically impossible: BAD_INPUT. */
   int32_t plausible_theta_urad;    /* |θ| <= this [µrad], > 0 */
   int32_t plausible_omega_urad_s;  /* |θ̇| <= this [µrad/s], > 0 */
   int32_t plausible_volume_sum;    /* V_rot + V_tgt + V_spill <= this, Q15 (32768 = all the liquid) */
@@ -67,8 +71,8 @@ typedef struct {
 
 /* Inputs of one tick. */
 typedef struct {
-  bool state_fresh;  /* a new state arrived since the last tick */
-  pour_state_t state;
+  bool sensors_fresh;     /* a new sensor sample arrived since the last tick */
+  pour_sensors_t sensors; /* that sample, raw */
   bool estop;        /* e-stop line/frame asserted (level) */
   bool clear_faults; /* request to clear latched faults (acted on when e-stop is released) */
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
@@ -99,7 +103,8 @@ typedef struct {
   uint32_t tick;
   uint32_t ms_since_fresh;
   uint32_t ms_to_decision;
-  pour_state_t state; /* latest fresh, plausible state */
+  pour_estimator_t estimator;
+  pour_state_t state; /* state estimated from the latest fresh, plausible sample */
   pour_obs_t obs;
   pour_policy_eval_t eval;
   bool probs_pending;     /* the latest greedy decision's probabilities are computed on the next tick */
@@ -119,9 +124,11 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
 
 /* One 1 ms tick. Never fails: problems show as mode and fault bits in the output.
  * Order: e-stop (zero torque now, whatever else the input says), link fault (FAULT), clear request,
- * stop, reset, input check (BAD_INPUT; a seq that does not advance makes the state not fresh), timeout
- * (STALE_INPUT, with SEQ if repeated states were refused; armed in RUN only), IDLE -> RUN on the first
- * fresh state, supervisor (RUN), policy decision on the first RUN tick and every decision_period_ms ticks
+ * stop, reset, input (a seq that does not advance makes the sample not fresh; the estimator turns a fresh
+ * one into the state, restarted in IDLE so that a run starts from its first sample; an implausible sample
+ * or state: BAD_INPUT), timeout (STALE_INPUT, with SEQ if repeated samples were refused; armed in RUN
+ * only), IDLE -> RUN on the first fresh sample, supervisor (RUN), policy decision on the first RUN tick
+ * and every decision_period_ms ticks
  * after, envelope; in FAULT the controlled stop. A clear never bypasses the envelope: RUN resumes from the safe torque through the slew limit.
  * out->tick counts the steps including this one. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);

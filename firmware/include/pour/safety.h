@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The torque envelope applied to every command: clamp, slew-rate limit, angle limits. */
+/* The torque envelope applied to every command: clamp, slew-rate limit, angle limits, and the motion
+ * envelope (a speed governor whose band widens at most at the acceleration limit). */
 #ifndef POUR_SAFETY_H
 #define POUR_SAFETY_H
 
@@ -12,28 +13,44 @@
 #define POUR_LIMIT_SLEW 0x02u      /* the change was cut to slew_per_tick */
 #define POUR_LIMIT_ANGLE_MAX 0x04u /* positive torque refused at or past theta_max */
 #define POUR_LIMIT_ANGLE_MIN 0x08u /* negative torque refused at or below theta_min */
+#define POUR_LIMIT_SPEED 0x10u     /* the governor cut the torque at the speed limit ±omega_max */
+#define POUR_LIMIT_ACCEL 0x20u     /* the governor cut it at a speed band still ramping at alpha_max */
+#define POUR_SAFETY_OMEGA_MAX_URAD_S 100000000 /* speeds the envelope works with, saturated: 100 rad/s */
 
 typedef struct {
   q15_t tau_limit;         /* |torque| <= tau_limit, fraction of tau_max Q15, > 0 */
   q15_t slew_per_tick;     /* |torque change| per 1 ms tick, Q15, > 0 */
   int32_t theta_min_urad;  /* no torque that tilts further back at or below this [µrad] */
   int32_t theta_max_urad;  /* no torque that tilts further forward at or past this [µrad] */
+  int32_t omega_max_urad_s;   /* speed limit: no torque that speeds |θ̇| up beyond it [µrad/s], > 0 */
+  int32_t alpha_max_urad_s2;  /* the speed band widens at most this fast [µrad/s²], >= 1000 */
+  int32_t omega_slack_urad_s; /* the band reaches this far beyond the current speed [µrad/s], > 0 */
+  q15_t torque_per_rad_s;     /* governor gain: torque bound per rad/s of speed margin, Q15, > 0 */
 } pour_safety_config_t;
 
 typedef struct {
   pour_safety_config_t config;
   q15_t torque;   /* last commanded torque, Q15 */
   uint8_t active; /* POUR_LIMIT_* bits of the last command */
+  int32_t alpha_step_urad_s;  /* alpha_max · 1 ms: the band's widening per tick [µrad/s] */
+  int32_t gain_q32;           /* torque_per_rad_s / 10^6: Q15 torque per µrad/s, Q32 (< 2^28) */
+  int32_t ceiling_urad_s;     /* speed band: no torque that speeds θ̇ beyond [floor, ceiling] [µrad/s] */
+  int32_t floor_urad_s;
 } pour_safety_t;
 
 /* Defaults for the bench rig (docs/safety.md). */
 pour_safety_config_t pour_safety_default_config(void);
 
-/* Validates the config; the envelope starts at zero torque. */
+/* Validates the config; the envelope starts at zero torque, its speed band at ±omega_slack (at rest). */
 pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t *config);
 
-/* Shapes a requested torque by angle limits, then clamp, then slew; returns the command. */
-q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_urad);
+/* Shapes a requested torque by angle limits, clamp, the speed band, slew, then cuts toward zero whatever still
+ * lies beyond the band or an angle limit (less torque never waits for the slew). The band follows the
+ * estimated speed omega_urad_s: ceiling = min(omega_max, ceiling + alpha step, max(θ̇, 0) + slack), floor
+ * likewise, torque within [K (floor - θ̇), K (ceiling - θ̇)] (K = torque_per_rad_s, each bound within
+ * ±tau_limit): beyond the band the bound changes sign and brakes, against gravity too. Returns the command;
+ * safety->active tells which rules shaped it. */
+q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_urad, int32_t omega_urad_s);
 
 /* Sets the command at once, bypassing the slew limit (e-stop and faults must not wait). */
 void pour_safety_force(pour_safety_t *safety, q15_t torque);

@@ -33,9 +33,12 @@ typedef struct {
   q15_t torque_min;              /* a mean |torque| over W at least this is beyond what gravity can resist, Q15 */
   int32_t omega_against_urad_s;  /* TORQUE_SIGN: moving against that torque faster than this [µrad/s], > 0 */
   uint8_t against_ms;            /* ... and speeding up that way, this many ticks in a row [ticks], >= 1 */
-  int32_t encoder_move_urad;     /* ENCODER: under that mean torque, one way all W ticks, θ moves more than this [µrad], > 0 */
-  q15_t volume_step_max;         /* VOLUME: no volume changes by more than this per tick, Q15, > 0 */
-  int32_t accel_full_urad_s2;    /* SCALE: full torque accelerates the lightest load at most this [µrad/s²] */
+  int32_t encoder_move_urad;     /* ENCODER: under at least that torque, one way, θ leaves ±this [µrad], > 0 ... */
+  uint8_t encoder_ms;            /* ... within this many ticks [ticks], >= 1 */
+  q15_t volume_step_max;         /* VOLUME: no volume changes by more than this per tick since the reading
+                                  * last changed (at most 16 ticks credited), Q15, > 0 */
+  int32_t accel_full_urad_s2;    /* SCALE: θ̇'s path over W (Σ|Δθ̇|) beyond what full torque gives the lightest
+                                  * load, at most this [µrad/s²] per unit of mean |τ| ... */
   int32_t accel_passive_urad_s2; /* ... and gravity and the liquid add at most this [µrad/s²], > 0 */
 } pour_supervisor_config_t;
 
@@ -44,18 +47,24 @@ typedef struct {
   int32_t theta_low_urad;        /* POSITION below this: the envelope's θmin - margin [µrad] */
   int32_t theta_high_urad;       /* ... or above this: θmax + margin [µrad] */
   q15_t torque[POUR_SUPERVISOR_WINDOW_MAX];  /* commanded torque of the last W ticks (ring), Q15 */
-  int32_t theta[POUR_SUPERVISOR_WINDOW_MAX]; /* θ and θ̇ seen at those ticks (ring) */
-  int32_t omega[POUR_SUPERVISOR_WINDOW_MAX];
+  int32_t omega[POUR_SUPERVISOR_WINDOW_MAX]; /* θ̇ seen at those ticks (ring) */
+  uint16_t dw[POUR_SUPERVISOR_WINDOW_MAX];   /* |θ̇ change| into each from the tick before [32 µrad/s] */
   uint8_t head;                  /* next ring slot */
   uint8_t filled;                /* ring entries in use, up to W */
   int32_t sum;                   /* Σ torque over the ring, Q15 (kept as entries come and go: O(1) a tick) */
   int32_t sum_abs;               /* Σ |torque| */
+  int32_t sum_dw;                /* Σ dw: the path of θ̇ over the ring [µrad/s] */
   int64_t passive_term;          /* accel_passive * W * 32768 [µrad/s² · ticks · Q15], fixed at init */
   uint8_t against;               /* consecutive ticks moving and speeding up against the torque */
   uint8_t over;                  /* consecutive ticks accelerating beyond what the command explains */
-  bool have_state;
-  pour_state_t last;             /* the last accepted state */
-  uint32_t ticks_since_state;    /* ticks since it [ticks] */
+  int32_t still_theta_urad;      /* θ where the encoder was last seen to move [µrad] */
+  uint16_t still_ticks;          /* fresh samples since, θ within ±encoder_move of it */
+  uint16_t push_ticks;           /* consecutive ticks commanding >= torque_min one way ... */
+  int8_t push_dir;               /* ... which way: +1, -1, or 0 (below torque_min) */
+  bool have_state;               /* a state was judged since the restart */
+  uint32_t last_seq;             /* seq of the last accepted sample */
+  q15_t volume[3];               /* V_rot, V_tgt, V_spill when the volume reading last changed, Q15 */
+  uint32_t ticks_since_volume;   /* ticks since then [ticks] */
   uint32_t seq_repeats;          /* fresh states refused since the last accepted one (seq did not advance) */
 } pour_supervisor_t;
 
@@ -69,10 +78,10 @@ pour_status_t pour_supervisor_init(pour_supervisor_t *sup, const pour_supervisor
 /* Forgets the history (a new run): the next state is accepted whatever its seq. */
 void pour_supervisor_restart(pour_supervisor_t *sup);
 
-/* Whether a fresh state continues the sample count: seq must advance by 1 .. 32767 (mod 2^32) over the last
- * accepted one. A state that does not is to be treated as not fresh (a frozen or replaying sender); it is
- * counted in seq_repeats, and the caller reports POUR_FAULT_SEQ when the input then times out. */
-bool pour_supervisor_accept(pour_supervisor_t *sup, const pour_state_t *state);
+/* Whether a fresh sample's seq continues the sample count: it must advance by 1 .. 32767 (mod 2^32) over the
+ * last accepted one. A sample that does not is to be treated as not fresh (a frozen or replaying sender);
+ * it is counted in seq_repeats, and the caller reports POUR_FAULT_SEQ when the input then times out. */
+bool pour_supervisor_accept(pour_supervisor_t *sup, uint32_t seq);
 
 /* One tick, before the command: state is the latest accepted state (fresh: it arrived this tick), judged
  * against the commands of the last W ticks. Returns the POUR_FAULT_* bits it proves (0: plausible). */

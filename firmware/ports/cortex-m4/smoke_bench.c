@@ -74,10 +74,11 @@ void pour_hal_can_poll(void) {
   rx_n = 0u;
   rx_i = 0u;
   if (tick >= 10u && tick < STATES_TO) {
-    const pour_can_state_a_t a = {theta_urad, omega_urad_s, (uint8_t)(tick & 0xFFu)};
-    const pour_can_state_b_t b = {(uint16_t)tick, 32767, 0, 0};
-    (void)pour_can_pack_state_a(0, &a, &rx[rx_n++]);
-    (void)pour_can_pack_state_b(0, &b, &rx[rx_n++]);
+    /* The 17-bit encoder's count at θ, rounded, wrapped below upright; 10 kg in the rotating bucket. */
+    const int64_t c = ((int64_t)theta_urad * 131072 * 1000 + (theta_urad >= 0 ? 3141592654LL : -3141592654LL)) /
+                      6283185307LL;
+    const pour_can_sensors_t m = {(uint8_t)(tick & 0xFFu), (uint32_t)((c + 131072) % 131072), 10000, 0};
+    (void)pour_can_pack_sensors(0, &m, &rx[rx_n++]);
   }
   if (tick == CLEAR_AT) {
     (void)pour_can_pack_command(0, POUR_CAN_CMD_CLEAR_ERRORS, &rx[rx_n++]);
@@ -94,8 +95,11 @@ int pour_hal_can_receive(pour_can_frame_t *frame) {
 
 static void on_torque(const pour_can_torque_t *t) {
   applied = power ? t->torque : 0;
+  /* Beyond the slew limit only toward zero (less torque never waits for the slew). */
   const int32_t step = (int32_t)t->torque - seen.last_torque;
-  if (t->torque != 0 && (step > 3277 || step < -3277)) {
+  const bool toward_zero = (seen.last_torque >= 0 && t->torque >= 0 && t->torque <= seen.last_torque) ||
+                           (seen.last_torque <= 0 && t->torque <= 0 && t->torque >= seen.last_torque);
+  if (!toward_zero && (step > 3277 || step < -3277)) {
     seen.slew_steps++;
   }
   seen.last_torque = t->torque;

@@ -63,8 +63,8 @@ typedef struct {
 static void send_answer(loop_t *l) {
   const pour_io_answer_t a = {
       .utime = wall_us(),
-      .state_seq = l->last_seq,
-      .state_utime = l->last_utime,
+      .sample_seq = l->last_seq,
+      .sample_utime = l->last_utime,
       .episode = l->last_episode,
       .out = &l->out,
       .n_actions = l->config->weights->n_actions,
@@ -116,7 +116,7 @@ static void maybe_send_status(loop_t *l, bool force) {
 
 /* Folds one wait's input into the loop: counters and the command level. */
 static void absorb(loop_t *l, const pour_io_input_t *in) {
-  l->stats->states_received += in->n_states;
+  l->stats->states_received += in->n_samples;
   l->stats->messages_dropped += in->n_dropped;
   if (in->have_command) {
     l->estop = in->estop;
@@ -129,9 +129,9 @@ static void absorb(loop_t *l, const pour_io_input_t *in) {
 static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   pour_control_input_t ci;
   memset(&ci, 0, sizeof ci);
-  ci.state_fresh = fresh;
+  ci.sensors_fresh = fresh;
   if (fresh) {
-    ci.state = in->state;
+    ci.sensors = in->sensors;
   }
   ci.estop = l->estop;
   ci.clear_faults = l->clear_pending;
@@ -180,8 +180,8 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   } else {
     l->have_last = true;
     l->last_episode = in->episode;
-    l->last_seq = in->state_seq;
-    l->last_utime = in->state_utime;
+    l->last_seq = in->sample_seq;
+    l->last_utime = in->sample_utime;
     send_answer(l);
   }
 }
@@ -196,7 +196,7 @@ static bool done(const loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_ns)
   return t_end_ns > 0 && mono_ns() >= t_end_ns;
 }
 
-/* Real time: tick k starts at t0 + k ms. All states that arrived since the last tick are read and
+/* Real time: tick k starts at t0 + k ms. All samples that arrived since the last tick are read and
  * the latest is used. A tick that ends after its deadline is an overrun; after a stall of more
  * than one period the schedule restarts from now rather than bursting to catch up. */
 static void run_realtime(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_ns) {
@@ -225,7 +225,7 @@ static void run_realtime(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
       l->stats->io_errors++;
     }
     absorb(l, &in);
-    tick(l, &in, in.n_states > 0);
+    tick(l, &in, in.n_samples > 0);
     maybe_send_status(l, false);
     const int64_t end = mono_ns();
     if (end > next + PERIOD_NS) {
@@ -238,9 +238,9 @@ static void run_realtime(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
   }
 }
 
-/* Lockstep: every state gets exactly one tick and one answer, whatever the wall clock does, so a run
- * is deterministic. A resent state (same episode and seq) gets the same answer again without a tick.
- * If no state comes for stall_ms, the loop ticks at 1 kHz on stale input, so that the core's input
+/* Lockstep: every sensor sample gets exactly one tick and one answer, whatever the wall clock does, so a
+ * run is deterministic. A resent sample (same episode and seq) gets the same answer again without a tick.
+ * If no sample comes for stall_ms, the loop ticks at 1 kHz on stale input, so that the core's input
  * timeout trips as it would in real time. */
 static void run_lockstep(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_ns) {
   int64_t last_state_ns = mono_ns();
@@ -264,10 +264,10 @@ static void run_lockstep(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
       l->stats->io_errors++;
     }
     absorb(l, &in);
-    if (in.n_states > 0) {
+    if (in.n_samples > 0) {
       stalled = false;
       last_state_ns = mono_ns();
-      if (l->have_last && in.episode == l->last_episode && in.state_seq == l->last_seq) {
+      if (l->have_last && in.episode == l->last_episode && in.sample_seq == l->last_seq) {
         l->stats->duplicates++;
         send_answer(l);
       } else {

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The controller process's loop: the firmware core at 1 kHz (or one tick per state in lockstep),
+/* The controller process's loop: the firmware core at 1 kHz (or one tick per sensor sample in lockstep),
  * fed through a pour_io_t. No transport and no argument parsing here. */
 #ifndef POUR_LINUX_CONTROLLER_H
 #define POUR_LINUX_CONTROLLER_H
@@ -12,10 +12,10 @@
 #include "pour/control.h"
 
 typedef struct {
-  bool lockstep;          /* one tick per received state (deterministic) instead of a 1 kHz clock */
-  int64_t stall_ms;       /* lockstep: no state for this long [ms] → tick at 1 kHz on stale input */
+  bool lockstep;          /* one tick per received sensor sample (deterministic) instead of a 1 kHz clock */
+  int64_t stall_ms;       /* lockstep: no sample for this long [ms] → tick at 1 kHz on stale input */
   int64_t duration_ms;    /* stop after this long [ms]; 0 runs until a signal */
-  int64_t max_states;     /* stop after answering this many states; 0: no limit */
+  int64_t max_states;     /* stop after answering this many sensor samples; 0: no limit */
   pour_control_config_t control;
   const pour_policy_weights_t *weights;
   bool verbose;           /* one line per status period on stderr */

@@ -9,14 +9,15 @@
 #include <stdint.h>
 
 #include "pour/control.h"
+#include "pour/sensors.h"
 
-/* What arrived during one wait. Only the latest state and the latest command are kept. */
+/* What arrived during one wait. Only the latest sensor sample and the latest command are kept. */
 typedef struct {
-  uint32_t n_states;     /* states decoded during this wait (> 1: older ones were superseded) */
-  pour_state_t state;    /* the latest state, already in the core's fixed-point units */
-  int64_t state_utime;   /* its source time stamp [µs], echoed in the answer */
-  int64_t state_seq;     /* its full sequence number (state.seq is the low 32 bits) */
-  int32_t episode;       /* its episode index (transports without one report 0) */
+  uint32_t n_samples;     /* sensor samples decoded during this wait (> 1: older ones were superseded) */
+  pour_sensors_t sensors; /* the latest sample, as the sensors read it (the core's estimator judges it) */
+  int64_t sample_utime;   /* its source time stamp [µs], echoed in the answer */
+  int64_t sample_seq;     /* its full sequence number (sensors.seq is the low 32 bits) */
+  int32_t episode;        /* its episode index (transports without one report 0) */
   bool have_command;     /* a command arrived */
   bool estop;            /* e-stop level of the latest command */
   bool clear_faults;     /* any command during this wait asked to clear faults */
@@ -25,15 +26,15 @@ typedef struct {
   uint32_t n_dropped;    /* messages on our channels that failed to decode */
 } pour_io_input_t;
 
-/* The answer to one state. */
+/* The answer to one sensor sample. */
 typedef struct {
   int64_t utime;         /* send time [µs], controller wall clock */
-  int64_t state_seq;     /* seq of the answered state */
-  int64_t state_utime;   /* utime of the answered state [µs] */
-  int32_t episode;       /* episode of the answered state */
+  int64_t sample_seq;    /* seq of the answered sample */
+  int64_t sample_utime;  /* utime of the answered sample [µs] */
+  int32_t episode;       /* episode of the answered sample */
   const pour_control_output_t *out;
   uint8_t n_actions;
-  const pour_obs_t *obs; /* observation the policy saw */
+  const pour_obs_t *obs; /* observation the policy saw (from the estimated state) */
   int32_t tau_max_mnm;   /* scale of the torque command [mN·m] */
   uint32_t weights_hash; /* content hash of the policy in use */
 } pour_io_answer_t;
@@ -45,7 +46,7 @@ typedef struct {
   uint8_t mode;            /* pour_mode_t */
   uint16_t faults;         /* POUR_FAULT_* */
   uint8_t limits;          /* POUR_LIMIT_* */
-  bool lockstep;           /* one tick per state instead of a 1 kHz wall clock */
+  bool lockstep;           /* one tick per sensor sample instead of a 1 kHz wall clock */
   int64_t overruns;        /* ticks that finished after their deadline */
   int32_t late_max_us;     /* worst tick-start lateness since the last status [µs] */
   int32_t step_time_ns;    /* last pour_control_step [ns] */
@@ -60,12 +61,12 @@ typedef struct pour_io pour_io_t;
 struct pour_io {
   void *ctx;
   /* Waits at most timeout_us (0: poll) for input and accumulates it into *in (which the caller
-   * zeroes). Returns 1 if a state arrived, 0 if not, negative on a transport error. */
+   * zeroes). Returns 1 if a sensor sample arrived, 0 if not, negative on a transport error. */
   int (*wait)(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in);
   /* Optional (NULL: the loop's own input stands): once per tick, the transport's part of the control
    * input. The CAN node supplies all of it there, its watchdog as the link fault included. */
   void (*begin_tick)(pour_io_t *io, pour_control_input_t *in);
-  /* Sends the answer to a state; returns 0 or negative on a transport error. */
+  /* Sends the answer to a sample; returns 0 or negative on a transport error. */
   int (*send_torque)(pour_io_t *io, const pour_io_answer_t *answer);
   /* Sends the health status; returns 0 or negative on a transport error. */
   int (*send_status)(pour_io_t *io, const pour_io_status_t *status);

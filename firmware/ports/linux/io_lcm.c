@@ -13,34 +13,39 @@
 #include "pour_command_t.h"
 #include "pour_controller_status_t.h"
 #include "pour_lcm/channels.h"
-#include "pour_plant_state_t.h"
+#include "pour_sensor_sample_t.h"
 #include "pour_torque_t.h"
-#include "state_si.h"
 
 typedef struct {
   lcm_t *lcm;
   pour_io_input_t *in; /* the wait in progress; handlers write here */
-  int got_state;
+  int got_sample;
 } io_lcm_t;
 
 /* A message counts only if it decodes completely and exactly: foreign fingerprints, truncated and
- * padded buffers are all dropped and counted. Both types are fixed-size, so decoding never allocates. */
-static void on_state(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
+ * padded buffers are all dropped and counted. Both types are fixed-size, so decoding never allocates.
+ * The readings reach the core as sent, with no conversion (the in-process simulator hands over the same
+ * integers): an impossible one (a negative or too large encoder count, a scale out of range) is the
+ * estimator's to refuse, which latches BAD_INPUT, rather than a message silently dropped here. */
+static void on_sensors(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
   (void)channel;
   io_lcm_t *s = user;
-  pour_plant_state_t msg;
-  const int n = pour_plant_state_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg);
+  pour_sensor_sample_t msg;
+  const int n = pour_sensor_sample_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg);
   if (n < 0 || (uint32_t)n != rbuf->data_size) {
     s->in->n_dropped++;
     return;
   }
-  pour_state_from_si(&s->in->state, msg.seq, msg.theta, msg.omega, msg.v_rotating, msg.v_target,
-                     msg.v_spill);
-  s->in->state_seq = msg.seq;
-  s->in->state_utime = msg.utime;
+  s->in->sensors.seq = (uint32_t)((uint64_t)msg.seq & 0xFFFFFFFFu);
+  /* Two's complement: a negative count becomes one >= 2^31, which no encoder has. */
+  s->in->sensors.encoder = (uint32_t)msg.encoder;
+  s->in->sensors.scale_rotating_g = msg.scale_rotating_g;
+  s->in->sensors.scale_target_g = msg.scale_target_g;
+  s->in->sample_seq = msg.seq;
+  s->in->sample_utime = msg.utime;
   s->in->episode = msg.episode;
-  s->in->n_states++;
-  s->got_state = 1;
+  s->in->n_samples++;
+  s->got_sample = 1;
 }
 
 static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *user) {
@@ -66,14 +71,14 @@ static int64_t now_us(void) {
 }
 
 /* select() gives µs resolution where lcm_handle_timeout() has ms; lcm_handle() then reads the
- * datagram that is known to be there. Returns at the first state so that a lockstep caller sees
- * every state; a real-time caller polls again with timeout 0 until nothing is left. */
+ * datagram that is known to be there. Returns at the first sample so that a lockstep caller sees
+ * every sample; a real-time caller polls again with timeout 0 until nothing is left. */
 static int io_lcm_wait(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in) {
   io_lcm_t *s = io->ctx;
   const int fd = lcm_get_fileno(s->lcm);
   const int64_t deadline = now_us() + (timeout_us < 0 ? 0 : timeout_us);
   s->in = in;
-  s->got_state = 0;
+  s->got_sample = 0;
   int rc = 0;
   for (;;) {
     int64_t wait_us = deadline - now_us();
@@ -96,7 +101,7 @@ static int io_lcm_wait(pour_io_t *io, int64_t timeout_us, pour_io_input_t *in) {
       rc = -1;
       break;
     }
-    if (s->got_state) {
+    if (s->got_sample) {
       rc = 1;
       break;
     }
@@ -110,8 +115,8 @@ static int io_lcm_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
   pour_torque_t msg;
   memset(&msg, 0, sizeof msg);
   msg.utime = a->utime;
-  msg.seq = a->state_seq;
-  msg.state_utime = a->state_utime;
+  msg.seq = a->sample_seq;
+  msg.state_utime = a->sample_utime;
   msg.episode = a->episode;
   msg.torque_q15 = a->out->torque;
   msg.torque = (double)a->out->torque / 32768.0 * (double)a->tau_max_mnm * 1e-3;
@@ -172,7 +177,7 @@ int pour_io_lcm_open(pour_io_t *io, const char *url) {
     free(s);
     return -1;
   }
-  if (lcm_subscribe(s->lcm, POUR_LCM_CHANNEL_STATE, on_state, s) == NULL ||
+  if (lcm_subscribe(s->lcm, POUR_LCM_CHANNEL_SENSORS, on_sensors, s) == NULL ||
       lcm_subscribe(s->lcm, POUR_LCM_CHANNEL_COMMAND, on_command, s) == NULL) {
     fprintf(stderr, "pour_controller: cannot subscribe on '%s'\n", u);
     lcm_destroy(s->lcm);

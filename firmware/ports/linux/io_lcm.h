@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* LCM transport for the controller: POUR_STATE and POUR_COMMAND in, POUR_TORQUE and POUR_STATUS out. */
+/* LCM transport for the controller: POUR_SENSORS and POUR_COMMAND in, POUR_TORQUE and POUR_STATUS out. */
 #ifndef POUR_LINUX_IO_LCM_H
 #define POUR_LINUX_IO_LCM_H
 

@@ -63,7 +63,7 @@ static void housekeeping(socketcan_t *s) {
   }
 }
 
-/* Moves the frames waiting on the socket into the node; stops after the first completed state. The
+/* Moves the frames waiting on the socket into the node; stops after the first sensor sample. The
  * control input itself is taken once per tick, in can_begin_tick. */
 static int drain(socketcan_t *s, pour_io_input_t *in) {
   for (;;) {
@@ -92,12 +92,12 @@ static int drain(socketcan_t *s, pour_io_input_t *in) {
       s->dropped_reported = d;
       continue;
     }
-    /* This frame completed a state (a command frame must not report the one still waiting for its tick). */
-    if ((f.id & POUR_CAN_CMD_MASK) == POUR_CAN_CMD_STATE_B && s->node.state_fresh) {
-      in->n_states++;
-      in->state = s->node.state;
-      in->state_seq = (int64_t)s->node.state.seq; /* 32 bits, extended by the node: no wrap, no reset */
-      in->state_utime = 0; /* CAN carries no time stamp; the bridge restores it */
+    /* This frame was a sample (a command frame must not report the one still waiting for its tick). */
+    if ((f.id & POUR_CAN_CMD_MASK) == POUR_CAN_CMD_SENSORS && s->node.sensors_fresh) {
+      in->n_samples++;
+      in->sensors = s->node.sensors;
+      in->sample_seq = (int64_t)s->node.sensors.seq; /* 32 bits, extended by the node: no wrap, no reset */
+      in->sample_utime = 0; /* CAN carries no time stamp; the bridge restores it */
       in->episode = 0;
       return 1;
     }

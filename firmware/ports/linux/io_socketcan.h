@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* SocketCAN transport for the controller: the pour CAN protocol (can/pour.dbc) on a Linux CAN interface.
- * StateA/StateB, Estop, Stop, ClearErrors and Reset in; Torque (one per answered state), Heartbeat and
+ * Sensors, Estop, Stop, ClearErrors and Reset in; Torque (one per answered state), Heartbeat and
  * Identity out. Every frame, the command watchdog and the control input of a tick are pour::can's node
  * (the same calls as the Cortex-M4 port); this file only moves frames and keeps the wall clock. */
 #ifndef POUR_LINUX_IO_SOCKETCAN_H

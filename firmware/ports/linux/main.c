@@ -25,11 +25,13 @@ static void usage(FILE *f) {
           "  --io lcm[:URL]         transport (default lcm with its default URL)\n"
           "  --io can:IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n"
           "                         SocketCAN, the protocol of can/pour.dbc (defaults 0, 100, 50)\n"
-          "  --lockstep             one tick per received state (deterministic; host_sim --lockstep)\n"
-          "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a state (2000)\n"
+          "  --lockstep             one tick per sensor sample (deterministic; host_sim --lockstep)\n"
+          "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a sample (2000)\n"
           "  --duration S           stop after S seconds (default: run until SIGINT/SIGTERM)\n"
-          "  --max-states N         stop after answering N states\n"
+          "  --max-states N         stop after answering N sensor samples\n"
           "  --input-timeout-ms N   the core's input timeout (default from the core)\n"
+          "  --encoder-bits N       resolution of the rig's absolute encoder, %u .. %u (default %u; host_sim's\n"
+          "                         encoder_bits must match)\n"
           "  --sampled              sample actions instead of the greedy argmax\n"
           "  --seed N               seed of the sampled mode\n"
           "  --verbose              a status line on stderr every 100 ms\n"
@@ -38,7 +40,8 @@ static void usage(FILE *f) {
           "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
           "transport cannot be opened, the core refuses its configuration); 2 bad command line (an unknown\n"
           "option or a bad value, --io's included). Numbers are decimal: node=010 is node 10.\n",
-          (unsigned)pour_weights_compiled.content_hash);
+          (unsigned)POUR_ENCODER_BITS_MIN, (unsigned)POUR_ENCODER_BITS_MAX,
+          (unsigned)pour_sensors_default_config().encoder_bits, (unsigned)pour_weights_compiled.content_hash);
 }
 
 /* Parses a whole decimal integer in [lo, hi]; prints a message naming the option otherwise. */
@@ -135,6 +138,12 @@ int main(int argc, char **argv) {
         return 2;
       }
       cfg.control.input_timeout_ms = (uint16_t)n;
+      i++;
+    } else if (strcmp(a, "--encoder-bits") == 0) {
+      if (parse_int(a, v, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, &n) != 0) {
+        return 2;
+      }
+      cfg.control.sensors.encoder_bits = (uint8_t)n;
       i++;
     } else if (strcmp(a, "--sampled") == 0) {
       cfg.control.policy_mode = POUR_POLICY_SAMPLED;

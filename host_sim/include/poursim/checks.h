@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* Physical checks of the simulated liquid against independent references: hydrostatics (an ideal
- * liquid's retention curve) and linear sloshing theory (the first mode of a rectangular tank). The
+/* Physical checks of the simulated liquid and rig against independent references: hydrostatics (an ideal
+ * liquid's retention curve, a resting liquid's weight), linear sloshing theory (the first mode of a
+ * rectangular tank), momentum (the stream's impact), Newton's second law and the drive's datasheet line. The
  * benchmark prints them, the tests pin them, pour-plots draws them (docs/simulator.md). */
 #ifndef POURSIM_CHECKS_H
 #define POURSIM_CHECKS_H
@@ -57,6 +58,48 @@ typedef struct {
 int poursim_measure_slosh(const poursim_config_t *config, uint32_t seed, int n_seeds, double tilt, double ramp_s,
                           double hold_s, double *trace, int trace_cap, poursim_slosh_t *out, char *err,
                           size_t err_len);
+
+/* ---- The rig: the drive and the sensors against their references (docs/simulator.md, "The rig"). ---- */
+
+typedef struct {
+  int latency_ticks;           /* steps from the call that commands torque to the first step the bucket moves */
+  double inertia_measured;     /* Σ net torque / Σ α over a spin-up from rest at upright [kg·m²] */
+  double inertia_expected;     /* the U of three boxes about the pivot, by hand, + J·N² [kg·m²] */
+  double inertia_bucket;       /* the U alone [kg·m²] */
+  double breakaway_torque;     /* delivered torque when the bucket first moves, slow ramp from rest [N·m] */
+  double terminal_load[2];     /* Coulomb friction of the two free-spin runs (the config's, and 10 N·m) [N·m] */
+  double terminal_speed[2];    /* full command, no stops, mean speed over the last second of 1.5 s [rad/s] */
+  double terminal_expected[2]; /* the datasheet line: ω₀·(1 − (τ_c + b·ω)/τ_peak), solved for ω [rad/s] */
+} poursim_drive_check_t;
+
+/* Runs the drive on the empty bucket (the liquid taken out) of config: latency, reflected inertia,
+ * Coulomb breakaway, and terminal speeds on the torque–speed line. */
+int poursim_measure_drive(const poursim_config_t *config, poursim_drive_check_t *out, char *err, size_t err_len);
+
+typedef struct {
+  double encoder_max_error;    /* max |count − θ·2^bits/2π| (wrapped) over a swing from the lower stop [counts] */
+  uint32_t encoder_at_stop;    /* the count at the lower stop (below upright: just under 2^bits) */
+  double liquid_g;             /* the liquid's mass [g] */
+  double rest_rotating_g;      /* mean rotating reading, full bucket held upright, 1 s [g] */
+  double target_liquid_g;      /* V_target × the liquid's mass, after the pour settled [g] */
+  double rest_target_g;        /* mean target reading then, 1 s [g] */
+  double update_rate_hz;       /* reading changes per second during the pour */
+  double delay_s;              /* the lag at which the conversions equal an undelayed every-step reading [s] */
+  double delay_match;          /* share of the conversions equal to it at that lag */
+  double noise_rms_g;          /* RMS of noisy − noise-free conversions, same seed [g] */
+  double noise_expected_g;     /* that RMS for Gaussian noise of scale_noise_g quantised to scale_resolution_g [g] */
+  double impact_impulse_gs;    /* ∫(target reading − mass inside the target) dt over the pour [g·s] */
+  double impact_expected_gs;   /* Σ m·v_down of particles entering the target, minus leaving, / g [g·s] */
+  double impact_peak_g;        /* largest impact term (50 ms mean) during the pour [g] */
+  double impact_peak_reading_g; /* the target reading at that moment [g] */
+  int hash_unchanged;          /* 1: noise, lag and rate of the scales left the trajectory hash as it was */
+} poursim_sensor_check_t;
+
+/* Pours with the servo (held upright 1 s, tilted at 0.5 rad/s to 125°, held 3 s) in three worlds of the
+ * same seed: the sensors of config, the same without noise, and an every-step undelayed noise-free
+ * reference; compares them, and the readings against the liquid's mass and momentum. */
+int poursim_measure_sensors(const poursim_config_t *config, uint32_t seed, poursim_sensor_check_t *out, char *err,
+                            size_t err_len);
 
 #ifdef __cplusplus
 }

@@ -64,6 +64,28 @@ typedef struct {
   double theta_min;       /* lower hard stop [rad] */
   double theta_max;       /* upper hard stop [rad] */
   double brake_torque;    /* holding brake's rating [N·m] (poursim_set_brake) */
+  /* the drive between the command and the bucket (docs/simulator.md, "The rig": defaults and sources) */
+  double motor_peak_torque;   /* peak torque at the output [N·m]: the command is clamped to it */
+  double motor_no_load_speed; /* output speed at which the available motoring torque reaches 0 [rad/s] */
+  double motor_rotor_inertia; /* rotor inertia at the motor [kg·m²]; J·N² is added to the bucket's */
+  double gear_ratio;          /* motor turns per output turn [-] */
+  double friction_coulomb;    /* the drive's Coulomb friction at the output, holds at standstill [N·m] */
+  double friction_viscous;    /* viscous friction at the output [N·m·s/rad] */
+  int command_latency_ticks;  /* a command acts this many steps after the step it is given in (>= 1) */
+  /* the rig's sensors (poursim_obs_t.encoder, scale_rotating_g, scale_target_g) */
+  int encoder_bits;           /* single-turn absolute encoder on the output shaft [bits] */
+  double scale_rate_hz;       /* load cells' conversion rate [Hz]; readings held between conversions */
+  double scale_delay_s;       /* a conversion reports the load this long before it [s] */
+  double scale_noise_g;       /* Gaussian noise of a conversion, standard deviation [g] */
+  double scale_resolution_g;  /* readings are multiples of this [g] */
+  /* domain randomisation: uniform ± around the nominal, drawn from the reset seed; 0 = off */
+  double rand_fill;           /* fill_depth, relative [-] */
+  double rand_target_dx;      /* target_dx [m] */
+  double rand_pivot_height;   /* pivot_height [m] */
+  double rand_motor;          /* peak torque, no-load speed, both frictions, rotor inertia, relative [-] */
+  double rand_bucket_mass;    /* bucket_mass, relative [-] */
+  double rand_liquid;         /* fluid viscosity, stiffness, agitation, liquid density, relative [-] */
+  double rand_sensor;         /* scale delay and noise, relative [-]; latency +0 or +1 tick */
   /* observation normalisation (must match the policy's weights.h) */
   double obs_theta_min;   /* [rad] */
   double obs_theta_max;   /* [rad] */
@@ -87,8 +109,14 @@ typedef struct {
   double v_flight;      /* fraction in none of those (in the air) */
   double obs[5];        /* normalised θ, θ̇, V_rot, V_tgt, V_spill, each in [0, 1] */
   double reward;        /* K_target·V_target − K_spill·V_spill of this state */
-  double torque;        /* torque applied in the step that led here [N·m] */
+  double torque;        /* torque commanded in the step that led here, a·tau_max [N·m] */
   int done;             /* 1 once t reaches episode_s */
+  /* What the rig delivers and senses (docs/simulator.md, "The rig"). */
+  double motor_torque;  /* torque the drive delivered at the output in that step (after latency, peak and
+                           back-EMF limits; friction acts on top) [N·m] */
+  uint32_t encoder;     /* output-shaft absolute encoder: round(θ·2^bits/2π) mod 2^bits (0 = upright) */
+  int32_t scale_rotating_g; /* load cell carrying the rotating bucket, tared empty [g] */
+  int32_t scale_target_g;   /* load cell under the target bucket, tared empty [g] */
 } poursim_obs_t;
 
 typedef struct poursim_world poursim_world_t;
@@ -106,6 +134,10 @@ int poursim_config_load(const char *path, poursim_config_t *config, char *err, s
 int poursim_config_set(poursim_config_t *config, const char *key, const char *value, char *err,
                        size_t err_len);
 
+/* Every config key with its unit, range and default, one a line (for --help); POURSIM_EINVAL if buf is
+ * too small (8 KiB is plenty). */
+int poursim_config_describe(char *buf, size_t len);
+
 /* Writes the config as a loadable file. */
 int poursim_config_write(const poursim_config_t *config, const char *path, char *err, size_t err_len);
 
@@ -115,14 +147,17 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
 /* Rebuilds the scene: new liquid arrangement from seed, settled, bucket upright at rest, t = 0. */
 int poursim_reset(poursim_world_t *world, uint32_t seed);
 
-/* One dt step with torque a·tau_max, a in [-1, 1] (clamped); fills *out (may be NULL).
+/* One dt step commanding torque a·tau_max, a in [-1, 1] (clamped), to the drive: it acts after
+ * command_latency_ticks steps, within the drive's peak and torque–speed line, against its friction and
+ * with its rotor inertia (docs/simulator.md, "The rig"); fills *out (may be NULL).
  * POURSIM_ENUMERIC if the liquid blew up in this step (a non-finite or runaway particle): the world is
  * then unusable until reset, and poursim_world_error() says which particle and where. */
 int poursim_step(poursim_world_t *world, double action, poursim_obs_t *out);
 
 /* Engages (1) or releases (0) the holding brake on the bucket's axis, for the steps that follow: a
  * friction brake that stops the axis and holds it against up to brake_torque, as the joint's motor at
- * zero speed with that torque limit. Torque from poursim_step still acts on top. */
+ * zero speed with that torque limit (plus the drive's friction_coulomb, which uses the same motor). Torque
+ * from poursim_step still acts on top. */
 int poursim_set_brake(poursim_world_t *world, int engaged);
 
 /* One dt step with the bucket driven toward theta_ref [rad] by a stiff servo (the joint's motor) instead
@@ -141,6 +176,10 @@ void poursim_observe(const poursim_world_t *world, poursim_obs_t *out);
 void poursim_destroy(poursim_world_t *world);
 
 const poursim_config_t *poursim_world_config(const poursim_world_t *world);
+
+/* The config of the current episode: the world's config with the rand_* draws of the last reset's seed
+ * applied (equal to poursim_world_config when every rand_* key is 0). */
+const poursim_config_t *poursim_episode_config(const poursim_world_t *world);
 
 /* Number of circles. */
 int poursim_particle_count(const poursim_world_t *world);
@@ -173,6 +212,7 @@ typedef struct {
   double theta_min, theta_max; /* normalisation [rad] */
   double omega_max;            /* [rad/s] */
   int greedy;                 /* 1: argmax (ties to lowest index); 0: sample with the seed */
+  double k_reversal;          /* training's reward shaping: cost of each torque reversal (0: none) */
 } poursim_policy_t;
 
 /* Caller-provided arrays; any pointer may be NULL. Capacities: decisions = ceil(steps / period). */
@@ -199,6 +239,10 @@ typedef struct {
   double ret;          /* Σ γ^t r_t */
   double reward_sum;   /* Σ r_t */
   double max_theta;    /* [rad] */
+  double liquid_l;     /* the episode's fill [L] (its config's fill_depth in a round bucket) */
+  double peak_omega;   /* max |θ̇| [rad/s] */
+  double peak_alpha;   /* max |θ̈|, θ̇ differenced over 10 ms [rad/s²] */
+  int reversals;       /* sign changes of the commanded torque beyond ±1 N·m */
 } poursim_episode_t;
 
 /* Resets the world with seed, runs one full episode: at steps 0, P, 2P, … the policy picks an action

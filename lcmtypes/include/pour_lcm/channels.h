@@ -4,9 +4,13 @@
 #ifndef POUR_LCM_CHANNELS_H
 #define POUR_LCM_CHANNELS_H
 
-/* Plant state, host_sim -> controller, every 1 ms tick (pour_plant_state_t). */
-#define POUR_LCM_CHANNEL_STATE "POUR_STATE"
-/* Torque answering one state, controller -> host_sim (pour_torque_t). */
+/* Raw sensor sample (encoder count, two scales), host_sim or a rig -> controller, every 1 ms tick
+ * (pour_sensor_sample_t). The only plant input the controller has. */
+#define POUR_LCM_CHANNEL_SENSORS "POUR_SENSORS"
+/* Ground truth of the simulated plant, host_sim -> bench tools only, every tick (pour_plant_truth_t);
+ * no controller subscribes to it. */
+#define POUR_LCM_CHANNEL_TRUTH "POUR_TRUTH"
+/* Torque answering one sensor sample, controller -> host_sim (pour_torque_t). */
 #define POUR_LCM_CHANNEL_TORQUE "POUR_TORQUE"
 /* Controller health at about 10 Hz (pour_controller_status_t). */
 #define POUR_LCM_CHANNEL_STATUS "POUR_STATUS"

@@ -13,6 +13,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import math
+
 import cantools
 
 SOURCE_DIR = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[3]))
@@ -20,11 +22,18 @@ BUILD_DIR = Path(os.environ.get("POUR_BUILD_DIR", SOURCE_DIR / "build" / "host")
 DBC = SOURCE_DIR / "can" / "pour.dbc"
 IFACE = "vcan0"
 FRAME = struct.Struct("=IB3x8s")
+ENCODER_BITS = 17  # the controller's default
+LIQUID_G = 10300   # 10 L of soymilk
+
+
+def encoder_count(theta_urad: float) -> int:
+    """What the 17-bit absolute encoder reads at tilt theta (0 upright; below upright wraps)."""
+    return round(theta_urad * 1e-6 * (1 << ENCODER_BITS) / (2 * math.pi)) % (1 << ENCODER_BITS)
 
 
 class Plant:
-    """A damped bucket that moves with the controller's torque, so that scripted states are physical: the
-    controller's supervisor calls a bucket that never moves under torque a frozen encoder. Per state:
+    """A damped bucket that moves with the controller's torque, so that scripted samples are physical: the
+    controller's supervisor calls a bucket that never moves under torque a frozen encoder. Per sample:
     θ̇ ← 0.9 θ̇ + 6 µrad/s per Q15 LSB of the last torque (≤ 2 rad/s), θ += θ̇ · 1 ms; added to what a test
     sends."""
 
@@ -64,11 +73,13 @@ class Bus:
         m = self.db.get_message_by_name(name)
         self.send_raw((node << 5) | m.frame_id, m.encode(signals, scaling=False))
 
-    def send_state(self, seq: int, theta_urad: int = 0, omega_urad_s: int = 0, vr: int = 32767, vt: int = 0,
-                   vs: int = 0, node: int = 0) -> None:
-        dtheta, domega = self.plant.advance()
-        self.send("StateA", node, Theta=theta_urad + dtheta, Omega=omega_urad_s + domega, SeqLow=seq & 0xFF)
-        self.send("StateB", node, Seq=seq & 0xFFFF, VRotating=vr, VTarget=vt, VSpill=vs)
+    def send_sample(self, seq: int, theta_urad: int = 0, rot_g: int = LIQUID_G, tgt_g: int = 0, node: int = 0,
+                    encoder: int | None = None) -> None:
+        """One Sensors frame: the encoder at the plant's tilt plus theta_urad (or the raw count given), the
+        scales as given [g]."""
+        dtheta, _ = self.plant.advance()
+        count = encoder_count(theta_urad + dtheta) if encoder is None else encoder
+        self.send("Sensors", node, Seq=seq & 0xFF, Encoder=count, ScaleRotating=rot_g, ScaleTarget=tgt_g)
 
     def recv(self, timeout: float) -> Frame | None:
         """The next frame, or None if none arrives within timeout."""

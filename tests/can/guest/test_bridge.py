@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
-"""can_bridge on vcan0 as LCM tools see it: POUR_STATE in, POUR_TORQUE and POUR_STATUS out from a controller
-that only speaks CAN, POUR_COMMAND e-stop and clear reaching it, garbage on LCM dropped and counted."""
+"""can_bridge on vcan0 as LCM tools see it: POUR_SENSORS in, POUR_TORQUE and POUR_STATUS out from a controller
+that only speaks CAN, POUR_COMMAND e-stop and clear reaching it, garbage on LCM dropped and counted, readings
+the Sensors frame cannot carry refused with a message."""
 from __future__ import annotations
 
 import random
@@ -12,7 +13,7 @@ import time
 import lcm
 import pytest
 
-from canbus import BUILD_DIR, SOURCE_DIR, Plant
+from canbus import BUILD_DIR, LIQUID_G, SOURCE_DIR, Plant, encoder_count
 from pour import channels, lcm_types
 
 msgs = lcm_types.load()
@@ -20,7 +21,7 @@ URL = "udpm://239.255.76.67:7683?ttl=0"
 
 
 class Host:
-    """A minimal LCM host: sends states, collects the answers and statuses the bridge publishes."""
+    """A minimal LCM host: sends sensor samples, collects the answers and statuses the bridge publishes."""
 
     def __init__(self) -> None:
         self.lc = lcm.LCM(URL)
@@ -35,12 +36,16 @@ class Host:
         while time.monotonic() < end:
             self.lc.handle_timeout(10)
 
-    def state(self, seq: int, episode: int = 7):
-        m = msgs.plant_state_t()
+    @staticmethod
+    def encode(seq: int, episode: int, encoder: int, scale_rotating_g: int = LIQUID_G) -> bytes:
+        m = msgs.sensor_sample_t()
         m.utime, m.seq, m.episode = 1000 * seq + 11, seq, episode
-        theta_urad, omega_urad_s = self.plant.advance()
-        m.theta, m.omega, m.v_rotating, m.v_target, m.v_spill = theta_urad * 1e-6, omega_urad_s * 1e-6, 1.0, 0.0, 0.0
-        self.lc.publish(channels.STATE, m.encode())
+        m.encoder, m.scale_rotating_g, m.scale_target_g = encoder, scale_rotating_g, 0
+        return m.encode()
+
+    def state(self, seq: int, episode: int = 7):
+        theta_urad, _ = self.plant.advance()
+        self.lc.publish(channels.SENSORS, self.encode(seq, episode, encoder_count(theta_urad)))
         end = time.monotonic() + 5.0
         while time.monotonic() < end:
             self.lc.handle_timeout(20)
@@ -99,9 +104,13 @@ def test_bridge_makes_a_can_controller_look_like_an_lcm_one():
 
         rng = random.Random(5)  # garbage on our channels: decoded by nobody, counted by the bridge
         for _ in range(5):
-            host.lc.publish(channels.STATE, bytes(rng.getrandbits(8) for _ in range(rng.randint(0, 40))))
+            host.lc.publish(channels.SENSORS, bytes(rng.getrandbits(8) for _ in range(rng.randint(0, 40))))
             host.lc.publish(channels.COMMAND, b"\x00\x01")
+        # A reading the Sensors frame cannot carry (±32767 g): refused by the bridge, never wrapped into
+        # another value; no answer comes to it.
+        host.lc.publish(channels.SENSORS, Host.encode(61, 7, 0, scale_rotating_g=40000))
         host.pump(0.2)
+        assert not [t for t in host.torques if t.seq == 61]
         assert host.state(61).seq == 61
     finally:
         bridge.send_signal(signal.SIGINT)
@@ -114,5 +123,6 @@ def test_bridge_makes_a_can_controller_look_like_an_lcm_one():
     assert m, out
     states, refused, torques, unmatched, heartbeats, identities, frames_dropped, commands, lcm_dropped = map(
         int, m.groups())
-    assert states == torques == 62 and refused == unmatched == frames_dropped == 0
+    assert states == torques == 62 and refused == 1 and unmatched == frames_dropped == 0
+    assert "POUR_SENSORS seq 61 not sent: scale_rotating_g outside -32767 .. 32767 g" in err
     assert heartbeats > 0 and identities > 0 and commands == 2 and lcm_dropped == 10

@@ -20,8 +20,7 @@
 #define POUR_CAN_CMD_ESTOP 0x02u        /* host -> controller */
 #define POUR_CAN_CMD_STOP 0x03u         /* host -> controller: end the run */
 #define POUR_CAN_CMD_IDENTITY 0x04u     /* controller -> host, with every heartbeat: policy, scale, version */
-#define POUR_CAN_CMD_STATE_A 0x10u      /* host -> controller: θ, θ̇, seq low byte */
-#define POUR_CAN_CMD_STATE_B 0x11u      /* host -> controller: seq, three volumes; completes a state */
+#define POUR_CAN_CMD_SENSORS 0x10u      /* host -> controller: one raw sensor sample (encoder, scales) */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
 #define POUR_CAN_CMD_RESET 0x19u        /* host -> controller: start a new run (refused while running) */
@@ -31,19 +30,19 @@
 #define POUR_CAN_DLC_ESTOP 1u
 #define POUR_CAN_DLC_STOP 0u
 #define POUR_CAN_DLC_IDENTITY 8u
-#define POUR_CAN_DLC_STATE_A 8u
-#define POUR_CAN_DLC_STATE_B 8u
+#define POUR_CAN_DLC_SENSORS 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
 #define POUR_CAN_DLC_RESET 0u
 
 /* Signal ranges, as the DBC's [min|max] in raw units; a value outside is out of range. */
-#define POUR_CAN_THETA_MAX_URAD 3200000   /* |θ| <= 3.2 rad; 24-bit signed field [µrad] */
-#define POUR_CAN_OMEGA_MAX_URAD_S 50000000 /* |θ̇| <= 50 rad/s [µrad/s] */
-#define POUR_CAN_VOLUME_MAX_Q15 32767      /* volumes in [0, 32767] Q15 */
+#define POUR_CAN_ENCODER_MAX 0xFFFFFFu /* 24-bit count field: encoders of up to 24 bits; the core's estimator
+                                         * refuses a count >= 2^encoder_bits (BAD_INPUT) */
+#define POUR_CAN_SCALE_MAX_G 32767     /* |scale| <= 32.767 kg [g]; -32768 is the load cell amplifier's
+                                         * overload code, out of range */
 #define POUR_CAN_MODE_MAX 3u               /* pour_mode_t */
 #define POUR_CAN_ACTION_MAX 15u
-#define POUR_CAN_LIMITS_MAX 15u
+#define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
 
 /* The CAN node's command watchdog latches in the core as its link fault. */
@@ -56,25 +55,21 @@ typedef struct {
   uint8_t data[8]; /* bytes past dlc are zero in packed frames and ignored on unpack */
 } pour_can_frame_t;
 
+/* One raw sensor sample (pour_sensors_t on the wire): the encoder and the scales as the sensors read them,
+ * no conversion, so a sample over CAN reaches the core with the bits it has in-process. */
 typedef struct {
-  int32_t theta_urad;   /* [µrad], |θ| <= POUR_CAN_THETA_MAX_URAD */
-  int32_t omega_urad_s; /* [µrad/s], |θ̇| <= POUR_CAN_OMEGA_MAX_URAD_S */
-  uint8_t seq_low;      /* low byte of the matching StateB seq */
-} pour_can_state_a_t;
-
-typedef struct {
-  uint16_t seq;     /* sample counter, wraps */
-  q15_t v_rotating; /* [0, 32767] Q15 */
-  q15_t v_target;   /* [0, 32767] Q15 */
-  q15_t v_spill;    /* [0, 32767] Q15 */
-} pour_can_state_b_t;
+  uint8_t seq_low;          /* low 8 bits of the sample counter; the node extends it to 32 bits */
+  uint32_t encoder;         /* raw single-turn count, 0 .. POUR_CAN_ENCODER_MAX */
+  int16_t scale_rotating_g; /* [g], |.| <= POUR_CAN_SCALE_MAX_G */
+  int16_t scale_target_g;   /* [g], |.| <= POUR_CAN_SCALE_MAX_G */
+} pour_can_sensors_t;
 
 typedef struct {
   uint16_t seq;   /* seq of the latest complete state */
   q15_t torque;   /* fraction of tau_max, Q15 */
   uint8_t action; /* 0 .. 15 */
   uint8_t mode;   /* pour_mode_t, 0 .. 3 */
-  uint8_t limits; /* POUR_LIMIT_* bits, 0 .. 15 */
+  uint8_t limits; /* POUR_LIMIT_* bits, 0 .. 63 */
 } pour_can_torque_t;
 
 typedef struct {
@@ -106,8 +101,7 @@ typedef enum {
   POUR_CAN_RX_OTHER_NODE = 1,  /* another node's id: not ours, silently ignored */
   POUR_CAN_RX_BAD_ID = -1,     /* our node, but no such cmd (or a cmd we only send) */
   POUR_CAN_RX_BAD_DLC = -2,    /* known cmd with the wrong data length */
-  POUR_CAN_RX_OUT_OF_RANGE = -3, /* a signal outside its DBC range */
-  POUR_CAN_RX_UNPAIRED = -4      /* (node) a StateB whose StateA was lost or did not match */
+  POUR_CAN_RX_OUT_OF_RANGE = -3 /* a signal outside its DBC range */
 } pour_can_rx_t;
 
 /* id of cmd for node_id (both masked to their field widths). */
@@ -118,8 +112,7 @@ static inline uint16_t pour_can_id(uint8_t node_id, uint8_t cmd) {
 
 /* Pack functions: POUR_EINVAL for a null pointer, a node id > 63 or a field outside its DBC range
  * (the frame is then left untouched). */
-pour_status_t pour_can_pack_state_a(uint8_t node_id, const pour_can_state_a_t *msg, pour_can_frame_t *frame);
-pour_status_t pour_can_pack_state_b(uint8_t node_id, const pour_can_state_b_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_sensors(uint8_t node_id, const pour_can_sensors_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
                                       pour_can_frame_t *frame);
@@ -130,8 +123,7 @@ pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame
 
 /* Unpack functions check the id's cmd, the DLC and every range; msg is written only on POUR_CAN_RX_OK.
  * The node id of the frame is not checked here (pour_can_classify does that). */
-pour_can_rx_t pour_can_unpack_state_a(const pour_can_frame_t *frame, pour_can_state_a_t *msg);
-pour_can_rx_t pour_can_unpack_state_b(const pour_can_frame_t *frame, pour_can_state_b_t *msg);
+pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_sensors_t *msg);
 pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg);
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg);
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg);

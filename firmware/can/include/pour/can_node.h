@@ -12,12 +12,13 @@
 #include "pour/can_codec.h"
 #include "pour/control.h"
 #include "pour/fixed.h"
+#include "pour/sensors.h"
 
 #define POUR_CAN_NODE_MAX_TX 3u /* frames one tick can produce: torque, heartbeat and identity */
 
 typedef struct {
   uint8_t node_id;              /* 0 .. 63 */
-  uint16_t watchdog_ms;         /* >= 1: no valid state or command for longer trips the watchdog [ms] */
+  uint16_t watchdog_ms;         /* >= 1: no valid sample or command for longer trips the watchdog [ms] */
   uint16_t heartbeat_period_ms; /* >= 1: a heartbeat and an identity frame every this many ticks [ms] */
   pour_can_identity_t identity; /* what the identity frame says (policy hash, tau_max, version, init) */
 } pour_can_node_config_t;
@@ -28,22 +29,19 @@ typedef struct {
   uint32_t bad_id;       /* our node, unknown or send-only cmd */
   uint32_t bad_dlc;      /* wrong data length */
   uint32_t out_of_range; /* a signal outside its DBC range */
-  uint32_t unpaired;     /* StateB without the StateA of the same sample */
   uint32_t other_node;   /* other nodes' frames (ignored, not an error) */
 } pour_can_node_counters_t;
 
 typedef struct {
   pour_can_node_config_t config;
-  pour_can_state_a_t pending_a; /* the latest StateA, waiting for its StateB */
-  bool have_a;
-  bool have_seq;                /* a state arrived since init or the last Reset */
-  pour_state_t state;           /* latest complete state, seq extended to 32 bits */
-  bool state_fresh;             /* completed since the last tick */
+  bool have_seq;                /* a sample arrived since init or the last Reset */
+  pour_sensors_t sensors;       /* latest sensor sample, seq extended to 32 bits */
+  bool sensors_fresh;           /* arrived since the last tick */
   bool estop;                   /* level, from the latest Estop frame */
   bool clear_request;           /* one-shot, from ClearErrors */
   bool stop_request;            /* one-shot, from Stop */
   bool reset_request;           /* one-shot, from Reset */
-  bool armed;                   /* watchdog runs once the first valid state or command arrived */
+  bool armed;                   /* watchdog runs once the first valid sample or command arrived */
   uint32_t ms_since_valid;
   uint16_t ms_to_heartbeat;
   uint8_t heartbeat_counter;
@@ -54,15 +52,16 @@ typedef struct {
  * an identity of hash 0, tau_max 0 and this firmware's version. */
 pour_can_node_config_t pour_can_node_default_config(void);
 
-/* Validates config (POUR_EINVAL otherwise); no state, heartbeat due on the first tick. */
+/* Validates config (POUR_EINVAL otherwise); no sample yet, heartbeat due on the first tick. */
 pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config);
 
 /* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
 
-/* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick, the
- * watchdog's state as in->link_fault. StateB's 16-bit seq reaches the core extended to 32 bits (it wraps
- * every 65.5 s at 1 kHz; a wrap is just the next sample, only a Reset frame restarts the count). */
+/* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick (the
+ * latest Sensors sample, as the sensors read it), the watchdog's state as in->link_fault. The frame's
+ * 8-bit seq reaches the core extended to 32 bits by its forward distance (it wraps every 256 ms at 1 kHz;
+ * a wrap is just the next sample, only a Reset frame restarts the count). */
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 
 /* End of a tick: advances the watchdog by 1 ms, then writes the torque frame and, when due, the

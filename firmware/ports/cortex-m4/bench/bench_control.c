@@ -26,17 +26,18 @@ static void spin(uint32_t n) {
 static pour_control_t ctl;
 static pour_control_input_t inputs[64];
 
+/* A bucket swinging at ±1.9 rad/s, its scales moving, the seq counting: every step a full RUN step (the
+ * estimator, the governor's band and every supervisor check compute on every tick). */
 static void make_inputs(void) {
   for (unsigned i = 0; i < 64u; ++i) {
-    inputs[i].state_fresh = true;
+    const int32_t k = (int32_t)(i < 32u ? i : 64u - i); /* up and back down, no jump at the ring's seam */
+    inputs[i].sensors_fresh = true;
     inputs[i].estop = false;
     inputs[i].clear_faults = false;
-    inputs[i].state.seq = i;
-    inputs[i].state.theta_urad = (int32_t)(i * 30000u);
-    inputs[i].state.omega_urad_s = (int32_t)(i * 20000u) - 600000;
-    inputs[i].state.v_rotating = (q15_t)(32767 - (int32_t)i * 500);
-    inputs[i].state.v_target = (q15_t)(i * 480u);
-    inputs[i].state.v_spill = (q15_t)(i * 10u);
+    inputs[i].sensors.seq = i;
+    inputs[i].sensors.encoder = (uint32_t)(20000 + 40 * k); /* 17-bit counts: ±1.92 rad/s */
+    inputs[i].sensors.scale_rotating_g = 10000 - 120 * k;
+    inputs[i].sensors.scale_target_g = 110 * k;
   }
 }
 
@@ -50,6 +51,8 @@ static pour_control_config_t bench_config(void) {
   config.supervisor.encoder_move_urad = 1;
   config.supervisor.volume_step_max = POUR_Q15_MAX;
   config.supervisor.accel_passive_urad_s2 = INT32_MAX;
+  config.supervisor.omega_max_urad_s = 50000000;
+  config.sensors.jump_max_urad = 1000000; /* the swing turns round within a tick */
   return config;
 }
 
@@ -62,7 +65,7 @@ static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
   pour_control_output_t out;
   const uint32_t t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
-    inputs[i & 63u].state.seq = i + 1u; /* a sender that counts, as the supervisor requires */
+    inputs[i & 63u].sensors.seq = i + 1u; /* a sender that counts, as the supervisor requires */
     if (do_step) {
       pour_control_step(&ctl, &inputs[i & 63u], &out);
     } else {
@@ -90,7 +93,7 @@ static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_ki
   pour_control_output_t out;
   const uint32_t period = w->decision_period_ms;
   for (uint32_t i = 0; i < N_STEPS; ++i) {
-    inputs[i & 63u].state.seq = i + 1u;
+    inputs[i & 63u].sensors.seq = i + 1u;
     const uint32_t t0 = now();
     pour_control_step(&ctl, &inputs[i & 63u], &out);
     sum[i % period] += elapsed(t0, now());
@@ -121,14 +124,31 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
   pour_policy_t policy;
   pour_policy_eval_t ev;
   pour_obs_t obs[64];
-  if (pour_policy_init(&policy, w, POUR_POLICY_GREEDY, 1u) != POUR_OK) {
+  pour_state_t states[64];
+  static pour_estimator_t est;
+  const pour_sensors_config_t sc = bench_config().sensors;
+  if (pour_policy_init(&policy, w, POUR_POLICY_GREEDY, 1u) != POUR_OK || pour_estimator_init(&est, &sc) != POUR_OK) {
     return;
   }
   uint32_t t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
-    pour_obs_quantize(&w->norm, &inputs[i & 63u].state, &obs[i & 63u]);
+    inputs[i & 63u].sensors.seq = i + 1u;
+    (void)pour_estimator_update(&est, &inputs[i & 63u].sensors, &states[i & 63u]);
+  }
+  const uint32_t estimate = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    pour_obs_quantize(&w->norm, &states[i & 63u], &obs[i & 63u]);
   }
   const uint32_t quant = elapsed(t0, now());
+  static pour_safety_t safety;
+  const pour_safety_config_t sfc = bench_config().safety;
+  (void)pour_safety_init(&safety, &sfc);
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    (void)pour_safety_apply(&safety, (q15_t)(i * 997u), states[i & 63u].theta_urad, states[i & 63u].omega_urad_s);
+  }
+  const uint32_t envelope = elapsed(t0, now());
   t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
     pour_policy_eval(&policy, &obs[i & 63u], &ev);
@@ -146,7 +166,10 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
   }
   const uint32_t softmax = elapsed(t0, now());
   const uint64_t scale = 1000ull * N_STEPS;
-  printf("  per call (loop included): pour_obs_quantize %u, pour_policy_eval %u = logits %u + softmax %u + argmax\n",
+  printf("  per call (loop included): pour_estimator_update %u, pour_safety_apply %u, pour_obs_quantize %u, "
+         "pour_policy_eval %u = logits %u + softmax %u + argmax\n",
+         (unsigned)((estimate * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((envelope * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((quant * (uint64_t)insn_per_kilotick) / scale), (unsigned)((eval * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((logits * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale));

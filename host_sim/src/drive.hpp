@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: MIT
+// The geared drive between the commanded torque and the bucket: command latency (CAN), peak torque, the
+// back-EMF torque–speed line. Its rotor inertia and friction act through Box2D (world.cpp): J·N² in the
+// bucket's mass data, Coulomb friction as the joint's motor at zero speed, viscous as a torque −b·ω.
+#ifndef POURSIM_DRIVE_HPP
+#define POURSIM_DRIVE_HPP
+
+#include <vector>
+
+#include "poursim/poursim.h"
+
+namespace poursim {
+
+class Drive {
+ public:
+  // Latency and limits of config c; the queue starts with zero commands (the drive idles at reset).
+  void reset(const poursim_config_t &c);
+  // Takes this step's command [N·m at the output] and returns the torque the drive delivers in this step
+  // at output speed omega [rad/s]: the command of command_latency_ticks steps ago, limited.
+  double step(double tau_cmd, double omega);
+  // The torque–speed envelope: clamp to ±peak; when the torque drives the motion (motoring), at most
+  // peak·(1 − |ω|/ω₀), down to 0 at the no-load speed ω₀. Braking is limited by the peak only.
+  static double limit(double tau, double omega, double peak, double no_load_speed);
+
+ private:
+  std::vector<double> queue_; // commands in flight, oldest at head_
+  size_t head_ = 0;
+  double peak_ = 0.0, no_load_ = 0.0;
+};
+
+// Rotor inertia seen at the output: J·N² [kg·m²].
+inline double reflected_inertia(const poursim_config_t &c) {
+  return c.motor_rotor_inertia * c.gear_ratio * c.gear_ratio;
+}
+
+} // namespace poursim
+
+#endif // POURSIM_DRIVE_HPP
