@@ -200,8 +200,9 @@ int bench_rig(const poursim_config_t &cfg) {
               "of %.1f g of liquid (%+.2f %%), the target %.1f g of the %.1f g inside it (%+.2f %%)\n",
               s.rest_rotating_g, s.liquid_g, 100 * (s.rest_rotating_g / s.liquid_g - 1), s.rest_target_g,
               s.target_liquid_g, 100 * (s.rest_target_g / s.target_liquid_g - 1));
-  std::printf("  %.2f conversions/s (config %.0f Hz), lag %.4f s (config %.4f s; %.1f %% of the conversions equal "
-              "the undelayed reading then), noise %.3f g RMS against %.3f g (%.2f g quantised to %.0f g)\n",
+  std::printf("  %.2f conversions/s (config %.0f Hz), filter span %.4f s (config %.4f s; %.1f %% of the conversions "
+              "within a resolution of the every-step load's mean over it), noise %.3f g RMS against %.3f g (%.2f g "
+              "quantised to %.0f g)\n",
               s.update_rate_hz, cfg.scale_rate_hz, s.delay_s, cfg.scale_delay_s, 100 * s.delay_match, s.noise_rms_g,
               s.noise_expected_g, cfg.scale_noise_g, cfg.scale_resolution_g);
   std::printf("  impact: the target reads %.1f g s beyond the liquid inside it over the pour, the stream's momentum "

@@ -327,7 +327,7 @@ extern "C" int poursim_measure_drive(const poursim_config_t *cfg, poursim_drive_
     const double P = cr.motor_peak_torque;
     out->terminal_load[r] = cr.friction_coulomb;
     out->terminal_speed[r] = sum / tail;
-    // ω = ω₀(1 − (τ_c + bω)/P) → ω = ω₀(1 − τ_c/P)/(1 + ω₀b/P); valid where the line is below the command.
+    // ω = ω₀(1 − (τ_c + bω)/P) → ω = ω₀(1 − τ_c/P)/(1 + ω₀b/P), where the line is below the command.
     out->terminal_expected[r] = cr.motor_no_load_speed * (1.0 - cr.friction_coulomb / P) /
                                 (1.0 + cr.motor_no_load_speed * cr.friction_viscous / P);
   }
@@ -383,7 +383,8 @@ extern "C" int poursim_measure_sensors(const poursim_config_t *cfg, uint32_t see
   const int k_tilted = k_tilt + static_cast<int>(std::lround(theta_end / rate / c.dt));
   const int n_steps = k_tilted + static_cast<int>(std::lround(3.0 / c.dt));
   const int k_last_s = n_steps - static_cast<int>(std::lround(1.0 / c.dt));
-  const int k_rest = static_cast<int>(std::lround(0.2 / c.dt)), avg = std::max(1, static_cast<int>(std::lround(0.05 / c.dt)));
+  const int k_rest = static_cast<int>(std::lround(0.2 / c.dt));
+  const int avg = std::max(1, static_cast<int>(std::lround(0.05 / c.dt)));
   std::vector<int32_t> ref(static_cast<size_t>(n_steps)), quiet(static_cast<size_t>(n_steps));
   std::vector<uint8_t> before(static_cast<size_t>(n), 0), reg(static_cast<size_t>(n), 0);
   std::vector<double> impact(static_cast<size_t>(n_steps), 0.0), reading(static_cast<size_t>(n_steps), 0.0);
@@ -448,17 +449,34 @@ extern "C" int poursim_measure_sensors(const poursim_config_t *cfg, uint32_t see
       out->impact_peak_reading_g = reading[static_cast<size_t>(k)];
     }
   }
-  // Rate and lag: conversions per second, and the lag at which they equal the every-step reference.
-  const double tilt_s = (k_tilted - k_tilt) * c.dt;
-  out->update_rate_hz = static_cast<double>(conv.size()) / tilt_s;
-  const int max_lag = static_cast<int>(std::lround(std::min(1.0, 2.0 * c.scale_delay_s + 0.05) / c.dt));
-  int best = 0, best_lag = 0;
-  for (int lag = 0; lag <= max_lag; ++lag) {
-    int hits = 0;
-    for (int k : conv) hits += k - lag >= 0 && quiet[static_cast<size_t>(k)] == ref[static_cast<size_t>(k - lag)];
-    if (hits > best) best = hits, best_lag = lag;
+  // Rate: a filtered reading may stay the same over a conversion, so the intervals between changes are
+  // whole numbers of conversion periods; the median interval names the period, the total time refines it.
+  std::vector<int> gaps;
+  for (size_t i = 1; i < conv.size(); ++i) gaps.push_back(conv[i] - conv[i - 1]);
+  if (!gaps.empty()) {
+    std::vector<int> sorted = gaps;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double p0 = sorted[sorted.size() / 2];
+    double periods = 0;
+    for (int gap : gaps) periods += std::max(1.0, std::nearbyint(gap / p0));
+    out->update_rate_hz = periods / ((conv.back() - conv.front()) * c.dt);
   }
-  out->delay_s = best_lag * c.dt;
+  // Filter: the span over which the every-step reference, averaged, gives each conversion (within the
+  // reference's own rounding: half a resolution each way).
+  std::vector<double> prefix(static_cast<size_t>(n_steps) + 1, 0.0);
+  for (size_t k = 0; k < static_cast<size_t>(n_steps); ++k) prefix[k + 1] = prefix[k] + ref[k];
+  const int max_span = static_cast<int>(std::lround(std::min(1.0, 2.0 * c.scale_delay_s + 0.05) / c.dt));
+  int best = 0, best_span = 1;
+  for (int span = 1; span <= max_span; ++span) {
+    int hits = 0;
+    for (int k : conv) {
+      if (k + 1 < span) continue;
+      const double mean = (prefix[static_cast<size_t>(k) + 1] - prefix[static_cast<size_t>(k + 1 - span)]) / span;
+      hits += std::fabs(quiet[static_cast<size_t>(k)] - mean) <= ep.scale_resolution_g;
+    }
+    if (hits > best) best = hits, best_span = span;
+  }
+  out->delay_s = best_span * c.dt;
   out->delay_match = conv.empty() ? 0.0 : static_cast<double>(best) / static_cast<double>(conv.size());
   out->noise_rms_g = conv.empty() ? 0.0 : std::sqrt(noise_sq / static_cast<double>(conv.size()));
   out->noise_expected_g = quantised_noise_rms(ep.scale_noise_g, ep.scale_resolution_g);

@@ -172,7 +172,7 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.command_latency_ticks = 1;      // one CAN frame: the torque of tick k acts in tick k + 1
   c.encoder_bits = 17;
   c.scale_rate_hz = 80.0;           // HX711 with RATE high: 80 samples/s
-  c.scale_delay_s = 0.05;           // HX711 output settling time at 80 samples/s
+  c.scale_delay_s = 0.05;           // HX711 output settling time at 80 samples/s: the filter's span
   c.scale_noise_g = 0.5;
   c.scale_resolution_g = 1.0;       // whole grams on the wire
   c.obs_theta_min = 0.0;
@@ -190,8 +190,8 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
   for (const Field &f : kFields) {
     double v = get_value(c, f);
     if (!std::isfinite(v) || v < f.min || v > f.max) {
-      return set_error(err, err_len, POURSIM_EINVAL, "config %s = %g is out of range [%g, %g]", f.name, v,
-                       f.min, f.max);
+      return set_error(err, err_len, POURSIM_EINVAL, "config %s = %g is out of range [%g, %g] (unit: %s)", f.name,
+                       v, f.min, f.max, f.unit);
     }
   }
   const double inner_depth = c->bucket_height - c->bucket_wall;
@@ -285,8 +285,8 @@ extern "C" int poursim_config_set(poursim_config_t *c, const char *key, const ch
   if (end == value || *end != '\0' || errno != 0 || !std::isfinite(v))
     return set_error(err, err_len, POURSIM_EPARSE, "config %s: '%s' is not a number", key, value);
   if (v < f->min || v > f->max)
-    return set_error(err, err_len, POURSIM_EINVAL, "config %s = %s is out of range [%g, %g]", key, value, f->min,
-                     f->max);
+    return set_error(err, err_len, POURSIM_EINVAL, "config %s = %s is out of range [%g, %g] (unit: %s)", key, value,
+                     f->min, f->max, f->unit);
   char *base = reinterpret_cast<char *>(c) + f->offset;
   switch (f->kind) {
     case Kind::Double: *reinterpret_cast<double *>(base) = v; break;

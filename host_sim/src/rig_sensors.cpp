@@ -31,8 +31,9 @@ void LoadCell::reset(const poursim_config_t &c, double load_g, Gauss &noise) {
   rate_ = c.scale_rate_hz;
   noise_g_ = c.scale_noise_g;
   resolution_g_ = c.scale_resolution_g;
-  const long delay_steps = std::lround(c.scale_delay_s / c.dt);
-  history_.assign(static_cast<size_t>(delay_steps) + 1, load_g);
+  const long span = std::max(1L, std::lround(c.scale_delay_s / c.dt));
+  history_.assign(static_cast<size_t>(span), load_g);
+  sum_ = load_g * static_cast<double>(span);
   head_ = 0;
   next_ = 1;
   reading_ = convert(load_g, noise);
@@ -42,16 +43,22 @@ int32_t LoadCell::convert(double load_g, Gauss &noise) const {
   // Draw even when the noise is 0, so that the stream's position never depends on the noise level.
   const double x = load_g + noise_g_ * noise.next();
   const double q = resolution_g_ * std::nearbyint(x / resolution_g_);
-  return static_cast<int32_t>(std::max(-2.0e9, std::min(2.0e9, q)));
+  return static_cast<int32_t>(std::llround(std::max(-2.0e9, std::min(2.0e9, q)))); // whole grams on the wire
 }
 
 int32_t LoadCell::update(uint32_t n, double load_g, Gauss &noise) {
-  // The ring holds loads n−delay .. n: the oldest is what a conversion now reports.
+  // The ring holds the loads of steps n−span+1 .. n; a conversion now reports their mean. The sum is
+  // refreshed from the ring once a round, so that rounding never accumulates over an episode.
+  sum_ += load_g - history_[head_];
   history_[head_] = load_g;
   head_ = (head_ + 1) % history_.size();
+  if (head_ == 0) {
+    sum_ = 0.0;
+    for (double x : history_) sum_ += x;
+  }
   const double t = n * dt_;
   if (static_cast<double>(next_) / rate_ <= t + 1e-9 * dt_) {
-    reading_ = convert(history_[head_], noise);
+    reading_ = convert(sum_ / static_cast<double>(history_.size()), noise);
     // Conversions that fell due within this step collapse into this one (rate <= 1/dt by validation).
     while (static_cast<double>(next_) / rate_ <= t + 1e-9 * dt_) ++next_;
   }

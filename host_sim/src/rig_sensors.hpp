@@ -29,10 +29,15 @@ class Gauss {
   bool has_spare_ = false;
 };
 
+// A sigma-delta ADC does not sample the load: its digital filter averages it. The HX711's at 80 samples/s
+// settles to a step in 50 ms (4 conversions, a sinc⁴-like response); modelled as the mean of the load
+// over the scale_delay_s before each conversion (a box of the same settling time: full response after
+// scale_delay_s, half after half of it). scale_delay_s = 0 samples the load at the conversion.
 class LoadCell {
  public:
-  // Rate, delay (rounded to whole steps), noise and resolution of config c; the load has been load_g
-  // [g] for as long as the delay reaches back (the liquid settled before t = 0); converts once at t = 0.
+  // Rate, filter span (rounded to whole steps), noise and resolution of config c; the load has been
+  // load_g [g] for as long as the filter reaches back (the liquid settled before t = 0); converts once
+  // at t = 0.
   void reset(const poursim_config_t &c, double load_g, Gauss &noise);
   // The load after step n (t = n·dt) [g]; converts when a conversion falls due at or before t. Returns
   // the reading held since the last conversion [g].
@@ -41,8 +46,9 @@ class LoadCell {
 
  private:
   int32_t convert(double load_g, Gauss &noise) const;
-  std::vector<double> history_; // the last delay+1 loads, oldest at head_ [g]
+  std::vector<double> history_; // the loads of the filter's span, oldest at head_ [g]
   size_t head_ = 0;
+  double sum_ = 0.0;            // their sum [g], kept by adding the newest and dropping the oldest
   double dt_ = 0.001, rate_ = 80.0, noise_g_ = 0.0, resolution_g_ = 1.0;
   uint64_t next_ = 1; // index of the next conversion, at next_/rate
   int32_t reading_ = 0;

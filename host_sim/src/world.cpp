@@ -107,7 +107,7 @@ static void build_scene(poursim_world_t *w, uint32_t seed) {
     Eigen::Vector2d mid = 0.5 * (lo[i] + hi[i]) + target_centre, half = 0.5 * (hi[i] - lo[i]);
     b2Polygon box = b2MakeOffsetBox(static_cast<float>(half.x()), static_cast<float>(half.y()),
                                     {static_cast<float>(mid.x()), static_cast<float>(mid.y())}, b2Rot_identity);
-    b2CreatePolygonShape(w->target, &sd, &box);
+    w->target_shapes[i] = b2CreatePolygonShape(w->target, &sd, &box);
   }
 
   // The rotating bucket: a dynamic body whose origin is the pivot (the bucket's centre).
@@ -278,7 +278,9 @@ static void cell_loads(poursim_world_t *w, double *rotating_g, double *target_g)
     const b2ContactData &cd = w->contacts[static_cast<size_t>(k)];
     const b2Manifold &m = cd.manifold;
     // The solver pushes shape B along +normal (and +tangent = right perpendicular) and A the other way.
-    const bool target_is_a = B2_ID_EQUALS(b2Shape_GetBody(cd.shapeIdA), w->target);
+    const bool target_is_a = B2_ID_EQUALS(cd.shapeIdA, w->target_shapes[0]) ||
+                             B2_ID_EQUALS(cd.shapeIdA, w->target_shapes[1]) ||
+                             B2_ID_EQUALS(cd.shapeIdA, w->target_shapes[2]);
     const double normal_y = m.normal.y, tangent_y = -static_cast<double>(m.normal.x);
     double py = 0.0;
     for (int j = 0; j < m.pointCount; ++j)

@@ -19,6 +19,7 @@ struct poursim_world {
   bool has_world = false;
   b2WorldId world{};
   b2BodyId ground{}, target{}, bucket{}; // target: the target bucket, a static body of its own (its scale)
+  b2ShapeId target_shapes[3]{};          // its three boxes
   b2JointId joint{};
   std::vector<b2BodyId> circles;
   std::vector<float> radii;   // [m]

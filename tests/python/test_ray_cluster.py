@@ -48,6 +48,7 @@ def test_rollouts_spread_over_both_nodes_and_the_run_is_unchanged(two_nodes, tmp
     assert len(alive) == 2 and int(ray.cluster_resources()["CPU"]) == 2
     cfg = _cfg()
     train.train(cfg, tmp_path / "local", quiet=True)
+    NodeRecorder.nodes = []
     train.train(cfg, tmp_path / "ray", quiet=True, make_runner=NodeRecorder)
     assert_same_run(tmp_path / "local", tmp_path / "ray")
     # One batch per CPU of the cluster, each call's two batches spread over the two nodes.
@@ -123,3 +124,20 @@ def test_robustness_at_scale_on_the_cluster_equals_one_host_sim_run(two_nodes, t
     assert rows[0]["episodes"] == 6 and sum(r["episodes"] for r in rows[1:]) == 6
     assert rows[0]["poured_pct"] == pytest.approx(one["poured_pct"], abs=1e-3)
     assert (tmp_path / "robust_scale.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--rigs", "0"], "--rigs 0: expected 1..10000000"),
+    (["--per-task", "0"], "--per-task 0: expected 1..100000"),
+    (["--set", "rand_fil=0.2"], "--set 'rand_fil=0.2': expected one of rand_fill"),
+    (["--set", "rand_fill=lots"], "--set 'rand_fill=lots': 'lots' is not a number"),
+    (["--header", "nowhere.h"], "--header nowhere.h: no such file"),
+    (["--ray-address", "127.0.0.1:1"], "cannot reach the Ray cluster at 127.0.0.1:1"),
+])
+def test_robust_scale_cli_errors_are_named(tmp_path, source_dir, args, message):
+    base = ["--header", str(source_dir / "policy" / "weights.h"), "--rigs", "2", "--out", str(tmp_path / "o")]
+    r = subprocess.run([sys.executable, "-m", "pour.robust_scale", *base, *args],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2, r.stderr
+    assert "pour-robust-scale: error:" in r.stderr and message in r.stderr, r.stderr
+    assert "Traceback" not in r.stderr and not (tmp_path / "o").exists()

@@ -3,7 +3,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "pour/control.h"
 #include "pour/safety.h"
+#include "pour/sensors.h"
 #include "poursim/poursim.h"
 #include "unity.h"
 
@@ -83,8 +85,9 @@ static void test_rollout_FillsArraysConsistently(void) {
   TEST_ASSERT_TRUE(ep.max_theta > 0.2); /* the policy did tilt the bucket */
 }
 
-/* The rollout must equal a hand-written loop: decide at steps 0, P, 2P from that step's state,
- * pass the level through pour_safety_apply, step. Compared bit for bit through θ of every step. */
+/* The rollout must equal a hand-written loop: the firmware's estimator makes the state of each step's
+ * sensor readings, the policy decides at steps 0, P, 2P from that state, the level passes through
+ * pour_safety_apply, step. Compared bit for bit through θ of every step. */
 static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
   poursim_rollout_buffers_t b = buffers();
   poursim_episode_t ep;
@@ -93,16 +96,25 @@ static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
   TEST_ASSERT_EQUAL_INT(429, ep.n_decisions); /* ceil(3000 / 7) */
 
   poursim_reset(world, 3);
-  pour_safety_config_t sc = pour_safety_default_config();
+  pour_control_config_t fw = pour_control_default_config();
+  fw.sensors.encoder_bits = (uint8_t)cfg.encoder_bits;
   pour_safety_t safety;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &sc));
+  pour_estimator_t est;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &fw.safety));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_estimator_init(&est, &fw.sensors));
+  pour_state_t s;
+  memset(&s, 0, sizeof s);
   poursim_obs_t o;
   poursim_observe(world, &o);
   int action = 0, limited = 0;
   for (int t = 0; t < 3000; ++t) {
+    const pour_sensors_t sample = {(uint32_t)t, o.encoder, o.scale_rotating_g, o.scale_target_g};
+    pour_estimator_update(&est, &sample, &s);
     if (t % 7 == 0) {
-      double x[6] = {fmin(fmax(o.theta / 2.356194, 0), 1), fmin(fmax((o.omega + 4.0) / 8.0, 0), 1), o.v_rotating,
-                     o.v_target, o.v_spill, 1.0};
+      const double th = s.theta_urad * 1e-6, om = s.omega_urad_s * 1e-6;
+      double x[6] = {fmin(fmax(th / 2.356194, 0), 1), fmin(fmax((om + 4.0) / 8.0, 0), 1), s.v_rotating / 32768.0,
+                     s.v_target / 32768.0, s.v_spill / 32768.0, 1.0};
+      for (int k = 2; k < 5; ++k) x[k] = fmin(fmax(x[k], 0), 1);
       double best = -INFINITY;
       for (int a = 0; a < N_ACT; ++a) {
         double l = 0.0;
@@ -113,7 +125,7 @@ static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
     }
     double q = nearbyint(levels[action] * 32768.0);
     q15_t req = (q15_t)(q > 32767.0 ? 32767.0 : q);
-    q15_t cmd = pour_safety_apply(&safety, req, (int32_t)lround(o.theta * 1e6));
+    q15_t cmd = pour_safety_apply(&safety, req, s.theta_urad, s.omega_urad_s);
     limited |= cmd != req;
     poursim_step(world, cmd / 32768.0, &o);
     TEST_ASSERT_EQUAL_DOUBLE(o.theta, step_theta[t]);

@@ -113,7 +113,7 @@ def probe(address: str, timeout_s: float = CONNECT_TIMEOUT_S, gcs_timeout_s: flo
         if r.returncode == 0:
             return
         lines = [ln for ln in r.stderr.strip().splitlines() if ln.strip()]
-        why = lines[-1][:200] if lines else f"exit status {r.returncode}"
+        why = lines[-1][:600] if lines else f"exit status {r.returncode}"
     raise ExecutorError(f"cannot reach the Ray cluster at {address}: the port is open but no Ray control "
                         f"service answered ({why})")
 
@@ -151,17 +151,18 @@ def connect(address: str | None, num_cpus: int | None = None) -> bool:
 
 
 def _current_cluster() -> str | None:
-    """The address `ray start --head` on this machine left for `ray.init(address='auto')`."""
+    """The address `ray start --head` on this machine wrote for `ray.init(address='auto')`, as written
+    (Ray's own lookup would turn a loopback head's 127.0.0.1 into the machine's outward address)."""
     try:
-        from ray._private.services import get_ray_address_from_environment
-        return get_ray_address_from_environment("auto", None)
-    except Exception:  # no cluster file, or a Ray without that helper
+        from ray._private.utils import read_ray_address
+        return read_ray_address() or None
+    except Exception:  # a Ray without that helper
         return None
 
 
 # --- the task ---------------------------------------------------------------------------------------
 
-_ENVS: dict[tuple, Any] = {}
+_ENVS: dict[str, Any] = {}   # this worker process's environments, by their arguments
 
 
 def rollout_batch(env_args: tuple, w: np.ndarray, seeds: Sequence[int], greedy: bool,
@@ -230,7 +231,8 @@ class RayRunner:
         Placing each batch on a node (soft affinity) spreads a call's batches over the nodes in
         proportion to their CPUs; Ray's own placement packs short tasks onto the driver's node first. Soft:
         when that node is busy or gone, Ray runs the batch elsewhere (and re-runs it if the node dies)."""
-        per_node = [(n["NodeID"], int(n.get("Resources", {}).get("CPU", 0))) for n in self.ray.nodes() if n.get("Alive")]
+        per_node = [(n["NodeID"], int(n.get("Resources", {}).get("CPU", 0)))
+                    for n in self.ray.nodes() if n.get("Alive")]
         out, k = [], 0
         while any(c > k for _, c in per_node):
             out += [node for node, c in per_node if c > k]
@@ -266,9 +268,8 @@ class RayRunner:
         return [ep for _, eps in results for ep in eps]
 
     def cancel(self) -> None:
-        """Cancels the tasks of an unfinished run() (force: their workers are killed)."""
-        for ref in self.pending:
-            self.ray.cancel(ref, force=True)
+        """Cancels the tasks of an unfinished run()."""
+        cancel_all(self.ray, self.pending)
         self.pending = []
 
     def close(self) -> None:
@@ -282,6 +283,21 @@ class RayRunner:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def cancel_all(ray: Any, refs: Sequence[Any]) -> None:
+    """Cancels the tasks of refs that have not finished (force: their workers are killed). Only unfinished
+    ones: Ray 2.60's driver aborts on a cancel of some finished tasks (task_manager.cc check failure)."""
+    if not refs:
+        return
+    done, _ = ray.wait(list(refs), num_returns=len(refs), timeout=0)
+    finished = set(done)
+    for ref in refs:
+        if ref not in finished:
+            try:
+                ray.cancel(ref, force=True)
+            except Exception:  # already finished or gone meanwhile: nothing to stop
+                pass
 
 
 def runner_factory(executor: str, address: str | None = None) -> Any:

@@ -112,7 +112,8 @@ def main() -> int:
         runner.close()
         ideal = cpus / t_ep
         print(f"| local pool | {cpus} | {bulk * 1e3:.3f} | {rt * 1e3:.3f} | 1 (chunksize) | {args.episodes / wall:.1f} "
-              f"| {args.episodes / wall / ideal:.2f} | {(cpus * wall - args.episodes * t_ep) / args.episodes * 1e3:.2f} |")
+              f"| {args.episodes / wall / ideal:.2f} "
+              f"| {(cpus * wall - args.episodes * t_ep) / args.episodes * 1e3:.2f} |", flush=True)
         executors.connect("local", num_cpus=cpus)
         try:
             bulk, rt = ray_task_overhead(ray)

@@ -92,14 +92,13 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
                 for s in range(first_seed, first_seed + rigs, k)]
         try:
             per = [e for batch in ray.get(refs) for e in batch]
-        except ray.exceptions.RayTaskError as exc:
-            if isinstance(getattr(exc, "cause", None), Exception):
+        except BaseException as exc:
+            executors.cancel_all(ray, refs)
+            if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(getattr(exc, "cause", None), Exception):
                 raise exc.cause from None
             raise
         wall = time.monotonic() - t0
     finally:
-        for r in refs:
-            ray.cancel(r, force=True)
         if owns:
             ray.shutdown()
     rows = reduce(per, sets)

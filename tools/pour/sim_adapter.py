@@ -83,16 +83,30 @@ class SimEnv:
 
 
 class SimStepper:
-    """Tick-by-tick access for the Gymnasium env; torques pass the firmware's safety envelope."""
+    """Tick-by-tick access for the Gymnasium env, as the firmware sees the rig: the sensor sample through the
+    estimator (tools/pour/fixedpoint.py, bit-exact with firmware/src/sensors.c), torques through the safety
+    envelope with its motion limits."""
 
     def __init__(self, options: dict[str, Any] | None = None):
         self.world = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
+        self.sensors = fp.SensorsConfig(encoder_bits=int(self.world.config.encoder_bits))
 
     def reset(self, seed: int) -> None:
         with _env_errors("poursim_reset"):
             self.obs = self.world.reset(seed)
         self.safety = fp.SafetyEnvelope()
+        self.estimator = fp.Estimator(self.sensors)
+        self.seq = 0
+        self.state = (0, 0, 0, 0, 0, 0)
+        self._sense()
+
+    def _sense(self) -> None:
+        o = self.obs
+        s = self.estimator.update(self.seq, o.encoder, o.scale_rotating_g, o.scale_target_g)
+        if s is not None:  # a sample the firmware would refuse leaves the last state in place
+            self.state = s
+        self.seq += 1
 
     @property
     def v_tgt(self) -> float:
@@ -103,17 +117,16 @@ class SimStepper:
         return float(self.obs.v_spill)
 
     def features(self) -> np.ndarray:
-        o = self.obs
-        return envs.normalise(o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill)
+        _, theta, omega, v_rot, v_tgt, v_spill = self.state
+        return envs.normalise(theta * 1e-6, omega * 1e-6, v_rot / 32768.0, v_tgt / 32768.0, v_spill / 32768.0)
 
     def advance(self, level: float, ticks: int) -> float:
         req = fp.float_to_q15(level)
         r = 0.0
         with _env_errors("poursim_step"):
             for _ in range(ticks):
-                t = max(-2e9, min(2e9, self.obs.theta * 1e6))
-                theta_urad = int(math.copysign(math.floor(abs(t) + 0.5), t))  # C's round(): half away from 0
-                cmd = self.safety.apply(req, theta_urad)
+                cmd = self.safety.apply(req, self.state[1], self.state[2])
                 self.obs = self.world.step(cmd / 32768.0)
+                self._sense()
                 r += self.obs.reward
         return r

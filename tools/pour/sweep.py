@@ -30,6 +30,7 @@ import io
 import itertools
 import json
 import math
+import shlex
 import sys
 import tomllib
 from pathlib import Path
@@ -86,8 +87,8 @@ def parse_range(items: Sequence[str]) -> dict[str, tuple[float, float, bool]]:
         except (ValueError, IndexError):
             raise SweepError(f"--range {item!r}: expected KEY=LOW:HIGH or KEY=LOW:HIGH:log") from None
         log = len(parts) == 3 and parts[2] == "log"
-        if len(parts) > 3 or (len(parts) == 3 and not log) or not (math.isfinite(lo) and math.isfinite(hi) and lo < hi) \
-                or (log and lo <= 0):
+        finite = math.isfinite(lo) and math.isfinite(hi) and lo < hi
+        if len(parts) > 3 or (len(parts) == 3 and not log) or not finite or (log and lo <= 0):
             raise SweepError(f"--range {item!r}: expected finite LOW < HIGH (LOW > 0 for :log)")
         out[key] = (lo, hi, log)
     return out
@@ -110,7 +111,8 @@ def points(grid: dict[str, list[Any]], ranges: dict[str, tuple[float, float, boo
         draw = {}
         for key, (lo, hi, log) in ranges.items():
             u = float(rng.random())
-            draw[key] = float(f"{(math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) if log else lo + u * (hi - lo)):.4g}")
+            v = math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) if log else lo + u * (hi - lo)
+            draw[key] = float(f"{v:.4g}")   # 4 digits: the table and the run directories stay readable
         out += [{**b, **draw} for b in base]
     return out
 
@@ -150,7 +152,8 @@ def run_trial(doc: dict[str, Any], run_dir: str, held_out: int) -> dict[str, Any
 
 
 def run(config_path: str, out: Path, pts: list[dict[str, Any]], seeds: Sequence[int], iterations: int | None,
-        held_out: int, executor: str, address: str | None, num_cpus: int | None) -> dict[str, Any]:
+        held_out: int, executor: str, address: str | None, num_cpus: int | None,
+        command: str | None = None) -> dict[str, Any]:
     try:
         base = tomllib.loads(Path(config_path).read_text())
     except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -176,22 +179,21 @@ def run(config_path: str, out: Path, pts: list[dict[str, Any]], seeds: Sequence[
             task = ray.remote(num_cpus=1, max_retries=executors.MAX_RETRIES, retry_exceptions=False)(run_trial)
             refs = [task.remote(*j) for j in jobs]
             outs = ray.get(refs)
-        except ray.exceptions.RayTaskError as exc:
-            if isinstance(getattr(exc, "cause", None), Exception):
+        except BaseException as exc:
+            executors.cancel_all(ray, refs)   # an error or Ctrl-C: the other trials stop (each resumes on re-run)
+            if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(getattr(exc, "cause", None), Exception):
                 raise exc.cause from None
             raise
         finally:
-            for r in refs:
-                ray.cancel(r, force=True)
             if owns:
                 ray.shutdown()
     for t, o in zip(trials, outs):
         t.update(o)
-    return report(out, config_path, trials, pts, held_out)
+    return report(out, config_path, trials, pts, held_out, command)
 
 
 def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[dict[str, Any]],
-           held_out: int) -> dict[str, Any]:
+           held_out: int, command: str | None = None) -> dict[str, Any]:
     from pour import plots
     keys = list(dict.fromkeys(k for p in pts for k in p))
     buf = io.StringIO()
@@ -216,7 +218,8 @@ def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[
         groups[label] = [Path(out) / "runs" / t["trial"] for t in mine]
     order = sorted(range(len(rows)), key=lambda k: -rows[k]["return"])
     table = (f"Sweep of `{config_path}`: {len(pts)} point(s) x {len(trials) // max(1, len(pts))} seed(s), best "
-             "held-out return first.\n\n" + results.markdown([rows[k] for k in order], held_out))
+             "held-out return first." + (f" Made by `{command}`." if command else "") + "\n\n"
+             + results.markdown([rows[k] for k in order], held_out))
     atomic.write_atomic(out / "sweep.csv", buf.getvalue())
     atomic.write_atomic(out / "sweep.md", table)
     doc = {"config": config_path, "points": pts, "rows": [rows[k] for k in order],
@@ -260,7 +263,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise SweepError(f"--random {args.random}: expected 0..10000")
         pts = points(parse_grid(args.grid), parse_range(args.range), args.random, args.search_seed)
         doc = run(args.config, args.out, pts, seeds, args.iterations, args.held_out, args.executor,
-                  args.ray_address, args.num_cpus)
+                  args.ray_address, args.num_cpus,
+                  shlex.join(["pour-sweep", *(sys.argv[1:] if argv is None else argv)]))
     except (SweepError, cfgmod.ConfigError, envs.EnvError, executors.ExecutorError) as exc:
         print(f"pour-sweep: error: {exc}", file=sys.stderr)
         return 2

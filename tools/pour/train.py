@@ -395,7 +395,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if over:
             cfg = cfgmod.with_overrides(cfg, **over)
         res = train(cfg, args.out, resume=not args.fresh, quiet=args.quiet,
-                    make_runner=executors.runner_factory(args.executor, args.ray_address))
+                    make_runner=executors.runner_factory("ray", args.ray_address) if args.executor == "ray" else Runner)
     except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError, executors.ExecutorError) as exc:
         print(f"pour-train: error: {exc}", file=sys.stderr)
         return 2

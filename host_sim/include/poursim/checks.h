@@ -83,9 +83,9 @@ typedef struct {
   double rest_rotating_g;      /* mean rotating reading, full bucket held upright, 1 s [g] */
   double target_liquid_g;      /* V_target × the liquid's mass, after the pour settled [g] */
   double rest_target_g;        /* mean target reading then, 1 s [g] */
-  double update_rate_hz;       /* reading changes per second during the pour */
-  double delay_s;              /* the lag at which the conversions equal an undelayed every-step reading [s] */
-  double delay_match;          /* share of the conversions equal to it at that lag */
+  double update_rate_hz;       /* conversions per second during the pour (from the intervals between changes) */
+  double delay_s;              /* the span over which the every-step reference, averaged, gives the conversions [s] */
+  double delay_match;          /* share of the conversions within a resolution of that mean */
   double noise_rms_g;          /* RMS of noisy − noise-free conversions, same seed [g] */
   double noise_expected_g;     /* that RMS for Gaussian noise of scale_noise_g quantised to scale_resolution_g [g] */
   double impact_impulse_gs;    /* ∫(target reading − mass inside the target) dt over the pour [g·s] */
@@ -96,7 +96,7 @@ typedef struct {
 } poursim_sensor_check_t;
 
 /* Pours with the servo (held upright 1 s, tilted at 0.5 rad/s to 125°, held 3 s) in three worlds of the
- * same seed: the sensors of config, the same without noise, and an every-step undelayed noise-free
+ * same seed: the sensors of config, the same without noise, and an every-step unfiltered noise-free
  * reference; compares them, and the readings against the liquid's mass and momentum. */
 int poursim_measure_sensors(const poursim_config_t *config, uint32_t seed, poursim_sensor_check_t *out, char *err,
                             size_t err_len);

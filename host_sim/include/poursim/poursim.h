@@ -75,7 +75,7 @@ typedef struct {
   /* the rig's sensors (poursim_obs_t.encoder, scale_rotating_g, scale_target_g) */
   int encoder_bits;           /* single-turn absolute encoder on the output shaft [bits] */
   double scale_rate_hz;       /* load cells' conversion rate [Hz]; readings held between conversions */
-  double scale_delay_s;       /* a conversion reports the load this long before it [s] */
+  double scale_delay_s;       /* lag: a conversion reports the mean load over this span before it (settling) [s] */
   double scale_noise_g;       /* Gaussian noise of a conversion, standard deviation [g] */
   double scale_resolution_g;  /* readings are multiples of this [g] */
   /* domain randomisation: uniform ± around the nominal, drawn from the reset seed; 0 = off */
