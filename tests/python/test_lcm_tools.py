@@ -29,10 +29,10 @@ def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_di
     t = threading.Thread(target=spam)
     with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
          Proc([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir), "--lcm", u,
-               "--realtime", "--set", "episode_s=6"]):
+               "--realtime", "--set", "episode_s=10"]):
         t.start()
         try:
-            r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", u, "--save", png, "--frames", "10"],
+            r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", u, "--save", png, "--frames", "5"],
                                capture_output=True, text=True, timeout=120)
         finally:
             stop.set()

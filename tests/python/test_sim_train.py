@@ -23,12 +23,12 @@ def test_sim_gym_env_passes_the_checker():
 
 def test_gym_steps_reproduce_the_c_rollout():
     """Tick-by-tick stepping (Python envelope mirror) and the C whole-episode rollout agree exactly."""
-    sim = envs.make_env("sim", 11, 10, 0.4)
+    sim = envs.make_env("sim", 11, 10, 0.6)
     w = np.zeros((6, 11))
-    w[0, :] = np.linspace(3, -3, 11)  # torque falls as theta grows, so actions change along the way
+    w[0, :] = np.linspace(30, -30, 11)  # torque falls as theta grows, so actions change along the way
     w[5, :] = np.linspace(-2, 2, 11)
     ep = sim.rollout(w, 31, True)
-    env = pour.gym_env.PourEnv("sim", episode_s=0.4)
+    env = pour.gym_env.PourEnv("sim", episode_s=0.6)
     env._plant.reset(31)
     env._k, env._started = 0, True
     xs, rewards = [env._plant.features()], []
