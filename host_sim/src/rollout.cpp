@@ -43,6 +43,8 @@ int validate_policy(const poursim_policy_t *p, char *err, size_t err_len) {
       return set_error(err, err_len, POURSIM_EINVAL, "policy level[%d] outside [-1, 1]", i);
   if (!(p->theta_max > p->theta_min) || !(p->omega_max > 0.0))
     return set_error(err, err_len, POURSIM_EINVAL, "policy normalisation ranges are empty");
+  if (!(std::isfinite(p->k_reversal) && p->k_reversal >= 0.0))
+    return set_error(err, err_len, POURSIM_EINVAL, "policy k_reversal %g: want a finite value >= 0", p->k_reversal);
   return POURSIM_OK;
 }
 

@@ -104,3 +104,16 @@ def test_episode_metrics_count_reversals_and_litres():
     # Bang-bang about theta_n = 0.2 (27 deg): +tau_max below it, -tau_max above: reverses again and again.
     bang = run([[8, -8], [0, 0], [0, 0], [0, 0], [0, 0], [-1.6, 1.6]])
     assert bang["reversals"] >= 10 and bang["peak_alpha"] > 0
+
+
+def test_a_bad_reversal_cost_is_refused_by_the_c_rollout():
+    import numpy as np
+    import pytest
+
+    from pour import sim
+    cfg = sim.make_config({"episode_s": 0.1})
+    for bad in (float("nan"), -1.0):
+        pol = sim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, cfg.obs_theta_min, cfg.obs_theta_max,
+                         cfg.obs_omega_max, True, bad)
+        with pytest.raises(sim.SimError, match="k_reversal"):
+            sim.rollout_batch(cfg, pol, [1], n_threads=1)

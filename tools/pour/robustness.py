@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -152,7 +151,3 @@ def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed:
     atomic.write_atomic(out / "robustness.md", table(rows, header, seed))
     plot(rows, out / "robustness.png")
     return rows
-
-
-def workers_default() -> int:
-    return max(1, min(2, os.cpu_count() or 1))
