@@ -192,10 +192,8 @@ int parse_args(int argc, char **argv, Options &o) {
 
 struct Episode {
   uint32_t seed = 0;
-  double poured = 0, spilled = 0, remaining = 0, finish = -1, ret = 0;
-  double litres = 0, peak_omega = 0, peak_alpha = 0; // fill [L], max |θ̇| [rad/s], max |θ̈| [rad/s²]
-  int reversals = 0;
-  std::string error; // why the world stopped, if it did
+  poursim_episode_t m{}; // libpoursim's figures of the episode (metrics.hpp)
+  std::string error;     // why the world stopped, if it did
 };
 
 // One step of history for CSV and rendering.
@@ -248,16 +246,7 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
       if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
     }
   }
-  const poursim_episode_t m = meter.result();
-  e.poured = m.poured;
-  e.spilled = m.spilled;
-  e.remaining = m.remaining;
-  e.finish = m.finish_time;
-  e.ret = m.ret;
-  e.litres = m.liquid_l;
-  e.peak_omega = m.peak_omega;
-  e.peak_alpha = m.peak_alpha;
-  e.reversals = m.reversals;
+  e.m = meter.result();
   return e;
 }
 
@@ -284,7 +273,7 @@ bool write_render_json(const std::string &path, const poursim_world_t *world, co
   const std::vector<float> &radius = rec.radius;
   int n = static_cast<int>(radius.size());
   std::fprintf(f, "{\"fps\": %.3f, \"title\": \"%s\", \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs, title.c_str(),
-               e.poured, e.spilled, e.finish);
+               e.m.poured, e.m.spilled, e.m.finish_time);
   std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
                   "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
                c->bucket_inner_width, c->bucket_height, c->bucket_wall, c->pivot_height, c->target_dx, c->theta_max);
@@ -479,24 +468,25 @@ int main(int argc, char **argv) {
       std::fprintf(per,
                    "episode %d seed %u: poured %5.1f %% (%5.2f L)  spilled %4.1f %% (%4.2f L)  left %4.1f %%  finish %s"
                    "  peak %.2f rad/s %.0f rad/s²  reversals %d  return %.1f\n",
-                   k + 1, seed, 100 * e.poured, e.poured * e.litres, 100 * e.spilled, e.spilled * e.litres,
-                   100 * e.remaining, e.finish < 0 ? "  -   " : (std::to_string(e.finish).substr(0, 5) + " s").c_str(),
-                   e.peak_omega, e.peak_alpha, e.reversals, e.ret);
+                   k + 1, seed, 100 * e.m.poured, e.m.poured * e.m.liquid_l, 100 * e.m.spilled,
+                   e.m.spilled * e.m.liquid_l, 100 * e.m.remaining,
+                   e.m.finish_time < 0 ? "  -   " : (std::to_string(e.m.finish_time).substr(0, 5) + " s").c_str(),
+                   e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
     if (k == 0 && !o.render.empty()) first = rec;
     if (csv != nullptr) write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
   std::vector<double> poured, spilled, poured_l, spilled_l, finish, ret, peak_omega, peak_alpha, reversals;
   int unfinished = 0;
   for (const Episode &e : eps) {
-    poured.push_back(100 * e.poured);
-    spilled.push_back(100 * e.spilled);
-    poured_l.push_back(e.poured * e.litres);
-    spilled_l.push_back(e.spilled * e.litres);
-    ret.push_back(e.ret);
-    peak_omega.push_back(e.peak_omega);
-    peak_alpha.push_back(e.peak_alpha);
-    reversals.push_back(e.reversals);
-    if (e.finish >= 0) finish.push_back(e.finish);
+    poured.push_back(100 * e.m.poured);
+    spilled.push_back(100 * e.m.spilled);
+    poured_l.push_back(e.m.poured * e.m.liquid_l);
+    spilled_l.push_back(e.m.spilled * e.m.liquid_l);
+    ret.push_back(e.m.ret);
+    peak_omega.push_back(e.m.peak_omega);
+    peak_alpha.push_back(e.m.peak_alpha);
+    reversals.push_back(e.m.reversals);
+    if (e.m.finish_time >= 0) finish.push_back(e.m.finish_time);
     else ++unfinished;
   }
   const double max_finish = finish.empty() ? -1.0 : *std::max_element(finish.begin(), finish.end());
@@ -516,8 +506,8 @@ int main(int argc, char **argv) {
       std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"liquid_l\": %.4f, "
                   "\"finish_s\": %.4f, \"peak_omega_rad_s\": %.4f, \"peak_alpha_rad_s2\": %.3f, \"reversals\": %d, "
                   "\"return\": %.4f}",
-                  k ? ", " : "", e.seed, 100 * e.poured, 100 * e.spilled, e.litres, e.finish, e.peak_omega,
-                  e.peak_alpha, e.reversals, e.ret);
+                  k ? ", " : "", e.seed, 100 * e.m.poured, 100 * e.m.spilled, e.m.liquid_l, e.m.finish_time,
+                  e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
     }
     std::printf("]}\n");
   } else {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace poursim {
 
@@ -13,7 +14,8 @@ void EpisodeMeter::reset(const poursim_config_t &config, const poursim_obs_t &fi
   const double r = 0.5 * config.bucket_inner_width;
   litres_ = 1000.0 * M_PI * r * r * config.fill_depth;
   settled_.clear();
-  omega_.clear();
+  settled_.reserve(static_cast<size_t>(std::lround(config.episode_s / config.dt)));
+  steps_ = 0;
   last_ = first;
   peak_omega_ = std::fabs(first.omega);
   peak_alpha_ = 0.0;
@@ -22,19 +24,19 @@ void EpisodeMeter::reset(const poursim_config_t &config, const poursim_obs_t &fi
   disc_ = 1.0;
   last_sign_ = 0;
   reversals_ = 0;
-  omega_.push_back(first.omega);
+  std::fill(std::begin(omega_), std::end(omega_), first.omega);
 }
 
 void EpisodeMeter::add(const poursim_obs_t &obs, double command_nm) {
   last_ = obs;
   settled_.push_back(obs.v_target + obs.v_spill);
-  omega_.push_back(obs.omega);
   peak_omega_ = std::max(peak_omega_, std::fabs(obs.omega));
   max_theta_ = std::max(max_theta_, obs.theta);
-  if (omega_.size() > static_cast<size_t>(kAccelWindow)) {
-    double d = obs.omega - omega_[omega_.size() - 1 - kAccelWindow];
-    peak_alpha_ = std::max(peak_alpha_, std::fabs(d) / (kAccelWindow * dt_));
-  }
+  // The slot of step n - kAccelWindow (step 0 = the first observation) is the one this step overwrites.
+  double &then = omega_[steps_ % kAccelWindow];
+  if (++steps_ >= kAccelWindow)
+    peak_alpha_ = std::max(peak_alpha_, std::fabs(obs.omega - then) / (kAccelWindow * dt_));
+  then = obs.omega;
   int sign = command_nm > kReversalTorque ? 1 : (command_nm < -kReversalTorque ? -1 : 0);
   if (sign != 0) {
     if (last_sign_ != 0 && sign != last_sign_) ++reversals_;

@@ -28,7 +28,8 @@ class EpisodeMeter {
  private:
   double dt_ = 0.001, litres_ = 0.0;
   std::vector<double> settled_; // V_target + V_spill after each step
-  std::vector<double> omega_;   // θ̇ after each step [rad/s]
+  double omega_[kAccelWindow] = {}; // θ̇ of the last kAccelWindow steps (ring) [rad/s]
+  int steps_ = 0;
   poursim_obs_t last_{};
   double peak_omega_ = 0.0, peak_alpha_ = 0.0, max_theta_ = 0.0, ret_ = 0.0, sum_ = 0.0, disc_ = 1.0, gamma_ = 1.0;
   int last_sign_ = 0, reversals_ = 0;
