@@ -54,6 +54,7 @@ struct Result {
   uint16_t faults = 0;
   int slew_violations = 0, clamp_violations = 0, band_violations = 0;
   double peak_omega = 0.0;  // max |θ̇| of the bucket [rad/s]
+  int peak_omega_ms = 0;    // the tick it was reached
   bool ok = true;
   std::string why;
 };
@@ -180,7 +181,7 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
     const int64_t lo = std::min<int64_t>((-ccfg.safety.omega_max_urad_s - w) * k_gain / 1000000, 0);
     if (out.power && (cmd > hi + 1 || cmd < lo - 1)) r.band_violations++;
     last = cmd;
-    r.peak_omega = std::max(r.peak_omega, std::fabs(obs.omega));
+    if (std::fabs(obs.omega) > r.peak_omega) r.peak_omega = std::fabs(obs.omega), r.peak_omega_ms = k;
     // The actuator: motor torque through the injected faults; the brake is the simulator's (below).
     const double commanded = out.power ? cmd / 32768.0 : 0.0;
     double applied = commanded;
@@ -230,23 +231,27 @@ int main(int argc, char **argv) {
   }
   const poursim_config_t base = poursim_default_config();
   const double theta_bar_deg = base.theta_max * 180.0 / M_PI + 10.0;
-  // The nominal pour, for the extra spill and the worst angle of the e-stop (its fastest tick).
+  // The nominal pour, for the extra spill and the worst moment of a fault: its fastest tick.
   const Scenario nominal = {"nominal", Fault::kNone, 0, 3.0, false};
   const Result ref = run(nominal, seed, base);
-  std::printf("nominal pour (seed %u): poured %.1f %%, spilled %.1f %%, peak |θ̇| %.2f rad/s, faults 0x%04x\n",
-              static_cast<unsigned>(seed), ref.poured, ref.spilled, ref.peak_omega, static_cast<unsigned>(ref.faults));
+  std::printf("nominal pour (seed %u): poured %.1f %%, spilled %.1f %%, peak |θ̇| %.2f rad/s at %d ms, faults 0x%04x\n",
+              static_cast<unsigned>(seed), ref.poured, ref.spilled, ref.peak_omega, ref.peak_omega_ms,
+              static_cast<unsigned>(ref.faults));
   int failures = ref.detect_ms >= 0 || ref.band_violations > 0 ? 1 : 0;  // a nominal pour must not trip
   const std::vector<Scenario> scenarios = {
       {"reversed motor sign", Fault::kMotorReversed, 30, 3.0, false},
       {"reversed encoder sign", Fault::kEncoderReversed, 30, 3.0, false},
       {"frozen encoder", Fault::kEncoderFrozen, 30, 3.0, false},
+      {"reversed motor sign at the fastest tilt", Fault::kMotorReversed, ref.peak_omega_ms, 3.0, false},
+      {"reversed encoder sign at the fastest tilt", Fault::kEncoderReversed, ref.peak_omega_ms, 3.0, false},
+      {"frozen encoder at the fastest tilt", Fault::kEncoderFrozen, ref.peak_omega_ms, 3.0, false},
       {"frozen sender (repeated state)", Fault::kSenderFrozen, 60, 3.0, false},
       {"torque scale stuck at full", Fault::kScaleStuckFull, 400, 3.0, false},
       {"bus silent", Fault::kBusSilent, 60, 3.0, false},
       {"10 % of states lost", Fault::kLoss10, 0, 10.0, false},
       {"ClearErrors right after a watchdog trip (CAN node)", Fault::kClearAfterWatchdog, 60, 3.0, true},
       {"seq wrap, 70 s of running (CAN node)", Fault::kSeqWrap, 0, 70.0, true},
-      {"e-stop at the fastest tilt", Fault::kEstopWorstAngle, 100, 3.0, false},
+      {"e-stop at the fastest tilt", Fault::kEstopWorstAngle, ref.peak_omega_ms, 3.0, false},
       {"load cell drops by the whole liquid at once", Fault::kLoadCellJump, 400, 3.0, false},
       {"load cell over range (amplifier saturated)", Fault::kLoadCellOverRange, 400, 3.0, false},
       {"encoder count out of range", Fault::kEncoderGarbage, 400, 3.0, false},
