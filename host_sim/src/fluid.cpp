@@ -58,9 +58,11 @@ void Fluid::predict(double dt, double gy, const double *x, const double *y, cons
 }
 
 // Counting sort of the particles into cells of size h over their bounding box, then each particle
-// against its own cell and four forward neighbours: every pair closer than h exactly once.
+// against its own cell and four forward neighbours: every pair closer than h exactly once, in a fixed
+// order. Also sums each particle's density over the pairs.
 void Fluid::find_pairs() {
   pairs_.clear();
+  std::fill(rho_.begin(), rho_.end(), 0.0);
   if (n_ < 2) return;
   const auto [x0, x1] = std::minmax_element(px_.begin(), px_.end());
   const auto [y0, y1] = std::minmax_element(py_.begin(), py_.end());
@@ -82,31 +84,31 @@ void Fluid::find_pairs() {
     sx_[slot] = px_[static_cast<size_t>(i)], sy_[slot] = py_[static_cast<size_t>(i)]; // cell order: contiguous scans
   }
 
+  // Scanned in slot order, which is cell order: a particle's own cell after it and the cell to its right
+  // are adjacent slots, and so are the three cells of the row above (left to right); two ranges a particle.
+  // The density sums each pair's weight as it is found.
   const double h2 = p_.h * p_.h;
-  auto scan = [&](int a, int b0, int b1) {
-    const int i = sorted_[static_cast<size_t>(a)];
-    const double xi = sx_[static_cast<size_t>(a)], yi = sy_[static_cast<size_t>(a)];
-    for (int b = b0; b < b1; ++b) {
-      const double ex = sx_[static_cast<size_t>(b)] - xi, ey = sy_[static_cast<size_t>(b)] - yi;
+  auto scan = [&](size_t a, int32_t b0, int32_t b1) {
+    const int32_t i = sorted_[a];
+    const double xi = sx_[a], yi = sy_[a];
+    for (size_t b = static_cast<size_t>(b0); b < static_cast<size_t>(b1); ++b) {
+      const double ex = sx_[b] - xi, ey = sy_[b] - yi;
       const double r2 = ex * ex + ey * ey;
       if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
-      const double r = std::sqrt(r2);
-      pairs_.push_back({i, sorted_[static_cast<size_t>(b)], ex / r, ey / r, 1.0 - r * inv});
+      const double r = std::sqrt(r2), w = 1.0 - r * inv;
+      const int32_t j = sorted_[b];
+      pairs_.push_back({i, j, ex / r, ey / r, w});
+      rho_[static_cast<size_t>(i)] += w * w;
+      rho_[static_cast<size_t>(j)] += w * w;
     }
   };
-  static const int kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-  for (int cy = 0; cy < ny; ++cy) {
-    for (int cx = 0; cx < nx; ++cx) {
-      const size_t c = static_cast<size_t>(cy * nx + cx);
-      for (int a = cell_start_[c]; a < cell_start_[c + 1]; ++a) {
-        scan(a, a + 1, cell_start_[c + 1]);
-        for (const auto &f : kForward) {
-          const int fx = cx + f[0], fy = cy + f[1];
-          if (fx < 0 || fx >= nx || fy >= ny) continue;
-          const size_t o = static_cast<size_t>(fy * nx + fx);
-          scan(a, cell_start_[o], cell_start_[o + 1]);
-        }
-      }
+  for (size_t a = 0; a < static_cast<size_t>(n_); ++a) {
+    const int32_t c = cell_of_[static_cast<size_t>(sorted_[a])], cx = c % nx, cy = c / nx;
+    scan(a, static_cast<int32_t>(a) + 1, cell_start_[static_cast<size_t>(cx + 1 < nx ? c + 2 : c + 1)]);
+    if (cy + 1 < ny) {
+      const int32_t row = (cy + 1) * nx;
+      scan(a, cell_start_[static_cast<size_t>(row + std::max(cx - 1, 0))],
+           cell_start_[static_cast<size_t>(row + std::min(cx + 1, nx - 1) + 1)]);
     }
   }
 }
@@ -132,12 +134,7 @@ void Fluid::step(double dt, double gy, const double *x, const double *y, double 
     }
   }
 
-  // Density; pressure k(ρ − ρ0), never a pull.
-  std::fill(rho_.begin(), rho_.end(), 0.0);
-  for (const Pair &pr : pairs_) {
-    rho_[static_cast<size_t>(pr.i)] += pr.w * pr.w;
-    rho_[static_cast<size_t>(pr.j)] += pr.w * pr.w;
-  }
+  // Density (summed by find_pairs); pressure k(ρ − ρ0), never a pull.
   max_ratio_ = 0.0;
   for (size_t i = 0; i < n; ++i) {
     max_ratio_ = std::max(max_ratio_, rho_[i] / p_.rho0);

@@ -211,9 +211,7 @@ static void measure(poursim_world_t *w) {
   int counts[4] = {0, 0, 0, 0};
   uint64_t h = w->hash;
   for (size_t i = 0; i < n; ++i) {
-    b2Vec2 p = b2Body_GetPosition(w->circles[i]);
-    w->pos[2 * i] = p.x;
-    w->pos[2 * i + 1] = p.y;
+    const b2Vec2 p = {w->pos[2 * i], w->pos[2 * i + 1]};
     h = fnv_mix(h, &p, sizeof p);
     const double px = p.x, py = p.y;
     Eigen::Vector2d local = to_bucket * (Eigen::Vector2d(px, py) - pivot);
@@ -319,29 +317,34 @@ static void set_joint_friction(poursim_world_t *w) {
   b2RevoluteJoint_SetMaxMotorTorque(w->joint, static_cast<float>(hold));
 }
 
+// The circles' positions and velocities, read from Box2D once a step (after it moved them) for the fluid
+// layer, the numerics check and the measurements.
+static void read_circles(poursim_world_t *w) {
+  for (size_t i = 0; i < w->circles.size(); ++i) {
+    const b2Vec2 p = b2Body_GetPosition(w->circles[i]), v = b2Body_GetLinearVelocity(w->circles[i]);
+    w->pos[2 * i] = p.x, w->pos[2 * i + 1] = p.y;
+    w->fx[i] = p.x, w->fy[i] = p.y, w->fvx[i] = v.x, w->fvy[i] = v.y;
+  }
+}
+
 // One dt: the fluid layer changes the circles' velocities, then Box2D moves everything and resolves the
 // contacts with the buckets.
 static void advance(poursim_world_t *w) {
   const poursim_config_t &c = w->ep;
   if (c.fluid && !w->circles.empty()) {
-    const size_t n = w->circles.size();
-    for (size_t i = 0; i < n; ++i) {
-      b2Vec2 p = b2Body_GetPosition(w->circles[i]), v = b2Body_GetLinearVelocity(w->circles[i]);
-      w->fx[i] = p.x, w->fy[i] = p.y, w->fvx[i] = v.x, w->fvy[i] = v.y;
-    }
     w->fluid.step(c.dt, -kGravity, w->fx.data(), w->fy.data(), w->fvx.data(), w->fvy.data());
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < w->circles.size(); ++i)
       b2Body_SetLinearVelocity(w->circles[i], {static_cast<float>(w->fvx[i]), static_cast<float>(w->fvy[i])});
   }
   b2World_Step(w->world, static_cast<float>(c.dt), c.substeps);
+  read_circles(w);
 }
 
 // A liquid that blew up shows as a particle that is not finite, has left the world, or moves faster
 // than anything in a pour can; found at the step where it happens, never carried on.
 static int check_numerics(poursim_world_t *w) {
   for (size_t i = 0; i < w->circles.size(); ++i) {
-    b2Vec2 pf = b2Body_GetPosition(w->circles[i]), vf = b2Body_GetLinearVelocity(w->circles[i]);
-    const double px = pf.x, py = pf.y, vx = vf.x, vy = vf.y;
+    const double px = w->fx[i], py = w->fy[i], vx = w->fvx[i], vy = w->fvy[i];
     bool inside = std::fabs(px) <= kWorldHalfWidth + 0.5 && py >= -0.5 && py <= kWorldHeight + 0.5;
     double speed = std::sqrt(vx * vx + vy * vy);
     if (!std::isfinite(px) || !std::isfinite(py) || !inside || !(speed <= kRunawaySpeed)) {
@@ -403,6 +406,7 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   size_t n = w->circles.size();
   w->pos.assign(2 * n, 0.0f);
   w->region.assign(n, 0);
+  read_circles(w);
   // Settle with the bucket held by the joint motor, then release it at rest.
   int settle_steps = static_cast<int>(std::lround(c.settle_s / c.dt));
   w->step = 0;
