@@ -65,11 +65,14 @@ void Fluid::find_pairs() {
   pairs_.clear();
   std::fill(rho_.begin(), rho_.end(), 0.0);
   if (n_ < 2) return;
-  const auto [x0, x1] = std::minmax_element(px_.begin(), px_.end());
-  const auto [y0, y1] = std::minmax_element(py_.begin(), py_.end());
-  const double inv = 1.0 / p_.h, ox = *x0, oy = *y0;
+  double ox = px_[0], x1 = ox, oy = py_[0], y1 = oy; // the bounding box (min and max: no branches)
+  for (size_t i = 1; i < static_cast<size_t>(n_); ++i) {
+    ox = std::min(ox, px_[i]), x1 = std::max(x1, px_[i]);
+    oy = std::min(oy, py_[i]), y1 = std::max(y1, py_[i]);
+  }
+  const double inv = 1.0 / p_.h;
   // The world keeps every position finite and inside it, so the grid stays small (< 10^4 cells).
-  const int nx = static_cast<int>((*x1 - ox) * inv) + 1, ny = static_cast<int>((*y1 - oy) * inv) + 1;
+  const int nx = static_cast<int>((x1 - ox) * inv) + 1, ny = static_cast<int>((y1 - oy) * inv) + 1;
   cell_start_.assign(static_cast<size_t>(nx) * static_cast<size_t>(ny) + 1, 0);
   for (size_t i = 0; i < static_cast<size_t>(n_); ++i) {
     int cx = std::min(nx - 1, static_cast<int>((px_[i] - ox) * inv));
