@@ -45,7 +45,7 @@ void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
   for (std::vector<double> *v : {&px_, &py_, &sx_, &sy_, &rho_}) v->assign(un, 0.0);
   cell_of_.assign(un, 0);
   sorted_.assign(un, 0);
-  near_.assign(un * (un - 1) / 2 + 1, SlotPair{}); // every pair a candidate at worst (one cell), and one spare
+  near_.assign(un * 16, SlotPair{}); // grows if a step has more candidates (kept from then on)
   pairs_.clear();
   pairs_.reserve(un * 8);
   max_ratio_ = 0.0;
@@ -104,6 +104,7 @@ void Fluid::find_pairs() {
     }
   };
   for (size_t a = 0; a < static_cast<size_t>(n_); ++a) {
+    if (m + static_cast<size_t>(n_) > near_.size()) near_.resize(2 * (m + static_cast<size_t>(n_))); // < n a particle
     const int32_t c = cell_of_[static_cast<size_t>(sorted_[a])], cx = c % nx, cy = c / nx;
     scan(a, static_cast<int32_t>(a) + 1, cell_start_[static_cast<size_t>(cx + 1 < nx ? c + 2 : c + 1)]);
     if (cy + 1 < ny) {
