@@ -8,11 +8,6 @@ namespace poursim {
 
 namespace {
 
-q15_t saturate_q15(double x) {
-  double r = std::nearbyint(x);
-  return static_cast<q15_t>(std::max(-32768.0, std::min(32767.0, r)));
-}
-
 // The firmware's defaults with the rig's encoder as the simulator models it.
 pour_control_config_t firmware_config(const poursim_config_t &sim) {
   pour_control_config_t c = pour_control_default_config();
@@ -71,7 +66,7 @@ class EnvelopedController : public Controller {
     pour_estimator_update(&est_, &sample, &state_);
     double want = request(state_.theta_urad * 1e-6, state_.omega_urad_s * 1e-6);
     t_ += 0.001;
-    q15_t cmd = pour_safety_apply(&safety_, saturate_q15(want * 32768.0), state_.theta_urad, state_.omega_urad_s);
+    q15_t cmd = pour_safety_apply(&safety_, poursim_fraction_to_q15(want), state_.theta_urad, state_.omega_urad_s);
     return cmd / 32768.0;
   }
 

@@ -60,13 +60,13 @@ Features features_of(const poursim_policy_t *p, const pour_state_t &s) {
   return x;
 }
 
-// Torque fraction → Q15 for the envelope: round to nearest, saturate.
-q15_t to_q15(double a) {
-  double q = std::nearbyint(a * 32768.0);
-  return static_cast<q15_t>(std::max(-32768.0, std::min(32767.0, q)));
-}
-
 } // namespace
+
+extern "C" int16_t poursim_fraction_to_q15(double fraction) {
+  if (std::isnan(fraction)) return 0;
+  const double q = std::nearbyint(fraction * 32768.0); // the default rounding mode: ties to even
+  return static_cast<int16_t>(q < -32768.0 ? -32768.0 : (q > 32767.0 ? 32767.0 : q));
+}
 
 extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *policy, uint32_t seed,
                                const poursim_rollout_buffers_t *buf, poursim_episode_t *ep) {
@@ -133,7 +133,7 @@ extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *p
           for (int k = 0; k < n_act; ++k) buf->probs[d * static_cast<size_t>(n_act) + static_cast<size_t>(k)] = probs(k);
       }
     }
-    q15_t cmd = pour_safety_apply(&safety, to_q15(policy->levels[action]), state.theta_urad, state.omega_urad_s);
+    q15_t cmd = pour_safety_apply(&safety, poursim_fraction_to_q15(policy->levels[action]), state.theta_urad, state.omega_urad_s);
     rc = poursim_step(world, cmd / 32768.0, &o);
     if (rc != POURSIM_OK) return rc;
     meter.add(o, cmd / 32768.0 * cfg->tau_max);
