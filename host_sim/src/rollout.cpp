@@ -64,7 +64,7 @@ Features features_of(const poursim_policy_t *p, const pour_state_t &s) {
 
 extern "C" int16_t poursim_fraction_to_q15(double fraction) {
   if (std::isnan(fraction)) return 0;
-  const double q = std::nearbyint(fraction * 32768.0); // the default rounding mode: ties to even
+  const double q = std::floor(fraction * 32768.0 + 0.5); // half up, as the firmware rounds
   return static_cast<int16_t>(q < -32768.0 ? -32768.0 : (q > 32767.0 ? 32767.0 : q));
 }
 

@@ -168,7 +168,7 @@ static void test_rollout_RefusesBadPolicy(void) {
   TEST_ASSERT_EQUAL_INT(POURSIM_EINVAL, poursim_rollout(world, &pol, 1, NULL, &ep));
 }
 
-static void test_fraction_to_q15_RoundsTiesToEvenSaturatesAndMapsNanToZero(void) {
+static void test_fraction_to_q15_RoundsHalfUpSaturatesAndMapsNanToZero(void) {
   const double lsb = 1.0 / 32768.0;
   TEST_ASSERT_EQUAL_INT16(0, poursim_fraction_to_q15(NAN));
   TEST_ASSERT_EQUAL_INT16(32767, poursim_fraction_to_q15(INFINITY));
@@ -176,13 +176,12 @@ static void test_fraction_to_q15_RoundsTiesToEvenSaturatesAndMapsNanToZero(void)
   TEST_ASSERT_EQUAL_INT16(32767, poursim_fraction_to_q15(1.0));
   TEST_ASSERT_EQUAL_INT16(-32768, poursim_fraction_to_q15(-1.0));
   TEST_ASSERT_EQUAL_INT16(32767, poursim_fraction_to_q15(1e300));
-  TEST_ASSERT_EQUAL_INT16(32766, poursim_fraction_to_q15(32766.5 * lsb)); /* a tie below the limit: to even */
-  TEST_ASSERT_EQUAL_INT16(0, poursim_fraction_to_q15(0.5 * lsb));         /* half an LSB: ties to even */
-  TEST_ASSERT_EQUAL_INT16(2, poursim_fraction_to_q15(1.5 * lsb));
-  TEST_ASSERT_EQUAL_INT16(2, poursim_fraction_to_q15(2.5 * lsb));
-  TEST_ASSERT_EQUAL_INT16(0, poursim_fraction_to_q15(-0.5 * lsb));
-  TEST_ASSERT_EQUAL_INT16(-2, poursim_fraction_to_q15(-1.5 * lsb));
-  TEST_ASSERT_EQUAL_INT16(1, poursim_fraction_to_q15(0.5000001 * lsb));
+  TEST_ASSERT_EQUAL_INT16(1, poursim_fraction_to_q15(0.5 * lsb)); /* half an LSB: up */
+  TEST_ASSERT_EQUAL_INT16(0, poursim_fraction_to_q15(0.4999999 * lsb));
+  TEST_ASSERT_EQUAL_INT16(3, poursim_fraction_to_q15(2.5 * lsb));
+  TEST_ASSERT_EQUAL_INT16(0, poursim_fraction_to_q15(-0.5 * lsb)); /* up is toward +inf */
+  TEST_ASSERT_EQUAL_INT16(-1, poursim_fraction_to_q15(-1.5 * lsb));
+  TEST_ASSERT_EQUAL_INT16(32767, poursim_fraction_to_q15(32766.5 * lsb));
   TEST_ASSERT_EQUAL_INT16(-32768, poursim_fraction_to_q15(-32768.5 * lsb));
 }
 
@@ -192,6 +191,6 @@ int main(void) {
   RUN_TEST(test_rollout_MatchesManualLoopThroughSafetyEnvelope);
   RUN_TEST(test_rollout_IsDeterministicAndBatchMatchesSequential);
   RUN_TEST(test_rollout_RefusesBadPolicy);
-  RUN_TEST(test_fraction_to_q15_RoundsTiesToEvenSaturatesAndMapsNanToZero);
+  RUN_TEST(test_fraction_to_q15_RoundsHalfUpSaturatesAndMapsNanToZero);
   return UNITY_END();
 }
