@@ -45,7 +45,6 @@ void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
   for (std::vector<double> *v : {&px_, &py_, &sx_, &sy_, &rho_}) v->assign(un, 0.0);
   cell_of_.assign(un, 0);
   sorted_.assign(un, 0);
-  near_.assign(un * 16, SlotPair{}); // grows if a step has more candidates (kept from then on)
   pairs_.clear();
   pairs_.reserve(un * 8);
   max_ratio_ = 0.0;
@@ -60,10 +59,9 @@ void Fluid::predict(double dt, double gy, const double *x, const double *y, cons
 
 // Counting sort of the particles into cells of size h over their bounding box, then each particle
 // against its own cell and four forward neighbours: every pair closer than h exactly once, in a fixed
-// order. Also sums each particle's density over the pairs.
+// order.
 void Fluid::find_pairs() {
   pairs_.clear();
-  std::fill(rho_.begin(), rho_.end(), 0.0);
   if (n_ < 2) return;
   double ox = px_[0], x1 = ox, oy = py_[0], y1 = oy; // the bounding box (min and max: no branches)
   for (size_t i = 1; i < static_cast<size_t>(n_); ++i) {
@@ -90,21 +88,20 @@ void Fluid::find_pairs() {
 
   // Scanned in slot order, which is cell order: a particle's own cell after it and the cell to its right
   // are adjacent slots, and so are the three cells of the row above (left to right); two ranges a particle.
-  // First every candidate in reach, without a branch a candidate (about a third are in reach: a branch
-  // would guess wrong often), then their pairs in that order, with each particle's density summed.
   const double h2 = p_.h * p_.h;
-  size_t m = 0;
   auto scan = [&](size_t a, int32_t b0, int32_t b1) {
+    const int32_t i = sorted_[a];
     const double xi = sx_[a], yi = sy_[a];
     for (size_t b = static_cast<size_t>(b0); b < static_cast<size_t>(b1); ++b) {
       const double ex = sx_[b] - xi, ey = sy_[b] - yi;
       const double r2 = ex * ex + ey * ey;
-      near_[m] = {static_cast<int32_t>(a), static_cast<int32_t>(b)};
-      m += static_cast<size_t>(!(r2 >= h2) & !(r2 < 1e-18)); // coincident particles have no axis: skipped
+      if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
+      const double r = std::sqrt(r2), w = 1.0 - r * inv;
+      const int32_t j = sorted_[b];
+      pairs_.push_back({i, j, ex / r, ey / r, w});
     }
   };
   for (size_t a = 0; a < static_cast<size_t>(n_); ++a) {
-    if (m + static_cast<size_t>(n_) > near_.size()) near_.resize(2 * (m + static_cast<size_t>(n_))); // < n a particle
     const int32_t c = cell_of_[static_cast<size_t>(sorted_[a])], cx = c % nx, cy = c / nx;
     scan(a, static_cast<int32_t>(a) + 1, cell_start_[static_cast<size_t>(cx + 1 < nx ? c + 2 : c + 1)]);
     if (cy + 1 < ny) {
@@ -112,16 +109,6 @@ void Fluid::find_pairs() {
       scan(a, cell_start_[static_cast<size_t>(row + std::max(cx - 1, 0))],
            cell_start_[static_cast<size_t>(row + std::min(cx + 1, nx - 1) + 1)]);
     }
-  }
-  pairs_.reserve(m);
-  for (size_t k = 0; k < m; ++k) {
-    const size_t a = static_cast<size_t>(near_[k].a), b = static_cast<size_t>(near_[k].b);
-    const double ex = sx_[b] - sx_[a], ey = sy_[b] - sy_[a];
-    const double r = std::sqrt(ex * ex + ey * ey), w = 1.0 - r * inv;
-    const int32_t i = sorted_[a], j = sorted_[b];
-    pairs_.push_back({i, j, ex / r, ey / r, w});
-    rho_[static_cast<size_t>(i)] += w * w;
-    rho_[static_cast<size_t>(j)] += w * w;
   }
 }
 
@@ -146,7 +133,12 @@ void Fluid::step(double dt, double gy, const double *x, const double *y, double 
     }
   }
 
-  // Density (summed by find_pairs); pressure k(ρ − ρ0), never a pull.
+  // Density; pressure k(ρ − ρ0), never a pull.
+  std::fill(rho_.begin(), rho_.end(), 0.0);
+  for (const Pair &pr : pairs_) {
+    rho_[static_cast<size_t>(pr.i)] += pr.w * pr.w;
+    rho_[static_cast<size_t>(pr.j)] += pr.w * pr.w;
+  }
   max_ratio_ = 0.0;
   for (size_t i = 0; i < n; ++i) {
     max_ratio_ = std::max(max_ratio_, rho_[i] / p_.rho0);

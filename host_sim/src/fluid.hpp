@@ -52,10 +52,6 @@ class Fluid {
   uint64_t rng_ = 1;
   std::vector<double> px_, py_, sx_, sy_, rho_; // predicted positions; the same in cell order
   std::vector<int32_t> cell_of_, cell_start_, fill_, sorted_;
-  struct SlotPair {
-    int32_t a, b; // slots (cell order) of a pair in reach
-  };
-  std::vector<SlotPair> near_;
   std::vector<Pair> pairs_;
   double max_ratio_ = 0.0;
 };
