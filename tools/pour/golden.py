@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from pour import fixedpoint as fp
+from pour import paths
 from pour import weights_h
 
-SOURCE_DIR = Path(__file__).resolve().parents[2]
+SOURCE_DIR = paths.SOURCE_DIR
 NORM = fp.ObsNorm(0, 2356194, 4000000)  # 0..135 deg, ±4 rad/s
 
 

@@ -2,7 +2,7 @@
 """Python binding of libpoursim (host_sim/include/poursim/poursim.h) through ctypes.
 
 The library is looked for at $POUR_SIM_LIB, then $POUR_BUILD_DIR/lib/libpoursim.so, then
-<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so. Build it with
+<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so (pour.paths). Build it with
 `cmake --build --preset host`.
 
     from pour import sim
@@ -18,13 +18,14 @@ GIL during every call, so rollouts also run in parallel from Python threads.
 from __future__ import annotations
 
 import ctypes as C
-import glob
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable, Mapping, Sequence
 
 import numpy as np
+
+from pour import paths
 
 N_FEATURES = 6
 MAX_ACTIONS = 16
@@ -146,15 +147,7 @@ _lib: C.CDLL | None = None
 
 def library_candidates() -> list[Path]:
     """Where load_library() looks, in order ($POUR_SIM_LIB alone when it is set)."""
-    if os.environ.get("POUR_SIM_LIB"):
-        return [Path(os.environ["POUR_SIM_LIB"])]
-    out: list[Path] = []
-    if os.environ.get("POUR_BUILD_DIR"):
-        out.append(Path(os.environ["POUR_BUILD_DIR"]) / "lib" / "libpoursim.so")
-    build = Path(__file__).resolve().parents[2] / "build"
-    out.append(build / "host" / "lib" / "libpoursim.so")
-    out += [p for p in map(Path, sorted(glob.glob(str(build / "*" / "lib" / "libpoursim.so")))) if p not in out]
-    return out
+    return paths.sim_library_candidates()
 
 
 def load_library() -> C.CDLL:
