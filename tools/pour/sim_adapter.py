@@ -2,9 +2,10 @@
 """The trainer's glue onto libpoursim, built on the binding in pour.sim.
 
 SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy, the
-firmware's safety envelope on every torque) and returns it as an episode.Episode. SimStepper advances
-the world tick by tick for the Gymnasium environment, with the same envelope (its bit-exact Python
-mirror). Failures come out as episode.EnvError, which the trainer reports; pour.sim finds the library.
+firmware's safety envelope on every torque) and returns it as an Episode. SimStepper advances the world
+tick by tick for the Gymnasium environment through the same C code: the firmware's estimator and envelope
+(pour.core, from the same library), so a stepped episode equals the C rollout's. Failures come out as
+EnvError, which the trainer reports; pour.sim finds the library.
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from pour import episode
+from pour import core, episode
 from pour import fixedpoint as fp
 from pour import reinforce
 from pour import sim
@@ -84,19 +85,23 @@ class SimEnv:
 
 class SimStepper:
     """Tick-by-tick access for the Gymnasium env, as the firmware sees the rig: the sensor sample through the
-    estimator (tools/pour/fixedpoint.py, bit-exact with firmware/src/sensors.c), torques through the safety
-    envelope with its motion limits."""
+    firmware's estimator (firmware/src/sensors.c), torques through its safety envelope with the motion limits
+    (firmware/src/safety.c), both called in C through pour.core with the defaults poursim_rollout uses."""
 
     def __init__(self, options: dict[str, Any] | None = None):
         self.world = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
-        self.sensors = fp.SensorsConfig(encoder_bits=int(self.world.config.encoder_bits))
+        with _env_errors("the firmware core in libpoursim"):
+            fw = core.control_config()
+        self.safety_config = fw.safety
+        self.sensors_config = fw.sensors
+        self.sensors_config.encoder_bits = int(self.world.config.encoder_bits)
 
     def reset(self, seed: int) -> None:
         with _env_errors("poursim_reset"):
             self.obs = self.world.reset(seed)
-        self.safety = fp.SafetyEnvelope()
-        self.estimator = fp.Estimator(self.sensors)
+        self.safety = core.Envelope(self.safety_config)
+        self.estimator = core.Estimator(self.sensors_config)
         self.seq = 0
         self.state = (0, 0, 0, 0, 0, 0)
         self._sense()
