@@ -38,74 +38,79 @@ class CoreError(RuntimeError):
     """The core refused a config (its pour_status_t name in the message)."""
 
 
-class SafetyConfig(C.Structure):
+class _Struct(C.Structure):
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(" + ", ".join(f"{k}={getattr(self, k)!r}" for k, _ in self._fields_) + ")"
+
+
+class SafetyConfig(_Struct):
     _fields_ = [("tau_limit", q15), ("slew_per_tick", q15), ("theta_min_urad", C.c_int32),
                 ("theta_max_urad", C.c_int32), ("omega_max_urad_s", C.c_int32), ("alpha_max_urad_s2", C.c_int32),
                 ("omega_slack_urad_s", C.c_int32), ("torque_per_rad_s", q15)]
 
 
-class SafetyState(C.Structure):
+class SafetyState(_Struct):
     _fields_ = [("config", SafetyConfig), ("torque", q15), ("active", C.c_uint8), ("alpha_step_urad_s", C.c_int32),
                 ("gain_q32", C.c_int32), ("ceiling_urad_s", C.c_int32), ("floor_urad_s", C.c_int32)]
 
 
-class SensorsConfig(C.Structure):
+class SensorsConfig(_Struct):
     _fields_ = [("encoder_bits", C.c_uint8), ("bandwidth_rad_s", C.c_uint16), ("scale_min_g", C.c_int32),
                 ("scale_max_g", C.c_int32), ("mass_min_g", C.c_int32), ("jump_max_urad", C.c_int32)]
 
 
-class EstimatorState(C.Structure):
+class EstimatorState(_Struct):
     _fields_ = [("config", SensorsConfig), ("gain_theta_q24", C.c_int32), ("gain_omega_q24", C.c_int32),
                 ("started", C.c_bool), ("last_seq", C.c_uint32), ("theta_q16", C.c_int64), ("omega_q16", C.c_int64),
                 ("m0_g", C.c_int32)]
 
 
-class PlantState(C.Structure):
+class PlantState(_Struct):
     _fields_ = [("seq", C.c_uint32), ("theta_urad", C.c_int32), ("omega_urad_s", C.c_int32), ("v_rotating", q15),
                 ("v_target", q15), ("v_spill", q15)]
 
 
-class SensorSample(C.Structure):
+class SensorSample(_Struct):
     _fields_ = [("seq", C.c_uint32), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
                 ("scale_target_g", C.c_int32)]
 
 
-class ObsNorm(C.Structure):
+class ObsNorm(_Struct):
     _fields_ = [("theta_min_urad", C.c_int32), ("theta_max_urad", C.c_int32), ("omega_max_urad_s", C.c_int32)]
 
 
-class PolicyWeights(C.Structure):
+class PolicyWeights(_Struct):
     _fields_ = [("n_actions", C.c_uint8), ("w_frac_bits", C.c_uint8), ("decision_period_ms", C.c_uint16),
                 ("w", C.POINTER(C.c_int16)), ("action_levels", C.POINTER(q15)), ("norm", ObsNorm),
                 ("tau_max_mnm", C.c_int32), ("content_hash", C.c_uint32)]
 
 
-class SupervisorConfig(C.Structure):
+class SupervisorConfig(_Struct):
     _fields_ = [("checks", C.c_uint8), ("theta_margin_urad", C.c_int32), ("omega_max_urad_s", C.c_int32),
                 ("window_ms", C.c_uint8), ("torque_min", q15), ("omega_against_urad_s", C.c_int32),
                 ("against_ms", C.c_uint8), ("encoder_move_urad", C.c_int32), ("encoder_ms", C.c_uint8),
                 ("volume_step_max", q15), ("accel_full_urad_s2", C.c_int32), ("accel_passive_urad_s2", C.c_int32)]
 
 
-class StopConfig(C.Structure):
+class StopConfig(_Struct):
     _fields_ = [("torque_max", q15), ("return_speed_urad_s", C.c_int32), ("return_gain_per_s", C.c_uint16),
                 ("torque_per_rad_s", q15), ("rest_theta_urad", C.c_int32), ("rest_omega_urad_s", C.c_int32),
                 ("timeout_ms", C.c_uint16)]
 
 
-class ControlConfig(C.Structure):
+class ControlConfig(_Struct):
     _fields_ = [("safety", SafetyConfig), ("sensors", SensorsConfig), ("input_timeout_ms", C.c_uint16),
                 ("safe_torque", q15), ("policy_mode", C.c_int), ("seed", C.c_uint32),
                 ("plausible_theta_urad", C.c_int32), ("plausible_omega_urad_s", C.c_int32),
                 ("plausible_volume_sum", C.c_int32), ("supervisor", SupervisorConfig), ("stop", StopConfig)]
 
 
-class ControlInput(C.Structure):
+class ControlInput(_Struct):
     _fields_ = [("sensors_fresh", C.c_bool), ("sensors", SensorSample), ("estop", C.c_bool),
                 ("clear_faults", C.c_bool), ("link_fault", C.c_bool), ("stop", C.c_bool), ("reset", C.c_bool)]
 
 
-class ControlOutput(C.Structure):
+class ControlOutput(_Struct):
     _fields_ = [("torque", q15), ("action", C.c_uint8), ("probs", q15 * POLICY_MAX_ACTIONS), ("mode", C.c_uint8),
                 ("faults", C.c_uint16), ("limits", C.c_uint8), ("tick", C.c_uint32), ("brake", C.c_bool),
                 ("power", C.c_bool)]
