@@ -24,7 +24,7 @@ import numpy as np
 
 from pour import config as cfgmod
 from pour import envs, executors, reinforce
-from pour.executors import Runner  # noqa: F401 (train.Runner: the local pool, the default executor)
+from pour.executors import Runner  # the local pool, the default executor (also as train.Runner)
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
 
