@@ -128,8 +128,8 @@ def test_envelope_holds_every_rule_after_every_tick(case):
         # the limit bits say which rule shaped the command, and only rules that could have
         if act == 0:
             assert cmd == req
-        if act & core.LIMIT_CLAMP:
-            assert abs(req) > cfg.tau_limit
+        angle_refused = (req > 0 and theta >= cfg.theta_max_urad) or (req < 0 and theta <= cfg.theta_min_urad)
+        assert bool(act & core.LIMIT_CLAMP) == (abs(req) > cfg.tau_limit and not angle_refused)
         if act & core.LIMIT_ANGLE_MAX:
             assert theta >= cfg.theta_max_urad
         if act & core.LIMIT_ANGLE_MIN:
