@@ -46,7 +46,8 @@ fi
 stamp_want=$(cat tools/requirements.lock tools/pyproject.toml | sha256sum | cut -c1-16)
 if [ "$(cat .venv/.pour-stamp 2>/dev/null)" != "$stamp_want" ]; then
   log "venv: installing tools/requirements.lock"
-  .venv/bin/python -m pip install -q --disable-pip-version-check -r tools/requirements.lock
+  # Every file checked against the lock's sha256 (pip refuses an unpinned or unhashed package).
+  .venv/bin/python -m pip install -q --disable-pip-version-check --require-hashes -r tools/requirements.lock
   .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps -e tools
   echo "$stamp_want" > .venv/.pour-stamp
 fi

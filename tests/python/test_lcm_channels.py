@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from pour import channels, lcm_types
+from pour import channels, lcm_types, paths
 
 
 def header_macros(source_dir) -> dict:
@@ -71,6 +71,6 @@ def test_generated_types_refuse_foreign_and_truncated_data(build_dir, monkeypatc
 def test_missing_build_gives_a_clear_message(monkeypatch, tmp_path):
     monkeypatch.setenv("POUR_LCMTYPES_PYTHON", str(tmp_path))
     monkeypatch.setenv("POUR_BUILD_DIR", str(tmp_path))
-    monkeypatch.setattr(lcm_types, "_SOURCE_DIR", tmp_path)
+    monkeypatch.setattr(paths, "SOURCE_DIR", tmp_path)
     with pytest.raises(SystemExit, match="generated LCM types not found"):
         lcm_types.load()

@@ -9,7 +9,7 @@ import pytest
 from PIL import Image
 
 from lcm_helpers import Proc, binary, url
-from pour import lcm_spy
+from pour import lcm_spy, paths
 
 
 def make_xwd(rgb: np.ndarray, byte_order: int = 0) -> bytes:
@@ -66,7 +66,7 @@ def test_lcm_spy_decodes_our_types_under_xvfb(build_dir, source_dir, tmp_path):
 
 def test_lcm_spy_without_jar_says_what_to_build(tmp_path, monkeypatch):
     monkeypatch.delenv("POUR_BUILD_DIR", raising=False)
-    monkeypatch.setattr(lcm_spy, "_SOURCE_DIR", tmp_path)
+    monkeypatch.setattr(paths, "SOURCE_DIR", tmp_path)
     with pytest.raises(SystemExit, match="pour_lcmtypes.jar not found"):
         lcm_spy.find_jar(str(tmp_path))
 

@@ -93,7 +93,8 @@ def test_episode_metrics_count_reversals_and_litres():
     def run(w):
         pol = sim.Policy(np.asarray(w, dtype=float), levels, 10, cfg.obs_theta_min, cfg.obs_theta_max,
                          cfg.obs_omega_max, True)
-        return sim.rollout_batch(cfg, pol, [5], n_threads=1)[0].metrics
+        with sim.World(cfg) as world:
+            return world.rollout(pol, 5).metrics
 
     forward = run([[0, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 1]])  # always +tau_max
     assert forward["reversals"] == 0
@@ -116,4 +117,4 @@ def test_a_bad_reversal_cost_is_refused_by_the_c_rollout():
         pol = sim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, cfg.obs_theta_min, cfg.obs_theta_max,
                          cfg.obs_omega_max, True, bad)
         with pytest.raises(sim.SimError, match="k_reversal"):
-            sim.rollout_batch(cfg, pol, [1], n_threads=1)
+            sim.World(cfg).rollout(pol, 1)

@@ -93,21 +93,12 @@ def test_rollout_arrays_and_determinism():
     assert np.array_equal(a.actions, b.actions) and a.ret == b.ret
 
 
-def test_batch_on_two_threads_equals_sequential():
-    pol = small_policy()
-    cfg = {"episode_s": 1.5}
-    batch = sim.rollout_batch(cfg, pol, seeds=[7, 8, 9], n_threads=2)
-    with sim.World(cfg) as w:
-        seq = [w.rollout(pol, seed=s) for s in (7, 8, 9)]
-    for x, y in zip(batch, seq):
-        assert x.seed == y.seed and x.ret == y.ret and np.array_equal(x.actions, y.actions)
-
-
 def test_bad_policy_shape_raises():
     with pytest.raises(sim.SimError, match="shape"):
         sim.Policy(w=np.zeros((5, 11)), levels=sim.uniform_levels(11))._struct()
     with pytest.raises(sim.SimError):
-        sim.rollout_batch({"episode_s": 0.1}, sim.Policy(w=np.zeros((6, 3)), levels=np.array([-2.0, 0, 1])), [1])
+        with sim.World({"episode_s": 0.1}) as w:
+            w.rollout(sim.Policy(w=np.zeros((6, 3)), levels=np.array([-2.0, 0, 1])), 1)
 
 
 def _load_in_subprocess(lib_path):

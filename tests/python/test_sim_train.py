@@ -11,7 +11,7 @@ from gymnasium.utils.env_checker import check_env
 
 import pour.gym_env
 from pour import config as cfgmod
-from pour import envs, evaluate, sim_adapter, train, weights_h
+from pour import core, envs, evaluate, sim_adapter, train, weights_h
 
 SRC = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
@@ -22,7 +22,8 @@ def test_sim_gym_env_passes_the_checker():
 
 
 def test_gym_steps_reproduce_the_c_rollout():
-    """Tick-by-tick stepping (Python envelope mirror) and the C whole-episode rollout agree exactly."""
+    """Tick-by-tick stepping (the firmware's estimator and envelope, in C through pour.core) and the C
+    whole-episode rollout agree exactly."""
     sim = envs.make_env("sim", 11, 10, 0.6)
     w = np.zeros((6, 11))
     w[0, :] = np.linspace(30, -30, 11)  # torque falls as theta grows, so actions change along the way
@@ -31,6 +32,7 @@ def test_gym_steps_reproduce_the_c_rollout():
     env = pour.gym_env.PourEnv("sim", episode_s=0.6)
     env._plant.reset(31)
     env._k, env._started = 0, True
+    assert isinstance(env._plant.safety, core.Envelope) and isinstance(env._plant.estimator, core.Estimator)
     xs, rewards = [env._plant.features()], []
     for a in ep.actions:
         obs, r, term, trunc, info = env.step(int(a))

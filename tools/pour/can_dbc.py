@@ -12,11 +12,13 @@ import re
 import sys
 from pathlib import Path
 
+from pour import paths
+
 NODE_ID_MAX = 63
 CMD_MASK = 0x1F
 NODE_SHIFT = 5
 
-DBC_PATH = Path(__file__).resolve().parents[2] / "can" / "pour.dbc"
+DBC_PATH = paths.SOURCE_DIR / "can" / "pour.dbc"
 
 
 def can_id(node_id: int, cmd: int) -> int:

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import shutil
 import subprocess
 import sys
@@ -20,7 +19,7 @@ import numpy as np
 
 from pour import envs
 from pour import fixedpoint as fp
-from pour import weights_h
+from pour import paths, weights_h
 
 
 def state_of_features(x: np.ndarray, norm: fp.ObsNorm) -> list[int]:
@@ -53,15 +52,9 @@ def held_out_seeds(n: int, base: int = 1_000_000) -> list[int]:
 
 def host_sim_binary(build_dir: str | Path | None = None) -> Path:
     """The host_sim executable of a build directory (POUR_BUILD_DIR, or build/host)."""
-    root = Path(__file__).resolve().parents[2]
-    cands = [Path(build_dir)] if build_dir else []
-    if os.environ.get("POUR_BUILD_DIR"):
-        cands.append(Path(os.environ["POUR_BUILD_DIR"]))
-    cands += [root / "build" / "host"]
-    for c in cands:
-        p = c / "bin" / "host_sim"
-        if p.is_file() and os.access(p, os.X_OK):
-            return p
+    p = paths.binary("host_sim", build_dir)
+    if p is not None:
+        return p
     found = shutil.which("host_sim")
     if found:
         return Path(found)

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: MIT
-"""Ray as an executor of the trainer's rollouts (`pour-train --executor ray`), and the connection to a cluster.
+"""The executors of the trainer's rollouts: the local process pool (Runner, the default) and Ray
+(`pour-train --executor ray`, RayRunner), with the connection to a cluster.
 
-RayRunner has the interface of train.Runner (run(w, seeds, greedy) -> episodes in seed order, tau_max_nm,
-close(), a context manager), so the training loop does not know which one it drives. Each Ray task runs
-a contiguous batch of episodes (by default one batch per CPU of the cluster, so the per-task cost of
+Both have one interface (run(w, seeds, greedy) -> episodes in seed order, tau_max_nm, close(), a context
+manager), so the training loop does not know which one it drives. Runner forks `workers` processes, each
+with its own episode source (one libpoursim world each). Each RayRunner task runs a contiguous batch of episodes (by default one batch per CPU of the cluster, so the per-task cost of
 scheduling and of moving the weights is paid once per batch, not once per episode). The seeds come from
 the run's config through the driver; a worker only evaluates (W, seed) -> episode, which is a pure
 function, so a run on Ray is bit-identical to the same run on the local pool.
@@ -14,7 +15,7 @@ An address that cannot be reached fails within a bounded time with an error nami
 (ExecutorError). A KeyboardInterrupt (SIGINT) cancels the outstanding tasks; the run's last checkpoint
 is untouched, so the run resumes from it as it does on the local pool.
 
-Workers find libpoursim the way the driver does (pour.sim.library_candidates: $POUR_SIM_LIB,
+Workers find libpoursim the way the driver does (pour.paths.sim_library_candidates: $POUR_SIM_LIB,
 $POUR_BUILD_DIR/lib, the source tree's build/*/lib); the driver passes $POUR_SIM_LIB and $POUR_BUILD_DIR
 to its workers in the job's runtime environment when they are set. On a multi-machine cluster every
 node needs the `pour` package (`pip install ./tools[ray]`) and libpoursim at the same path, or
@@ -25,6 +26,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import multiprocessing as mp
 import os
 import signal
 import socket
@@ -34,6 +36,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pour import config as cfgmod
 from pour import envs
 
 # Loopback only unless the user names another host: a local instance never binds a public interface.
@@ -160,6 +163,55 @@ def _current_cluster() -> str | None:
         return None
 
 
+# --- the local pool (the default executor) ---------------------------------------------------------
+
+_ENV: Any = None
+
+
+def _init_worker(env_args: tuple) -> None:
+    global _ENV
+    _ENV = envs.make_env(*env_args)
+
+
+def _run(job: tuple) -> envs.Episode:
+    w, seed, greedy = job
+    return _ENV.rollout(w, seed, greedy)
+
+
+class Runner:
+    """Runs episodes in order on `workers` processes (or in-process for one worker)."""
+
+    def __init__(self, cfg: cfgmod.TrainConfig):
+        self.env_args = (cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
+                         cfg.env.episode_s, cfg.env.options)
+        _init_worker(self.env_args)  # fail early and clearly in the parent (missing library, bad option)
+        self.tau_max_nm = float(_ENV.tau_max_nm)
+        self.pool = None
+        if cfg.workers > 1:
+            self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
+
+    def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
+        jobs = [(w, s, greedy) for s in seeds]
+        if self.pool is None:
+            return [_run(j) for j in jobs]
+        return self.pool.map(_run, jobs, chunksize=1)
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.close()
+            self.pool.join()
+            self.pool = None
+
+    def __enter__(self) -> "Runner":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool.join()
+            self.pool = None
+
+
 # --- the task ---------------------------------------------------------------------------------------
 
 _ENVS: dict[str, Any] = {}   # this worker process's environments, by their arguments
@@ -204,7 +256,7 @@ def batches(seeds: Sequence[int], n_tasks: int) -> list[list[int]]:
 
 
 class RayRunner:
-    """train.Runner's interface on Ray tasks. address: see connect(); episodes_per_task: batch size
+    """Runner's interface on Ray tasks. address: see connect(); episodes_per_task: batch size
     (default: the episodes of a call spread evenly, one batch per CPU of the cluster)."""
 
     def __init__(self, cfg: Any, address: str | None = None, num_cpus: int | None = None,
@@ -301,9 +353,8 @@ def cancel_all(ray: Any, refs: Sequence[Any]) -> None:
 
 
 def runner_factory(executor: str, address: str | None = None) -> Any:
-    """cfg -> runner for `pour-train --executor`: 'local' (train.Runner, the default) or 'ray'."""
+    """cfg -> runner for `pour-train --executor`: 'local' (Runner, the default) or 'ray'."""
     if executor == "local":
-        from pour.train import Runner
         return Runner
     if executor == "ray":
         # A local instance gets the config's `workers` CPUs, as the local pool gets that many processes.

@@ -1,6 +1,12 @@
 # SPDX-License-Identifier: MIT
 """Hand-made policies and golden vectors for the firmware's unit tests.
 
+The fixed-point kernels' vectors (quantisation, softmax and argmax, the policy's logits, probabilities and
+sampled actions) come from the independent Python reference, pour.fixedpoint. The stateful parts (the
+safety envelope, the estimator, whole control-step trajectories) are recorded from the C core itself
+through pour.core (libpoursim): regression pins, not a second implementation. Their correctness against
+docs/safety.md is what tests/python/test_core_properties.py checks, with Hypothesis.
+
     python -m pour.golden            # rewrites tests/golden/golden_vectors.h and the hand-made policies
     python -m pour.golden --check    # exits 1 if any committed file differs from a fresh generation
 """
@@ -12,10 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+from pour import core, paths
 from pour import fixedpoint as fp
 from pour import weights_h
 
-SOURCE_DIR = Path(__file__).resolve().parents[2]
+SOURCE_DIR = paths.SOURCE_DIR
 NORM = fp.ObsNorm(0, 2356194, 4000000)  # 0..135 deg, ±4 rad/s
 
 
@@ -164,28 +171,39 @@ def _control_script(rng: np.random.Generator) -> list[tuple[bool, tuple, bool, b
     return ticks
 
 
+# Per control config: tau_limit, slew_per_tick, theta_min, theta_max, input_timeout_ms, safe_torque, sampled,
+# seed, omega_max, alpha_max, omega_slack, torque_per_rad_s, encoder_bits, bandwidth (test_golden.c's order).
+CONTROL_CONFIGS = (
+    ("greedy, default config",
+     (32767, 3277, -87266, 2356194, 20, 0, 0, 1, 2000000, 3400000, 800000, 16384, 17, 300)),
+    ("sampled (seed 7), tighter envelope and motion limits, 10 ms timeout, a slow tracking loop (80 rad/s)",
+     (24000, 2000, -20000, 1900000, 10, -1000, 1, 7, 1500000, 10000000, 400000, 30000, 17, 80)),
+)
+
+
+def control_config(row: tuple) -> core.ControlConfig:
+    """The C config of a CONTROL_CONFIGS row, set as test_golden.c sets it (the supervisor disarmed)."""
+    c = core.control_config()
+    s = c.safety
+    (s.tau_limit, s.slew_per_tick, s.theta_min_urad, s.theta_max_urad, c.input_timeout_ms, c.safe_torque, sampled,
+     c.seed, s.omega_max_urad_s, s.alpha_max_urad_s2, s.omega_slack_urad_s, s.torque_per_rad_s,
+     c.sensors.encoder_bits, c.sensors.bandwidth_rad_s) = row
+    c.policy_mode = 1 if sampled else 0
+    c.supervisor.checks = 0  # the vectors are scripted, not physical, states
+    return c
+
+
 def _control_lines(ex: weights_h.WeightsH, rng: np.random.Generator) -> list[str]:
-    configs = [("greedy, default config", fp.ControlConfig()),
-               ("sampled (seed 7), tighter envelope and motion limits, 10 ms timeout, a slow tracking loop (80 rad/s)",
-                fp.ControlConfig(safety=fp.SafetyConfig(tau_limit=24000, slew_per_tick=2000, theta_min_urad=-20000,
-                                                        theta_max_urad=1900000, omega_max_urad_s=1500000,
-                                                        alpha_max_urad_s2=10000000, omega_slack_urad_s=400000,
-                                                        torque_per_rad_s=30000),
-                                 sensors=fp.SensorsConfig(encoder_bits=17, bandwidth_rad_s=80),
-                                 input_timeout_ms=10, safe_torque=-1000, sampled=True, seed=7))]
     lines = ["/* pour_control_step on example_weights.h: per tick the inputs (flags: 1 fresh, 2 e-stop, 4 clear;",
              " * sample seq, encoder, scale_rotating_g, scale_target_g) and the outputs (torque, action, mode,",
              " * faults, limits). */",
              "typedef struct { uint8_t flags; uint32_t sample[4]; int16_t torque; uint8_t action; uint8_t mode; "
              "uint16_t faults; uint8_t limits; } pour_golden_tick_t;"]
     script = _control_script(rng)
-    for i, (what, cfg) in enumerate(configs):
-        ctl = fp.Controller(ex.w_q, ex.w_frac_bits, ex.levels_q15, ex.decision_period_ms, ex.norm, cfg)
-        sc = cfg.safety or fp.SafetyConfig()
-        se = cfg.sensors or fp.SensorsConfig()
+    for i, (what, row) in enumerate(CONTROL_CONFIGS):
+        ctl = core.Controller(ex, control_config(row))
         lines += [f"/* {what} */",
-                  f"static const int32_t pour_golden_control_config_{i}[14] = "
-                  f"{_c_array([sc.tau_limit, sc.slew_per_tick, sc.theta_min_urad, sc.theta_max_urad, cfg.input_timeout_ms, cfg.safe_torque, int(cfg.sampled), cfg.seed, sc.omega_max_urad_s, sc.alpha_max_urad_s2, sc.omega_slack_urad_s, sc.torque_per_rad_s, se.encoder_bits, se.bandwidth_rad_s])};",
+                  f"static const int32_t pour_golden_control_config_{i}[14] = {_c_array(row)};",
                   f"static const pour_golden_tick_t pour_golden_control_{i}[] = {{"]
         for fresh, smp, estop, clear in script:
             o = ctl.step(smp if fresh else None, estop=estop, clear_faults=clear)
@@ -203,10 +221,12 @@ ESTIMATOR_LEN = 200
 def _estimator_lines(rng: np.random.Generator) -> list[str]:
     """pour_estimator_update over a scripted motion per config: rest, a swing through upright (the wrap),
     seq gaps, repeats, held scales, and implausible samples (count, scales, m0) in between."""
-    configs = [fp.SensorsConfig(), fp.SensorsConfig(encoder_bits=12, bandwidth_rad_s=40, scale_min_g=-100,
-                                                    scale_max_g=20000, mass_min_g=2000, jump_max_urad=3000),
-               fp.SensorsConfig(encoder_bits=24, bandwidth_rad_s=1000, scale_min_g=-32767, scale_max_g=32767,
-                                mass_min_g=1, jump_max_urad=1000000)]
+    configs = [core.sensors_config(encoder_bits=17, bandwidth_rad_s=300, scale_min_g=-2000, scale_max_g=30000,
+                                   mass_min_g=1000, jump_max_urad=10000),
+               core.sensors_config(encoder_bits=12, bandwidth_rad_s=40, scale_min_g=-100, scale_max_g=20000,
+                                   mass_min_g=2000, jump_max_urad=3000),
+               core.sensors_config(encoder_bits=24, bandwidth_rad_s=1000, scale_min_g=-32767, scale_max_g=32767,
+                                   mass_min_g=1, jump_max_urad=1000000)]
     lines = ["/* pour_estimator_update: config (encoder_bits, bandwidth, scale_min, scale_max, mass_min, jump_max), per",
              " * sample (seq, encoder, scale_rotating_g, scale_target_g) -> ok and the state (θ, θ̇, V_rot, V_tgt,",
              " * V_spill; the last good one where not ok) */",
@@ -214,7 +234,7 @@ def _estimator_lines(rng: np.random.Generator) -> list[str]:
              f"int32_t state[{ESTIMATOR_LEN}][5]; }} pour_golden_estimator_t;",
              "static const pour_golden_estimator_t pour_golden_estimator[] = {"]
     for cfg in configs:
-        est = fp.Estimator(cfg)
+        est = core.Estimator(cfg)
         bits = cfg.encoder_bits
         theta, omega, seq, m_rot, m_tgt = 300000, 0.0, 7, 9000, 1000
         samples, oks, states, last = [], [], [], (0, 0, 0, 0, 0)
@@ -260,7 +280,8 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
     n = ex.n_actions
     lines = [
         f"/* golden_vectors.h — expected outputs of the fixed-point core, generated by tools/pour/golden.py "
-        f"(pour.fixedpoint, seed {seed}) from {EXAMPLE_REL} (content hash 0x{ex.content_hash:08x}). DO NOT EDIT. */",
+        f"(seed {seed}; kernels from pour.fixedpoint, envelope, estimator and control step recorded from the C "
+        f"core through pour.core) from {EXAMPLE_REL} (content hash 0x{ex.content_hash:08x}). DO NOT EDIT. */",
         "#ifndef POUR_GOLDEN_VECTORS_H",
         "#define POUR_GOLDEN_VECTORS_H",
         "#include <stdint.h>",
@@ -307,10 +328,12 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
         acts = [sp.eval(ob).action for _ in range(SAMPLED_LEN)]
         lines.append(f"    {{{seed_i}u, {_c_array(ob)}, {_c_array(acts)}}},")
     lines += ["};", f"#define POUR_GOLDEN_N_SAMPLED {N_SAMPLED}", f"#define POUR_GOLDEN_SAMPLED_LEN {SAMPLED_LEN}", ""]
-    configs = [fp.SafetyConfig(), fp.SafetyConfig(tau_limit=20000, slew_per_tick=3000, theta_min_urad=-1000,
-                                                  theta_max_urad=2000000, omega_max_urad_s=3000000,
-                                                  alpha_max_urad_s2=50000000, omega_slack_urad_s=200000,
-                                                  torque_per_rad_s=32767)]
+    configs = [core.safety_config(tau_limit=32767, slew_per_tick=3277, theta_min_urad=-87266, theta_max_urad=2356194,
+                                  omega_max_urad_s=2000000, alpha_max_urad_s2=3400000, omega_slack_urad_s=800000,
+                                  torque_per_rad_s=16384),
+               core.safety_config(tau_limit=20000, slew_per_tick=3000, theta_min_urad=-1000, theta_max_urad=2000000,
+                                  omega_max_urad_s=3000000, alpha_max_urad_s2=50000000, omega_slack_urad_s=200000,
+                                  torque_per_rad_s=32767)]
     lines += ["/* pour_safety_apply: config (tau_limit, slew_per_tick, theta_min, theta_max, omega_max, alpha_max,",
               " * omega_slack, torque_per_rad_s), then per tick requested torque, θ and θ̇ -> command and active limits */",
               f"typedef struct {{ int32_t config[8]; int32_t requested[{SAFETY_LEN}]; int32_t theta[{SAFETY_LEN}]; "
@@ -318,7 +341,7 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
               "pour_golden_safety_t;",
               "static const pour_golden_safety_t pour_golden_safety[] = {"]
     for cfg in configs:
-        env = fp.SafetyEnvelope(cfg)
+        env = core.Envelope(cfg)
         req, th, om, tq, act = [], [], [], [], []
         omega = 0
         for t in range(SAFETY_LEN):

@@ -17,19 +17,15 @@ import subprocess
 import sys
 from pathlib import Path
 
-_SOURCE_DIR = Path(__file__).resolve().parents[2]
+from pour import paths
 
 
 def find_binary(name: str, build_dir: str | None) -> Path:
-    """NAME in the build tree (bin/ or the folder of its target; the newest copy wins)."""
-    dirs = [Path(build_dir)] if build_dir else []
-    if os.environ.get("POUR_BUILD_DIR"):
-        dirs.append(Path(os.environ["POUR_BUILD_DIR"]))
-    dirs.append(_SOURCE_DIR / "build" / "host")
-    for d in dirs:
-        p = d / "bin" / name
-        if p.is_file():
-            return p
+    """NAME in a build tree's bin/ (pour.paths.build_dirs order)."""
+    p = paths.find(Path("bin") / name, build_dir)
+    if p is not None:
+        return p
+    dirs = paths.build_dirs(build_dir)
     raise SystemExit(f"error: {name} not found under {', '.join(map(str, dirs))}; build first "
                      "(cmake --workflow --preset host)")
 

@@ -20,21 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from pour import channels
-
-_SOURCE_DIR = Path(__file__).resolve().parents[2]
-
+from pour import channels, paths
 
 def find_jar(build_dir: str | None = None) -> Path:
     """The types jar: --build-dir, then $POUR_BUILD_DIR, then build/host of the source tree."""
-    dirs = [Path(build_dir)] if build_dir else []
-    if os.environ.get("POUR_BUILD_DIR"):
-        dirs.append(Path(os.environ["POUR_BUILD_DIR"]))
-    dirs.append(_SOURCE_DIR / "build" / "host")
-    for d in dirs:
-        jar = d / "lcmtypes" / "pour_lcmtypes.jar"
-        if jar.is_file():
-            return jar
+    jar = paths.find(Path("lcmtypes") / "pour_lcmtypes.jar", build_dir)
+    if jar is not None:
+        return jar
+    dirs = paths.build_dirs(build_dir)
     raise SystemExit("error: pour_lcmtypes.jar not found in " + ", ".join(str(d / "lcmtypes") for d in dirs)
                      + "; build first (cmake --workflow --preset host)")
 

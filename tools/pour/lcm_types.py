@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-_SOURCE_DIR = Path(__file__).resolve().parents[2]
+from pour import paths
 
 
 def candidates() -> list[Path]:
@@ -16,10 +16,7 @@ def candidates() -> list[Path]:
     out = []
     if os.environ.get("POUR_LCMTYPES_PYTHON"):
         out.append(Path(os.environ["POUR_LCMTYPES_PYTHON"]))
-    if os.environ.get("POUR_BUILD_DIR"):
-        out.append(Path(os.environ["POUR_BUILD_DIR"]) / "lcmtypes" / "python")
-    out.append(_SOURCE_DIR / "build" / "host" / "lcmtypes" / "python")
-    return out
+    return out + paths.candidates(Path("lcmtypes") / "python")
 
 
 def load() -> ModuleType:

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from pour import envs, executors, train
+from pour import envs, executors
 from pour import config as cfgmod
 
 
@@ -105,9 +105,9 @@ def main() -> int:
         cfg = _cfg(args.env, args.episode_s, cpus)
         with mp.get_context("fork").Pool(cpus) as pool:
             bulk, rt = pool_task_overhead(pool)
-        runner = train.Runner(cfg)
+        runner = executors.Runner(cfg)
         if runner.pool is None:   # one worker runs in-process; measure a pool of one as the comparison
-            runner.pool = mp.get_context("fork").Pool(1, train._init_worker, (runner.env_args,))
+            runner.pool = mp.get_context("fork").Pool(1, executors._init_worker, (runner.env_args,))
         wall = throughput(runner, args.episodes)
         runner.close()
         ideal = cpus / t_ep

@@ -2,7 +2,7 @@
 """Python binding of libpoursim (host_sim/include/poursim/poursim.h) through ctypes.
 
 The library is looked for at $POUR_SIM_LIB, then $POUR_BUILD_DIR/lib/libpoursim.so, then
-<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so. Build it with
+<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so (pour.paths). Build it with
 `cmake --build --preset host`.
 
     from pour import sim
@@ -10,21 +10,21 @@ The library is looked for at $POUR_SIM_LIB, then $POUR_BUILD_DIR/lib/libpoursim.
     obs = world.step(0.3)                      # torque 0.3·tau_max for 1 ms
     pol = sim.Policy(w=np.zeros((6, 11)), levels=np.linspace(-1, 1, 11), decision_period=10)
     ro = world.rollout(pol, seed=7)            # a whole episode in C: ro.features, ro.actions, ro.rewards
-    ros = sim.rollout_batch(cfg, pol, seeds=range(8), n_threads=2)   # both cores
 
-Process-safe and thread-safe across worlds (each World owns its own Box2D world); ctypes releases the
-GIL during every call, so rollouts also run in parallel from Python threads.
+Process-safe and thread-safe across worlds (each World owns its own Box2D world). Episodes in parallel:
+the trainer's executors (pour.executors: a process pool, or Ray), one world per worker.
 """
 from __future__ import annotations
 
 import ctypes as C
-import glob
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
+
+from pour import paths
 
 N_FEATURES = 6
 MAX_ACTIONS = 16
@@ -146,15 +146,7 @@ _lib: C.CDLL | None = None
 
 def library_candidates() -> list[Path]:
     """Where load_library() looks, in order ($POUR_SIM_LIB alone when it is set)."""
-    if os.environ.get("POUR_SIM_LIB"):
-        return [Path(os.environ["POUR_SIM_LIB"])]
-    out: list[Path] = []
-    if os.environ.get("POUR_BUILD_DIR"):
-        out.append(Path(os.environ["POUR_BUILD_DIR"]) / "lib" / "libpoursim.so")
-    build = Path(__file__).resolve().parents[2] / "build"
-    out.append(build / "host" / "lib" / "libpoursim.so")
-    out += [p for p in map(Path, sorted(glob.glob(str(build / "*" / "lib" / "libpoursim.so")))) if p not in out]
-    return out
+    return paths.sim_library_candidates()
 
 
 def load_library() -> C.CDLL:
@@ -209,8 +201,6 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_max_wall_penetration": ([C.c_void_p], C.c_double),
         "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
         "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
-        "poursim_rollout_batch": ([P(ConfigStruct), P(PolicyStruct), P(C.c_uint32), C.c_int, C.c_int,
-                                   P(BuffersStruct), P(EpisodeStruct)] + err, C.c_int),
         "poursim_version": ([], C.c_char_p),
     }
     for name, (args, res) in sig.items():
@@ -448,31 +438,9 @@ class World:
         rc = self._lib.poursim_rollout(self._check(), C.byref(ps), int(seed) & 0xFFFFFFFF, C.byref(bufs.struct),
                                        C.byref(e))
         if rc != 0:
-            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels and ranges")
+            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges and k_reversal")
         del keep
         return bufs.result(seed, e)
-
-
-def rollout_batch(config: ConfigStruct | Mapping[str, float] | None, policy: Policy, seeds: Iterable[int],
-                  n_threads: int = 2, record_steps: bool = False) -> list[Rollout]:
-    """Rollouts of seeds in C threads (one world per thread). Results in the order of seeds."""
-    lib = load_library()
-    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
-    seeds = [int(s) & 0xFFFFFFFF for s in seeds]
-    n = len(seeds)
-    ps, keep = policy._struct()
-    n_steps = _n_steps(cfg)
-    bufs = [_Buffers(-(-n_steps // policy.decision_period), ps.n_actions, n_steps if record_steps else 0)
-            for _ in seeds]
-    arr_b = (BuffersStruct * max(n, 1))(*[b.struct for b in bufs])
-    arr_e = (EpisodeStruct * max(n, 1))()
-    arr_s = (C.c_uint32 * max(n, 1))(*seeds)
-    e = _err()
-    rc = lib.poursim_rollout_batch(C.byref(cfg), C.byref(ps), arr_s, n, int(n_threads), arr_b, arr_e, e, ERR_LEN)
-    if rc != 0:
-        raise SimError(e.value.decode())
-    del keep
-    return [bufs[i].result(seeds[i], arr_e[i]) for i in range(n)]
 
 
 @dataclass
@@ -559,5 +527,5 @@ def uniform_levels(n_actions: int) -> np.ndarray:
 
 
 __all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
-                          "make_config", "rollout_batch", "retention", "slosh", "measure_drive", "measure_sensors",
+                          "make_config", "retention", "slosh", "measure_drive", "measure_sensors",
                           "load_library", "uniform_levels", "CONFIG_KEYS", "REGIONS", "version")

@@ -2,9 +2,10 @@
 """The trainer's glue onto libpoursim, built on the binding in pour.sim.
 
 SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy, the
-firmware's safety envelope on every torque) and returns it as an envs.Episode. SimStepper advances
-the world tick by tick for the Gymnasium environment, with the same envelope (its bit-exact Python
-mirror). Failures come out as envs.EnvError, which the trainer reports; pour.sim finds the library.
+firmware's safety envelope on every torque) and returns it as an Episode. SimStepper advances the world
+tick by tick for the Gymnasium environment through the same C code: the firmware's estimator and envelope
+(pour.core, from the same library), so a stepped episode equals the C rollout's. Failures come out as
+EnvError, which the trainer reports; pour.sim finds the library.
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from pour import envs
+from pour import core, episode
 from pour import fixedpoint as fp
 from pour import reinforce
 from pour import sim
@@ -26,7 +27,7 @@ def _env_errors(what: str) -> Iterator[None]:
     try:
         yield
     except sim.SimError as exc:
-        raise envs.EnvError(f"{what}: {exc}") from exc
+        raise episode.EnvError(f"{what}: {exc}") from exc
 
 
 def _open_world(options: dict[str, Any]) -> sim.World:
@@ -37,17 +38,17 @@ def _open_world(options: dict[str, Any]) -> sim.World:
         cfg = sim.make_config(options)
     except sim.SimError as exc:
         what = f"option {exc.key} = {options[exc.key]!r}" if exc.key in options else "config"
-        raise envs.EnvError(f"simulator {what}: {exc}") from exc
-    want = (envs.THETA_MIN_RAD, envs.THETA_MAX_RAD, envs.OMEGA_MAX_RAD_S)
+        raise episode.EnvError(f"simulator {what}: {exc}") from exc
+    want = (episode.THETA_MIN_RAD, episode.THETA_MAX_RAD, episode.OMEGA_MAX_RAD_S)
     have = (cfg.obs_theta_min, cfg.obs_theta_max, cfg.obs_omega_max)
     if any(abs(a - b) > 1e-9 for a, b in zip(want, have)):
-        raise envs.EnvError(f"simulator normalisation {have} differs from the trainer's {want}")
+        raise episode.EnvError(f"simulator normalisation {have} differs from the trainer's {want}")
     with _env_errors("poursim_create"):
         return sim.World(cfg)
 
 
 class SimEnv:
-    """rollout(w, seed, greedy) -> envs.Episode, one whole episode in C."""
+    """rollout(w, seed, greedy) -> episode.Episode, one whole episode in C."""
 
     def __init__(self, n_actions: int, decision_period_ms: int, episode_s: float,
                  options: dict[str, Any] | None = None):
@@ -56,19 +57,19 @@ class SimEnv:
         # Reward shaping of training alone (the world's reward stays K_target·V_target − K_spill·V_spill).
         self.k_reversal = float(opts.pop("k_reversal", 0.0))
         if not (math.isfinite(self.k_reversal) and self.k_reversal >= 0.0):
-            raise envs.EnvError(f"option k_reversal = {self.k_reversal!r}: want a finite value >= 0")
+            raise episode.EnvError(f"option k_reversal = {self.k_reversal!r}: want a finite value >= 0")
         self.world = _open_world(opts)
         cfg = self.world.config
         if abs(cfg.dt - 1e-3) > 1e-12:
-            raise envs.EnvError(f"simulator dt = {cfg.dt}: the policy's decision period assumes 1 ms ticks")
+            raise episode.EnvError(f"simulator dt = {cfg.dt}: the policy's decision period assumes 1 ms ticks")
         self.tau_max_nm = float(cfg.tau_max)
         self.n_actions, self.period = n_actions, decision_period_ms
         self.levels = reinforce.action_levels(n_actions)
 
-    def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> envs.Episode:
+    def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> episode.Episode:
         w = np.asarray(w, dtype=np.float64)
         if w.shape != (sim.N_FEATURES, self.n_actions):
-            raise envs.EnvError(f"W has shape {w.shape}, expected ({sim.N_FEATURES}, {self.n_actions})")
+            raise episode.EnvError(f"W has shape {w.shape}, expected ({sim.N_FEATURES}, {self.n_actions})")
         cfg = self.world.config
         pol = sim.Policy(w, self.levels, self.period, cfg.obs_theta_min, cfg.obs_theta_max, cfg.obs_omega_max,
                          bool(greedy), self.k_reversal)
@@ -79,24 +80,28 @@ class SimEnv:
                    "max_theta": ro.max_theta, "liquid_l": ro.metrics["liquid_l"],
                    "peak_omega": ro.metrics["peak_omega"], "peak_alpha": ro.metrics["peak_alpha"],
                    "reversals": ro.metrics["reversals"]}
-        return envs.Episode(ro.features, ro.actions.astype(np.int64), ro.rewards, metrics, int(seed))
+        return episode.Episode(ro.features, ro.actions.astype(np.int64), ro.rewards, metrics, int(seed))
 
 
 class SimStepper:
     """Tick-by-tick access for the Gymnasium env, as the firmware sees the rig: the sensor sample through the
-    estimator (tools/pour/fixedpoint.py, bit-exact with firmware/src/sensors.c), torques through the safety
-    envelope with its motion limits."""
+    firmware's estimator (firmware/src/sensors.c), torques through its safety envelope with the motion limits
+    (firmware/src/safety.c), both called in C through pour.core with the defaults poursim_rollout uses."""
 
     def __init__(self, options: dict[str, Any] | None = None):
         self.world = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
-        self.sensors = fp.SensorsConfig(encoder_bits=int(self.world.config.encoder_bits))
+        with _env_errors("the firmware core in libpoursim"):
+            fw = core.control_config()
+        self.safety_config = fw.safety
+        self.sensors_config = fw.sensors
+        self.sensors_config.encoder_bits = int(self.world.config.encoder_bits)
 
     def reset(self, seed: int) -> None:
         with _env_errors("poursim_reset"):
             self.obs = self.world.reset(seed)
-        self.safety = fp.SafetyEnvelope()
-        self.estimator = fp.Estimator(self.sensors)
+        self.safety = core.Envelope(self.safety_config)
+        self.estimator = core.Estimator(self.sensors_config)
         self.seq = 0
         self.state = (0, 0, 0, 0, 0, 0)
         self._sense()
@@ -118,7 +123,7 @@ class SimStepper:
 
     def features(self) -> np.ndarray:
         _, theta, omega, v_rot, v_tgt, v_spill = self.state
-        return envs.normalise(theta * 1e-6, omega * 1e-6, v_rot / 32768.0, v_tgt / 32768.0, v_spill / 32768.0)
+        return episode.normalise(theta * 1e-6, omega * 1e-6, v_rot / 32768.0, v_tgt / 32768.0, v_spill / 32768.0)
 
     def advance(self, level: float, ticks: int) -> float:
         req = fp.float_to_q15(level)

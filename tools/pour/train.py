@@ -13,7 +13,6 @@ import argparse
 import csv
 import io
 import json
-import multiprocessing as mp
 import os
 import sys
 import time
@@ -25,6 +24,7 @@ import numpy as np
 
 from pour import config as cfgmod
 from pour import envs, executors, reinforce
+from pour.executors import Runner  # the local pool, the default executor (also as train.Runner)
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
 
@@ -41,55 +41,6 @@ def episode_seeds(seed: int, stream: int, index: int, n: int) -> list[int]:
     """n episode seeds (uint32) for one iteration (or evaluation set) of one stream."""
     ss = np.random.SeedSequence([seed, stream, index])
     return [int(s) for s in ss.generate_state(n, dtype=np.uint32)]
-
-
-# --- rollouts on a process pool -----------------------------------------------------------------
-
-_ENV: Any = None
-
-
-def _init_worker(env_args: tuple) -> None:
-    global _ENV
-    _ENV = envs.make_env(*env_args)
-
-
-def _run(job: tuple) -> envs.Episode:
-    w, seed, greedy = job
-    return _ENV.rollout(w, seed, greedy)
-
-
-class Runner:
-    """Runs episodes in order on `workers` processes (or in-process for one worker)."""
-
-    def __init__(self, cfg: cfgmod.TrainConfig):
-        self.env_args = (cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
-                         cfg.env.episode_s, cfg.env.options)
-        _init_worker(self.env_args)  # fail early and clearly in the parent (missing library, bad option)
-        self.tau_max_nm = float(_ENV.tau_max_nm)
-        self.pool = None
-        if cfg.workers > 1:
-            self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
-
-    def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
-        jobs = [(w, s, greedy) for s in seeds]
-        if self.pool is None:
-            return [_run(j) for j in jobs]
-        return self.pool.map(_run, jobs, chunksize=1)
-
-    def close(self) -> None:
-        if self.pool is not None:
-            self.pool.close()
-            self.pool.join()
-            self.pool = None
-
-    def __enter__(self) -> "Runner":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        if self.pool is not None:
-            self.pool.terminate()
-            self.pool.join()
-            self.pool = None
 
 
 # --- atomic files ---------------------------------------------------------------------------------

@@ -1,0 +1,65 @@
+# SPDX-License-Identifier: MIT
+"""Where the source tree and the CMake build tree are: the one place the package looks for what CMake built
+(libpoursim, host_sim and the other programs, the generated LCM types).
+
+A build tree is looked for, in order, at an explicit --build-dir, at $POUR_BUILD_DIR (ctest sets it), then
+at <source>/build/host (the `host` preset), then, for callers that accept any preset, at the other
+<source>/build/* folders. libpoursim alone can also be named directly with $POUR_SIM_LIB (Ray workers, a
+library built elsewhere). Nothing here imports the rest of the package.
+"""
+from __future__ import annotations
+
+import glob
+import os
+from pathlib import Path
+
+# The checkout this package lives in (tools/pour/paths.py -> the repository root); an installed copy's
+# "source dir" holds no build tree, so only $POUR_BUILD_DIR / $POUR_SIM_LIB / --build-dir find one there.
+SOURCE_DIR = Path(__file__).resolve().parents[2]
+SIM_LIB_REL = Path("lib") / "libpoursim.so"
+
+
+def build_dirs(build_dir: str | os.PathLike | None = None, any_preset: bool = False) -> list[Path]:
+    """Build trees to search, in order: build_dir, $POUR_BUILD_DIR, <source>/build/host, then (any_preset)
+    the other <source>/build/* folders, sorted."""
+    out: list[Path] = [Path(build_dir)] if build_dir else []
+    if os.environ.get("POUR_BUILD_DIR"):
+        out.append(Path(os.environ["POUR_BUILD_DIR"]))
+    host = SOURCE_DIR / "build" / "host"
+    if host not in out:
+        out.append(host)
+    if any_preset:
+        out += [p for p in map(Path, sorted(glob.glob(str(SOURCE_DIR / "build" / "*")))) if p not in out]
+    return out
+
+
+def candidates(rel: str | os.PathLike, build_dir: str | os.PathLike | None = None,
+               any_preset: bool = False) -> list[Path]:
+    """rel (a path inside a build tree, e.g. "bin/host_sim") under each of build_dirs(), in order."""
+    return [d / rel for d in build_dirs(build_dir, any_preset)]
+
+
+def find(rel: str | os.PathLike, build_dir: str | os.PathLike | None = None, any_preset: bool = False,
+         kind: str = "file") -> Path | None:
+    """The first of candidates() that exists (kind "file", "dir" or "exe": an executable file), else None."""
+    for p in candidates(rel, build_dir, any_preset):
+        if kind == "dir" and p.is_dir():
+            return p
+        if kind == "file" and p.is_file():
+            return p
+        if kind == "exe" and p.is_file() and os.access(p, os.X_OK):
+            return p
+    return None
+
+
+def binary(name: str, build_dir: str | os.PathLike | None = None) -> Path | None:
+    """The program NAME in a build tree's bin/, or None."""
+    return find(Path("bin") / name, build_dir, kind="exe")
+
+
+def sim_library_candidates() -> list[Path]:
+    """Where libpoursim is looked for, in order: $POUR_SIM_LIB alone when it is set, else lib/libpoursim.so of
+    every build tree (any preset)."""
+    if os.environ.get("POUR_SIM_LIB"):
+        return [Path(os.environ["POUR_SIM_LIB"])]
+    return candidates(SIM_LIB_REL, any_preset=True)
