@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pour import fixedpoint as fp
-from pour import golden, weights_h
+from pour import golden, sim, weights_h
 
 
 def test_exp2_table_matches_the_c_source(source_dir):
@@ -60,6 +60,20 @@ def test_golden_never_overwrites_a_trained_policy(tmp_path, source_dir):
     (-1.5 / 32768, -1), (0.49 / 32768, 0), (2.0, 32767), (-2.0, -32768), (32767.5 / 32768, 32767)])
 def test_float_to_q15_rounds_half_up_then_saturates(value, expected):
     assert fp.float_to_q15(value) == expected
+
+
+EDGES = [float("nan"), float("inf"), -float("inf"), 1.0, -1.0, 0.0, -0.0, 1e300, -1e300, 5e-324,
+         0.5 / 32768, -0.5 / 32768, 1.5 / 32768, -1.5 / 32768, 0.4999999 / 32768, 32766.5 / 32768,
+         32767.5 / 32768, -32768.5 / 32768, -32767.5 / 32768, 0.1, -0.1, 2.0 / 3.0]
+
+
+def test_float_to_q15_follows_the_c_rule_on_every_edge_value():
+    """Python's quantiser and libpoursim's poursim_fraction_to_q15 (host_sim, the rollout) agree: NaN, the
+    infinities, half an LSB either way, the limits."""
+    lib = sim.load_library()
+    for x in EDGES:
+        assert fp.float_to_q15(x) == lib.poursim_fraction_to_q15(x), x
+    assert fp.float_to_q15(float("nan")) == 0
 
 
 def test_round_half_up_shift_matches_floor_semantics():

@@ -10,6 +10,8 @@ docs/safety.md. Integers are Python ints (no overflow); where C saturates, so do
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -69,8 +71,12 @@ def round_half_up_shift(x: int, shift: int) -> int:
 
 
 def float_to_q15(x: float) -> int:
-    """Round to nearest (half up), then saturate: +1.0 -> 32767, -1.0 -> -32768."""
-    return sat_q15(int(np.floor(float(x) * Q15_ONE + 0.5)))
+    """A fraction as Q15, the host's one rule (libpoursim's poursim_fraction_to_q15 is the C side): round half
+    up, then saturate (+1.0 -> 32767, -1.0 -> -32768, +-inf to the limits); NaN -> 0, never a plausible value."""
+    x = float(x)
+    if math.isnan(x):
+        return 0
+    return sat_q15(math.floor(max(-65536.0, min(65536.0, x * Q15_ONE + 0.5))))
 
 
 def ratio_q15(num: int, den: int) -> int:

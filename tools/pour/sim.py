@@ -202,6 +202,7 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
         "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
         "poursim_version": ([], C.c_char_p),
+        "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
     }
     for name, (args, res) in sig.items():
         fn = getattr(lib, name)
