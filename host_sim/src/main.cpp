@@ -23,6 +23,7 @@
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
+#include "stats.hpp"
 
 extern char **environ;
 
@@ -335,21 +336,11 @@ int run_render(const std::string &renderer, const std::string &json_path, const 
   return 0;
 }
 
-double mean(const std::vector<double> &v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
-double stdev(const std::vector<double> &v) {
-  if (v.size() < 2) return 0.0;
-  double m = mean(v), s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / static_cast<double>(v.size() - 1));
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
+  using poursim::mean;
+  using poursim::stdev;
   Options o;
   int rc = parse_args(argc, argv, o);
   if (rc >= 0) return rc;
