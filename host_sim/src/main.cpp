@@ -76,9 +76,9 @@ const char *kUsage =
     "or another output. Each is written beside its target and renamed over it when complete, so a failed\n"
     "or interrupted run leaves an existing file as it was.\n"
     "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (writing an\n"
-    "output, the renderer, the LCM link); 2 bad input, refused before any work: the command line, or a\n"
-    "file it names (policy, config, an output path that cannot be written or names an input), or a program\n"
-    "--render needs (pour-render, ffmpeg) that cannot be found; 3 (--lcm) the\n"
+    "output, the renderer, the LCM link, the simulated world); 2 bad input, refused before any work: the\n"
+    "command line, or a file it names (policy, config, an output path that cannot be written or names an\n"
+    "input), or a program --render needs (pour-render, ffmpeg) that cannot be found; 3 (--lcm) the\n"
     "controller does not answer; 4 (--lcm) it runs other weights.\n"
     "\n"
     "Examples:\n"
@@ -247,6 +247,10 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   }
   while (!o.done) {
     double a = ctl.command(o);
+    if (ctl.failed()) {
+      e.error = ctl.failure();
+      return e;
+    }
     if (poursim_step(world, a, &o) != POURSIM_OK) {
       e.error = poursim_world_error(world);
       return e;
@@ -467,9 +471,16 @@ int main(int argc, char **argv) {
     rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
     Episode e = run_episode(world, *ctl, seed, &rec);
     if (!e.error.empty()) {
-      std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      int status = 1;
+      if (lcm_ctl != nullptr && lcm_ctl->failed()) {
+        std::fprintf(stderr, "host_sim: %s\n", e.error.c_str());
+        std::fprintf(stderr, "host_sim: %s\n", lcm_ctl->link().summary().c_str());
+        status = lcm_ctl->failure_status();
+      } else {
+        std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      }
       poursim_destroy(world);
-      return 1;
+      return status;
     }
     eps.push_back(e);
     if (!o.quiet)
