@@ -10,6 +10,8 @@ cd "$ROOT"
 cmake --preset host >/dev/null
 cmake --build --preset host --target host_sim
 mkdir -p out
+# host_sim --render runs the tools' pour-render, from the venv's bin.
+export PATH="$ROOT/.venv/bin:$PATH"
 ./build/host/bin/host_sim --policy policy/weights.h --seed 1 --render out/pour.gif "$@"
 echo
 echo "Rendered pour: out/pour.gif (animation) and out/pour.png (snapshot)"

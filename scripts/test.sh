@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Builds and tests everything: host (all labels), host under ASan+UBSan (unit tests), the Cortex-M4
+# Builds and tests everything: host (all labels), host under ASan+UBSan (the C/C++ tests but the slow
+# physics ones, and the pytest files that drive our programs), the Cortex-M4
 # image with its unit tests on an emulated MCU, and the libFuzzer targets (clang, ASan+UBSan) run on
 # their corpus and briefly fuzzed. Installs what is missing first. Warnings are errors here
 # (POUR_WERROR, which the presets read from the environment); a user's build only warns.

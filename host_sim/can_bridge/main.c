@@ -154,7 +154,7 @@ static void usage(FILE *f) {
              "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n"
              "  numbers are decimal (--node 010 is node 10)\n"
              "exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
-             "CAN interface or LCM cannot be opened); 2 bad command line\n",
+             "CAN interface or LCM cannot be opened, or fails while bridging); 2 bad command line\n",
           POUR_LCM_DEFAULT_URL);
 }
 

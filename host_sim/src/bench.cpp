@@ -14,6 +14,7 @@
 #include "poursim/checks.h"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
+#include "stats.hpp"
 
 namespace poursim {
 
@@ -25,12 +26,6 @@ double cpu_s(clockid_t clock) {
   timespec ts;
   clock_gettime(clock, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double mean(const std::vector<double> &v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
 }
 
 // 1. Real time on one core, contact quality and compression, over hand-written pours (the liquid moves

@@ -29,6 +29,10 @@ class Controller {
   virtual double command(const poursim_obs_t &obs) = 0;
   // Index of the action in force (policies), -1 for baselines.
   virtual int action() const { return -1; }
+  // Whether the controller can no longer command (a controller across LCM that stopped answering), and why.
+  // After a failure command() returns 0 (no torque); the caller ends the run.
+  virtual bool failed() const { return false; }
+  virtual std::string failure() const { return {}; }
 };
 
 // The firmware core (pour_control_step) with a weights.h loaded at run time, fed the rig's sensor sample

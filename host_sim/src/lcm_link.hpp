@@ -101,6 +101,11 @@ class LcmController : public Controller {
   void reset(uint32_t seed) override;
   double command(const poursim_obs_t &obs) override;
   int action() const override { return link_->last_action(); }
+  bool failed() const override { return failure_status_ != 0; }
+  std::string failure() const override { return failure_; }
+  // After a failure, the exit status it means in every pour program: 3 the controller does not answer,
+  // 4 it answers with other weights than expected_weights_hash; 0 while there is none.
+  int failure_status() const { return failure_status_; }
   // Particles are published from this world at the link's viewing rate (nullptr: none).
   void set_world(const poursim_world_t *world) { world_ = world; }
   LcmLink &link() { return *link_; }
@@ -111,6 +116,8 @@ class LcmController : public Controller {
   const poursim_world_t *world_ = nullptr;
   int episode_ = -1;
   bool warned_ = false;
+  std::string failure_;
+  int failure_status_ = 0;
 };
 
 } // namespace poursim

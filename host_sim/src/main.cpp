@@ -23,6 +23,7 @@
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
+#include "stats.hpp"
 
 extern char **environ;
 
@@ -58,7 +59,8 @@ const char *kUsage =
     "  --json              print the summary as one JSON object (per-episode lines go to stderr)\n"
     "  --csv FILE          write every step of every episode as CSV\n"
     "  --render FILE       animate the first episode into FILE (.gif, or .mp4 with ffmpeg), and write\n"
-    "                      a .png snapshot beside it (same name)\n"
+    "                      a .png snapshot beside it (same name), with the program $POUR_RENDER if set,\n"
+    "                      else pour-render (the tools' entry point, in the venv's bin) found on PATH\n"
     "  --quiet             only the summary\n"
     "  --realtime          with --lcm: pace at 1 kHz wall clock, use the latest torque, count misses\n"
     "  --lcm-timeout-ms T  with --lcm in lockstep: give up after T ms without an answer (default 2000)\n"
@@ -74,8 +76,9 @@ const char *kUsage =
     "or another output. Each is written beside its target and renamed over it when complete, so a failed\n"
     "or interrupted run leaves an existing file as it was.\n"
     "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (writing an\n"
-    "output, the renderer, the LCM link); 2 bad input, refused before any work: the command line, or a\n"
-    "file it names (policy, config, an output path that cannot be written or names an input); 3 (--lcm) the\n"
+    "output, the renderer, the LCM link, the simulated world); 2 bad input, refused before any work: the\n"
+    "command line, or a file it names (policy, config, an output path that cannot be written or names an\n"
+    "input), or a program --render needs (pour-render, ffmpeg) that cannot be found; 3 (--lcm) the\n"
     "controller does not answer; 4 (--lcm) it runs other weights.\n"
     "\n"
     "Examples:\n"
@@ -104,18 +107,26 @@ int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
-// Whether an executable called name is on PATH.
-bool on_path(const char *name) {
+// The program a shell would run for name: name itself if it holds a '/', else the first executable of that
+// name in a PATH folder (an empty entry is the current folder). Empty if there is none.
+std::string find_program(const std::string &name) {
+  if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
   const char *path = std::getenv("PATH");
   std::string dirs = path != nullptr ? path : "";
   for (size_t a = 0; a <= dirs.size();) {
     size_t b = dirs.find(':', a);
     if (b == std::string::npos) b = dirs.size();
     std::string file = (b > a ? dirs.substr(a, b - a) : ".") + "/" + name;
-    if (access(file.c_str(), X_OK) == 0) return true;
+    if (access(file.c_str(), X_OK) == 0) return file;
     a = b + 1;
   }
-  return false;
+  return "";
+}
+
+// The renderer host_sim --render runs: $POUR_RENDER, else the tools' console entry point on PATH.
+const char *renderer_name() {
+  const char *env = std::getenv("POUR_RENDER");
+  return env != nullptr && *env != '\0' ? env : "pour-render";
 }
 
 bool parse_long(const char *s, long long lo, long long hi, long long &out) {
@@ -236,6 +247,10 @@ Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t s
   }
   while (!o.done) {
     double a = ctl.command(o);
+    if (ctl.failed()) {
+      e.error = ctl.failure();
+      return e;
+    }
     if (poursim_step(world, a, &o) != POURSIM_OK) {
       e.error = poursim_world_error(world);
       return e;
@@ -263,7 +278,7 @@ void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vect
                  s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
 }
 
-// The trajectory as JSON for tools/pour/render.py.
+// The trajectory as JSON for pour-render (the tools' renderer).
 bool write_render_json(const std::string &path, const poursim_world_t *world, const Recorder &rec,
                        const std::string &title, const Episode &e, std::string *why) {
   poursim::AtomicFile out;
@@ -303,44 +318,33 @@ bool write_render_json(const std::string &path, const poursim_world_t *world, co
   return out.commit(why);
 }
 
-int run_render(const std::string &json_path, const std::string &out) {
-  const char *py = std::getenv("POUR_PYTHON");
-  std::string python = py != nullptr ? py : POURSIM_PYTHON;
-  std::string script = POURSIM_RENDER_PY;
-  std::vector<std::string> args = {python, script, json_path, out};
+// Runs `renderer TRAJECTORY.json OUT` and waits for it; returns 0 if it exited 0.
+int run_render(const std::string &renderer, const std::string &json_path, const std::string &out) {
+  std::vector<std::string> args = {renderer, json_path, out};
   std::vector<char *> argv;
   for (std::string &s : args) argv.push_back(s.data());
   argv.push_back(nullptr);
   std::fflush(stdout);
   std::fflush(stderr);
   pid_t pid;
-  if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), environ) != 0) {
-    std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", python.c_str(), std::strerror(errno));
+  int err = posix_spawn(&pid, renderer.c_str(), nullptr, nullptr, argv.data(), environ);
+  if (err != 0) {
+    std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", renderer.c_str(), std::strerror(err));
     return 1;
   }
   int status = 0;
   if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::fprintf(stderr, "host_sim: the renderer (%s %s) failed\n", python.c_str(), script.c_str());
+    std::fprintf(stderr, "host_sim: the renderer (%s) failed\n", renderer.c_str());
     return 1;
   }
   return 0;
 }
 
-double mean(const std::vector<double> &v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
-double stdev(const std::vector<double> &v) {
-  if (v.size() < 2) return 0.0;
-  double m = mean(v), s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / static_cast<double>(v.size() - 1));
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
+  using poursim::mean;
+  using poursim::stdev;
   Options o;
   int rc = parse_args(argc, argv, o);
   if (rc >= 0) return rc;
@@ -383,7 +387,7 @@ int main(int argc, char **argv) {
   if (o.bench) return poursim::run_bench(cfg, o.policy, o.episodes);
 
   // Every output checked before any work: none may name an input or another output, all must be writable.
-  std::string render_base, render_json;
+  std::string render_base, render_json, renderer;
   std::vector<poursim::NamedPath> outputs;
   if (!o.csv.empty()) outputs.push_back({"--csv", o.csv});
   if (!o.render.empty()) {
@@ -392,9 +396,17 @@ int main(int argc, char **argv) {
     render_base = o.render.substr(0, o.render.size() - 4);
     if (render_base.empty() || render_base.back() == '/')
       return usage_error("--render wants a file name before its .gif or .mp4, got '%s'", o.render.c_str());
-    if (ext == ".mp4" && !on_path("ffmpeg")) {
+    if (ext == ".mp4" && find_program("ffmpeg").empty()) {
       std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
                    o.render.c_str());
+      return 2;
+    }
+    renderer = find_program(renderer_name());
+    if (renderer.empty()) {
+      std::fprintf(stderr,
+                   "host_sim: --render needs the renderer '%s', which is not an executable%s (put the venv's bin, "
+                   "e.g. .venv/bin, on PATH, or set POUR_RENDER to the program)\n",
+                   renderer_name(), std::strchr(renderer_name(), '/') != nullptr ? "" : " on PATH");
       return 2;
     }
     render_json = render_base + ".json";
@@ -459,9 +471,16 @@ int main(int argc, char **argv) {
     rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
     Episode e = run_episode(world, *ctl, seed, &rec);
     if (!e.error.empty()) {
-      std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      int status = 1;
+      if (lcm_ctl != nullptr && lcm_ctl->failed()) {
+        std::fprintf(stderr, "host_sim: %s\n", e.error.c_str());
+        std::fprintf(stderr, "host_sim: %s\n", lcm_ctl->link().summary().c_str());
+        status = lcm_ctl->failure_status();
+      } else {
+        std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      }
       poursim_destroy(world);
-      return 1;
+      return status;
     }
     eps.push_back(e);
     if (!o.quiet)
@@ -536,7 +555,7 @@ int main(int argc, char **argv) {
     if (!write_render_json(render_json, world, first, ctl->name(), eps[0], &why)) {
       std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
-    } else if (run_render(render_json, o.render) != 0) {
+    } else if (run_render(renderer, render_json, o.render) != 0) {
       status = 1;
     } else if (!o.quiet) {
       std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render_base.c_str(),

@@ -52,5 +52,19 @@ def test_host_sim_bad_input_is_2_and_a_failed_renderer_1(bin_dir, tmp_path):
     assert _run(hs, "--baseline", "nope").returncode == 2
     assert _run(hs, "--policy", tmp_path / "missing.h").returncode == 2
     r = _run(hs, "--baseline", "full", "--set", "episode_s=0.05", "--render", tmp_path / "x.gif",
-             env={"POUR_PYTHON": "/bin/false"})
+             env={"POUR_RENDER": "/bin/false"})
     assert r.returncode == 1 and "renderer" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("env", [{"POUR_RENDER": "/nonexistent/pour-render"}, {"POUR_RENDER": "no-such-renderer"},
+                                 {"POUR_RENDER": "", "PATH": "/usr/bin:/bin"}])
+def test_host_sim_without_its_renderer_refuses_before_the_run(bin_dir, tmp_path, env):
+    # pour-render is found through $POUR_RENDER, else on PATH, and checked with the outputs: one line, exit 2,
+    # nothing run (no episode line) and nothing written.
+    r = _run(bin_dir / "host_sim", "--baseline", "full", "--csv", tmp_path / "x.csv", "--render", tmp_path / "x.gif",
+             env=env)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("host_sim: --render needs the renderer"), r.stderr
+    assert (env.get("POUR_RENDER") or "pour-render") in lines[0] and "PATH" in lines[0]
+    assert r.stdout == "" and list(tmp_path.iterdir()) == []

@@ -152,11 +152,14 @@ def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, so
     assert "answers 6000" in c.out and "resets 2" in c.out
 
 
-def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_dir, source_dir):
+def test_host_sim_lockstep_without_controller_exits_3_naming_the_channel(build_dir, source_dir, tmp_path):
     host_sim = binary(build_dir, "host_sim")
-    r = run([host_sim, *host_sim_args(build_dir, "--lcm", url(17), "--lcm-timeout-ms", "300")])
+    csv = tmp_path / "run.csv"
+    r = run([host_sim, *host_sim_args(build_dir, "--lcm", url(17), "--lcm-timeout-ms", "300", "--csv", csv)])
     assert r.returncode == 3
     assert "no answer on POUR_TORQUE to POUR_SENSORS seq 0" in r.stderr
+    # The link reports the failure to host_sim, which ends the run: no CSV, no temporary left behind.
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build_dir, source_dir):

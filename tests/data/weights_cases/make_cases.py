@@ -3,7 +3,8 @@
 
 cases.tsv lists, per file: what host_sim's parser and pour.weights_h must both do (accept or refuse),
 a text their error message must contain, and what the firmware build does with it (ok: compiles and
-the core's init accepts it; build: the compiler refuses it; init: compiles, the core's init refuses it
+the core's init accepts it; build: the compiler refuses it; build-named: the compiler refuses it with a
+diagnostic that names that text too (the checks in firmware/src/weights_compiled.c); init: compiles, the core's init refuses it
 (content hash); stricter: the compiler accepts it (float reference: when compiled without
 POUR_WEIGHTS_FLOAT_REFERENCE) but our parsers refuse it on purpose, see docs/weights-h.md). Run from the repository root: python3 tests/data/weights_cases/make_cases.py
 """
@@ -64,6 +65,8 @@ CASES = [
     ("hash_negative", "refuse", "POUR_WEIGHTS_CONTENT_HASH", "build", sub(rb"0x09b1269bu", b"-1")),
     ("hash_too_big", "refuse", "POUR_WEIGHTS_CONTENT_HASH", "build", sub(rb"0x09b1269bu", b"0x109b1269bu")),
     ("hash_mismatch", "refuse", "edited or corrupted", "init", sub(rb"0x09b1269bu", b"0x09b1269cu")),
+    # A hash >= 0x80000000 is a valid uint32_t: it compiles (only the content check refuses this one).
+    ("hash_mismatch_high_bit", "refuse", "edited or corrupted", "init", sub(rb"0x09b1269bu", b"0xfedcba98u")),
     ("nan_float_reference", "refuse", "pour_weights_w_float[0][0]", "stricter",
      sub(rb"(pour_weights_w_float\[[^\n]*\n    \{)8\.0f", rb"\1NAN")),
     ("inf_float_reference", "refuse", "pour_weights_w_float[0][0]", "stricter",
@@ -118,6 +121,37 @@ CASES = [
     ("weight_out_of_int16", "refuse", "pour_weights_w[0][0]", "build", sub(W_FIRST, rb"\g<1>40000")),
     ("too_many_rows", "refuse", "more than 6 rows", "build",
      sub(rb"(\{-14746[^\n]*\})\n", rb"\1,\n    \1" + b"\n")),
+    # The firmware build's own checks (weights_compiled.c): each must be refused by the compiler with a
+    # diagnostic naming the field (build-named), and by the parsers naming it too.
+    ("bad_format", "refuse", "POUR_WEIGHTS_FORMAT", "build-named",
+     sub(rb"POUR_WEIGHTS_FORMAT 1", b"POUR_WEIGHTS_FORMAT 2", count=0)),
+    ("wrong_features", "refuse", "POUR_WEIGHTS_N_FEATURES", "build-named",
+     sub(rb"POUR_WEIGHTS_N_FEATURES 6", b"POUR_WEIGHTS_N_FEATURES 5", count=0)),
+    ("too_many_actions", "refuse", "POUR_WEIGHTS_N_ACTIONS", "build-named",
+     sub(rb"POUR_WEIGHTS_N_ACTIONS [0-9]+", b"POUR_WEIGHTS_N_ACTIONS 17", count=0)),
+    ("frac_bits_out_of_range", "refuse", "POUR_WEIGHTS_W_FRAC_BITS", "build-named",
+     sub(rb"POUR_WEIGHTS_W_FRAC_BITS [0-9]+", b"POUR_WEIGHTS_W_FRAC_BITS 16", count=0)),
+    ("zero_period", "refuse", "POUR_WEIGHTS_DECISION_PERIOD_MS", "build-named",
+     sub(rb"POUR_WEIGHTS_DECISION_PERIOD_MS [0-9]+", b"POUR_WEIGHTS_DECISION_PERIOD_MS 0", count=0)),
+    ("inverted_theta", "refuse", "POUR_WEIGHTS_THETA_MAX_URAD", "build-named",
+     sub(rb"POUR_WEIGHTS_THETA_MAX_URAD [0-9]+", b"POUR_WEIGHTS_THETA_MAX_URAD -1", count=0)),
+    ("missing_tau_max", "refuse", "POUR_WEIGHTS_TAU_MAX_MNM", "build-named",
+     sub(rb"\n#define POUR_WEIGHTS_TAU_MAX_MNM [^\n]*\n", b"\n", count=0)),
+    ("missing_hash", "refuse", "POUR_WEIGHTS_CONTENT_HASH", "build-named",
+     sub(rb"\n#define POUR_WEIGHTS_CONTENT_HASH [^\n]*\n", b"\n", count=0)),
+    ("missing_levels", "refuse", "pour_weights_action_levels_q15", "build-named",
+     sub(rb"\n" + LEVELS + rb"[^\n]*\n", b"\n", count=0)),
+    ("wrong_shape", "refuse", "pour_weights_w", "build-named",
+     sub(rb"pour_weights_w\[POUR_WEIGHTS_N_FEATURES\]\[POUR_WEIGHTS_N_ACTIONS\]",
+         b"pour_weights_w[POUR_WEIGHTS_N_FEATURES][10]", count=0)),
+    ("truncated_rows", "refuse", "pour_weights_w", "build-named",
+     sub(rb",\n    \{[^\n]*\}(\n\}.\n" + LEVELS + b")", rb"\1",
+         sub(rb"pour_weights_w\[POUR_WEIGHTS_N_FEATURES\]", b"pour_weights_w[]", count=0), count=0)),
+    ("truncated_levels", "refuse", "pour_weights_action_levels_q15", "build-named",
+     sub(rb"(pour_weights_action_levels_q15)\[POUR_WEIGHTS_N_ACTIONS\]( = \{[^\n]*), [-0-9]+\}", rb"\1[]\2}",
+         count=0)),
+    ("wrong_level_type", "refuse", "pour_weights_action_levels_q15", "build-named",
+     sub(LEVELS, b"static const int32_t pour_weights_action_levels_q15", count=0)),
 ]
 
 
