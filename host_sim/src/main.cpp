@@ -287,7 +287,8 @@ bool write_render_json(const std::string &path, const poursim_world_t *world, co
   const poursim_config_t *c = poursim_world_config(world);
   const std::vector<float> &radius = rec.radius;
   int n = static_cast<int>(radius.size());
-  std::fprintf(f, "{\"fps\": %.3f, \"title\": \"%s\", \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs, title.c_str(),
+  std::fprintf(f, "{\"fps\": %.3f, \"title\": %s, \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs,
+               poursim::json_quote(title).c_str(),
                e.m.poured, e.m.spilled, e.m.finish_time);
   std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
                   "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
@@ -511,13 +512,13 @@ int main(int argc, char **argv) {
   const double max_finish = finish.empty() ? -1.0 : *std::max_element(finish.begin(), finish.end());
   const double max_peak = *std::max_element(peak_omega.begin(), peak_omega.end());
   if (o.json) {
-    std::printf("{\"controller\": \"%s\", \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
+    std::printf("{\"controller\": %s, \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
                 "\"poured_pct\": %.3f, \"poured_pct_std\": %.3f, \"spilled_pct\": %.3f, \"spilled_pct_std\": %.3f, "
                 "\"poured_l\": %.4f, \"spilled_l\": %.4f, \"finish_s\": %.4f, \"finish_max_s\": %.4f, "
                 "\"unfinished\": %d, \"peak_omega_rad_s\": %.4f, \"peak_omega_max_rad_s\": %.4f, "
                 "\"peak_alpha_rad_s2\": %.3f, \"reversals\": %.2f, \"return\": %.4f, \"return_std\": %.4f, "
                 "\"per_episode\": [",
-                ctl->name().c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
+                poursim::json_quote(ctl->name()).c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
                 stdev(spilled), mean(poured_l), mean(spilled_l), finish.empty() ? -1.0 : mean(finish), max_finish,
                 unfinished, mean(peak_omega), max_peak, mean(peak_alpha), mean(reversals), mean(ret), stdev(ret));
     for (size_t k = 0; k < eps.size(); ++k) {

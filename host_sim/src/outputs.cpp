@@ -111,6 +111,24 @@ bool check_outputs(const std::vector<NamedPath> &outputs, const std::vector<Name
   return true;
 }
 
+std::string json_quote(const std::string &s) {
+  std::string q = "\"";
+  for (const char ch : s) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '"' || c == '\\') {
+      q += '\\';
+      q += ch;
+    } else if (c < 0x20 || c == 0x7F) {
+      char u[8];
+      std::snprintf(u, sizeof u, "\\u%04x", c);
+      q += u;
+    } else {
+      q += ch;
+    }
+  }
+  return q + "\"";
+}
+
 bool AtomicFile::open(const std::string &path, std::string *err) {
   discard();
   install_handlers();

@@ -10,6 +10,10 @@
 
 namespace poursim {
 
+// s as a JSON string literal, quotes included: a quote and a backslash escaped with a backslash, control
+// characters as \u00XX, every other byte (UTF-8 included) as it is.
+std::string json_quote(const std::string &s);
+
 struct NamedPath {
   std::string flag; // the option it came from, for messages ("--csv", "--render (its .png)")
   std::string path;

@@ -53,7 +53,12 @@ def main(argv: list[str] | None = None) -> int:
     ctl = subprocess.Popen(ctl_args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         hs_args = [str(host_sim), *rest, "--lcm", url] + (["--realtime"] if a.realtime else [])
-        rc = subprocess.call(hs_args)
+        # host_sim --render runs pour-render: the one installed beside this Python, unless told otherwise.
+        env = dict(os.environ)
+        renderer = Path(sys.executable).with_name("pour-render")
+        if "POUR_RENDER" not in env and renderer.exists():
+            env["POUR_RENDER"] = str(renderer)
+        rc = subprocess.call(hs_args, env=env)
     finally:
         if ctl.poll() is None:
             ctl.send_signal(signal.SIGINT)
