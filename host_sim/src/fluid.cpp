@@ -45,6 +45,7 @@ void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
   for (std::vector<double> *v : {&px_, &py_, &sx_, &sy_, &rho_}) v->assign(un, 0.0);
   cell_of_.assign(un, 0);
   sorted_.assign(un, 0);
+  first_.assign(un + 1, 0);
   pairs_.clear();
   pairs_.reserve(un * 8);
   max_ratio_ = 0.0;
@@ -90,7 +91,6 @@ void Fluid::find_pairs() {
   // are adjacent slots, and so are the three cells of the row above (left to right); two ranges a particle.
   const double h2 = p_.h * p_.h;
   auto scan = [&](size_t a, int32_t b0, int32_t b1) {
-    const int32_t i = sorted_[a];
     const double xi = sx_[a], yi = sy_[a];
     for (size_t b = static_cast<size_t>(b0); b < static_cast<size_t>(b1); ++b) {
       const double ex = sx_[b] - xi, ey = sy_[b] - yi;
@@ -98,10 +98,11 @@ void Fluid::find_pairs() {
       if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
       const double r = std::sqrt(r2), w = 1.0 - r * inv;
       const int32_t j = sorted_[b];
-      pairs_.push_back({i, j, ex / r, ey / r, w});
+      pairs_.push_back({j, ex / r, ey / r, w});
     }
   };
   for (size_t a = 0; a < static_cast<size_t>(n_); ++a) {
+    first_[a] = static_cast<int32_t>(pairs_.size());
     const int32_t c = cell_of_[static_cast<size_t>(sorted_[a])], cx = c % nx, cy = c / nx;
     scan(a, static_cast<int32_t>(a) + 1, cell_start_[static_cast<size_t>(cx + 1 < nx ? c + 2 : c + 1)]);
     if (cy + 1 < ny) {
@@ -110,6 +111,7 @@ void Fluid::find_pairs() {
            cell_start_[static_cast<size_t>(row + std::min(cx + 1, nx - 1) + 1)]);
     }
   }
+  first_[static_cast<size_t>(n_)] = static_cast<int32_t>(pairs_.size());
 }
 
 void Fluid::step(double dt, double gy, const double *x, const double *y, double *vx, double *vy) {
@@ -119,25 +121,41 @@ void Fluid::step(double dt, double gy, const double *x, const double *y, double 
   predict(dt, gy, x, y, vx, vy);
   find_pairs();
 
+  // Each loop below goes over the pairs slot by slot: a slot's pairs share their first particle, whose
+  // velocity (or density) stays in a register meanwhile. No other pair touches it, so every sum is made
+  // in the order of the pairs, as in one loop over them.
+
   // Viscosity and agitation on the relative normal velocity u of each pair, weights (1 − q)² and
   // (1 − q): du = −σ(1 − q)²·u·dt + √(2σ·dt)·v_T·(1 − q)·ξ, half to each particle. For one pair this
   // settles at ⟨u²⟩ = v_T² (fluctuation–dissipation).
   if (p_.sigma > 0.0) {
     const double kick = std::sqrt(2.0 * p_.sigma * dt) * p_.agitation;
-    for (const Pair &pr : pairs_) {
-      const size_t i = static_cast<size_t>(pr.i), j = static_cast<size_t>(pr.j);
-      const double u = (vx[j] - vx[i]) * pr.ex + (vy[j] - vy[i]) * pr.ey;
-      const double du = -p_.sigma * pr.w * pr.w * u * dt + kick * pr.w * unit_noise(rng_);
-      vx[i] -= 0.5 * du * pr.ex, vy[i] -= 0.5 * du * pr.ey;
-      vx[j] += 0.5 * du * pr.ex, vy[j] += 0.5 * du * pr.ey;
+    for (size_t a = 0; a < n; ++a) {
+      const size_t i = static_cast<size_t>(sorted_[a]);
+      double vxi = vx[i], vyi = vy[i];
+      for (size_t k = static_cast<size_t>(first_[a]); k < static_cast<size_t>(first_[a + 1]); ++k) {
+        const Pair &pr = pairs_[k];
+        const size_t j = static_cast<size_t>(pr.j);
+        const double u = (vx[j] - vxi) * pr.ex + (vy[j] - vyi) * pr.ey;
+        const double du = -p_.sigma * pr.w * pr.w * u * dt + kick * pr.w * unit_noise(rng_);
+        vxi -= 0.5 * du * pr.ex, vyi -= 0.5 * du * pr.ey;
+        vx[j] += 0.5 * du * pr.ex, vy[j] += 0.5 * du * pr.ey;
+      }
+      vx[i] = vxi, vy[i] = vyi;
     }
   }
 
   // Density; pressure k(ρ − ρ0), never a pull.
   std::fill(rho_.begin(), rho_.end(), 0.0);
-  for (const Pair &pr : pairs_) {
-    rho_[static_cast<size_t>(pr.i)] += pr.w * pr.w;
-    rho_[static_cast<size_t>(pr.j)] += pr.w * pr.w;
+  for (size_t a = 0; a < n; ++a) {
+    const size_t i = static_cast<size_t>(sorted_[a]);
+    double rho_i = rho_[i];
+    for (size_t k = static_cast<size_t>(first_[a]); k < static_cast<size_t>(first_[a + 1]); ++k) {
+      const Pair &pr = pairs_[k];
+      rho_i += pr.w * pr.w;
+      rho_[static_cast<size_t>(pr.j)] += pr.w * pr.w;
+    }
+    rho_[i] = rho_i;
   }
   max_ratio_ = 0.0;
   for (size_t i = 0; i < n; ++i) {
@@ -148,11 +166,17 @@ void Fluid::step(double dt, double gy, const double *x, const double *y, double 
   // Relaxation, Clavet's displacement summed over both ends of a pair: each end moves dt²·P̄·(1 − q)
   // along the pair's axis, P̄ the pair's mean pressure; the move, over dt, is a velocity change.
   const double half_dt = 0.5 * dt;
-  for (const Pair &pr : pairs_) {
-    const size_t i = static_cast<size_t>(pr.i), j = static_cast<size_t>(pr.j);
-    const double d = half_dt * (rho_[i] + rho_[j]) * pr.w;
-    vx[i] -= d * pr.ex, vy[i] -= d * pr.ey;
-    vx[j] += d * pr.ex, vy[j] += d * pr.ey;
+  for (size_t a = 0; a < n; ++a) {
+    const size_t i = static_cast<size_t>(sorted_[a]);
+    double vxi = vx[i], vyi = vy[i];
+    for (size_t k = static_cast<size_t>(first_[a]); k < static_cast<size_t>(first_[a + 1]); ++k) {
+      const Pair &pr = pairs_[k];
+      const size_t j = static_cast<size_t>(pr.j);
+      const double d = half_dt * (rho_[i] + rho_[j]) * pr.w;
+      vxi -= d * pr.ex, vyi -= d * pr.ey;
+      vx[j] += d * pr.ex, vy[j] += d * pr.ey;
+    }
+    vx[i] = vxi, vy[i] = vyi;
   }
 }
 

@@ -40,8 +40,8 @@ class Fluid {
 
  private:
   struct Pair {
-    int32_t i, j;
-    double ex, ey; // unit vector from i to j
+    int32_t j;     // the other end; the first is the particle of the slot whose pairs these are (first_)
+    double ex, ey; // unit vector from the first particle to j
     double w;      // 1 − r/h
   };
   void predict(double dt, double gy, const double *x, const double *y, const double *vx, const double *vy);
@@ -51,7 +51,7 @@ class Fluid {
   int n_ = 0;
   uint64_t rng_ = 1;
   std::vector<double> px_, py_, sx_, sy_, rho_; // predicted positions; the same in cell order
-  std::vector<int32_t> cell_of_, cell_start_, fill_, sorted_;
+  std::vector<int32_t> cell_of_, cell_start_, fill_, sorted_, first_; // first_[a]: slot a's first pair
   std::vector<Pair> pairs_;
   double max_ratio_ = 0.0;
 };
