@@ -19,6 +19,7 @@ extern "C" {
 #include "metrics.hpp"
 #include "poursim/poursim.h"
 #include "poursim_internal.hpp"
+#include "world.hpp"
 
 using poursim::set_error;
 
@@ -170,7 +171,7 @@ extern "C" int poursim_rollout_batch(const poursim_config_t *config, const pours
   std::atomic<int> next{0};
   std::atomic<int> failed{POURSIM_OK};
   auto worker = [&]() {
-    poursim_world_t *w = poursim_create(config, nullptr, 0);
+    poursim_world_t *w = poursim::create_unset(config, nullptr, 0); // each rollout resets it
     if (w == nullptr) {
       failed = POURSIM_ESTATE;
       return;

@@ -373,9 +373,9 @@ void empty_bucket(poursim_world_t *w, bool free_spin) {
 
 } // namespace poursim
 
-extern "C" {
+namespace poursim {
 
-poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
+poursim_world_t *create_unset(const poursim_config_t *config, char *err, size_t err_len) {
   if (poursim_config_validate(config, err, err_len) != POURSIM_OK) return nullptr;
   // Box2D's length unit is global: 0.1 (decimetre-scale tolerances) suits circles of ~1 cm.
   std::call_once(g_units_once, [] { b2SetLengthUnitsPerMeter(0.1f); });
@@ -386,6 +386,17 @@ poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_
   }
   w->cfg = *config;
   w->ep = *config;
+  return w;
+}
+
+} // namespace poursim
+
+extern "C" {
+
+
+poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
+  poursim_world_t *w = poursim::create_unset(config, err, err_len);
+  if (w == nullptr) return nullptr;
   int rc = poursim_reset(w, config->seed);
   if (rc != POURSIM_OK) {
     set_error(err, err_len, rc, "while the liquid settled: %s", w->error);

@@ -46,6 +46,10 @@ namespace poursim {
 // free_spin also the joint's stops, so that the bucket can turn for good.
 void empty_bucket(poursim_world_t *w, bool free_spin);
 
+// A world with its config and no scene yet (poursim_create without its reset): only poursim_reset and
+// poursim_destroy may be called on it. For callers that reset it at once with their own seed.
+poursim_world_t *create_unset(const poursim_config_t *config, char *err, size_t err_len);
+
 } // namespace poursim
 
 #endif // POURSIM_WORLD_HPP
