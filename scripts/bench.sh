@@ -145,6 +145,7 @@ bench_sim() {
   rm -f "$log"
   echo "   machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) (other jobs slow the wall-time figures)"
   ./build/host/bin/host_sim --bench --policy policy/weights.h | sed 's/^/   /'
+  cmake --build --preset host -j2 --target bench_fluid >/dev/null && ./build/host/bin/bench_fluid | sed 's/^/   /'
 }
 
 # --- section: can — the pour CAN protocol: bus load, and the full loop on real SocketCAN ------------------
