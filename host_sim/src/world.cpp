@@ -393,7 +393,6 @@ poursim_world_t *create_unset(const poursim_config_t *config, char *err, size_t 
 
 extern "C" {
 
-
 poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len) {
   poursim_world_t *w = poursim::create_unset(config, err, err_len);
   if (w == nullptr) return nullptr;
