@@ -22,7 +22,7 @@ from pour import paths
 
 def find_binary(name: str, build_dir: str | None) -> Path:
     """NAME in a build tree's bin/ (pour.paths.build_dirs order)."""
-    p = paths.find(Path("bin") / name, build_dir)
+    p = paths.binary(name, build_dir)
     if p is not None:
         return p
     dirs = paths.build_dirs(build_dir)
