@@ -46,8 +46,7 @@ void Fluid::configure(const FluidParams &p, int n, uint64_t seed) {
   cell_of_.assign(un, 0);
   sorted_.assign(un, 0);
   first_.assign(un + 1, 0);
-  pairs_.clear();
-  pairs_.reserve(un * 8);
+  pairs_.assign(un * 8, Pair{});
   max_ratio_ = 0.0;
 }
 
@@ -62,7 +61,6 @@ void Fluid::predict(double dt, double gy, const double *x, const double *y, cons
 // against its own cell and four forward neighbours: every pair closer than h exactly once, in a fixed
 // order.
 void Fluid::find_pairs() {
-  pairs_.clear();
   if (n_ < 2) return;
   double ox = px_[0], x1 = ox, oy = py_[0], y1 = oy; // the bounding box (min and max: no branches)
   for (size_t i = 1; i < static_cast<size_t>(n_); ++i) {
@@ -90,19 +88,22 @@ void Fluid::find_pairs() {
   // Scanned in slot order, which is cell order: a particle's own cell after it and the cell to its right
   // are adjacent slots, and so are the three cells of the row above (left to right); two ranges a particle.
   const double h2 = p_.h * p_.h;
+  size_t np = 0; // pairs so far; pairs_ only grows, room is made once a range, not once a pair
   auto scan = [&](size_t a, int32_t b0, int32_t b1) {
     const double xi = sx_[a], yi = sy_[a];
+    if (b1 > b0 && pairs_.size() < np + static_cast<size_t>(b1 - b0))
+      pairs_.resize(std::max(2 * pairs_.size(), np + static_cast<size_t>(b1 - b0)));
     for (size_t b = static_cast<size_t>(b0); b < static_cast<size_t>(b1); ++b) {
       const double ex = sx_[b] - xi, ey = sy_[b] - yi;
       const double r2 = ex * ex + ey * ey;
       if (r2 >= h2 || r2 < 1e-18) continue; // coincident particles have no axis: skipped this step
       const double r = std::sqrt(r2), w = 1.0 - r * inv;
       const int32_t j = sorted_[b];
-      pairs_.push_back({j, ex / r, ey / r, w});
+      pairs_[np++] = {j, ex / r, ey / r, w};
     }
   };
   for (size_t a = 0; a < static_cast<size_t>(n_); ++a) {
-    first_[a] = static_cast<int32_t>(pairs_.size());
+    first_[a] = static_cast<int32_t>(np);
     const int32_t c = cell_of_[static_cast<size_t>(sorted_[a])], cx = c % nx, cy = c / nx;
     scan(a, static_cast<int32_t>(a) + 1, cell_start_[static_cast<size_t>(cx + 1 < nx ? c + 2 : c + 1)]);
     if (cy + 1 < ny) {
@@ -111,7 +112,7 @@ void Fluid::find_pairs() {
            cell_start_[static_cast<size_t>(row + std::min(cx + 1, nx - 1) + 1)]);
     }
   }
-  first_[static_cast<size_t>(n_)] = static_cast<int32_t>(pairs_.size());
+  first_[static_cast<size_t>(n_)] = static_cast<int32_t>(np);
 }
 
 void Fluid::step(double dt, double gy, const double *x, const double *y, double *vx, double *vy) {

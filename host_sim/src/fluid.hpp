@@ -52,7 +52,7 @@ class Fluid {
   uint64_t rng_ = 1;
   std::vector<double> px_, py_, sx_, sy_, rho_; // predicted positions; the same in cell order
   std::vector<int32_t> cell_of_, cell_start_, fill_, sorted_, first_; // first_[a]: slot a's first pair
-  std::vector<Pair> pairs_;
+  std::vector<Pair> pairs_; // slot a's pairs are [first_[a], first_[a + 1]); beyond first_[n] unused room
   double max_ratio_ = 0.0;
 };
 

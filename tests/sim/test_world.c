@@ -9,7 +9,7 @@
 
 /* Trajectory hash of seed 1 with the action sequence of run_pinned() on the default config. Pinned so
  * that any change to the physics or the measurements shows up; update it only on purpose. */
-#define PINNED_HASH 0x3a57304ec490d0e2ULL
+#define PINNED_HASH 0x8cae6376baf41cc1ULL
 
 static poursim_config_t cfg;
 static poursim_world_t *world;
