@@ -102,7 +102,8 @@ def test_bad_policy_shape_raises():
 
 
 def _load_in_subprocess(lib_path):
-    code = "from pour.sim import poursim\ntry:\n    poursim.load_library()\nexcept poursim.SimError as e:\n    print('SimError:', e)\n"
+    code = ("from pour.sim import poursim\ntry:\n    poursim.load_library()\n"
+            "except poursim.SimError as e:\n    print('SimError:', e)\n")
     env = dict(os.environ, POUR_SIM_LIB=str(lib_path))
     return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
 

@@ -15,7 +15,7 @@ from pour.policy import fixedpoint as fp
 from pour.policy import golden
 from pour.sim import poursim
 from pour.policy.weights_h import (WeightsHError, choose_frac_bits, content_hash, parse_weights_h,
-                            parse_weights_h_bytes, quantize_weights, render_weights_h, write_weights_h)
+                                   parse_weights_h_bytes, quantize_weights, render_weights_h, write_weights_h)
 
 NORM = (0, 2356194, 4000000)
 

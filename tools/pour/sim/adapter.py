@@ -5,7 +5,7 @@ SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linea
 firmware's safety envelope on every torque) and returns it as an Episode. SimStepper advances the world
 tick by tick for the Gymnasium environment through the same C code: the firmware's estimator and envelope
 (pour.policy.core, from the same library), so a stepped episode equals the C rollout's. Failures come out as
-EnvError, which the trainer reports; pour.sim.poursim finds the library.
+EnvError, which the trainer reports; pour.libpoursim finds the library.
 """
 from __future__ import annotations
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from pour.policy import linear
 from pour.sim.episode import (N_FEATURES, OMEGA_MAX_RAD_S, THETA_MAX_RAD, THETA_MIN_RAD, EnvError,  # noqa: F401
-                          Episode, normalise)
+                              Episode, normalise)
 
 
 def choose(w: np.ndarray, x: np.ndarray, greedy: bool, rng: np.random.Generator) -> int:
