@@ -165,7 +165,7 @@ bench_can() {
     return 1
   fi
   echo "-- computed from can/pour.dbc:"
-  .venv/bin/python -m pour.can_bus_load | sed 's/^/   /'
+  .venv/bin/python -m pour.can.bus_load | sed 's/^/   /'
   guest=$(mktemp -d)
   cat >"$guest/loop.sh" <<EOS
 B=$ROOT/$build; U="udpm://239.255.76.67:7699?ttl=0"
@@ -188,7 +188,7 @@ EOS
     grep -E '^lcm lockstep' "$guest/host.txt" | sed 's/^/   /'
     awk -v a="$t0" -v b="$t1" 'BEGIN { printf "   10,000 steps in %.1f s wall: %.0f steps/s\n", b - a, 10000 / (b - a) }'
     sed 's/^/   /' "$guest/bridge.txt"
-    .venv/bin/python -m pour.can_bus_load --candump "$guest/candump.log" | tail -n 1 | sed 's/^/   /'
+    .venv/bin/python -m pour.can.bus_load --candump "$guest/candump.log" | tail -n 1 | sed 's/^/   /'
   else
     cat "$log"
     echo "error: the guest run failed" >&2
@@ -196,7 +196,7 @@ EOS
   rm -rf "$guest" "$log"
 }
 
-# --- section: weights — parse time of weights.h against its size (host_sim's C++ loader, pour.weights_h) --
+# --- section: weights — parse time of weights.h against its size (host_sim's C++ loader, pour.policy.weights_h) --
 # The worst inputs of the 1 MiB the loaders read: an accepted header made long by one comment or by many
 # comment lines, and one single token. Best of 5 runs (C) or 3 (Python) per size; ns/byte staying flat
 # as the size doubles shows the parse is linear. Bar: < 100 ms for 1 MiB.
@@ -213,11 +213,11 @@ bench_weights() {
   rm -f "$log"
   echo "-- C++ (host_sim, poursim_weights_parse):"
   ./build/host/bin/bench_weights_parse policy/example_weights.h | sed 's/^/   /'
-  echo "-- Python (pour.weights_h.parse_weights_h_bytes):"
+  echo "-- Python (pour.policy.weights_h.parse_weights_h_bytes):"
   .venv/bin/python - <<'EOS' | sed 's/^/   /'
 import time
 from pathlib import Path
-from pour.weights_h import WeightsHError, parse_weights_h_bytes
+from pour.policy.weights_h import WeightsHError, parse_weights_h_bytes
 good = Path("policy/example_weights.h").read_bytes()
 key = b"#define POUR_WEIGHTS_FORMAT 1"
 for what in ("accepted, one long comment", "one token (refused)"):

@@ -11,9 +11,9 @@ from typing import Callable
 
 import lcm
 
-from pour import channels, lcm_sensors, lcm_types
+from pour.lcm import channels, messages, sensors
 
-msgs = lcm_types.load()
+msgs = messages.load()
 
 LIQUID_G = 10300
 """Scripted samples weigh 10 L of soymilk (1.03 kg/L) in all."""
@@ -119,7 +119,7 @@ class Bus:
         LIQUID_G; raw= encoder, scale_rotating_g, scale_target_g override the readings as given (bad input)."""
         m = msgs.sensor_sample_t()
         m.utime, m.seq, m.episode = seq * 1000, seq, episode
-        m.encoder = lcm_sensors.encoder_count(theta)
+        m.encoder = sensors.encoder_count(theta)
         m.scale_rotating_g, m.scale_target_g = round(v[0] * LIQUID_G), round(v[1] * LIQUID_G)
         for k, value in raw.items():
             setattr(m, k, value)

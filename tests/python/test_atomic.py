@@ -10,7 +10,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 from matplotlib.artist import Artist  # noqa: E402
 
-from pour import atomic, plots  # noqa: E402
+from pour import atomic  # noqa: E402
+from pour.eval import plots  # noqa: E402
 
 
 def test_write_atomic_replaces_the_file_with_normal_permissions(tmp_path):

@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from pour import can_bus_load as bl
+from pour.can import bus_load as bl
 
 
 def test_frame_bits_of_known_lengths():
@@ -52,7 +52,7 @@ def test_protocol_load_at_1khz_is_under_half_the_bus():
 
 
 def test_cli_reports_and_rejects_bad_input(tmp_path):
-    run = lambda *a: subprocess.run([sys.executable, "-m", "pour.can_bus_load", *a], capture_output=True,
+    run = lambda *a: subprocess.run([sys.executable, "-m", "pour.can.bus_load", *a], capture_output=True,
                                     text=True, timeout=60)
     ok = run()
     assert ok.returncode == 0 and "bar 50 %: ok" in ok.stdout

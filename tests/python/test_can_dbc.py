@@ -12,7 +12,7 @@ import cantools
 import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
-from pour import can_dbc
+from pour.can import dbc
 
 SEED = 20261123
 N_RANDOM = 400
@@ -145,11 +145,11 @@ def test_pack_matches_dbc_for_random_and_edge_values(db, harness, cname):
             cases.append(case)
     cases += [[rng.randint(lo, hi) for lo, hi in ranges] for _ in range(N_RANDOM)]
     for values in cases:
-        node = rng.randint(0, can_dbc.NODE_ID_MAX)
+        node = rng.randint(0, dbc.NODE_ID_MAX)
         got = c_pack(harness, cname, node, values)
         assert got is not None, (cname, values)
         frame_id, dlc, data = got
-        assert frame_id == can_dbc.can_id(node, msg.frame_id)
+        assert frame_id == dbc.can_id(node, msg.frame_id)
         assert dlc == msg.length
         want = msg.encode(to_signals(cname, values), scaling=False, strict=True)
         # The C codec only carries the fault bits the DBC names.
@@ -242,7 +242,7 @@ def test_cmd_ids_and_lengths_match_the_c_header(db, source_dir):
         c = names[m.name]
         assert f"#define POUR_CAN_CMD_{c} 0x{m.frame_id:02X}u" in header
         assert f"#define POUR_CAN_DLC_{c} {m.length}u" in header
-        assert m.frame_id <= can_dbc.CMD_MASK
+        assert m.frame_id <= dbc.CMD_MASK
 
 
 def test_every_signal_has_a_unit_or_choices_and_a_comment(db):
@@ -281,7 +281,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
 
 def test_dbc_for_node_shifts_every_id(db):
     for node in (0, 1, 37, 63):
-        other = cantools.database.load_string(can_dbc.dbc_for_node(node), "dbc")
+        other = cantools.database.load_string(dbc.dbc_for_node(node), "dbc")
         assert sorted(m.frame_id for m in other.messages) == sorted((node << 5) | m.frame_id for m in db.messages)
         for m in db.messages:
             o = other.get_message_by_name(m.name)
@@ -293,7 +293,7 @@ def test_dbc_for_node_shifts_every_id(db):
 
 @pytest.mark.parametrize("bad", ["64", "-1", "x", "1.5"])
 def test_dbc_generator_rejects_bad_node_ids(bad, tmp_path):
-    out = subprocess.run([sys.executable, "-m", "pour.can_dbc", "--node-id", bad, "-o", str(tmp_path / "x.dbc")],
+    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node-id", bad, "-o", str(tmp_path / "x.dbc")],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 2
     assert "pour-can-dbc: error:" in out.stderr
@@ -301,7 +301,7 @@ def test_dbc_generator_rejects_bad_node_ids(bad, tmp_path):
 
 
 def test_dbc_generator_writes_a_loadable_file(tmp_path):
-    out = subprocess.run([sys.executable, "-m", "pour.can_dbc", "--node-id", "0x3", "-o", str(tmp_path / "n3.dbc")],
+    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node-id", "0x3", "-o", str(tmp_path / "n3.dbc")],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     db3 = cantools.database.load_file(str(tmp_path / "n3.dbc"))

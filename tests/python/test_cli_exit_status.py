@@ -18,7 +18,8 @@ def bin_dir(build_dir):
     return build_dir / "bin"
 
 
-@pytest.mark.parametrize("program", ["host_sim", "pour_controller", "can_bridge", "pour.export", "pour.render"])
+@pytest.mark.parametrize("program", ["host_sim", "pour_controller", "can_bridge", "pour.policy.export",
+                                     "pour.eval.render"])
 def test_help_documents_the_exit_statuses(bin_dir, program):
     argv = [sys.executable, "-m", program] if program.startswith("pour.") else [bin_dir / program]
     r = _run(*argv, "--help")

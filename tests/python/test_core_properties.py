@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Property tests (Hypothesis) of the firmware core itself, driven through ctypes (pour.core on libpoursim):
+"""Property tests (Hypothesis) of the firmware core itself, driven through ctypes (pour.policy.core on libpoursim):
 after every tick the rules of docs/safety.md hold — clamp, slew, angle limits, the speed band, e-stop,
 latched faults, the input timeout, refused samples — for generated configs and input scripts.
 
@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pour import core, weights_h
+from pour.policy import core, weights_h
 
 PROFILE = settings(max_examples=300, derandomize=True, database=None, deadline=None,
                    suppress_health_check=[HealthCheck.too_slow])
@@ -28,8 +28,8 @@ CC = os.environ.get("CC") or shutil.which("cc") or "gcc"
 # --- the ctypes structures are the C headers' ----------------------------------------------------------
 
 def test_mirrored_structs_match_the_c_headers(tmp_path, source_dir):
-    """Every size and field offset of pour.core's ctypes structures equals the compiler's, and
-    pour_control_t fits the room pour.core lends it."""
+    """Every size and field offset of pour.policy.core's ctypes structures equals the compiler's, and
+    pour_control_t fits the room pour.policy.core lends it."""
     lines = ["#include <stddef.h>", "#include <stdio.h>", '#include "pour/control.h"', "int main(void) {",
              '  printf("pour_control_t %zu\\n", sizeof(pour_control_t));']
     want = {}

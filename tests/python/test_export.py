@@ -11,9 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pour import envs, export, train, weights_h
-from pour import fixedpoint as fp
-from pour import config as cfgmod
+from pour.policy import export, weights_h
+from pour.policy import fixedpoint as fp
+from pour.sim import envs
+from pour.train import config as cfgmod
+from pour.train import trainer
 
 SRC = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 CC = shutil.which("cc") or shutil.which("gcc")
@@ -109,7 +111,7 @@ def test_trained_run_exports_identically_after_retraining(tmp_path):
                             "algo": {"batch_episodes": 2}, "eval": {"every": 3, "episodes": 1},
                             "env": {"kind": "toy", "episode_s": 1.0}})
     for d in ("r1", "r2"):
-        train.train(cfg, tmp_path / d, quiet=True)
+        trainer.train(cfg, tmp_path / d, quiet=True)
         export.export(tmp_path / d, tmp_path / d / "weights.h")
     assert (tmp_path / "r1/weights.h").read_bytes() == (tmp_path / "r2/weights.h").read_bytes()
     res = weights_h.parse_weights_h(tmp_path / "r1/weights.h")
@@ -171,13 +173,13 @@ def test_quantised_policy_agrees_with_float_on_visited_states(tmp_path):
     cfg = cfgmod.from_dict({"seed": 2, "iterations": 12, "workers": 2, "policy": {"n_actions": 11},
                             "algo": {"batch_episodes": 8, "lr": 0.15, "entropy_coef": 0.0},
                             "eval": {"every": 4, "episodes": 2}, "env": {"kind": "toy", "episode_s": 4.0}})
-    train.train(cfg, tmp_path / "run", quiet=True)
+    trainer.train(cfg, tmp_path / "run", quiet=True)
     res = export.export(tmp_path / "run", tmp_path / "w.h")
     doc = export.load_policy(tmp_path / "run")
     w = export.weights_of(doc)
     env = envs.ToyEnv(11, 10, 4.0)
-    from pour import evaluate
-    xs = np.concatenate([env.rollout(w, s, True).x for s in train.episode_seeds(2, train.STREAM_TEST, 0, 5)])
+    from pour.eval import evaluate
+    xs = np.concatenate([env.rollout(w, s, True).x for s in trainer.episode_seeds(2, trainer.STREAM_TEST, 0, 5)])
     agree = evaluate.agreement(w, res, xs)
     assert agree >= 0.99
 
@@ -206,7 +208,7 @@ def test_bad_policy_files_give_clear_errors(tmp_path):
     with pytest.raises(export.ExportError, match="does not fit int16"):
         export.export(huge, tmp_path / "o.h")
     assert not (tmp_path / "o.h").exists()
-    r = subprocess.run([sys.executable, "-m", "pour.export", str(tmp_path / "missing.json"), "--out",
+    r = subprocess.run([sys.executable, "-m", "pour.policy.export", str(tmp_path / "missing.json"), "--out",
                         str(tmp_path / "o.h")], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and r.stderr.startswith("pour-export: error:") and "Traceback" not in r.stderr
 
@@ -292,7 +294,7 @@ def test_a_failed_write_leaves_the_previous_header_whole(tmp_path):
     _policy_json(tmp_path / "policy.json", np.ones((6, 3)))
     code = ("import resource, signal, sys; signal.signal(signal.SIGXFSZ, signal.SIG_IGN); "
             "resource.setrlimit(resource.RLIMIT_FSIZE, (1024, 1024)); "
-            "from pour.export import main; sys.exit(main(sys.argv[1:]))")
+            "from pour.policy.export import main; sys.exit(main(sys.argv[1:]))")
     r = subprocess.run([sys.executable, "-c", code, str(tmp_path / "policy.json"), "--out", str(tmp_path / "w.h")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr  # a failure while running: 1
@@ -302,11 +304,11 @@ def test_a_failed_write_leaves_the_previous_header_whole(tmp_path):
 
 
 def test_pour_eval_agree_on_a_toy_run_and_its_errors(tmp_path, capsys):
-    from pour import evaluate
+    from pour.eval import evaluate
     cfg = cfgmod.from_dict({"seed": 4, "iterations": 2, "workers": 1, "policy": {"n_actions": 5},
                             "algo": {"batch_episodes": 2}, "eval": {"every": 2, "episodes": 1},
                             "env": {"kind": "toy", "episode_s": 1.0}})
-    train.train(cfg, tmp_path / "run", quiet=True)
+    trainer.train(cfg, tmp_path / "run", quiet=True)
     export.export(tmp_path / "run", tmp_path / "w.h")
     assert evaluate.main(["agree", str(tmp_path / "run"), "--header", str(tmp_path / "w.h"), "--episodes", "2",
                           "--episode-s", "1.0"]) == 0

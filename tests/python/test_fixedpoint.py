@@ -1,12 +1,13 @@
 # SPDX-License-Identifier: MIT
-"""pour.fixedpoint: the Python reference of the firmware's fixed-point kernels, and the golden vectors."""
+"""pour.policy.fixedpoint: the Python reference of the firmware's fixed-point kernels, and the golden vectors."""
 import re
 
 import numpy as np
 import pytest
 
-from pour import fixedpoint as fp
-from pour import golden, sim, weights_h
+from pour.policy import fixedpoint as fp
+from pour.policy import golden, weights_h
+from pour.sim import poursim
 
 
 def test_exp2_table_matches_the_c_source(source_dir):
@@ -70,7 +71,7 @@ EDGES = [float("nan"), float("inf"), -float("inf"), 1.0, -1.0, 0.0, -0.0, 1e300,
 def test_float_to_q15_follows_the_c_rule_on_every_edge_value():
     """Python's quantiser and libpoursim's poursim_fraction_to_q15 (host_sim, the rollout) agree: NaN, the
     infinities, half an LSB either way, the limits."""
-    lib = sim.load_library()
+    lib = poursim.load_library()
     for x in EDGES:
         assert fp.float_to_q15(x) == lib.poursim_fraction_to_q15(x), x
     assert fp.float_to_q15(float("nan")) == 0

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import pour.gym_env  # noqa: F401  (registers the ids)
-from pour import envs
+import pour.sim.gym_env  # noqa: F401  (registers the ids)
+from pour.sim import envs
 
 
 def test_toy_env_passes_the_gymnasium_checker():
@@ -36,7 +36,7 @@ def test_step_matches_the_trainer_rollout():
     w = np.zeros((6, 11))
     w[5, 8] = 3.0  # greedy: always level 8
     ep = envs.ToyEnv(11, 10, 2.0).rollout(w, 77, True)
-    env = pour.gym_env.PourEnv("toy", episode_s=2.0)
+    env = pour.sim.gym_env.PourEnv("toy", episode_s=2.0)
     env._plant.reset(77)
     env._k, env._started = 0, True
     rewards = [env.step(int(a))[1] for a in ep.actions]
@@ -45,10 +45,10 @@ def test_step_matches_the_trainer_rollout():
 
 def test_bad_arguments_and_actions_are_refused():
     with pytest.raises(envs.EnvError, match="backend 'mujoco'"):
-        pour.gym_env.PourEnv("mujoco")
+        pour.sim.gym_env.PourEnv("mujoco")
     with pytest.raises(envs.EnvError, match="n_actions = 1"):
-        pour.gym_env.PourEnv("toy", n_actions=1)
-    env = pour.gym_env.PourEnv("toy")
+        pour.sim.gym_env.PourEnv("toy", n_actions=1)
+    env = pour.sim.gym_env.PourEnv("toy")
     with pytest.raises(gym.error.ResetNeeded):
         env.step(0)
     env.reset(seed=1)

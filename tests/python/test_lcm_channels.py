@@ -5,7 +5,8 @@ import re
 
 import pytest
 
-from pour import channels, lcm_types, paths
+from pour import paths
+from pour.lcm import channels, messages
 
 
 def header_macros(source_dir) -> dict:
@@ -42,7 +43,7 @@ def test_every_message_starts_with_utime_and_comments_each_field(source_dir):
 
 def test_generated_types_round_trip(build_dir, monkeypatch):
     monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
-    m = lcm_types.load()
+    m = messages.load()
     s = m.sensor_sample_t()
     s.utime, s.seq, s.encoder, s.scale_rotating_g, s.scale_target_g = 1000, 1, 131071, -5, 12345
     d = m.sensor_sample_t.decode(s.encode())
@@ -58,7 +59,7 @@ def test_generated_types_round_trip(build_dir, monkeypatch):
 
 def test_generated_types_refuse_foreign_and_truncated_data(build_dir, monkeypatch):
     monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
-    m = lcm_types.load()
+    m = messages.load()
     data = m.sensor_sample_t().encode()
     with pytest.raises(ValueError):
         m.torque_t.decode(data)
@@ -73,4 +74,4 @@ def test_missing_build_gives_a_clear_message(monkeypatch, tmp_path):
     monkeypatch.setenv("POUR_BUILD_DIR", str(tmp_path))
     monkeypatch.setattr(paths, "SOURCE_DIR", tmp_path)
     with pytest.raises(SystemExit, match="generated LCM types not found"):
-        lcm_types.load()
+        messages.load()

@@ -7,7 +7,7 @@ import time
 import pytest
 
 from lcm_helpers import Bus, Proc, binary, msgs, url
-from pour import channels
+from pour.lcm import channels
 
 FAULT_STALE_INPUT = 0x1
 MODE_RUN, MODE_FAULT = 1, 2

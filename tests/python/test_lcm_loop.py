@@ -8,7 +8,7 @@ import threading
 import pytest
 
 from lcm_helpers import Bus, Proc, binary, compiled_weights, url
-from pour import channels
+from pour.lcm import channels
 
 STEPS = "1500"
 

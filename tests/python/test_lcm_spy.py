@@ -9,7 +9,8 @@ import pytest
 from PIL import Image
 
 from lcm_helpers import Proc, binary, url
-from pour import lcm_spy, paths
+from pour import paths
+from pour.lcm import spy
 
 
 def make_xwd(rgb: np.ndarray, byte_order: int = 0) -> bytes:
@@ -25,7 +26,7 @@ def make_xwd(rgb: np.ndarray, byte_order: int = 0) -> bytes:
 @pytest.mark.parametrize("byte_order", [0, 1])
 def test_xwd_reader_decodes_truecolor(byte_order):
     rgb = np.random.default_rng(1).integers(0, 256, size=(7, 5, 3), dtype=np.uint8)
-    assert np.array_equal(lcm_spy.xwd_to_rgb(make_xwd(rgb, byte_order)), rgb)
+    assert np.array_equal(spy.xwd_to_rgb(make_xwd(rgb, byte_order)), rgb)
 
 
 @pytest.mark.parametrize("mutate, needle", [
@@ -36,7 +37,7 @@ def test_xwd_reader_decodes_truecolor(byte_order):
 def test_xwd_reader_rejects_bad_files(mutate, needle):
     data = make_xwd(np.zeros((4, 4, 3), dtype=np.uint8))
     with pytest.raises(ValueError, match=needle):
-        lcm_spy.xwd_to_rgb(mutate(data))
+        spy.xwd_to_rgb(mutate(data))
 
 
 def test_lcm_spy_decodes_our_types_under_xvfb(build_dir, source_dir, tmp_path):
@@ -46,7 +47,7 @@ def test_lcm_spy_decodes_our_types_under_xvfb(build_dir, source_dir, tmp_path):
     png, log = tmp_path / "spy.png", tmp_path / "spy.log"
     with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]), \
          Proc([driver, "--mode", "lcm", "--url", u, "--realtime", "--steps", "45000", "--particles-ms", "33"]):
-        r = subprocess.run([sys.executable, "-m", "pour.lcm_spy", "--url", u, "--build-dir", build_dir,
+        r = subprocess.run([sys.executable, "-m", "pour.lcm.spy", "--url", u, "--build-dir", build_dir,
                             "--screenshot", png, "--seconds", "6", "--log", log],
                            capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
@@ -68,10 +69,10 @@ def test_lcm_spy_without_jar_says_what_to_build(tmp_path, monkeypatch):
     monkeypatch.delenv("POUR_BUILD_DIR", raising=False)
     monkeypatch.setattr(paths, "SOURCE_DIR", tmp_path)
     with pytest.raises(SystemExit, match="pour_lcmtypes.jar not found"):
-        lcm_spy.find_jar(str(tmp_path))
+        spy.find_jar(str(tmp_path))
 
 
 def test_lcm_spy_rejects_bad_seconds():
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_spy", "--screenshot", "x.png", "--seconds", "0"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.spy", "--screenshot", "x.png", "--seconds", "0"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--seconds must be positive" in r.stderr

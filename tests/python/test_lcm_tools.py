@@ -11,7 +11,7 @@ import numpy as np
 from PIL import Image
 
 from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
-from pour import channels
+from pour.lcm import channels
 
 
 def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_dir, tmp_path):
@@ -32,7 +32,7 @@ def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_di
                "--realtime", "--set", "episode_s=10"]):
         t.start()
         try:
-            r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", u, "--save", png, "--frames", "5"],
+            r = subprocess.run([sys.executable, "-m", "pour.lcm.live_view", "--url", u, "--save", png, "--frames", "5"],
                                capture_output=True, text=True, timeout=120)
         finally:
             stop.set()
@@ -45,13 +45,13 @@ def test_live_view_draws_a_running_pour_and_ignores_garbage(build_dir, source_di
 
 
 def test_live_view_without_traffic_fails_clearly():
-    r = subprocess.run([sys.executable, "-m", "pour.live_view", "--url", url(42), "--save", "x.png", "--timeout",
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.live_view", "--url", url(42), "--save", "x.png", "--timeout",
                         "0.5"], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "no POUR_PARTICLES" in r.stderr
 
 
 def test_live_view_rejects_bad_arguments():
-    r = subprocess.run([sys.executable, "-m", "pour.live_view", "--save", "x.png", "--frames", "0"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.live_view", "--save", "x.png", "--frames", "0"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--frames must be >= 1" in r.stderr
 
@@ -63,7 +63,7 @@ def test_lcm_cmd_estop_and_clear_reach_the_controller(build_dir):
         bus.ask(0, theta=0.3)
 
         def cmd(*flags: str) -> None:
-            r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--url", u, *flags], capture_output=True,
+            r = subprocess.run([sys.executable, "-m", "pour.lcm.cmd", "--url", u, *flags], capture_output=True,
                                text=True, timeout=60)
             assert r.returncode == 0, r.stderr
             bus.pump(0.05)
@@ -82,16 +82,16 @@ def test_lcm_cmd_estop_and_clear_reach_the_controller(build_dir):
 
 
 def test_lcm_cmd_bad_inputs():
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--url", "nosuchprovider://x", "--clear"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.cmd", "--url", "nosuchprovider://x", "--clear"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "cannot open LCM" in r.stderr
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_cmd", "--clear", "--estop"], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.cmd", "--clear", "--estop"], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "not allowed with" in r.stderr
 
 
 def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--",
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.run", "--build-dir", build_dir, "--",
                         "--policy", compiled_weights(build_dir), "--set", "episode_s=0.5"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
@@ -100,36 +100,36 @@ def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
 
 
 def test_lcm_run_passes_on_host_sim_failures_and_refuses_doubled_flags(build_dir):
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--build-dir", build_dir, "--", "--policy",
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.run", "--build-dir", build_dir, "--", "--policy",
                         "/nonexistent/weights.h"], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "bad policy" in r.stderr
-    r = subprocess.run([sys.executable, "-m", "pour.lcm_run", "--", "--lcm", "x"], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.run", "--", "--lcm", "x"], capture_output=True, text=True,
                        timeout=60)
     assert r.returncode == 2 and "not to host_sim" in r.stderr
 
 
 def test_live_view_window_under_xvfb(build_dir, source_dir, tmp_path):
-    from pour import lcm_spy
+    from pour.lcm import spy
 
     u = url(44)
-    xvfb, display = lcm_spy.start_xvfb("800x600x24")
+    xvfb, display = spy.start_xvfb("800x600x24")
     try:
         env = dict(os.environ, DISPLAY=display, MPLBACKEND="TkAgg")
         with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]), \
              Proc([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir), "--lcm", u,
                    "--realtime", "--set", "episode_s=8"]):
-            p = subprocess.Popen([sys.executable, "-m", "pour.live_view", "--url", u, "--seconds", "6"], env=env,
+            p = subprocess.Popen([sys.executable, "-m", "pour.lcm.live_view", "--url", u, "--seconds", "6"], env=env,
                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
             white = 0
             for _ in range(40):  # the window appears once Python, matplotlib and Tk have started
                 time.sleep(0.25)
-                rgb = lcm_spy.screenshot(display, tmp_path / "window.png")
+                rgb = spy.screenshot(display, tmp_path / "window.png")
                 white = int((rgb.sum(axis=2) > 600).sum())
                 if white > 50000 or p.poll() is not None:
                     break
             out, err = p.communicate(timeout=60)
     finally:
-        lcm_spy.stop(xvfb)
+        spy.stop(xvfb)
     assert p.returncode == 0, err
     frames = int(out.split("pour-live-view: ")[1].split()[0])
     assert frames > 10
@@ -137,7 +137,7 @@ def test_live_view_window_under_xvfb(build_dir, source_dir, tmp_path):
 
 
 def test_live_view_shows_the_raw_sample_and_flags_an_impossible_count():
-    from pour import live_view
+    from pour.lcm import live_view
 
     view = live_view.LiveView(url(45))
     assert "no POUR_SENSORS yet" in view.sensors_text()

@@ -16,7 +16,7 @@ import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
 from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
-from pour import channels, lcm_sensors, lcmlog
+from pour.lcm import channels, logfile, sensors
 
 LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
 
@@ -64,7 +64,7 @@ def recorded(tmp_path_factory):
 def test_log_summary_matches_the_simulated_pour(recorded):
     log, host_out, tmp = recorded
     out = tmp / "plots"
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", log, "--out", out, "--json"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", log, "--out", out, "--json"],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     s = json.loads(r.stdout)
@@ -83,10 +83,10 @@ def test_log_summary_matches_the_simulated_pour(recorded):
     assert ep["source"] == channels.TRUTH
     # The tools read the encoder as the simulator writes it: every logged count is the count of the true
     # tilt of the same sample (round(θ·2^17/2π) mod 2^17).
-    (e,) = lcmlog.read_log(log).episodes
+    (e,) = logfile.read_log(log).episodes
     both = [k for k in e.raw if k in e.truth]
     assert len(both) >= 1900
-    assert all(lcm_sensors.encoder_count(e.truth[k][0]) == e.raw[k][0] for k in both)
+    assert all(sensors.encoder_count(e.truth[k][0]) == e.raw[k][0] for k in both)
     for png in ("traces.png", "latency.png"):
         assert (out / png).stat().st_size > 10000
     assert json.loads((out / "summary.json").read_text())["episodes"] == s["episodes"]
@@ -94,7 +94,7 @@ def test_log_summary_matches_the_simulated_pour(recorded):
 
 def test_log_text_output_reads_like_host_sim(recorded):
     log, host_out, _ = recorded
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", log], capture_output=True, text=True, timeout=300)
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", log], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert summary_line(r.stdout).startswith("summary (1 episode): poured ")
     assert "latency POUR_SENSORS -> POUR_TORQUE: median" in r.stdout
@@ -105,7 +105,7 @@ def test_log_text_output_reads_like_host_sim(recorded):
 def test_log_renders_like_host_sim(recorded):
     log, _, tmp = recorded
     gif = tmp / "replay.gif"
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", log, "--render", gif], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", log, "--render", gif], capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stderr
     assert gif.stat().st_size > 10000 and gif.with_suffix(".png").stat().st_size > 10000
@@ -127,14 +127,14 @@ def test_log_with_garbage_counts_it_and_still_analyses(tmp_path):
     w.write_event(30000, channels.SENSORS, msgs.command_t().encode())
     w.write_event(30001, "SOMEONE_ELSE", b"ignored")
     w.close()
-    s = lcmlog.analyse(path, None)
+    s = logfile.analyse(path, None)
     assert s["undecodable"] == {channels.TORQUE: 20, channels.SENSORS: 1}
     assert s["states"] == 20 and s["unanswered"] == 0
     assert s["latency_us"]["median"] == 80
 
 
 def test_missing_log_is_a_clear_error(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", tmp_path / "nope.lcmlog"], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", tmp_path / "nope.lcmlog"], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2 and "no such log file" in r.stderr
 
@@ -142,7 +142,7 @@ def test_missing_log_is_a_clear_error(tmp_path):
 def test_garbage_file_is_a_clear_error(tmp_path):
     path = tmp_path / "junk.lcmlog"
     path.write_bytes(bytes(random.Random(1).randrange(256) for _ in range(5000)))
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "holds no usable POUR_SENSORS messages" in r.stderr
 
 
@@ -151,7 +151,7 @@ def test_log_without_particles_cannot_render(tmp_path):
     w = lcm.EventLog(str(path), "w", overwrite=True)
     w.write_event(0, channels.SENSORS, Bus.state(None, 0))
     w.close()
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path, "--render", tmp_path / "x.gif"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path, "--render", tmp_path / "x.gif"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "no POUR_PARTICLES" in r.stderr
 
@@ -159,7 +159,7 @@ def test_log_without_particles_cannot_render(tmp_path):
 def test_render_needs_gif_or_mp4(tmp_path):
     path = tmp_path / "a.lcmlog"
     path.write_bytes(b"")
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path, "--render", tmp_path / "x.avi"],
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path, "--render", tmp_path / "x.avi"],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "--render wants a .gif or .mp4" in r.stderr
 
@@ -179,7 +179,7 @@ def test_log_replays_onto_the_bus_and_analyses_the_same(recorded, tmp_path):
     finally:
         logger.send_signal(signal.SIGINT)
         logger.wait(timeout=10)
-    first, second = lcmlog.analyse(log, None)["_log"], lcmlog.analyse(again, None)["_log"]
+    first, second = logfile.analyse(log, None)["_log"], logfile.analyse(again, None)["_log"]
     (a,), (b,) = first.episodes, second.episodes
     # UDP may drop a few replayed messages, but what arrives is the same pour, state for state.
     assert len(b.seq) >= 0.9 * len(a.seq)
@@ -208,7 +208,7 @@ def test_log_without_truth_reads_the_plant_from_the_sensors(tmp_path):
     path = tmp_path / "rig.lcmlog"
     # 10 L pour: 60 % moves to the target, 5 % goes missing; the bucket tilts to 100° and back below upright.
     sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 1.75, (0.5, 0.4), {}), (2, -0.02, (0.35, 0.6), {})])
-    s = lcmlog.analyse(path, None)
+    s = logfile.analyse(path, None)
     (ep,) = s["episodes"]
     assert ep["source"].startswith(channels.SENSORS)
     assert ep["poured"] == pytest.approx(0.6, abs=1e-4) and ep["spilled"] == pytest.approx(0.05, abs=1e-4)
@@ -225,21 +225,21 @@ def test_log_prefers_truth_and_refuses_impossible_values(tmp_path):
                       (3, 0.2, (0.8, 0.2), {"encoder": -1})],
                truth=[(0, (0.0, 0.0, 1.0, 0.0, 0.0)), (1, (0.1, 1.0, 0.7, 0.25, 0.05)),
                       (2, (float("nan"), 0.0, 0.5, 0.5, 0.0)), (3, (0.2, float("inf"), 0.5, 0.5, 0.0))])
-    s = lcmlog.analyse(path, None)
+    s = logfile.analyse(path, None)
     (ep,) = s["episodes"]
     assert ep["source"] == channels.TRUTH and ep["states"] == 4
     assert ep["poured"] == 0.25 and ep["spilled"] == 0.05  # the last plausible truth, not the scales
     assert s["refused"] == {channels.SENSORS: 2, channels.TRUTH: 2}
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and "refused 4" in r.stdout
     # The same samples read as a 24-bit encoder's: 2^17 is then a count like any other.
-    assert lcmlog.analyse(path, None, encoder_bits=24)["refused"] == {channels.SENSORS: 1, channels.TRUTH: 2}
+    assert logfile.analyse(path, None, encoder_bits=24)["refused"] == {channels.SENSORS: 1, channels.TRUTH: 2}
 
 
 def test_log_without_liquid_on_the_scales_is_a_clear_error(tmp_path):
     path = tmp_path / "empty.lcmlog"
     sensor_log(path, [(0, 0.0, (0.0, 0.0), {}), (1, 0.1, (0.0, 0.0), {})])
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path], capture_output=True, text=True, timeout=60)
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1 and "weighs 0 g of liquid" in r.stderr
 
 
@@ -247,22 +247,22 @@ def test_log_without_liquid_on_the_scales_is_a_clear_error(tmp_path):
 def test_bad_encoder_bits_is_a_clear_error(tmp_path, bits):
     path = tmp_path / "a.lcmlog"
     path.write_bytes(b"")
-    r = subprocess.run([sys.executable, "-m", "pour.lcmlog", path, "--encoder-bits", bits], capture_output=True,
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path, "--encoder-bits", bits], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2 and "--encoder-bits must be 8 .. 24" in r.stderr
 
 
 def test_sensor_readings_in_physical_units_and_their_bad_input():
-    assert lcm_sensors.encoder_count(0.0) == 0 and lcm_sensors.encoder_count(-1e-4) == (1 << 17) - 2
-    assert lcm_sensors.encoder_angle(1 << 15) == pytest.approx(3.141592653589793 / 2)
-    assert lcm_sensors.encoder_angle((1 << 17) - 2) == pytest.approx(-2 * 2 * 3.141592653589793 / (1 << 17))
-    assert lcm_sensors.volumes(5150, 4120, 10300) == pytest.approx((0.5, 0.4, 0.1))
-    assert lcm_sensors.volumes(9000, 2000, 10300)[2] == 0.0  # more than m0 on the scales: nothing missing
+    assert sensors.encoder_count(0.0) == 0 and sensors.encoder_count(-1e-4) == (1 << 17) - 2
+    assert sensors.encoder_angle(1 << 15) == pytest.approx(3.141592653589793 / 2)
+    assert sensors.encoder_angle((1 << 17) - 2) == pytest.approx(-2 * 2 * 3.141592653589793 / (1 << 17))
+    assert sensors.volumes(5150, 4120, 10300) == pytest.approx((0.5, 0.4, 0.1))
+    assert sensors.volumes(9000, 2000, 10300)[2] == 0.0  # more than m0 on the scales: nothing missing
     with pytest.raises(ValueError, match="outside 0 .. 2"):
-        lcm_sensors.encoder_angle(1 << 17)
+        sensors.encoder_angle(1 << 17)
     with pytest.raises(ValueError, match="outside 0 .. 2"):
-        lcm_sensors.encoder_angle(-1)
+        sensors.encoder_angle(-1)
     with pytest.raises(ValueError, match="not finite"):
-        lcm_sensors.encoder_count(float("nan"))
+        sensors.encoder_count(float("nan"))
     with pytest.raises(ValueError, match="must be positive"):
-        lcm_sensors.volumes(1, 1, 0)
+        sensors.volumes(1, 1, 0)

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
-from pour import config as cfgmod
-from pour import envs, reinforce, train
+from pour.policy import linear
+from pour.sim import envs
+from pour.train import config as cfgmod
+from pour.train import reinforce, trainer
 
 
 def _problem(seed=0, t=7, f=6, a=5):
@@ -44,7 +46,7 @@ def test_batch_gradient_matches_finite_differences_of_mean_surrogate():
         # Mean over episodes of the advantage term; the entropy bonus is coef x (decisions per
         # episode) x (mean entropy over all decisions), spread over the n episodes of the mean.
         pg = np.mean([reinforce.surrogate(wv, b.x[i], b.actions[i], adv[i]) for i in range(n)])
-        return pg + coef * t * np.mean(reinforce.entropy(reinforce.probs(wv, b.x.reshape(n * t, f)))) / n
+        return pg + coef * t * np.mean(reinforce.entropy(linear.probs(wv, b.x.reshape(n * t, f)))) / n
 
     g = reinforce.batch_gradient(w, b, adv, coef)
     num = np.zeros_like(w)
@@ -85,7 +87,7 @@ def test_normalised_advantages_have_zero_mean_unit_std():
 
 
 def test_softmax_survives_huge_logits():
-    p = reinforce.softmax(np.array([[1e300, 0.0, -1e300], [1000.0, 1000.0, 0.0]]))
+    p = linear.softmax(np.array([[1e300, 0.0, -1e300], [1000.0, 1000.0, 0.0]]))
     assert np.all(np.isfinite(p))
     np.testing.assert_allclose(p[0], [1, 0, 0])
     np.testing.assert_allclose(p[1], [0.5, 0.5, 0])
@@ -115,7 +117,7 @@ def test_nan_reward_gives_a_clear_gradient_error():
     ep = envs.Episode(np.ones((4, 6)), np.zeros(4, dtype=int), np.array([1.0, np.nan, 0.0, 0.0]),
                       {"v_target": 0, "v_spill": 0, "finish_s": 0})
     with pytest.raises(reinforce.GradientError, match=r"iteration 7: gradient has .* non-finite.*lower algo.lr"):
-        train.update(cfg, np.zeros((6, 11)), [ep, ep], reinforce.Adam((6, 11), 0.1), 7)
+        trainer.update(cfg, np.zeros((6, 11)), [ep, ep], reinforce.Adam((6, 11), 0.1), 7)
 
 
 def test_overflowing_weights_give_a_clear_gradient_error():
@@ -126,7 +128,7 @@ def test_overflowing_weights_give_a_clear_gradient_error():
     ep = envs.Episode(np.ones((4, 6)), np.array([0, 1, 2, 3]), np.full(4, 1e307),
                       {"v_target": 0, "v_spill": 0, "finish_s": 0})
     with pytest.raises(reinforce.GradientError, match="non-finite"):
-        train.update(cfg, np.zeros((6, 11)), [ep], None, 0)
+        trainer.update(cfg, np.zeros((6, 11)), [ep], None, 0)
 
 
 def test_feedback_parameterisation_gradient_matches_finite_differences():
@@ -159,7 +161,7 @@ def test_mean_kl_is_zero_for_the_same_policy_and_matches_the_definition():
     w, x, _, _ = _problem(seed=5)
     w2 = w + np.random.default_rng(6).normal(0, 0.3, w.shape)
     assert reinforce.mean_kl(w, w, x) == pytest.approx(0.0, abs=1e-15)
-    p, q = reinforce.probs(w, x), reinforce.probs(w2, x)
+    p, q = linear.probs(w, x), linear.probs(w2, x)
     want = np.mean(np.sum(p * np.log(p / q), axis=1))
     assert reinforce.mean_kl(w, w2, x) == pytest.approx(want, rel=1e-12)
     assert reinforce.mean_kl(w, w2, x) > 0
@@ -192,11 +194,11 @@ def test_update_keeps_the_feedback_policy_inside_the_trust_region():
                             "algo": {"batch_episodes": 4, "lr": 0.25, "max_kl": 0.02}, "env": {"kind": "toy"}})
     env = envs.make_env("toy", 11, 10, 1.0, {})
     p0 = np.array(cfg.policy.init_beta, dtype=np.float64)
-    w0 = train.weights(cfg, p0)
+    w0 = trainer.weights(cfg, p0)
     eps = [env.rollout(w0, s, False) for s in range(4)]
-    p1, st = train.update(cfg, p0, eps, reinforce.Adam(p0.shape, cfg.algo.lr), 0)
+    p1, st = trainer.update(cfg, p0, eps, reinforce.Adam(p0.shape, cfg.algo.lr), 0)
     x = np.concatenate([e.x for e in eps])
-    kl = reinforce.mean_kl(w0, train.weights(cfg, p1), x)
+    kl = reinforce.mean_kl(w0, trainer.weights(cfg, p1), x)
     assert 0 < kl <= 0.02 and st["kl"] == pytest.approx(kl, rel=1e-12)
     assert st["step_scale"] < 1.0 and st["lr"] == 0.25
     # Adam's first step is lr x sign(g) before the trust region scales it down.

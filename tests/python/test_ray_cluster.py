@@ -16,7 +16,8 @@ os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
 import ray  # noqa: E402
 from ray.cluster_utils import Cluster  # noqa: E402
 
-from pour import evaluate, executors, robust_scale, sweep, train  # noqa: E402
+from pour.eval import evaluate, robust_scale, sweep  # noqa: E402
+from pour.train import executors, trainer  # noqa: E402
 from test_ray_executor import CountingRunner, _cfg, assert_same_run  # noqa: E402
 
 NODE = {"num_cpus": 1, "node_ip_address": "127.0.0.1", "include_dashboard": False,
@@ -47,9 +48,9 @@ def test_rollouts_spread_over_both_nodes_and_the_run_is_unchanged(two_nodes, tmp
     alive = {n["NodeID"] for n in ray.nodes() if n["Alive"]}
     assert len(alive) == 2 and int(ray.cluster_resources()["CPU"]) == 2
     cfg = _cfg()
-    train.train(cfg, tmp_path / "local", quiet=True)
+    trainer.train(cfg, tmp_path / "local", quiet=True)
     NodeRecorder.nodes = []
-    train.train(cfg, tmp_path / "ray", quiet=True, make_runner=NodeRecorder)
+    trainer.train(cfg, tmp_path / "ray", quiet=True, make_runner=NodeRecorder)
     assert_same_run(tmp_path / "local", tmp_path / "ray")
     # One batch per CPU of the cluster, each call's two batches spread over the two nodes.
     assert len(NodeRecorder.nodes) == 2 * (4 + 2)
@@ -101,7 +102,7 @@ def test_random_search_is_seeded_and_within_its_ranges():
     (["--ray-address", "127.0.0.1:1"], "cannot reach the Ray cluster at 127.0.0.1:1"),
 ])
 def test_sweep_cli_errors_are_named(tmp_path, source_dir, args, message):
-    r = subprocess.run([sys.executable, "-m", "pour.sweep", str(source_dir / "configs" / "train" / "toy.toml"),
+    r = subprocess.run([sys.executable, "-m", "pour.eval.sweep", str(source_dir / "configs" / "train" / "toy.toml"),
                         "--out", str(tmp_path / "o"), "--iterations", "1", *args],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2, r.stderr
@@ -136,7 +137,7 @@ def test_robustness_at_scale_on_the_cluster_equals_one_host_sim_run(two_nodes, t
 ])
 def test_robust_scale_cli_errors_are_named(tmp_path, source_dir, args, message):
     base = ["--header", str(source_dir / "policy" / "weights.h"), "--rigs", "2", "--out", str(tmp_path / "o")]
-    r = subprocess.run([sys.executable, "-m", "pour.robust_scale", *base, *args],
+    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", *base, *args],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2, r.stderr
     assert "pour-robust-scale: error:" in r.stderr and message in r.stderr, r.stderr

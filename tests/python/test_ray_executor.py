@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""pour-train on Ray (tools/pour/executors.py), on a local Ray instance of 2 CPUs on loopback.
+"""pour-train on Ray (tools/pour/train/executors.py), on a local Ray instance of 2 CPUs on loopback.
 
 A run on Ray is bit-identical to the same run on the local pool (toy plant and libpoursim), a worker
 killed mid-run is retried with the result unchanged, an unreachable address fails fast naming it, and
@@ -23,8 +23,9 @@ import pytest
 os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
 import ray  # noqa: E402
 
-from pour import config as cfgmod  # noqa: E402
-from pour import envs, executors, train  # noqa: E402
+from pour.train import config as cfgmod  # noqa: E402
+from pour.sim import envs  # noqa: E402
+from pour.train import executors, trainer  # noqa: E402
 
 TOY = {"seed": 11, "iterations": 4, "workers": 2,
        "policy": {"n_actions": 5, "decision_period_ms": 10},
@@ -74,16 +75,16 @@ class CountingRunner(executors.RayRunner):
 
 def test_toy_run_on_ray_is_bit_identical_to_the_local_pool(local_ray, tmp_path):
     cfg = _cfg()
-    train.train(cfg, tmp_path / "local", quiet=True)
+    trainer.train(cfg, tmp_path / "local", quiet=True)
     CountingRunner.tasks = 0
-    res = train.train(cfg, tmp_path / "ray", quiet=True,
+    res = trainer.train(cfg, tmp_path / "ray", quiet=True,
                       make_runner=lambda c: CountingRunner(c, episodes_per_task=2))
     assert res.iterations == 4
     assert_same_run(tmp_path / "local", tmp_path / "ray")
     # 4 iterations x 3 tasks of 2 training episodes, 2 evaluations x 2 tasks (2 + 1 episodes).
     assert CountingRunner.tasks == 4 * 3 + 2 * 2
     # A different seed gives a different run: the comparison can fail.
-    train.train(_cfg(seed=12), tmp_path / "other", quiet=True, make_runner=executors.RayRunner)
+    trainer.train(_cfg(seed=12), tmp_path / "other", quiet=True, make_runner=executors.RayRunner)
     assert (tmp_path / "other" / "policy.json").read_bytes() != (tmp_path / "local" / "policy.json").read_bytes()
 
 
@@ -95,10 +96,10 @@ def test_simulator_run_on_ray_is_bit_identical_and_workers_find_libpoursim(local
          "algo": {"batch_episodes": 4}, "eval": {"every": 1, "episodes": 2},
          "env": {"kind": "sim", "episode_s": 0.5}}
     cfg = _cfg(d)
-    train.train(cfg, tmp_path / "local", quiet=True)
-    train.train(cfg, tmp_path / "ray", quiet=True, make_runner=executors.RayRunner)
+    trainer.train(cfg, tmp_path / "local", quiet=True)
+    trainer.train(cfg, tmp_path / "ray", quiet=True, make_runner=executors.RayRunner)
     assert_same_run(tmp_path / "local", tmp_path / "ray")
-    w0 = train.weights(cfg, np.array(beta))
+    w0 = trainer.weights(cfg, np.array(beta))
     assert json.loads((tmp_path / "ray" / "policy.json").read_text())["w"] != w0.tolist()
 
 
@@ -110,9 +111,9 @@ def test_batches_are_contiguous_balanced_and_in_order():
 
 def test_a_killed_worker_is_retried_and_the_run_is_unchanged(local_ray, tmp_path):
     cfg = _cfg()
-    train.train(cfg, tmp_path / "local", quiet=True)
+    trainer.train(cfg, tmp_path / "local", quiet=True)
     marker = tmp_path / "killed"
-    train.train(cfg, tmp_path / "ray", quiet=True,
+    trainer.train(cfg, tmp_path / "ray", quiet=True,
                 make_runner=lambda c: executors.RayRunner(c, max_retries=2, kill_marker=str(marker)))
     # The first task SIGKILLed its own worker process (the marker holds its pid), and that process is gone.
     pid = int(marker.read_text())
@@ -124,7 +125,7 @@ def test_a_killed_worker_is_retried_and_the_run_is_unchanged(local_ray, tmp_path
 def test_without_retries_a_killed_worker_fails_the_run_with_a_clear_error(local_ray, tmp_path):
     marker = tmp_path / "killed"
     with pytest.raises(executors.ExecutorError, match="worker died 1 times"):
-        train.train(_cfg(), tmp_path / "ray", quiet=True,
+        trainer.train(_cfg(), tmp_path / "ray", quiet=True,
                     make_runner=lambda c: executors.RayRunner(c, max_retries=0, kill_marker=str(marker)))
     assert marker.exists()
 
@@ -158,7 +159,7 @@ def test_unreachable_address_fails_fast_naming_it(tmp_path):
     _toml(cfg_file, 2)
     addr = f"127.0.0.1:{_free_port()}"
     t0 = time.monotonic()
-    r = subprocess.run([sys.executable, "-m", "pour.train", str(cfg_file), "--out", str(tmp_path / "o"),
+    r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(cfg_file), "--out", str(tmp_path / "o"),
                         "--executor", "ray", "--ray-address", addr], capture_output=True, text=True, timeout=120)
     assert r.returncode == 2, r.stderr
     assert f"pour-train: error: cannot reach the Ray cluster at {addr}: Connection refused" in r.stderr
@@ -197,7 +198,7 @@ def test_sigint_leaves_a_run_that_resumes_to_the_uninterrupted_result(tmp_path):
     cfg_file = tmp_path / "toy.toml"
     _toml(cfg_file, 12)
     run = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "pour.train", str(cfg_file), "--out", str(run), "--quiet",
+    proc = subprocess.Popen([sys.executable, "-m", "pour.train.trainer", str(cfg_file), "--out", str(run), "--quiet",
                              "--executor", "ray"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
     try:
@@ -216,7 +217,7 @@ def test_sigint_leaves_a_run_that_resumes_to_the_uninterrupted_result(tmp_path):
     assert 2 <= done < 12
     assert not list(run.glob("*.tmp"))
     cfg = cfgmod.load(cfg_file)
-    resumed = train.train(cfg, run, quiet=True)
+    resumed = trainer.train(cfg, run, quiet=True)
     assert resumed.iterations == 12
-    train.train(cfg, tmp_path / "ref", quiet=True)
+    trainer.train(cfg, tmp_path / "ref", quiet=True)
     assert_same_run(run, tmp_path / "ref")

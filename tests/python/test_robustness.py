@@ -4,7 +4,7 @@ import json
 import subprocess
 import sys
 
-from pour import robustness
+from pour.eval import robustness
 
 
 def episode(poured=99.5, spilled=0.3, finish=2.0, peak=1.9, alpha=60.0, reversals=5):
@@ -58,14 +58,14 @@ def test_edges_judge_the_means_and_every_episode_judges_the_motion():
 
 
 def test_a_missing_header_is_named_with_exit_2(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "pour.evaluate", "robust", "--header", str(tmp_path / "no.h"),
+    r = subprocess.run([sys.executable, "-m", "pour.eval.evaluate", "robust", "--header", str(tmp_path / "no.h"),
                         "--out", str(tmp_path / "r")], capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "no.h" in r.stderr and "Traceback" not in r.stderr
 
 
 def test_a_short_run_on_the_simulator_writes_the_table(tmp_path, source_dir, build_dir):
     out = tmp_path / "rob"
-    r = subprocess.run([sys.executable, "-m", "pour.evaluate", "robust", "--header",
+    r = subprocess.run([sys.executable, "-m", "pour.eval.evaluate", "robust", "--header",
                         str(source_dir / "policy" / "weights.h"), "--out", str(out), "--nominal-episodes", "1",
                         "--edge-episodes", "1", "--build-dir", str(build_dir)],
                        capture_output=True, text=True, timeout=600)
@@ -86,14 +86,14 @@ def test_episode_metrics_count_reversals_and_litres():
 
     import numpy as np
 
-    from pour import sim
-    cfg = sim.make_config({"episode_s": 2.0})
+    from pour.sim import poursim
+    cfg = poursim.make_config({"episode_s": 2.0})
     levels = np.array([-1.0, 1.0])
 
     def run(w):
-        pol = sim.Policy(np.asarray(w, dtype=float), levels, 10, cfg.obs_theta_min, cfg.obs_theta_max,
+        pol = poursim.Policy(np.asarray(w, dtype=float), levels, 10, cfg.obs_theta_min, cfg.obs_theta_max,
                          cfg.obs_omega_max, True)
-        with sim.World(cfg) as world:
+        with poursim.World(cfg) as world:
             return world.rollout(pol, 5).metrics
 
     forward = run([[0, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 1]])  # always +tau_max
@@ -111,10 +111,10 @@ def test_a_bad_reversal_cost_is_refused_by_the_c_rollout():
     import numpy as np
     import pytest
 
-    from pour import sim
-    cfg = sim.make_config({"episode_s": 0.1})
+    from pour.sim import poursim
+    cfg = poursim.make_config({"episode_s": 0.1})
     for bad in (float("nan"), -1.0):
-        pol = sim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, cfg.obs_theta_min, cfg.obs_theta_max,
+        pol = poursim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, cfg.obs_theta_min, cfg.obs_theta_max,
                          cfg.obs_omega_max, True, bad)
-        with pytest.raises(sim.SimError, match="k_reversal"):
-            sim.World(cfg).rollout(pol, 1)
+        with pytest.raises(poursim.SimError, match="k_reversal"):
+            poursim.World(cfg).rollout(pol, 1)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""tools/pour/sim.py: the ctypes binding of libpoursim."""
+"""tools/pour/sim/poursim.py: the ctypes binding of libpoursim."""
 import os
 import subprocess
 import sys
@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from pour import sim
+from pour.sim import poursim
 
 
 @pytest.fixture(autouse=True)
@@ -16,15 +16,15 @@ def _lib(build_dir, monkeypatch):
 
 
 def small_policy(greedy=False):
-    lv = sim.uniform_levels(5)
+    lv = poursim.uniform_levels(5)
     w = np.zeros((6, 5))
     w[0], w[2], w[5] = -3 * lv, 2 * lv, lv  # tilt while full and upright
-    return sim.Policy(w=w, levels=lv, decision_period=10, greedy=greedy)
+    return poursim.Policy(w=w, levels=lv, decision_period=10, greedy=greedy)
 
 
 def test_default_config_has_the_documented_scene():
-    c = sim.default_config()
-    assert set(c) == set(sim.CONFIG_KEYS)
+    c = poursim.default_config()
+    assert set(c) == set(poursim.CONFIG_KEYS)
     assert c["n_particles"] == 150 and c["bucket_inner_width"] == 0.24 and c["bucket_height"] == 0.33
     assert c["bucket_wall"] == 0.005 and c["dt"] == 0.001 and c["episode_s"] == 10.0
     assert c["restitution_liquid"] == 0.5 and c["restitution_wall"] == 0.1
@@ -32,11 +32,11 @@ def test_default_config_has_the_documented_scene():
 
 def test_rig_keys_and_readings_cross_the_binding_with_the_c_layout():
     # Values the C side sets land in the right Python fields only if the layouts agree field by field.
-    c = sim.default_config()
+    c = poursim.default_config()
     assert (c["motor_peak_torque"], c["motor_no_load_speed"], c["gear_ratio"]) == (25.0, 21.0, 20.0)
     assert (c["command_latency_ticks"], c["encoder_bits"], c["scale_rate_hz"]) == (1, 17, 80.0)
     assert c["rand_sensor"] == 0.0 and c["k_target"] == 1.0 and c["seed"] == 1
-    with sim.World(seed=3) as w:
+    with poursim.World(seed=3) as w:
         o = w.observe()
         assert o.encoder in (0, (1 << 17) - 1) or o.encoder < 50 or o.encoder > (1 << 17) - 50
         assert 7000 < o.scale_rotating_g < 14000 and abs(o.scale_target_g) < 500  # 10.3 kg of agitated liquid
@@ -44,27 +44,27 @@ def test_rig_keys_and_readings_cross_the_binding_with_the_c_layout():
         o = w.step(1.0)
         assert o.torque == 20.0 and 19.0 < o.motor_torque <= 20.0  # the command of the step before, at speed
         assert o.encoder == round(o.theta * (1 << 17) / (2 * np.pi))
-    with sim.World({"rand_fill": 0.2, "rand_motor": 0.15}, seed=5) as w:
+    with poursim.World({"rand_fill": 0.2, "rand_motor": 0.15}, seed=5) as w:
         e = w.episode_config()
         assert e["fill_depth"] != c["fill_depth"] and abs(e["fill_depth"] / c["fill_depth"] - 1) <= 0.2
         assert abs(e["motor_peak_torque"] / 25.0 - 1) <= 0.15 and e["rand_fill"] == 0.2
-    d = sim.measure_drive()
+    d = poursim.measure_drive()
     assert d["latency_ticks"] == 1 and d["inertia_measured"] == pytest.approx(d["inertia_expected"], rel=0.01)
-    with pytest.raises(sim.SimError, match="encoder_bits"):
-        sim.make_config({"encoder_bits": 40})
+    with pytest.raises(poursim.SimError, match="encoder_bits"):
+        poursim.make_config({"encoder_bits": 40})
 
 
 def test_bad_config_key_or_value_raises_naming_it():
-    with pytest.raises(sim.SimError, match="no_such_key"):
-        sim.make_config({"no_such_key": 1})
-    with pytest.raises(sim.SimError, match="gamma"):
-        sim.make_config({"gamma": 2.0})
-    with pytest.raises(sim.SimError, match="cannot read config file"):
-        sim.make_config(path="/nonexistent/sim.cfg")
+    with pytest.raises(poursim.SimError, match="no_such_key"):
+        poursim.make_config({"no_such_key": 1})
+    with pytest.raises(poursim.SimError, match="gamma"):
+        poursim.make_config({"gamma": 2.0})
+    with pytest.raises(poursim.SimError, match="cannot read config file"):
+        poursim.make_config(path="/nonexistent/sim.cfg")
 
 
 def test_world_steps_and_accounts_for_every_circle():
-    with sim.World(seed=2) as w:
+    with poursim.World(seed=2) as w:
         o0 = w.observe()
         assert o0.step == 0 and o0.v_rotating == 1.0
         for _ in range(300):
@@ -75,13 +75,13 @@ def test_world_steps_and_accounts_for_every_circle():
         reg = w.regions()
         assert np.bincount(reg, minlength=4).sum() == 150
         assert o.v_rotating == pytest.approx(np.mean(reg == 0))
-        with pytest.raises(sim.SimError, match="finite"):
+        with pytest.raises(poursim.SimError, match="finite"):
             w.step(float("nan"))
 
 
 def test_rollout_arrays_and_determinism():
     pol = small_policy()
-    with sim.World({"episode_s": 2.0}) as w:
+    with poursim.World({"episode_s": 2.0}) as w:
         a = w.rollout(pol, seed=4, record_steps=True)
         b = w.rollout(pol, seed=4)
     assert a.features.shape == (200, 6) and a.actions.shape == (200,) and a.probs.shape == (200, 5)
@@ -94,15 +94,16 @@ def test_rollout_arrays_and_determinism():
 
 
 def test_bad_policy_shape_raises():
-    with pytest.raises(sim.SimError, match="shape"):
-        sim.Policy(w=np.zeros((5, 11)), levels=sim.uniform_levels(11))._struct()
-    with pytest.raises(sim.SimError):
-        with sim.World({"episode_s": 0.1}) as w:
-            w.rollout(sim.Policy(w=np.zeros((6, 3)), levels=np.array([-2.0, 0, 1])), 1)
+    with pytest.raises(poursim.SimError, match="shape"):
+        poursim.Policy(w=np.zeros((5, 11)), levels=poursim.uniform_levels(11))._struct()
+    with pytest.raises(poursim.SimError):
+        with poursim.World({"episode_s": 0.1}) as w:
+            w.rollout(poursim.Policy(w=np.zeros((6, 3)), levels=np.array([-2.0, 0, 1])), 1)
 
 
 def _load_in_subprocess(lib_path):
-    code = "from pour import sim\ntry:\n    sim.load_library()\nexcept sim.SimError as e:\n    print('SimError:', e)\n"
+    code = ("from pour.sim import poursim\ntry:\n    poursim.load_library()\n"
+            "except poursim.SimError as e:\n    print('SimError:', e)\n")
     env = dict(os.environ, POUR_SIM_LIB=str(lib_path))
     return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
 

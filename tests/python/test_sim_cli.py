@@ -268,7 +268,7 @@ def test_renderer_refuses_bad_input(tmp_path, content, out, message):
     traj = tmp_path / "t.json"
     if content is not None:
         traj.write_text(content)
-    r = subprocess.run([sys.executable, "-m", "pour.render", str(traj), str(tmp_path / out)],
+    r = subprocess.run([sys.executable, "-m", "pour.eval.render", str(traj), str(tmp_path / out)],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and message in r.stderr, r.stderr
 

@@ -9,27 +9,30 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import pour.gym_env
-from pour import config as cfgmod
-from pour import core, envs, evaluate, sim_adapter, train, weights_h
+import pour.sim.gym_env
+from pour.eval import evaluate
+from pour.policy import core, weights_h
+from pour.sim import adapter, envs
+from pour.train import config as cfgmod
+from pour.train import trainer
 
 SRC = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
 
 def test_sim_gym_env_passes_the_checker():
-    env = pour.gym_env.PourEnv("sim", episode_s=0.1)
+    env = pour.sim.gym_env.PourEnv("sim", episode_s=0.1)
     check_env(env, skip_render_check=True)
 
 
 def test_gym_steps_reproduce_the_c_rollout():
-    """Tick-by-tick stepping (the firmware's estimator and envelope, in C through pour.core) and the C
+    """Tick-by-tick stepping (the firmware's estimator and envelope, in C through pour.policy.core) and the C
     whole-episode rollout agree exactly."""
     sim = envs.make_env("sim", 11, 10, 0.6)
     w = np.zeros((6, 11))
     w[0, :] = np.linspace(30, -30, 11)  # torque falls as theta grows, so actions change along the way
     w[5, :] = np.linspace(-2, 2, 11)
     ep = sim.rollout(w, 31, True)
-    env = pour.gym_env.PourEnv("sim", episode_s=0.6)
+    env = pour.sim.gym_env.PourEnv("sim", episode_s=0.6)
     env._plant.reset(31)
     env._k, env._started = 0, True
     assert isinstance(env._plant.safety, core.Envelope) and isinstance(env._plant.estimator, core.Estimator)
@@ -49,8 +52,8 @@ def test_one_training_iteration_on_the_simulator(tmp_path):
                             "policy": {"n_actions": 11, "param": "feedback", "init": "beta", "init_beta": beta},
                             "algo": {"batch_episodes": 2}, "eval": {"every": 1, "episodes": 2},
                             "env": {"kind": "sim", "episode_s": 0.8}})
-    res = train.train(cfg, tmp_path / "r", quiet=True)
-    w0 = train.weights(cfg, np.array(beta))
+    res = trainer.train(cfg, tmp_path / "r", quiet=True)
+    w0 = trainer.weights(cfg, np.array(beta))
     assert res.iterations == 1 and not np.array_equal(res.w, w0)
     assert (tmp_path / "r" / "policy.json").exists()
 
@@ -59,7 +62,7 @@ def test_missing_library_gives_a_clear_error(tmp_path):
     cfg = tmp_path / "c.toml"
     cfg.write_text('iterations = 1\n[env]\nkind = "sim"\n')
     env = dict(os.environ, POUR_SIM_LIB=str(tmp_path / "nowhere" / "libpoursim.so"))
-    r = subprocess.run([sys.executable, "-m", "pour.train", str(cfg), "--out", str(tmp_path / "o")],
+    r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(cfg), "--out", str(tmp_path / "o")],
                        capture_output=True, text=True, env=env, timeout=120)
     assert r.returncode == 2
     assert "pour-train: error: cannot load the simulator library" in r.stderr and "nowhere" in r.stderr

@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pour import config as cfgmod
-from pour import envs, train
+from pour.train import config as cfgmod
+from pour.sim import envs
+from pour.train import trainer
 
 TOY = {"seed": 5, "iterations": 6, "workers": 1,
        "policy": {"n_actions": 5, "decision_period_ms": 10},
@@ -46,23 +47,23 @@ def _toml(d, path):
 
 
 def test_same_config_same_run_whatever_the_worker_count(tmp_path):
-    a = train.train(_cfg(workers=1), tmp_path / "a", quiet=True)
-    b = train.train(_cfg(workers=2), tmp_path / "b", quiet=True)
+    a = trainer.train(_cfg(workers=1), tmp_path / "a", quiet=True)
+    b = trainer.train(_cfg(workers=2), tmp_path / "b", quiet=True)
     np.testing.assert_array_equal(a.w, b.w)
     np.testing.assert_array_equal(a.best_w, b.best_w)
     assert _rows(tmp_path / "a") == _rows(tmp_path / "b")
     assert len(_rows(tmp_path / "a")) == 6
     # The exporter's input, hence weights.h, is byte-identical too.
     assert (tmp_path / "a" / "policy.json").read_bytes() == (tmp_path / "b" / "policy.json").read_bytes()
-    c = train.train(_cfg(seed=6), tmp_path / "c", quiet=True)
+    c = trainer.train(_cfg(seed=6), tmp_path / "c", quiet=True)
     assert not np.array_equal(a.w, c.w)
 
 
 def test_resume_after_a_partial_run_is_bit_identical(tmp_path):
-    full = train.train(_cfg(), tmp_path / "full", quiet=True)
-    part = train.train(_cfg(), tmp_path / "part", quiet=True, stop_after=3)
+    full = trainer.train(_cfg(), tmp_path / "full", quiet=True)
+    part = trainer.train(_cfg(), tmp_path / "part", quiet=True, stop_after=3)
     assert part.iterations == 3
-    resumed = train.train(_cfg(), tmp_path / "part", quiet=True)
+    resumed = trainer.train(_cfg(), tmp_path / "part", quiet=True)
     assert resumed.iterations == 6
     np.testing.assert_array_equal(full.w, resumed.w)
     assert _rows(tmp_path / "full") == _rows(tmp_path / "part")
@@ -73,7 +74,7 @@ def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
     cfg_file = tmp_path / "toy.toml"
     _toml(d, cfg_file)
     run = tmp_path / "run"
-    proc = subprocess.Popen([sys.executable, "-m", "pour.train", str(cfg_file), "--out", str(run), "--quiet"],
+    proc = subprocess.Popen([sys.executable, "-m", "pour.train.trainer", str(cfg_file), "--out", str(run), "--quiet"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 60
     try:
@@ -91,9 +92,9 @@ def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
     rows_before = _rows(run)
     assert len(rows_before) >= done  # the log may hold one row more than the checkpoint, never fewer
     cfg = cfgmod.load(cfg_file)
-    resumed = train.train(cfg, run, quiet=True)
+    resumed = trainer.train(cfg, run, quiet=True)
     assert resumed.iterations == 16
-    ref = train.train(cfg, tmp_path / "ref", quiet=True)
+    ref = trainer.train(cfg, tmp_path / "ref", quiet=True)
     np.testing.assert_array_equal(ref.w, resumed.w)
     assert _rows(run) == _rows(tmp_path / "ref")
     assert not list(run.glob("*.tmp"))
@@ -101,23 +102,23 @@ def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
 
 def test_learning_rate_decays_linearly_to_lr_final():
     cfg = _cfg(iterations=5, algo={"lr": 0.1, "lr_final": 0.02})
-    assert [round(train.learning_rate(cfg, i), 12) for i in range(5)] == [0.1, 0.08, 0.06, 0.04, 0.02]
-    assert train.learning_rate(_cfg(), 3) == 0.1
+    assert [round(trainer.learning_rate(cfg, i), 12) for i in range(5)] == [0.1, 0.08, 0.06, 0.04, 0.02]
+    assert trainer.learning_rate(_cfg(), 3) == 0.1
 
 
 def test_resume_with_another_config_is_refused(tmp_path):
-    train.train(_cfg(), tmp_path / "r", quiet=True, stop_after=1)
-    with pytest.raises(train.TrainError, match="different config"):
-        train.train(_cfg(seed=99), tmp_path / "r", quiet=True)
-    train.train(_cfg(workers=2), tmp_path / "r", quiet=True, stop_after=1)  # workers do not matter
+    trainer.train(_cfg(), tmp_path / "r", quiet=True, stop_after=1)
+    with pytest.raises(trainer.TrainError, match="different config"):
+        trainer.train(_cfg(seed=99), tmp_path / "r", quiet=True)
+    trainer.train(_cfg(workers=2), tmp_path / "r", quiet=True, stop_after=1)  # workers do not matter
 
 
 def test_training_improves_the_toy_policy(tmp_path):
     cfg = _cfg(iterations=40, workers=2, eval={"every": 39, "episodes": 4}, env={"kind": "toy", "episode_s": 6.0},
                algo={"batch_episodes": 8, "lr": 0.15, "entropy_coef": 0.0})
-    res = train.train(cfg, tmp_path / "t", quiet=True)
+    res = trainer.train(cfg, tmp_path / "t", quiet=True)
     env = envs.ToyEnv(5, 10, 6.0)
-    seeds = train.episode_seeds(123, train.STREAM_TEST, 0, 8)
+    seeds = trainer.episode_seeds(123, trainer.STREAM_TEST, 0, 8)
     before = np.mean([env.rollout(np.zeros((6, 5)), s, False).metrics["v_target"] for s in seeds])
     after = np.mean([env.rollout(res.w, s, False).metrics["v_target"] for s in seeds])
     assert before < 0.05  # the uniform policy hardly tilts the bucket
@@ -181,7 +182,7 @@ def test_cli_reports_bad_files_and_values_with_exit_code_2(tmp_path):
         p = tmp_path / name
         if text is not None:
             p.write_text(text)
-        r = subprocess.run([sys.executable, "-m", "pour.train", str(p), "--out", str(tmp_path / "o")],
+        r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(p), "--out", str(tmp_path / "o")],
                            capture_output=True, text=True, env=env, timeout=60)
         assert r.returncode == 2, r.stderr
         assert r.stderr.startswith("pour-train: error: ") and name in r.stderr
@@ -195,15 +196,15 @@ def test_unknown_toy_option_is_an_env_error():
 
 
 def test_plots_of_toy_runs(tmp_path):
-    from pour import plots
+    from pour.eval import plots
     for s in (1, 2):
-        train.train(_cfg(seed=s, iterations=3), tmp_path / f"r{s}", quiet=True)
+        trainer.train(_cfg(seed=s, iterations=3), tmp_path / f"r{s}", quiet=True)
     v = cfgmod.from_dict(dict(TOY, iterations=8, algo={"kind": "vanilla", "batch_episodes": 1, "optimizer": "sgd",
                                                           "baseline": "none", "normalize_advantages": False,
                                                           "reward_to_go": False, "entropy_coef": 0.0,
                                                           "lr": 1e-4},
                               eval={"every": 4, "episodes": 1}))
-    train.train(v, tmp_path / "v", quiet=True)
+    trainer.train(v, tmp_path / "v", quiet=True)
     rc = plots.main(["--group", "ours", str(tmp_path / "r1"), str(tmp_path / "r2"), "--group", "vanilla",
                      str(tmp_path / "v"), "--out", str(tmp_path / "png")])
     assert rc == 0
@@ -217,7 +218,7 @@ def test_rollback_undoes_a_step_that_drops_the_return_and_resumes_bit_identicall
     # A rate far too large for the toy: some steps make the next batch's return drop.
     algo = {"batch_episodes": 4, "lr": 2.0, "max_kl": 10.0, "rollback": 0.05, "rollback_shrink": 0.1}
     cfg = _cfg(iterations=12, algo=algo)
-    train.train(cfg, tmp_path / "full", quiet=True)
+    trainer.train(cfg, tmp_path / "full", quiet=True)
     rows = _rows(tmp_path / "full")
     rolled = [i for i, r in enumerate(rows) if r["rolled_back"] == "1"]
     assert rolled, "the test needs at least one rolled-back step"
@@ -229,8 +230,8 @@ def test_rollback_undoes_a_step_that_drops_the_return_and_resumes_bit_identicall
         best = max(best, ret) if i not in rolled else best
     # Each undone step shrinks the trust region by rollback_shrink.
     first = rolled[0]
-    sched = [train.max_kl(cfg, i) for i in range(12)]
+    sched = [trainer.max_kl(cfg, i) for i in range(12)]
     assert float(rows[first + 1]["kl_bound"]) == pytest.approx(sched[first + 1] * 0.1, rel=1e-9)
-    train.train(cfg, tmp_path / "part", quiet=True, stop_after=first + 1)
-    train.train(cfg, tmp_path / "part", quiet=True)
+    trainer.train(cfg, tmp_path / "part", quiet=True, stop_after=first + 1)
+    trainer.train(cfg, tmp_path / "part", quiet=True)
     assert _rows(tmp_path / "full") == _rows(tmp_path / "part")

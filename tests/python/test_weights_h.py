@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""pour.weights_h: writing, parsing and hashing weights.h (docs/weights-h.md)."""
+"""pour.policy.weights_h: writing, parsing and hashing weights.h (docs/weights-h.md)."""
 import ctypes
 import hashlib
 import random
@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pour import fixedpoint as fp
-from pour import golden
-from pour import sim
-from pour.weights_h import (WeightsHError, choose_frac_bits, content_hash, parse_weights_h,
-                            parse_weights_h_bytes, quantize_weights, render_weights_h, write_weights_h)
+from pour.policy import fixedpoint as fp
+from pour.policy import golden
+from pour.sim import poursim
+from pour.policy.weights_h import (WeightsHError, choose_frac_bits, content_hash, parse_weights_h,
+                                   parse_weights_h_bytes, quantize_weights, render_weights_h, write_weights_h)
 
 NORM = (0, 2356194, 4000000)
 
@@ -224,7 +224,7 @@ def _mutations(base: bytes, rng: random.Random, count: int):
 def test_c_and_python_parsers_agree_message_for_message(source_dir):
     """Both parsers, on every shared case and on 3000 seeded mutations of them: the same verdict and the
     same message (line and field included)."""
-    lib = sim.load_library()
+    lib = poursim.load_library()
     lib.poursim_weights_parse.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p, ctypes.c_void_p,
                                           ctypes.c_char_p, ctypes.c_size_t]
     lib.poursim_weights_parse.restype = ctypes.c_int

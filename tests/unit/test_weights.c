@@ -23,7 +23,7 @@ void tearDown(void) {}
 static void rehash(void) { copy.content_hash = pour_policy_weights_hash(&copy); }
 
 static void test_weights_hash_MatchesThePythonWriter(void) {
-  /* The header's CONTENT_HASH was computed by tools/pour/weights_h.py. */
+  /* The header's CONTENT_HASH was computed by tools/pour/policy/weights_h.py. */
   TEST_ASSERT_EQUAL_HEX32(pour_weights_compiled.content_hash, pour_policy_weights_hash(&pour_weights_compiled));
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_weights_validate(&pour_weights_compiled));
 }

@@ -1,1 +1,28 @@
-"""pour: offline tools for the soymilk-pouring controller."""
+"""pour: offline tools for the soymilk-pouring controller.
+
+    pour.paths, pour.atomic, pour.libpoursim   shared: the build tree, atomic writes, libpoursim.so opened once
+    pour.policy   the policy as the firmware runs it: float softmax-linear (linear), its bit-exact
+                  fixed-point reference (fixedpoint), weights.h (weights_h), policy.json -> weights.h
+                  (export), the firmware core through ctypes (core), golden vectors (golden)
+    pour.sim      the simulator: libpoursim's binding (poursim), the episode record (episode), the trainer's
+                  episode sources (envs, adapter) and the Gymnasium environment (gym_env)
+    pour.train    REINFORCE: run config (config), gradients (reinforce), rollout executors (executors),
+                  the training loop (trainer), the Ray benchmark (ray_bench)
+    pour.eval     held-out evaluation and figures: evaluate, robustness, robust_scale, results, sweep,
+                  plots, render
+    pour.lcm      the LCM link's tools: channels, messages, sensors, cmd, run, spy, logfile, live_view
+    pour.can      the CAN protocol's DBC (dbc) and bus load (bus_load)
+
+A subpackage imports only those on its row (and the shared modules, which import no subpackage);
+tests/python/test_imports.py checks it:
+
+    pour.policy   -
+    pour.sim      policy
+    pour.train    sim, policy
+    pour.eval     train, sim, policy
+    pour.lcm      eval, sim
+    pour.can      -
+
+So the simulator never reaches the trainer, and nothing but the evaluation (a sweep trains its trials;
+results and robust_scale read training runs and use the trainer's Ray executors) imports pour.train.
+"""

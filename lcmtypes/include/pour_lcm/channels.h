@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* LCM channel names and the default URL: the one place C and C++ code take them from
- * (tools/pour/channels.py is the Python twin; a test checks that both agree). */
+ * (tools/pour/lcm/channels.py is the Python twin; a test checks that both agree). */
 #ifndef POUR_LCM_CHANNELS_H
 #define POUR_LCM_CHANNELS_H
 

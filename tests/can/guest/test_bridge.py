@@ -14,9 +14,9 @@ import lcm
 import pytest
 
 from canbus import BUILD_DIR, LIQUID_G, SOURCE_DIR, Plant, encoder_count
-from pour import channels, lcm_types
+from pour.lcm import channels, messages
 
-msgs = lcm_types.load()
+msgs = messages.load()
 URL = "udpm://239.255.76.67:7683?ttl=0"
 
 

@@ -1,4 +1,4 @@
-/* example_weights.h — pour policy. Hand-made (pour.golden.hand_made_weights(11), kept for tests). DO NOT EDIT. */
+/* example_weights.h — pour policy. Hand-made (pour.policy.golden.hand_made_weights(11), kept for tests). DO NOT EDIT. */
 #ifndef POUR_WEIGHTS_H
 #define POUR_WEIGHTS_H
 #include <stdint.h>

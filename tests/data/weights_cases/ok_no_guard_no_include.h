@@ -1,4 +1,4 @@
-/* example_weights.h — pour policy. Hand-made (pour.golden.hand_made_weights(11), kept for tests). DO NOT EDIT. */
+/* example_weights.h — pour policy. Hand-made (pour.policy.golden.hand_made_weights(11), kept for tests). DO NOT EDIT. */
 #define POUR_WEIGHTS_FORMAT 1
 #define POUR_WEIGHTS_N_FEATURES 6 /* theta, omega, v_rotating, v_target, v_spill, bias */
 #define POUR_WEIGHTS_N_ACTIONS 11

@@ -1,0 +1,1 @@
+"""The pour CAN protocol from Python: its DBC for any node id and its bus load."""

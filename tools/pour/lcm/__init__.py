@@ -1,0 +1,1 @@
+"""Tools for the LCM link: channel names, generated message types, and the pour-lcm-* programs."""

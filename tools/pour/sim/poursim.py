@@ -1,0 +1,518 @@
+# SPDX-License-Identifier: MIT
+"""Python binding of libpoursim (host_sim/include/poursim/poursim.h) through ctypes.
+
+The library is looked for at $POUR_SIM_LIB, then $POUR_BUILD_DIR/lib/libpoursim.so, then
+<source>/build/host/lib/libpoursim.so, then <source>/build/*/lib/libpoursim.so (pour.paths). Build it with
+`cmake --build --preset host`.
+
+    from pour.sim import poursim
+    world = poursim.World(poursim.default_config(), seed=1)
+    obs = world.step(0.3)                      # torque 0.3·tau_max for 1 ms
+    pol = poursim.Policy(w=np.zeros((6, 11)), levels=np.linspace(-1, 1, 11), decision_period=10)
+    ro = world.rollout(pol, seed=7)            # a whole episode in C: ro.features, ro.actions, ro.rewards
+
+Process-safe and thread-safe across worlds (each World owns its own Box2D world). Episodes in parallel:
+the trainer's executors (pour.train.executors: a process pool, or Ray), one world per worker.
+"""
+from __future__ import annotations
+
+import ctypes as C
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from pour import libpoursim
+from pour.libpoursim import SimError  # the binding's error, raised by the loader too
+
+N_FEATURES = 6
+MAX_ACTIONS = 16
+ERR_LEN = 256
+REGIONS = ("rotating", "target", "spilled", "flight")
+
+
+_DP = C.POINTER(C.c_double)
+
+
+class ConfigStruct(C.Structure):
+    _fields_ = [
+        ("dt", C.c_double), ("substeps", C.c_int), ("episode_s", C.c_double), ("settle_s", C.c_double),
+        ("bucket_inner_width", C.c_double), ("bucket_height", C.c_double), ("bucket_wall", C.c_double),
+        ("pivot_height", C.c_double), ("target_dx", C.c_double),
+        ("bucket_mass", C.c_double), ("fill_depth", C.c_double), ("liquid_density", C.c_double),
+        ("n_particles", C.c_int), ("fluid", C.c_int), ("fluid_smoothing", C.c_double),
+        ("fluid_contact_radius", C.c_double), ("fluid_stiffness", C.c_double), ("fluid_viscosity", C.c_double),
+        ("fluid_agitation", C.c_double), ("restitution_liquid", C.c_double), ("restitution_wall", C.c_double), ("friction", C.c_double),
+        ("restitution_threshold", C.c_double), ("contact_hertz", C.c_double),
+        ("tau_max", C.c_double), ("theta_min", C.c_double), ("theta_max", C.c_double),
+        ("brake_torque", C.c_double),
+        ("motor_peak_torque", C.c_double), ("motor_no_load_speed", C.c_double), ("motor_rotor_inertia", C.c_double),
+        ("gear_ratio", C.c_double), ("friction_coulomb", C.c_double), ("friction_viscous", C.c_double),
+        ("command_latency_ticks", C.c_int),
+        ("encoder_bits", C.c_int), ("scale_rate_hz", C.c_double), ("scale_delay_s", C.c_double),
+        ("scale_noise_g", C.c_double), ("scale_resolution_g", C.c_double),
+        ("rand_fill", C.c_double), ("rand_target_dx", C.c_double), ("rand_pivot_height", C.c_double),
+        ("rand_motor", C.c_double), ("rand_bucket_mass", C.c_double), ("rand_liquid", C.c_double),
+        ("rand_sensor", C.c_double),
+        ("obs_theta_min", C.c_double), ("obs_theta_max", C.c_double), ("obs_omega_max", C.c_double),
+        ("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double), ("seed", C.c_uint32),
+    ]
+
+
+class ObsStruct(C.Structure):
+    _fields_ = [
+        ("step", C.c_uint32), ("t", C.c_double), ("theta", C.c_double), ("omega", C.c_double),
+        ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
+        ("obs", C.c_double * 5), ("reward", C.c_double), ("torque", C.c_double), ("done", C.c_int),
+        ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
+        ("scale_target_g", C.c_int32),
+    ]
+
+
+class PolicyStruct(C.Structure):
+    _fields_ = [
+        ("n_actions", C.c_int), ("decision_period", C.c_int), ("w", _DP), ("levels", _DP),
+        ("theta_min", C.c_double), ("theta_max", C.c_double), ("omega_max", C.c_double), ("greedy", C.c_int),
+        ("k_reversal", C.c_double),
+    ]
+
+
+class BuffersStruct(C.Structure):
+    _fields_ = [
+        ("capacity", C.c_int), ("features", _DP), ("actions", C.POINTER(C.c_int32)), ("rewards", _DP),
+        ("probs", _DP), ("step_capacity", C.c_int), ("step_rewards", _DP), ("step_theta", _DP),
+    ]
+
+
+class EpisodeStruct(C.Structure):
+    _fields_ = [
+        ("n_steps", C.c_int), ("n_decisions", C.c_int), ("poured", C.c_double), ("spilled", C.c_double),
+        ("remaining", C.c_double), ("finish_time", C.c_double), ("ret", C.c_double),
+        ("reward_sum", C.c_double), ("max_theta", C.c_double), ("liquid_l", C.c_double),
+        ("peak_omega", C.c_double), ("peak_alpha", C.c_double), ("reversals", C.c_int),
+    ]
+
+
+RETENTION_MAX = 181
+
+
+class RetentionStruct(C.Structure):
+    _fields_ = [
+        ("n", C.c_int), ("theta", C.c_double * RETENTION_MAX), ("kept", C.c_double * RETENTION_MAX),
+        ("ideal", C.c_double * RETENTION_MAX), ("onset", C.c_double), ("ideal_onset", C.c_double),
+        ("rms_gap", C.c_double),
+    ]
+
+
+class SloshStruct(C.Structure):
+    _fields_ = [
+        ("freq", C.c_double), ("freq_theory", C.c_double), ("damping", C.c_double), ("amplitude", C.c_double),
+        ("noise", C.c_double), ("n", C.c_int),
+    ]
+
+
+class DriveCheckStruct(C.Structure):
+    _fields_ = [
+        ("latency_ticks", C.c_int), ("inertia_measured", C.c_double), ("inertia_expected", C.c_double),
+        ("inertia_bucket", C.c_double), ("breakaway_torque", C.c_double), ("terminal_load", C.c_double * 2),
+        ("terminal_speed", C.c_double * 2), ("terminal_expected", C.c_double * 2),
+    ]
+
+
+class SensorCheckStruct(C.Structure):
+    _fields_ = [
+        ("encoder_max_error", C.c_double), ("encoder_at_stop", C.c_uint32), ("liquid_g", C.c_double),
+        ("rest_rotating_g", C.c_double), ("target_liquid_g", C.c_double), ("rest_target_g", C.c_double),
+        ("update_rate_hz", C.c_double), ("delay_s", C.c_double), ("delay_match", C.c_double),
+        ("noise_rms_g", C.c_double), ("noise_expected_g", C.c_double), ("impact_impulse_gs", C.c_double),
+        ("impact_expected_gs", C.c_double), ("impact_peak_g", C.c_double), ("impact_peak_reading_g", C.c_double),
+        ("hash_unchanged", C.c_int),
+    ]
+
+
+CONFIG_KEYS: tuple[str, ...] = tuple(name for name, _ in ConfigStruct._fields_)
+
+_lib: C.CDLL | None = None
+
+
+def library_candidates() -> list[Path]:
+    """Where load_library() looks, in order ($POUR_SIM_LIB alone when it is set)."""
+    return libpoursim.candidates()
+
+
+def load_library() -> C.CDLL:
+    """Loads libpoursim once, with the simulator's entry points declared; SimError says where it looked if it
+    is not there."""
+    global _lib
+    if _lib is not None:
+        return _lib
+    lib = libpoursim.load()
+    try:
+        _declare(lib)
+    except AttributeError as e:
+        raise SimError(f"libpoursim at {lib._name} is not usable (missing symbol: {e})") from e
+    _lib = lib
+    return lib
+
+
+def _declare(lib: C.CDLL) -> None:
+    P = C.POINTER
+    err = [C.c_char_p, C.c_size_t]
+    sig = {
+        "poursim_default_config": ([], ConfigStruct),
+        "poursim_config_validate": ([P(ConfigStruct)] + err, C.c_int),
+        "poursim_config_load": ([C.c_char_p, P(ConfigStruct)] + err, C.c_int),
+        "poursim_config_set": ([P(ConfigStruct), C.c_char_p, C.c_char_p] + err, C.c_int),
+        "poursim_create": ([P(ConfigStruct)] + err, C.c_void_p),
+        "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
+        "poursim_step": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_step_servo": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_world_error": ([C.c_void_p], C.c_char_p),
+        "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
+        "poursim_measure_retention": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double,
+                                       P(RetentionStruct)] + err, C.c_int),
+        "poursim_measure_slosh": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
+                                   P(C.c_double), C.c_int, P(SloshStruct)] + err, C.c_int),
+        "poursim_observe": ([C.c_void_p, P(ObsStruct)], None),
+        "poursim_episode_config": ([C.c_void_p], P(ConfigStruct)),
+        "poursim_measure_drive": ([P(ConfigStruct), P(DriveCheckStruct)] + err, C.c_int),
+        "poursim_measure_sensors": ([P(ConfigStruct), C.c_uint32, P(SensorCheckStruct)] + err, C.c_int),
+        "poursim_destroy": ([C.c_void_p], None),
+        "poursim_particle_count": ([C.c_void_p], C.c_int),
+        "poursim_particles": ([C.c_void_p, P(C.c_float), P(C.c_float), C.c_int], C.c_int),
+        "poursim_particle_regions": ([C.c_void_p, P(C.c_uint8), C.c_int], C.c_int),
+        "poursim_max_overlap": ([C.c_void_p], C.c_double),
+        "poursim_max_wall_penetration": ([C.c_void_p], C.c_double),
+        "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
+        "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
+        "poursim_version": ([], C.c_char_p),
+        "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
+    }
+    for name, (args, res) in sig.items():
+        fn = getattr(lib, name)
+        fn.argtypes = args
+        fn.restype = res
+
+
+def _err() -> C.Array:
+    return C.create_string_buffer(ERR_LEN)
+
+
+def default_config() -> dict[str, float]:
+    """The simulator's defaults (docs/simulator.md), as a dict of config keys."""
+    s = load_library().poursim_default_config()
+    return {k: getattr(s, k) for k in CONFIG_KEYS}
+
+
+def make_config(overrides: Mapping[str, float | str] | None = None,
+                path: str | os.PathLike | None = None) -> ConfigStruct:
+    """Defaults, then a config file (if any), then overrides (numbers, or text passed as is); validated.
+
+    SimError names a bad key, and carries it in .key when an override was refused.
+    """
+    lib = load_library()
+    cfg = lib.poursim_default_config()
+    e = _err()
+    if path is not None and lib.poursim_config_load(str(path).encode(), C.byref(cfg), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode())
+    for key, value in (overrides or {}).items():
+        if key not in CONFIG_KEYS:
+            raise SimError(f"unknown config key '{key}'", key)
+        if isinstance(value, str):
+            text = value
+        elif isinstance(value, (int, np.integer)):
+            text = str(int(value))
+        else:
+            text = format(float(value), ".17g")
+        if lib.poursim_config_set(C.byref(cfg), key.encode(), text.encode(), e, ERR_LEN) != 0:
+            raise SimError(e.value.decode(errors="replace"), key)
+    if lib.poursim_config_validate(C.byref(cfg), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode())
+    return cfg
+
+
+@dataclass
+class Obs:
+    step: int
+    t: float
+    theta: float
+    omega: float
+    v_rotating: float
+    v_target: float
+    v_spill: float
+    v_flight: float
+    obs: np.ndarray
+    reward: float
+    torque: float              # commanded in this step [N·m]
+    done: bool
+    motor_torque: float = 0.0  # delivered by the drive in this step [N·m]
+    encoder: int = 0           # output-shaft absolute encoder count
+    scale_rotating_g: int = 0  # load cell carrying the rotating bucket [g]
+    scale_target_g: int = 0    # load cell under the target [g]
+
+    @staticmethod
+    def from_struct(o: ObsStruct) -> "Obs":
+        return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
+                   np.array(o.obs[:], dtype=np.float64), o.reward, o.torque, bool(o.done), o.motor_torque,
+                   int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g))
+
+
+@dataclass
+class Policy:
+    """Float softmax-linear policy: logits = x·w, x = [θn, ωn, V_rot, V_tgt, V_spill, 1]."""
+    w: np.ndarray                      # [6, n_actions]
+    levels: np.ndarray                 # [n_actions], torque fractions in [-1, 1]
+    decision_period: int = 10          # steps (ms) between decisions
+    theta_min: float = 0.0             # [rad]
+    theta_max: float = 2.356194        # [rad]
+    omega_max: float = 4.0             # [rad/s]
+    greedy: bool = False               # argmax instead of sampling
+    k_reversal: float = 0.0            # training's reward shaping: cost of each torque reversal
+
+    def _struct(self) -> tuple[PolicyStruct, tuple[np.ndarray, np.ndarray]]:
+        w = np.ascontiguousarray(self.w, dtype=np.float64)
+        lv = np.ascontiguousarray(self.levels, dtype=np.float64)
+        if w.ndim != 2 or w.shape[0] != N_FEATURES or not 2 <= w.shape[1] <= MAX_ACTIONS:
+            raise SimError(f"policy w has shape {w.shape}, expected (6, 2..16)")
+        if lv.shape != (w.shape[1],):
+            raise SimError(f"policy levels has shape {lv.shape}, expected ({w.shape[1]},)")
+        s = PolicyStruct(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
+                         self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0,
+                         float(self.k_reversal))
+        return s, (w, lv)  # the arrays must outlive the call
+
+
+@dataclass
+class Rollout:
+    """One episode: per decision the features, action, probabilities and summed reward."""
+    seed: int
+    features: np.ndarray      # [D, 6]
+    actions: np.ndarray       # [D] int32
+    rewards: np.ndarray       # [D] reward summed over the decision's steps
+    probs: np.ndarray         # [D, n_actions]
+    step_rewards: np.ndarray  # [T] (empty unless asked for)
+    step_theta: np.ndarray    # [T] (empty unless asked for)
+    poured: float
+    spilled: float
+    remaining: float
+    finish_time: float        # [s], -1 if nothing was poured
+    ret: float                # Σ γ^t r_t
+    reward_sum: float
+    max_theta: float
+    metrics: dict = field(default_factory=dict)
+
+
+def _n_steps(cfg: ConfigStruct) -> int:
+    return int(round(cfg.episode_s / cfg.dt))
+
+
+class _Buffers:
+    def __init__(self, n_decisions: int, n_actions: int, n_steps: int):
+        self.features = np.zeros((n_decisions, N_FEATURES))
+        self.actions = np.zeros(n_decisions, dtype=np.int32)
+        self.rewards = np.zeros(n_decisions)
+        self.probs = np.zeros((n_decisions, n_actions))
+        self.step_rewards = np.zeros(n_steps)
+        self.step_theta = np.zeros(n_steps)
+        self.struct = BuffersStruct(
+            n_decisions, self.features.ctypes.data_as(_DP), self.actions.ctypes.data_as(C.POINTER(C.c_int32)),
+            self.rewards.ctypes.data_as(_DP), self.probs.ctypes.data_as(_DP), n_steps,
+            self.step_rewards.ctypes.data_as(_DP) if n_steps else None,
+            self.step_theta.ctypes.data_as(_DP) if n_steps else None)
+
+    def result(self, seed: int, e: EpisodeStruct) -> Rollout:
+        d = e.n_decisions
+        m = {"poured": e.poured, "spilled": e.spilled, "remaining": e.remaining, "finish_time": e.finish_time,
+             "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta, "liquid_l": e.liquid_l,
+             "peak_omega": e.peak_omega, "peak_alpha": e.peak_alpha, "reversals": e.reversals}
+        return Rollout(seed, self.features[:d], self.actions[:d], self.rewards[:d], self.probs[:d],
+                       self.step_rewards, self.step_theta, e.poured, e.spilled, e.remaining, e.finish_time,
+                       e.ret, e.reward_sum, e.max_theta, m)
+
+
+class World:
+    """One simulated scene. Not shared between threads; make one per thread or process."""
+
+    def __init__(self, config: ConfigStruct | Mapping[str, float] | None = None, seed: int | None = None):
+        self._lib = load_library()
+        self.config = config if isinstance(config, ConfigStruct) else make_config(config)
+        e = _err()
+        self._w = self._lib.poursim_create(C.byref(self.config), e, ERR_LEN)
+        if not self._w:
+            raise SimError(e.value.decode())
+        if seed is not None:
+            self.reset(seed)
+
+    def close(self) -> None:
+        if getattr(self, "_w", None):
+            self._lib.poursim_destroy(self._w)
+            self._w = None
+
+    def __del__(self) -> None:
+        self.close()
+
+    def __enter__(self) -> "World":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def _check(self) -> C.c_void_p:
+        if not self._w:
+            raise SimError("world is closed")
+        return self._w
+
+    def reset(self, seed: int) -> Obs:
+        if self._lib.poursim_reset(self._check(), int(seed) & 0xFFFFFFFF) != 0:
+            raise SimError("reset failed")
+        return self.observe()
+
+    def step(self, action: float) -> Obs:
+        o = ObsStruct()
+        if self._lib.poursim_step(self._check(), float(action), C.byref(o)) != 0:
+            if self._lib.poursim_world_error(self._check()):
+                raise SimError(self._lib.poursim_world_error(self._check()).decode(errors="replace"))
+            raise SimError(f"step refused action {action!r} (must be a finite number)")
+        return Obs.from_struct(o)
+
+    def observe(self) -> Obs:
+        o = ObsStruct()
+        self._lib.poursim_observe(self._check(), C.byref(o))
+        return Obs.from_struct(o)
+
+    def episode_config(self) -> dict[str, float]:
+        """This episode's config: the world's with the reset seed's rand_* draws applied."""
+        c = self._lib.poursim_episode_config(self._check()).contents
+        return {k: getattr(c, k) for k in CONFIG_KEYS}
+
+    @property
+    def n_particles(self) -> int:
+        return self._lib.poursim_particle_count(self._check())
+
+    def particles(self) -> tuple[np.ndarray, np.ndarray]:
+        """Circle centres [n, 2] and radii [n] in metres."""
+        n = self.n_particles
+        xy = np.zeros((n, 2), dtype=np.float32)
+        r = np.zeros(n, dtype=np.float32)
+        self._lib.poursim_particles(self._check(), xy.ctypes.data_as(C.POINTER(C.c_float)),
+                                    r.ctypes.data_as(C.POINTER(C.c_float)), n)
+        return xy, r
+
+    def regions(self) -> np.ndarray:
+        """Per circle: 0 rotating, 1 target, 2 spilled, 3 in flight."""
+        n = self.n_particles
+        reg = np.zeros(n, dtype=np.uint8)
+        self._lib.poursim_particle_regions(self._check(), reg.ctypes.data_as(C.POINTER(C.c_uint8)), n)
+        return reg
+
+    def max_overlap(self) -> float:
+        return self._lib.poursim_max_overlap(self._check())
+
+    def max_wall_penetration(self) -> float:
+        return self._lib.poursim_max_wall_penetration(self._check())
+
+    def trajectory_hash(self) -> int:
+        return int(self._lib.poursim_trajectory_hash(self._check()))
+
+    def rollout(self, policy: Policy, seed: int, record_steps: bool = False) -> Rollout:
+        """A whole episode in C (reset with seed first)."""
+        ps, keep = policy._struct()
+        n_steps = _n_steps(self.config)
+        bufs = _Buffers(-(-n_steps // policy.decision_period), ps.n_actions, n_steps if record_steps else 0)
+        e = EpisodeStruct()
+        rc = self._lib.poursim_rollout(self._check(), C.byref(ps), int(seed) & 0xFFFFFFFF, C.byref(bufs.struct),
+                                       C.byref(e))
+        if rc != 0:
+            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges and k_reversal")
+        del keep
+        return bufs.result(seed, e)
+
+
+@dataclass
+class Retention:
+    """What the bucket keeps as it tilts (poursim_measure_retention), against an ideal liquid."""
+    theta: np.ndarray   # [rad], one per degree
+    kept: np.ndarray    # V_rotating, mean over the seeds
+    ideal: np.ndarray   # a level liquid's share below the lower lip
+    onset: float        # [rad], first <= 99.5 %
+    ideal_onset: float  # [rad]
+    rms_gap: float
+
+
+def retention(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 3,
+              rate: float = 0.02, theta_end: float = np.radians(125)) -> Retention:
+    """Servo-tilts the bucket at rate [rad/s] to theta_end [rad] once per seed; docs/simulator.md."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    r, e = RetentionStruct(), _err()
+    if lib.poursim_measure_retention(C.byref(cfg), int(seed), int(n_seeds), float(rate), float(theta_end),
+                                     C.byref(r), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    n = r.n
+    return Retention(np.array(r.theta[:n]), np.array(r.kept[:n]), np.array(r.ideal[:n]), r.onset, r.ideal_onset,
+                     r.rms_gap)
+
+
+@dataclass
+class Slosh:
+    """The liquid's centre of mass across the bucket after a tilt (poursim_measure_slosh)."""
+    freq: float          # [Hz]
+    freq_theory: float   # [Hz], first mode of a rectangular tank
+    damping: float
+    amplitude: float     # [m]
+    noise: float         # [m]
+    trace: np.ndarray    # [m], one sample a step, the oscillation about its equilibrium
+
+
+def slosh(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 16,
+          tilt: float = np.radians(12), ramp_s: float = 0.3, hold_s: float = 4.0) -> Slosh:
+    """Tilts to tilt [rad] in ramp_s, holds hold_s, averages n_seeds; docs/simulator.md."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cap = int(round(hold_s / cfg.dt)) + 1
+    trace, out, e = (C.c_double * cap)(), SloshStruct(), _err()
+    if lib.poursim_measure_slosh(C.byref(cfg), int(seed), int(n_seeds), float(tilt), float(ramp_s), float(hold_s),
+                                 trace, cap, C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return Slosh(out.freq, out.freq_theory, out.damping, out.amplitude, out.noise, np.array(trace[:out.n]))
+
+
+def _struct_dict(st: C.Structure) -> dict:
+    return {name: (list(getattr(st, name)) if isinstance(getattr(st, name), C.Array) else getattr(st, name))
+            for name, _ in st._fields_}
+
+
+def measure_drive(config: ConfigStruct | Mapping[str, float] | None = None) -> dict:
+    """The drive on the empty bucket against Newton and its datasheet line (poursim_measure_drive)."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    out, e = DriveCheckStruct(), _err()
+    if lib.poursim_measure_drive(C.byref(cfg), C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return _struct_dict(out)
+
+
+def measure_sensors(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1) -> dict:
+    """Encoder and load cells against mass, momentum and their config (poursim_measure_sensors)."""
+    lib = load_library()
+    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    out, e = SensorCheckStruct(), _err()
+    if lib.poursim_measure_sensors(C.byref(cfg), int(seed), C.byref(out), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"))
+    return _struct_dict(out)
+
+
+def version() -> str:
+    return load_library().poursim_version().decode()
+
+
+def uniform_levels(n_actions: int) -> np.ndarray:
+    """Torque levels evenly spaced in [-1, 1], as weights.h specifies."""
+    return np.linspace(-1.0, 1.0, n_actions)
+
+
+__all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
+                          "make_config", "retention", "slosh", "measure_drive", "measure_sensors",
+                          "load_library", "uniform_levels", "CONFIG_KEYS", "REGIONS", "version")

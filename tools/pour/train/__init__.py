@@ -1,0 +1,1 @@
+"""The trainer: REINFORCE on the softmax-linear policy, its config and its rollout executors."""

@@ -1,0 +1,245 @@
+# SPDX-License-Identifier: MIT
+"""Training configuration: one TOML file fully determines a run (seed -> identical run).
+
+Every value is checked once, at load time; a bad value raises ConfigError naming the key, its
+value and what is allowed, so a typo never turns into a silent default or a crash mid-run.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+class ConfigError(ValueError):
+    """A configuration file or value that cannot be used."""
+
+
+@dataclass(frozen=True)
+class PolicyConfig:
+    n_actions: int = 11            # torque levels evenly spaced in [-1, 1] x tau_max, 2..16
+    decision_period_ms: int = 10   # a new action every this many 1 ms ticks
+    init: str = "zeros"            # "zeros": every parameter 0 (param "full": uniform random actions, as the paper)
+    init_beta: list = field(default_factory=list)  # param "feedback", init "beta": the 6 initial beta values
+    param: str = "full"            # "full": W itself; "feedback": W from a linear feedback u(x) (reinforce.py)
+    sharpness: float = 4.0         # "feedback": c in logit_a = -c (L_a - u(x))^2
+
+
+@dataclass(frozen=True)
+class AlgoConfig:
+    kind: str = "pg"               # "vanilla" (paper eq. 19) or "pg" (the improved update)
+    batch_episodes: int = 16       # episodes per update (vanilla: the paper uses 1)
+    gamma: float = 0.9995          # discount per 1 ms tick (per decision: gamma ** period)
+    lr: float = 0.05               # learning rate at the first iteration
+    lr_final: float = -1.0         # linearly decayed to this at the last iteration (< 0: constant lr)
+    optimizer: str = "adam"        # "adam", "sgd" or "natural" (a natural-gradient step of KL max_kl)
+    reward_to_go: bool = True      # weight log pi(a_t) by the return from t on, not R(tau)
+    baseline: str = "loo"          # "none", "loo" (time-indexed mean of the others in the batch)
+    normalize_advantages: bool = True
+    entropy_coef: float = 0.01     # bonus on the mean policy entropy at the first iteration
+    entropy_coef_final: float = 0.0  # linearly annealed to this at the last iteration
+    grad_clip: float = 0.0         # clip the gradient's L2 norm to this (0 = off)
+    max_kl: float = 0.0            # trust region: halve the step until the mean KL(old || new) over
+                                   # the batch's states is <= this [nats] (0 = off)
+    max_kl_final: float = -1.0     # decayed geometrically to this at the last iteration (< 0: constant)
+    rollback: float = 0.0          # undo a step when the next batch's mean return falls below the best
+                                   # batch's by more than this fraction (+ 2 standard errors); 0 = off
+    rollback_shrink: float = 0.2   # each undone step multiplies the trust region (max_kl) by this
+    rollback_from: int = 0         # no step is undone before this iteration (the first steps may cross a
+                                   # valley on their way out of the initial policy's basin)
+    reward_scale: float = 1.0      # rewards are multiplied by this before anything else
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    every: int = 5                 # greedy evaluation every this many iterations (and the last)
+    episodes: int = 8              # validation episodes per evaluation (seeds disjoint from training)
+    select_best: bool = True       # keep the weights with the best greedy validation score
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    kind: str = "sim"              # "sim" (libpoursim through tools/pour/sim/poursim.py) or "toy"
+    episode_s: float = 10.0        # episode length [s]
+    options: dict = field(default_factory=dict)  # passed to the simulator as is (scene, K's, tau_max)
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    seed: int = 1
+    iterations: int = 100
+    workers: int = 2
+    policy: PolicyConfig = PolicyConfig()
+    algo: AlgoConfig = AlgoConfig()
+    eval: EvalConfig = EvalConfig()
+    env: EnvConfig = EnvConfig()
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+    def digest(self) -> str:
+        """sha256 of the canonical JSON of every value but `workers` (which never changes results)."""
+        d = self.to_dict()
+        del d["workers"]
+        blob = json.dumps(d, sort_keys=True, separators=(",", ":")).encode()
+        return hashlib.sha256(blob).hexdigest()
+
+
+_SECTIONS = {"policy": PolicyConfig, "algo": AlgoConfig, "eval": EvalConfig, "env": EnvConfig}
+
+
+def _typed(section: str, key: str, value: Any, want: Any) -> Any:
+    name = f"{section}.{key}" if section else key
+    if isinstance(want, bool):
+        if not isinstance(value, bool):
+            raise ConfigError(f"{name} = {value!r}: expected true or false")
+        return value
+    if isinstance(want, int):
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{name} = {value!r}: expected an integer")
+        return value
+    if isinstance(want, float):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{name} = {value!r}: expected a number")
+        if not math.isfinite(value):
+            raise ConfigError(f"{name} = {value!r}: expected a finite number")
+        return float(value)
+    if isinstance(want, str):
+        if not isinstance(value, str):
+            raise ConfigError(f"{name} = {value!r}: expected a string")
+        return value
+    if isinstance(want, list):
+        if not isinstance(value, list):
+            raise ConfigError(f"{name} = {value!r}: expected an array")
+        return list(value)
+    if isinstance(want, dict):
+        if not isinstance(value, dict):
+            raise ConfigError(f"{name} = {value!r}: expected a table")
+        return dict(value)
+    raise ConfigError(f"{name}: unsupported type")  # pragma: no cover - a bug in this module
+
+
+def _build(cls: type, section: str, table: dict) -> Any:
+    defaults = cls()
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise ConfigError(f"[{section}] unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+    kwargs = {k: _typed(section, k, v, getattr(defaults, k)) for k, v in table.items()}
+    return dataclasses.replace(defaults, **kwargs)
+
+
+def _check(cond: bool, msg: str) -> None:
+    if not cond:
+        raise ConfigError(msg)
+
+
+def validate(cfg: TrainConfig) -> TrainConfig:
+    """Checks every value's range; returns cfg unchanged or raises ConfigError."""
+    _check(0 <= cfg.seed < 2**32, f"seed = {cfg.seed}: expected 0 <= seed < 2^32")
+    _check(1 <= cfg.iterations <= 1_000_000, f"iterations = {cfg.iterations}: expected 1..1000000")
+    _check(1 <= cfg.workers <= 64, f"workers = {cfg.workers}: expected 1..64")
+    p, a, e, v = cfg.policy, cfg.algo, cfg.eval, cfg.env
+    _check(2 <= p.n_actions <= 16, f"policy.n_actions = {p.n_actions}: expected 2..16")
+    _check(1 <= p.decision_period_ms <= 1000,
+           f"policy.decision_period_ms = {p.decision_period_ms}: expected 1..1000")
+    _check(p.init in ("zeros", "beta"), f"policy.init = {p.init!r}: expected 'zeros' or 'beta'")
+    if p.init == "beta":
+        _check(p.param == "feedback", "policy.init = 'beta' needs policy.param = 'feedback'")
+        _check(len(p.init_beta) == 6 and all(isinstance(b, (int, float)) and not isinstance(b, bool)
+                                             and math.isfinite(b) for b in p.init_beta),
+               f"policy.init_beta = {p.init_beta!r}: expected 6 finite numbers (theta, omega, V_rot, V_tgt, "
+               "V_spill, bias)")
+    _check(p.param in ("full", "feedback"), f"policy.param = {p.param!r}: expected 'full' or 'feedback'")
+    _check(0.0 < p.sharpness <= 1000.0, f"policy.sharpness = {p.sharpness}: expected 0 < c <= 1000")
+    _check(a.kind in ("vanilla", "pg"), f"algo.kind = {a.kind!r}: expected 'vanilla' or 'pg'")
+    if a.kind == "vanilla":
+        paper = {"lr_final": -1.0, "reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
+                 "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0, "max_kl": 0.0,
+                 "max_kl_final": -1.0, "rollback": 0.0}
+        for k, want in paper.items():
+            _check(getattr(a, k) == want, f"algo.kind = 'vanilla' is the paper's update: algo.{k} must be {want!r} "
+                                       f"(got {getattr(a, k)!r}); use algo.kind = 'pg' to change it")
+        _check(p.param == "full", f"algo.kind = 'vanilla' is the paper's update: policy.param must be 'full' "
+                                  f"(got {p.param!r})")
+    _check(1 <= a.batch_episodes <= 4096, f"algo.batch_episodes = {a.batch_episodes}: expected 1..4096")
+    _check(0.0 < a.gamma <= 1.0, f"algo.gamma = {a.gamma}: expected 0 < gamma <= 1")
+    _check(0.0 < a.lr <= 10.0, f"algo.lr = {a.lr}: expected 0 < lr <= 10")
+    _check(a.lr_final < 0 or a.lr_final <= a.lr,
+           f"algo.lr_final = {a.lr_final}: expected <= algo.lr ({a.lr}), or negative for a constant lr")
+    _check(a.optimizer in ("adam", "sgd", "natural"),
+           f"algo.optimizer = {a.optimizer!r}: expected 'adam', 'sgd' or 'natural'")
+    _check(a.optimizer != "natural" or a.max_kl > 0,
+           "algo.optimizer = 'natural' needs algo.max_kl > 0 (the KL of each step)")
+    _check(a.max_kl_final < 0 or 0 < a.max_kl_final <= a.max_kl,
+           f"algo.max_kl_final = {a.max_kl_final}: expected 0 < max_kl_final <= algo.max_kl ({a.max_kl}), or "
+           "negative for a "
+           "constant bound")
+    _check(a.baseline in ("none", "loo"), f"algo.baseline = {a.baseline!r}: expected 'none' or 'loo'")
+    _check(a.baseline == "none" or a.batch_episodes >= 2,
+           f"algo.baseline = {a.baseline!r} needs algo.batch_episodes >= 2 (got {a.batch_episodes})")
+    _check(a.entropy_coef >= 0.0, f"algo.entropy_coef = {a.entropy_coef}: expected >= 0")
+    _check(a.entropy_coef_final >= 0.0, f"algo.entropy_coef_final = {a.entropy_coef_final}: expected >= 0")
+    _check(a.grad_clip >= 0.0, f"algo.grad_clip = {a.grad_clip}: expected >= 0 (0 = off)")
+    _check(0.0 <= a.max_kl <= 10.0, f"algo.max_kl = {a.max_kl}: expected 0 <= max_kl <= 10 [nats] (0 = off)")
+    _check(0.0 <= a.rollback <= 1.0, f"algo.rollback = {a.rollback}: expected 0..1 (0 = off)")
+    _check(a.rollback == 0 or a.max_kl > 0, "algo.rollback needs algo.max_kl > 0 (the trust region it shrinks)")
+    _check(a.rollback_from >= 0, f"algo.rollback_from = {a.rollback_from}: expected >= 0")
+    _check(0.0 < a.rollback_shrink <= 1.0, f"algo.rollback_shrink = {a.rollback_shrink}: expected 0 < s <= 1")
+    _check(a.reward_scale > 0.0, f"algo.reward_scale = {a.reward_scale}: expected > 0")
+    _check(e.every >= 1, f"eval.every = {e.every}: expected >= 1")
+    _check(0 <= e.episodes <= 1024, f"eval.episodes = {e.episodes}: expected 0..1024")
+    _check(v.kind in ("sim", "toy"), f"env.kind = {v.kind!r}: expected 'sim' or 'toy'")
+    _check(0.0 < v.episode_s <= 60.0, f"env.episode_s = {v.episode_s}: expected 0 < s <= 60")
+    steps = round(v.episode_s * 1000)
+    _check(steps % p.decision_period_ms == 0,
+           f"env.episode_s = {v.episode_s} is not a whole number of decision periods "
+           f"({p.decision_period_ms} ms)")
+    return cfg
+
+
+def from_dict(data: dict) -> TrainConfig:
+    """Builds and validates a config from a parsed TOML document."""
+    if not isinstance(data, dict):
+        raise ConfigError("config: expected a table at the top level")
+    top = {k: v for k, v in data.items() if k not in _SECTIONS}
+    known_top = {"seed", "iterations", "workers"}
+    unknown = sorted(set(top) - known_top)
+    if unknown:
+        raise ConfigError(f"unknown top-level key(s) {', '.join(unknown)}; known: "
+                          f"{', '.join(sorted(known_top | set(_SECTIONS)))}")
+    base = TrainConfig()
+    kwargs: dict[str, Any] = {k: _typed("", k, v, getattr(base, k)) for k, v in top.items()}
+    for name, cls in _SECTIONS.items():
+        if name in data:
+            if not isinstance(data[name], dict):
+                raise ConfigError(f"[{name}]: expected a table")
+            kwargs[name] = _build(cls, name, data[name])
+    return validate(dataclasses.replace(base, **kwargs))
+
+
+def load(path: str | Path) -> TrainConfig:
+    """Reads a TOML config file; every problem raises ConfigError with the file name."""
+    path = Path(path)
+    try:
+        text = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read config ({exc.strerror})") from exc
+    try:
+        data = tomllib.loads(text.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: not valid TOML ({exc})") from exc
+    try:
+        return from_dict(data)
+    except ConfigError as exc:
+        raise ConfigError(f"{path}: {exc}") from exc
+
+
+def with_overrides(cfg: TrainConfig, **changes: Any) -> TrainConfig:
+    """A copy with top-level fields replaced (e.g. seed, iterations), validated again."""
+    return validate(dataclasses.replace(cfg, **changes))
