@@ -18,8 +18,8 @@
 
 #include "bench.hpp"
 #include "controllers.hpp"
+#include "episode_run.hpp"
 #include "lcm_link.hpp"
-#include "metrics.hpp"
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
@@ -86,7 +86,7 @@ const char *kUsage =
     "  host_sim --baseline rate --episodes 5 --json\n"
     "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n";
 
-constexpr int kFrameEveryMs = 80; // 12.5 frames/s: smooth enough, and a GIF of 10 s renders in seconds
+constexpr int kFrameEverySteps = 80; // 12.5 frames/s at 1 ms: smooth enough, and a GIF of 10 s renders in seconds
 
 struct Options {
   std::string policy, baseline, config_path, csv, render;
@@ -201,124 +201,6 @@ int parse_args(int argc, char **argv, Options &o) {
   return -1;
 }
 
-struct Episode {
-  uint32_t seed = 0;
-  poursim_episode_t m{}; // libpoursim's figures of the episode (metrics.hpp)
-  std::string error;     // why the world stopped, if it did
-};
-
-// One step of history for CSV and rendering.
-struct Sample {
-  poursim_obs_t obs;
-  int action;
-};
-
-struct Recorder {
-  bool steps = false;          // keep every step (CSV, render plots)
-  int frame_every = 0;         // keep circle positions every this many steps (render), 0 = never
-  std::vector<Sample> samples;
-  std::vector<std::vector<float>> frames;
-  std::vector<double> frame_theta, frame_t;
-  std::vector<float> radius; // of this episode's circles (the order is shuffled per seed)
-};
-
-Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t seed, Recorder *rec) {
-  Episode e;
-  e.seed = seed;
-  poursim_reset(world, seed);
-  ctl.reset(seed);
-  const poursim_config_t *cfg = poursim_world_config(world);
-  int n = poursim_particle_count(world);
-  poursim_obs_t o;
-  poursim_observe(world, &o);
-  poursim::EpisodeMeter meter;
-  meter.reset(*poursim_episode_config(world), o);
-  auto keep_frame = [&](const poursim_obs_t &ob) {
-    std::vector<float> xy(static_cast<size_t>(2 * n));
-    poursim_particles(world, xy.data(), nullptr, n);
-    rec->frames.push_back(std::move(xy));
-    rec->frame_theta.push_back(ob.theta);
-    rec->frame_t.push_back(ob.t);
-  };
-  if (rec != nullptr && rec->frame_every > 0) {
-    rec->radius.assign(static_cast<size_t>(n), 0.0f);
-    poursim_particles(world, nullptr, rec->radius.data(), n);
-    keep_frame(o);
-  }
-  while (!o.done) {
-    double a = ctl.command(o);
-    if (ctl.failed()) {
-      e.error = ctl.failure();
-      return e;
-    }
-    if (poursim_step(world, a, &o) != POURSIM_OK) {
-      e.error = poursim_world_error(world);
-      return e;
-    }
-    meter.add(o, a * cfg->tau_max);
-    if (rec != nullptr) {
-      if (rec->steps) rec->samples.push_back({o, ctl.action()});
-      if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
-    }
-  }
-  e.m = meter.result();
-  return e;
-}
-
-// Every step of every episode, written as each episode ends (memory stays one episode's worth).
-void write_csv_header(std::FILE *f) {
-  std::fprintf(f, "episode,seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,action,"
-                  "torque_nm,torque_frac,reward\n");
-}
-
-void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vector<Sample> &samples, double tau_max) {
-  for (const Sample &s : samples)
-    std::fprintf(f, "%d,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", episode, seed, s.obs.step,
-                 s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill, s.obs.v_flight,
-                 s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
-}
-
-// The trajectory as JSON for pour-render (the tools' renderer).
-bool write_render_json(const std::string &path, const poursim_world_t *world, const Recorder &rec,
-                       const std::string &title, const Episode &e, std::string *why) {
-  poursim::AtomicFile out;
-  if (!out.open(path, why)) return false;
-  std::FILE *f = out.stream();
-  const poursim_config_t *c = poursim_world_config(world);
-  const std::vector<float> &radius = rec.radius;
-  int n = static_cast<int>(radius.size());
-  std::fprintf(f, "{\"fps\": %.3f, \"title\": %s, \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs,
-               poursim::json_quote(title).c_str(),
-               e.m.poured, e.m.spilled, e.m.finish_time);
-  std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
-                  "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
-               c->bucket_inner_width, c->bucket_height, c->bucket_wall, c->pivot_height, c->target_dx, c->theta_max);
-  std::fprintf(f, "\"radius\": [");
-  for (int i = 0; i < n; ++i) std::fprintf(f, "%s%.5f", i ? "," : "", static_cast<double>(radius[static_cast<size_t>(i)]));
-  std::fprintf(f, "],\n\"series\": {\"t\": [");
-  // Plots at 100 Hz are plenty.
-  std::vector<const Sample *> pick;
-  for (size_t i = 0; i < rec.samples.size(); i += 10) pick.push_back(&rec.samples[i]);
-  const char *keys[] = {"t", "theta", "v_rotating", "v_target", "v_spill", "torque"};
-  for (int k = 0; k < 6; ++k) {
-    if (k > 0) std::fprintf(f, "], \"%s\": [", keys[k]);
-    for (size_t i = 0; i < pick.size(); ++i) {
-      const poursim_obs_t &o = pick[i]->obs;
-      double v = k == 0 ? o.t : k == 1 ? o.theta : k == 2 ? o.v_rotating : k == 3 ? o.v_target : k == 4 ? o.v_spill : o.torque;
-      std::fprintf(f, "%s%.5g", i ? "," : "", v);
-    }
-  }
-  std::fprintf(f, "]},\n\"frames\": [");
-  for (size_t k = 0; k < rec.frames.size(); ++k) {
-    std::fprintf(f, "%s\n{\"t\": %.3f, \"theta\": %.5f, \"xy\": [", k ? "," : "", rec.frame_t[k], rec.frame_theta[k]);
-    const std::vector<float> &xy = rec.frames[k];
-    for (size_t i = 0; i < xy.size(); ++i) std::fprintf(f, "%s%.4f", i ? "," : "", static_cast<double>(xy[i]));
-    std::fprintf(f, "]}");
-  }
-  std::fprintf(f, "]}\n");
-  return out.commit(why);
-}
-
 // Runs `renderer TRAJECTORY.json OUT` and waits for it; returns 0 if it exited 0.
 int run_render(const std::string &renderer, const std::string &json_path, const std::string &out) {
   std::vector<std::string> args = {renderer, json_path, out};
@@ -344,7 +226,9 @@ int run_render(const std::string &renderer, const std::string &json_path, const 
 } // namespace
 
 int main(int argc, char **argv) {
+  using poursim::Episode;
   using poursim::mean;
+  using poursim::Recorder;
   using poursim::stdev;
   Options o;
   int rc = parse_args(argc, argv, o);
@@ -462,15 +346,15 @@ int main(int argc, char **argv) {
       return 1;
     }
     csv = csv_file.stream();
-    write_csv_header(csv);
+    poursim::write_csv_header(csv);
   }
   Recorder first;
   for (int k = 0; k < o.episodes; ++k) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
     Recorder rec;
     rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
-    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
-    Episode e = run_episode(world, *ctl, seed, &rec);
+    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEverySteps : 0;
+    Episode e = poursim::run_episode(world, *ctl, seed, &rec);
     if (!e.error.empty()) {
       int status = 1;
       if (lcm_ctl != nullptr && lcm_ctl->failed()) {
@@ -493,7 +377,7 @@ int main(int argc, char **argv) {
                    e.m.finish_time < 0 ? "  -   " : (std::to_string(e.m.finish_time).substr(0, 5) + " s").c_str(),
                    e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
     if (k == 0 && !o.render.empty()) first = rec;
-    if (csv != nullptr) write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
+    if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
   std::vector<double> poured, spilled, poured_l, spilled_l, finish, ret, peak_omega, peak_alpha, reversals;
   int unfinished = 0;
@@ -553,7 +437,7 @@ int main(int argc, char **argv) {
     }
   }
   if (!o.render.empty()) {
-    if (!write_render_json(render_json, world, first, ctl->name(), eps[0], &why)) {
+    if (!poursim::save_render_json(render_json, *poursim_world_config(world), first, ctl->name(), eps[0].m, &why)) {
       std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
     } else if (run_render(renderer, render_json, o.render) != 0) {
