@@ -1,17 +1,11 @@
 // SPDX-License-Identifier: MIT
 // host_sim: runs pours in the Box2D world with the firmware core in-process (or a baseline), prints
 // results, writes trajectories and renders them. `host_sim --help` explains the flags.
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -23,9 +17,8 @@
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
-#include "stats.hpp"
-
-extern char **environ;
+#include "renderer.hpp"
+#include "summary.hpp"
 
 namespace {
 
@@ -107,28 +100,6 @@ int usage_error(const char *fmt, const char *arg) {
   return 2;
 }
 
-// The program a shell would run for name: name itself if it holds a '/', else the first executable of that
-// name in a PATH folder (an empty entry is the current folder). Empty if there is none.
-std::string find_program(const std::string &name) {
-  if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
-  const char *path = std::getenv("PATH");
-  std::string dirs = path != nullptr ? path : "";
-  for (size_t a = 0; a <= dirs.size();) {
-    size_t b = dirs.find(':', a);
-    if (b == std::string::npos) b = dirs.size();
-    std::string file = (b > a ? dirs.substr(a, b - a) : ".") + "/" + name;
-    if (access(file.c_str(), X_OK) == 0) return file;
-    a = b + 1;
-  }
-  return "";
-}
-
-// The renderer host_sim --render runs: $POUR_RENDER, else the tools' console entry point on PATH.
-const char *renderer_name() {
-  const char *env = std::getenv("POUR_RENDER");
-  return env != nullptr && *env != '\0' ? env : "pour-render";
-}
-
 bool parse_long(const char *s, long long lo, long long hi, long long &out) {
   char *end = nullptr;
   errno = 0;
@@ -201,35 +172,11 @@ int parse_args(int argc, char **argv, Options &o) {
   return -1;
 }
 
-// Runs `renderer TRAJECTORY.json OUT` and waits for it; returns 0 if it exited 0.
-int run_render(const std::string &renderer, const std::string &json_path, const std::string &out) {
-  std::vector<std::string> args = {renderer, json_path, out};
-  std::vector<char *> argv;
-  for (std::string &s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  std::fflush(stdout);
-  std::fflush(stderr);
-  pid_t pid;
-  int err = posix_spawn(&pid, renderer.c_str(), nullptr, nullptr, argv.data(), environ);
-  if (err != 0) {
-    std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", renderer.c_str(), std::strerror(err));
-    return 1;
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::fprintf(stderr, "host_sim: the renderer (%s) failed\n", renderer.c_str());
-    return 1;
-  }
-  return 0;
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
   using poursim::Episode;
-  using poursim::mean;
   using poursim::Recorder;
-  using poursim::stdev;
   Options o;
   int rc = parse_args(argc, argv, o);
   if (rc >= 0) return rc;
@@ -281,17 +228,17 @@ int main(int argc, char **argv) {
     render_base = o.render.substr(0, o.render.size() - 4);
     if (render_base.empty() || render_base.back() == '/')
       return usage_error("--render wants a file name before its .gif or .mp4, got '%s'", o.render.c_str());
-    if (ext == ".mp4" && find_program("ffmpeg").empty()) {
+    if (ext == ".mp4" && poursim::find_program("ffmpeg").empty()) {
       std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
                    o.render.c_str());
       return 2;
     }
-    renderer = find_program(renderer_name());
+    renderer = poursim::find_program(poursim::renderer_name());
     if (renderer.empty()) {
       std::fprintf(stderr,
                    "host_sim: --render needs the renderer '%s', which is not an executable%s (put the venv's bin, "
                    "e.g. .venv/bin, on PATH, or set POUR_RENDER to the program)\n",
-                   renderer_name(), std::strchr(renderer_name(), '/') != nullptr ? "" : " on PATH");
+                   poursim::renderer_name(), std::strchr(poursim::renderer_name(), '/') != nullptr ? "" : " on PATH");
       return 2;
     }
     render_json = render_base + ".json";
@@ -368,61 +315,11 @@ int main(int argc, char **argv) {
       return status;
     }
     eps.push_back(e);
-    if (!o.quiet)
-      std::fprintf(per,
-                   "episode %d seed %u: poured %5.1f %% (%5.2f L)  spilled %4.1f %% (%4.2f L)  left %4.1f %%  finish %s"
-                   "  peak %.2f rad/s %.0f rad/s²  reversals %d  return %.1f\n",
-                   k + 1, seed, 100 * e.m.poured, e.m.poured * e.m.liquid_l, 100 * e.m.spilled,
-                   e.m.spilled * e.m.liquid_l, 100 * e.m.remaining,
-                   e.m.finish_time < 0 ? "  -   " : (std::to_string(e.m.finish_time).substr(0, 5) + " s").c_str(),
-                   e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
+    if (!o.quiet) poursim::print_episode(per, k + 1, e);
     if (k == 0 && !o.render.empty()) first = rec;
     if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
-  std::vector<double> poured, spilled, poured_l, spilled_l, finish, ret, peak_omega, peak_alpha, reversals;
-  int unfinished = 0;
-  for (const Episode &e : eps) {
-    poured.push_back(100 * e.m.poured);
-    spilled.push_back(100 * e.m.spilled);
-    poured_l.push_back(e.m.poured * e.m.liquid_l);
-    spilled_l.push_back(e.m.spilled * e.m.liquid_l);
-    ret.push_back(e.m.ret);
-    peak_omega.push_back(e.m.peak_omega);
-    peak_alpha.push_back(e.m.peak_alpha);
-    reversals.push_back(e.m.reversals);
-    if (e.m.finish_time >= 0) finish.push_back(e.m.finish_time);
-    else ++unfinished;
-  }
-  const double max_finish = finish.empty() ? -1.0 : *std::max_element(finish.begin(), finish.end());
-  const double max_peak = *std::max_element(peak_omega.begin(), peak_omega.end());
-  if (o.json) {
-    std::printf("{\"controller\": %s, \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
-                "\"poured_pct\": %.3f, \"poured_pct_std\": %.3f, \"spilled_pct\": %.3f, \"spilled_pct_std\": %.3f, "
-                "\"poured_l\": %.4f, \"spilled_l\": %.4f, \"finish_s\": %.4f, \"finish_max_s\": %.4f, "
-                "\"unfinished\": %d, \"peak_omega_rad_s\": %.4f, \"peak_omega_max_rad_s\": %.4f, "
-                "\"peak_alpha_rad_s2\": %.3f, \"reversals\": %.2f, \"return\": %.4f, \"return_std\": %.4f, "
-                "\"per_episode\": [",
-                poursim::json_quote(ctl->name()).c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
-                stdev(spilled), mean(poured_l), mean(spilled_l), finish.empty() ? -1.0 : mean(finish), max_finish,
-                unfinished, mean(peak_omega), max_peak, mean(peak_alpha), mean(reversals), mean(ret), stdev(ret));
-    for (size_t k = 0; k < eps.size(); ++k) {
-      const Episode &e = eps[k];
-      std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"liquid_l\": %.4f, "
-                  "\"finish_s\": %.4f, \"peak_omega_rad_s\": %.4f, \"peak_alpha_rad_s2\": %.3f, \"reversals\": %d, "
-                  "\"return\": %.4f}",
-                  k ? ", " : "", e.seed, 100 * e.m.poured, 100 * e.m.spilled, e.m.liquid_l, e.m.finish_time,
-                  e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
-    }
-    std::printf("]}\n");
-  } else {
-    std::printf("summary (%d episode%s): poured %.1f %% (%.2f L, sd %.1f %%)  spilled %.1f %% (%.2f L, sd %.1f %%)  "
-                "finish %s (max %s)  peak %.2f rad/s (max %.2f)  %.0f rad/s²  reversals %.1f  return %.1f\n",
-                o.episodes, o.episodes > 1 ? "s" : "", mean(poured), mean(poured_l), stdev(poured), mean(spilled),
-                mean(spilled_l), stdev(spilled),
-                finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(),
-                finish.empty() ? "-" : (std::to_string(max_finish).substr(0, 5) + " s").c_str(), mean(peak_omega),
-                max_peak, mean(peak_alpha), mean(reversals), mean(ret));
-  }
+  poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps);
   if (lcm_ctl != nullptr) {
     lcm_ctl->link().drain(50);
     std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());
@@ -440,7 +337,7 @@ int main(int argc, char **argv) {
     if (!poursim::save_render_json(render_json, *poursim_world_config(world), first, ctl->name(), eps[0].m, &why)) {
       std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
-    } else if (run_render(renderer, render_json, o.render) != 0) {
+    } else if (poursim::run_render(renderer, render_json, o.render) != 0) {
       status = 1;
     } else if (!o.quiet) {
       std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render_base.c_str(),
