@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "controllers.hpp"
-#include "metrics.hpp"
 
 namespace poursim {
 
@@ -19,12 +18,13 @@ std::string world_failure(const poursim_world_t *world, const char *call, int st
 
 } // namespace
 
-Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec) {
+Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec, StepHook *hook) {
   Episode e;
   e.seed = seed;
   int rc = poursim_reset(world, seed);
   if (rc != POURSIM_OK) {
     e.error = world_failure(world, "poursim_reset", rc);
+    e.status = rc;
     return e;
   }
   ctl.reset(seed);
@@ -50,14 +50,17 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
     const double a = ctl.command(o);
     if (ctl.failed()) {
       e.error = ctl.failure();
+      e.status = POURSIM_ESTATE;
       return e;
     }
     rc = poursim_step(world, a, &o);
     if (rc != POURSIM_OK) {
       e.error = world_failure(world, "poursim_step", rc);
+      e.status = rc;
       return e;
     }
     meter.add(o, a * cfg->tau_max);
+    if (hook != nullptr) hook->after_step(o, a, meter);
     if (rec != nullptr) {
       if (rec->steps) rec->samples.push_back({o, ctl.action()});
       if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // One episode in the world, driven by a Controller: its figures (EpisodeMeter) and, on request, every step
-// and frames of the liquid for the CSV and the renderer (outputs.hpp writes them).
+// and frames of the liquid for the CSV and the renderer (outputs.hpp writes them). host_sim's episodes and
+// the trainer's rollouts (rollout.cpp) both run through it.
 #ifndef POURSIM_EPISODE_RUN_HPP
 #define POURSIM_EPISODE_RUN_HPP
 
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "metrics.hpp"
 #include "poursim/poursim.h"
 
 namespace poursim {
@@ -31,15 +33,25 @@ struct Recorder {
   std::vector<float> radius; // of this episode's circles (the order is shuffled per seed) [m]
 };
 
+// Told of every step as it is made, after the meter has counted it.
+class StepHook {
+ public:
+  virtual ~StepHook() = default;
+  // obs: what the step produced; command: what it was given [fraction of tau_max]; meter: the episode so far.
+  virtual void after_step(const poursim_obs_t &obs, double command, const EpisodeMeter &meter) = 0;
+};
+
 struct Episode {
   uint32_t seed = 0;
   poursim_episode_t m{}; // the figures (metrics.hpp); valid only when error is empty
   std::string error;     // why the episode stopped early (the controller's or the world's failure), else empty
+  int status = POURSIM_OK; // with an error: the refused world call's status, POURSIM_ESTATE for the controller
 };
 
-// Resets world and controller to seed and steps until the episode is done, or until the controller fails
-// or a step is refused (the error then says why). rec (may be null) receives what it asks for.
-Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec);
+// Resets world and controller to seed and steps until the observation says the episode is done, or until
+// the controller fails or the world refuses a call (the error then says why). rec and hook (either may be
+// null) receive what they ask for.
+Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec, StepHook *hook = nullptr);
 
 } // namespace poursim
 
