@@ -1,11 +1,11 @@
 /* SPDX-License-Identifier: MIT */
-/* The C core against tests/golden/golden_vectors.h (python -m pour.golden). The fixed-point kernels
- * (quantisation, logits, probabilities, greedy and sampled actions) against the independent Python
- * reference of them (pour.fixedpoint), bit for bit. The stateful parts (the safety envelope with the motion
- * limits, the sensor estimator, whole control-step trajectories from raw sensor samples: modes, faults,
- * decision schedule) against what the C core itself did when the vectors were recorded (through pour.core):
- * regression pins, on the host and the emulated Cortex-M4 alike; test_core_properties.py checks them
- * against docs/safety.md. */
+/* The C core against tests/golden/golden_vectors.h (python -m pour.policy.golden). The fixed-point
+ * kernels (quantisation, logits, probabilities, greedy and sampled actions) against the independent Python
+ * reference of them (pour.policy.fixedpoint), bit for bit. The stateful parts (the safety envelope with the
+ * motion limits, the sensor estimator, whole control-step trajectories from raw sensor samples: modes,
+ * faults, decision schedule) against what the C core itself did when the vectors were recorded (through
+ * pour.policy.core): regression pins, on the host and the emulated Cortex-M4 alike;
+ * tests/python/test_core_properties.py checks them against docs/safety.md. */
 #include <string.h>
 
 #include "golden_vectors.h"
