@@ -1,31 +1,24 @@
 // SPDX-License-Identifier: MIT
 // host_sim: runs pours in the Box2D world with the firmware core in-process (or a baseline), prints
 // results, writes trajectories and renders them. `host_sim --help` explains the flags.
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "bench.hpp"
 #include "controllers.hpp"
+#include "episode_run.hpp"
 #include "lcm_link.hpp"
-#include "metrics.hpp"
 #include "outputs.hpp"
 #include "poursim/poursim.h"
 #include "poursim/weights_file.h"
-#include "stats.hpp"
-
-extern char **environ;
+#include "renderer.hpp"
+#include "summary.hpp"
 
 namespace {
 
@@ -86,7 +79,7 @@ const char *kUsage =
     "  host_sim --baseline rate --episodes 5 --json\n"
     "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n";
 
-constexpr int kFrameEveryMs = 80; // 12.5 frames/s: smooth enough, and a GIF of 10 s renders in seconds
+constexpr int kFrameEverySteps = 80; // 12.5 frames/s at 1 ms: smooth enough, and a GIF of 10 s renders in seconds
 
 struct Options {
   std::string policy, baseline, config_path, csv, render;
@@ -105,28 +98,6 @@ int usage_error(const char *fmt, const char *arg) {
   std::fprintf(stderr, fmt, arg);
   std::fprintf(stderr, "\n(run host_sim --help for usage)\n");
   return 2;
-}
-
-// The program a shell would run for name: name itself if it holds a '/', else the first executable of that
-// name in a PATH folder (an empty entry is the current folder). Empty if there is none.
-std::string find_program(const std::string &name) {
-  if (name.find('/') != std::string::npos) return access(name.c_str(), X_OK) == 0 ? name : "";
-  const char *path = std::getenv("PATH");
-  std::string dirs = path != nullptr ? path : "";
-  for (size_t a = 0; a <= dirs.size();) {
-    size_t b = dirs.find(':', a);
-    if (b == std::string::npos) b = dirs.size();
-    std::string file = (b > a ? dirs.substr(a, b - a) : ".") + "/" + name;
-    if (access(file.c_str(), X_OK) == 0) return file;
-    a = b + 1;
-  }
-  return "";
-}
-
-// The renderer host_sim --render runs: $POUR_RENDER, else the tools' console entry point on PATH.
-const char *renderer_name() {
-  const char *env = std::getenv("POUR_RENDER");
-  return env != nullptr && *env != '\0' ? env : "pour-render";
 }
 
 bool parse_long(const char *s, long long lo, long long hi, long long &out) {
@@ -201,151 +172,11 @@ int parse_args(int argc, char **argv, Options &o) {
   return -1;
 }
 
-struct Episode {
-  uint32_t seed = 0;
-  poursim_episode_t m{}; // libpoursim's figures of the episode (metrics.hpp)
-  std::string error;     // why the world stopped, if it did
-};
-
-// One step of history for CSV and rendering.
-struct Sample {
-  poursim_obs_t obs;
-  int action;
-};
-
-struct Recorder {
-  bool steps = false;          // keep every step (CSV, render plots)
-  int frame_every = 0;         // keep circle positions every this many steps (render), 0 = never
-  std::vector<Sample> samples;
-  std::vector<std::vector<float>> frames;
-  std::vector<double> frame_theta, frame_t;
-  std::vector<float> radius; // of this episode's circles (the order is shuffled per seed)
-};
-
-Episode run_episode(poursim_world_t *world, poursim::Controller &ctl, uint32_t seed, Recorder *rec) {
-  Episode e;
-  e.seed = seed;
-  poursim_reset(world, seed);
-  ctl.reset(seed);
-  const poursim_config_t *cfg = poursim_world_config(world);
-  int n = poursim_particle_count(world);
-  poursim_obs_t o;
-  poursim_observe(world, &o);
-  poursim::EpisodeMeter meter;
-  meter.reset(*poursim_episode_config(world), o);
-  auto keep_frame = [&](const poursim_obs_t &ob) {
-    std::vector<float> xy(static_cast<size_t>(2 * n));
-    poursim_particles(world, xy.data(), nullptr, n);
-    rec->frames.push_back(std::move(xy));
-    rec->frame_theta.push_back(ob.theta);
-    rec->frame_t.push_back(ob.t);
-  };
-  if (rec != nullptr && rec->frame_every > 0) {
-    rec->radius.assign(static_cast<size_t>(n), 0.0f);
-    poursim_particles(world, nullptr, rec->radius.data(), n);
-    keep_frame(o);
-  }
-  while (!o.done) {
-    double a = ctl.command(o);
-    if (ctl.failed()) {
-      e.error = ctl.failure();
-      return e;
-    }
-    if (poursim_step(world, a, &o) != POURSIM_OK) {
-      e.error = poursim_world_error(world);
-      return e;
-    }
-    meter.add(o, a * cfg->tau_max);
-    if (rec != nullptr) {
-      if (rec->steps) rec->samples.push_back({o, ctl.action()});
-      if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
-    }
-  }
-  e.m = meter.result();
-  return e;
-}
-
-// Every step of every episode, written as each episode ends (memory stays one episode's worth).
-void write_csv_header(std::FILE *f) {
-  std::fprintf(f, "episode,seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,action,"
-                  "torque_nm,torque_frac,reward\n");
-}
-
-void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vector<Sample> &samples, double tau_max) {
-  for (const Sample &s : samples)
-    std::fprintf(f, "%d,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", episode, seed, s.obs.step,
-                 s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill, s.obs.v_flight,
-                 s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
-}
-
-// The trajectory as JSON for pour-render (the tools' renderer).
-bool write_render_json(const std::string &path, const poursim_world_t *world, const Recorder &rec,
-                       const std::string &title, const Episode &e, std::string *why) {
-  poursim::AtomicFile out;
-  if (!out.open(path, why)) return false;
-  std::FILE *f = out.stream();
-  const poursim_config_t *c = poursim_world_config(world);
-  const std::vector<float> &radius = rec.radius;
-  int n = static_cast<int>(radius.size());
-  std::fprintf(f, "{\"fps\": %.3f, \"title\": %s, \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", 1000.0 / kFrameEveryMs,
-               poursim::json_quote(title).c_str(),
-               e.m.poured, e.m.spilled, e.m.finish_time);
-  std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
-                  "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
-               c->bucket_inner_width, c->bucket_height, c->bucket_wall, c->pivot_height, c->target_dx, c->theta_max);
-  std::fprintf(f, "\"radius\": [");
-  for (int i = 0; i < n; ++i) std::fprintf(f, "%s%.5f", i ? "," : "", static_cast<double>(radius[static_cast<size_t>(i)]));
-  std::fprintf(f, "],\n\"series\": {\"t\": [");
-  // Plots at 100 Hz are plenty.
-  std::vector<const Sample *> pick;
-  for (size_t i = 0; i < rec.samples.size(); i += 10) pick.push_back(&rec.samples[i]);
-  const char *keys[] = {"t", "theta", "v_rotating", "v_target", "v_spill", "torque"};
-  for (int k = 0; k < 6; ++k) {
-    if (k > 0) std::fprintf(f, "], \"%s\": [", keys[k]);
-    for (size_t i = 0; i < pick.size(); ++i) {
-      const poursim_obs_t &o = pick[i]->obs;
-      double v = k == 0 ? o.t : k == 1 ? o.theta : k == 2 ? o.v_rotating : k == 3 ? o.v_target : k == 4 ? o.v_spill : o.torque;
-      std::fprintf(f, "%s%.5g", i ? "," : "", v);
-    }
-  }
-  std::fprintf(f, "]},\n\"frames\": [");
-  for (size_t k = 0; k < rec.frames.size(); ++k) {
-    std::fprintf(f, "%s\n{\"t\": %.3f, \"theta\": %.5f, \"xy\": [", k ? "," : "", rec.frame_t[k], rec.frame_theta[k]);
-    const std::vector<float> &xy = rec.frames[k];
-    for (size_t i = 0; i < xy.size(); ++i) std::fprintf(f, "%s%.4f", i ? "," : "", static_cast<double>(xy[i]));
-    std::fprintf(f, "]}");
-  }
-  std::fprintf(f, "]}\n");
-  return out.commit(why);
-}
-
-// Runs `renderer TRAJECTORY.json OUT` and waits for it; returns 0 if it exited 0.
-int run_render(const std::string &renderer, const std::string &json_path, const std::string &out) {
-  std::vector<std::string> args = {renderer, json_path, out};
-  std::vector<char *> argv;
-  for (std::string &s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  std::fflush(stdout);
-  std::fflush(stderr);
-  pid_t pid;
-  int err = posix_spawn(&pid, renderer.c_str(), nullptr, nullptr, argv.data(), environ);
-  if (err != 0) {
-    std::fprintf(stderr, "host_sim: cannot start the renderer %s: %s\n", renderer.c_str(), std::strerror(err));
-    return 1;
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::fprintf(stderr, "host_sim: the renderer (%s) failed\n", renderer.c_str());
-    return 1;
-  }
-  return 0;
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
-  using poursim::mean;
-  using poursim::stdev;
+  using poursim::Episode;
+  using poursim::Recorder;
   Options o;
   int rc = parse_args(argc, argv, o);
   if (rc >= 0) return rc;
@@ -397,17 +228,17 @@ int main(int argc, char **argv) {
     render_base = o.render.substr(0, o.render.size() - 4);
     if (render_base.empty() || render_base.back() == '/')
       return usage_error("--render wants a file name before its .gif or .mp4, got '%s'", o.render.c_str());
-    if (ext == ".mp4" && find_program("ffmpeg").empty()) {
+    if (ext == ".mp4" && poursim::find_program("ffmpeg").empty()) {
       std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
                    o.render.c_str());
       return 2;
     }
-    renderer = find_program(renderer_name());
+    renderer = poursim::find_program(poursim::renderer_name());
     if (renderer.empty()) {
       std::fprintf(stderr,
                    "host_sim: --render needs the renderer '%s', which is not an executable%s (put the venv's bin, "
                    "e.g. .venv/bin, on PATH, or set POUR_RENDER to the program)\n",
-                   renderer_name(), std::strchr(renderer_name(), '/') != nullptr ? "" : " on PATH");
+                   poursim::renderer_name(), std::strchr(poursim::renderer_name(), '/') != nullptr ? "" : " on PATH");
       return 2;
     }
     render_json = render_base + ".json";
@@ -462,15 +293,15 @@ int main(int argc, char **argv) {
       return 1;
     }
     csv = csv_file.stream();
-    write_csv_header(csv);
+    poursim::write_csv_header(csv);
   }
   Recorder first;
   for (int k = 0; k < o.episodes; ++k) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
     Recorder rec;
     rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
-    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEveryMs : 0;
-    Episode e = run_episode(world, *ctl, seed, &rec);
+    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEverySteps : 0;
+    Episode e = poursim::run_episode(world, *ctl, seed, &rec);
     if (!e.error.empty()) {
       int status = 1;
       if (lcm_ctl != nullptr && lcm_ctl->failed()) {
@@ -484,61 +315,11 @@ int main(int argc, char **argv) {
       return status;
     }
     eps.push_back(e);
-    if (!o.quiet)
-      std::fprintf(per,
-                   "episode %d seed %u: poured %5.1f %% (%5.2f L)  spilled %4.1f %% (%4.2f L)  left %4.1f %%  finish %s"
-                   "  peak %.2f rad/s %.0f rad/s²  reversals %d  return %.1f\n",
-                   k + 1, seed, 100 * e.m.poured, e.m.poured * e.m.liquid_l, 100 * e.m.spilled,
-                   e.m.spilled * e.m.liquid_l, 100 * e.m.remaining,
-                   e.m.finish_time < 0 ? "  -   " : (std::to_string(e.m.finish_time).substr(0, 5) + " s").c_str(),
-                   e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
+    if (!o.quiet) poursim::print_episode(per, k + 1, e);
     if (k == 0 && !o.render.empty()) first = rec;
-    if (csv != nullptr) write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
+    if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
   }
-  std::vector<double> poured, spilled, poured_l, spilled_l, finish, ret, peak_omega, peak_alpha, reversals;
-  int unfinished = 0;
-  for (const Episode &e : eps) {
-    poured.push_back(100 * e.m.poured);
-    spilled.push_back(100 * e.m.spilled);
-    poured_l.push_back(e.m.poured * e.m.liquid_l);
-    spilled_l.push_back(e.m.spilled * e.m.liquid_l);
-    ret.push_back(e.m.ret);
-    peak_omega.push_back(e.m.peak_omega);
-    peak_alpha.push_back(e.m.peak_alpha);
-    reversals.push_back(e.m.reversals);
-    if (e.m.finish_time >= 0) finish.push_back(e.m.finish_time);
-    else ++unfinished;
-  }
-  const double max_finish = finish.empty() ? -1.0 : *std::max_element(finish.begin(), finish.end());
-  const double max_peak = *std::max_element(peak_omega.begin(), peak_omega.end());
-  if (o.json) {
-    std::printf("{\"controller\": %s, \"episodes\": %d, \"seed\": %u, \"tau_max_nm\": %.4f, "
-                "\"poured_pct\": %.3f, \"poured_pct_std\": %.3f, \"spilled_pct\": %.3f, \"spilled_pct_std\": %.3f, "
-                "\"poured_l\": %.4f, \"spilled_l\": %.4f, \"finish_s\": %.4f, \"finish_max_s\": %.4f, "
-                "\"unfinished\": %d, \"peak_omega_rad_s\": %.4f, \"peak_omega_max_rad_s\": %.4f, "
-                "\"peak_alpha_rad_s2\": %.3f, \"reversals\": %.2f, \"return\": %.4f, \"return_std\": %.4f, "
-                "\"per_episode\": [",
-                poursim::json_quote(ctl->name()).c_str(), o.episodes, seed0, cfg.tau_max, mean(poured), stdev(poured), mean(spilled),
-                stdev(spilled), mean(poured_l), mean(spilled_l), finish.empty() ? -1.0 : mean(finish), max_finish,
-                unfinished, mean(peak_omega), max_peak, mean(peak_alpha), mean(reversals), mean(ret), stdev(ret));
-    for (size_t k = 0; k < eps.size(); ++k) {
-      const Episode &e = eps[k];
-      std::printf("%s{\"seed\": %u, \"poured_pct\": %.3f, \"spilled_pct\": %.3f, \"liquid_l\": %.4f, "
-                  "\"finish_s\": %.4f, \"peak_omega_rad_s\": %.4f, \"peak_alpha_rad_s2\": %.3f, \"reversals\": %d, "
-                  "\"return\": %.4f}",
-                  k ? ", " : "", e.seed, 100 * e.m.poured, 100 * e.m.spilled, e.m.liquid_l, e.m.finish_time,
-                  e.m.peak_omega, e.m.peak_alpha, e.m.reversals, e.m.ret);
-    }
-    std::printf("]}\n");
-  } else {
-    std::printf("summary (%d episode%s): poured %.1f %% (%.2f L, sd %.1f %%)  spilled %.1f %% (%.2f L, sd %.1f %%)  "
-                "finish %s (max %s)  peak %.2f rad/s (max %.2f)  %.0f rad/s²  reversals %.1f  return %.1f\n",
-                o.episodes, o.episodes > 1 ? "s" : "", mean(poured), mean(poured_l), stdev(poured), mean(spilled),
-                mean(spilled_l), stdev(spilled),
-                finish.empty() ? "-" : (std::to_string(mean(finish)).substr(0, 5) + " s").c_str(),
-                finish.empty() ? "-" : (std::to_string(max_finish).substr(0, 5) + " s").c_str(), mean(peak_omega),
-                max_peak, mean(peak_alpha), mean(reversals), mean(ret));
-  }
+  poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps);
   if (lcm_ctl != nullptr) {
     lcm_ctl->link().drain(50);
     std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());
@@ -553,10 +334,10 @@ int main(int argc, char **argv) {
     }
   }
   if (!o.render.empty()) {
-    if (!write_render_json(render_json, world, first, ctl->name(), eps[0], &why)) {
+    if (!poursim::save_render_json(render_json, *poursim_world_config(world), first, ctl->name(), eps[0].m, &why)) {
       std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       status = 1;
-    } else if (run_render(renderer, render_json, o.render) != 0) {
+    } else if (poursim::run_render(renderer, render_json, o.render) != 0) {
       status = 1;
     } else if (!o.quiet) {
       std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render_base.c_str(),

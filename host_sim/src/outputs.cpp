@@ -183,4 +183,60 @@ void AtomicFile::discard() {
   slot_ = -1;
 }
 
+void write_csv_header(std::FILE *f) {
+  std::fprintf(f, "episode,seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,action,"
+                  "torque_nm,torque_frac,reward\n");
+}
+
+void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vector<Sample> &samples, double tau_max) {
+  for (const Sample &s : samples)
+    std::fprintf(f, "%d,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", episode, seed, s.obs.step,
+                 s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill, s.obs.v_flight,
+                 s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
+}
+
+void write_render_json(std::FILE *f, const poursim_config_t &config, const Recorder &rec, const std::string &title,
+                       const poursim_episode_t &m) {
+  const poursim_config_t *c = &config;
+  const std::vector<float> &radius = rec.radius;
+  const int n = static_cast<int>(radius.size());
+  const double fps = rec.frame_every > 0 ? 1.0 / (rec.frame_every * c->dt) : 0.0;
+  std::fprintf(f, "{\"fps\": %.3f, \"title\": %s, \"poured\": %.4f, \"spilled\": %.4f, \"finish_s\": %.3f,\n", fps,
+               json_quote(title).c_str(), m.poured, m.spilled, m.finish_time);
+  std::fprintf(f, "\"scene\": {\"inner_width\": %.5f, \"height\": %.5f, \"wall\": %.5f, \"pivot_x\": 0.0, "
+                  "\"pivot_y\": %.5f, \"target_x\": %.5f, \"theta_max\": %.5f},\n",
+               c->bucket_inner_width, c->bucket_height, c->bucket_wall, c->pivot_height, c->target_dx, c->theta_max);
+  std::fprintf(f, "\"radius\": [");
+  for (int i = 0; i < n; ++i) std::fprintf(f, "%s%.5f", i ? "," : "", static_cast<double>(radius[static_cast<size_t>(i)]));
+  std::fprintf(f, "],\n\"series\": {\"t\": [");
+  // Plots at 100 Hz are plenty.
+  std::vector<const Sample *> pick;
+  for (size_t i = 0; i < rec.samples.size(); i += 10) pick.push_back(&rec.samples[i]);
+  const char *keys[] = {"t", "theta", "v_rotating", "v_target", "v_spill", "torque"};
+  for (int k = 0; k < 6; ++k) {
+    if (k > 0) std::fprintf(f, "], \"%s\": [", keys[k]);
+    for (size_t i = 0; i < pick.size(); ++i) {
+      const poursim_obs_t &o = pick[i]->obs;
+      double v = k == 0 ? o.t : k == 1 ? o.theta : k == 2 ? o.v_rotating : k == 3 ? o.v_target : k == 4 ? o.v_spill : o.torque;
+      std::fprintf(f, "%s%.5g", i ? "," : "", v);
+    }
+  }
+  std::fprintf(f, "]},\n\"frames\": [");
+  for (size_t k = 0; k < rec.frames.size(); ++k) {
+    std::fprintf(f, "%s\n{\"t\": %.3f, \"theta\": %.5f, \"xy\": [", k ? "," : "", rec.frame_t[k], rec.frame_theta[k]);
+    const std::vector<float> &xy = rec.frames[k];
+    for (size_t i = 0; i < xy.size(); ++i) std::fprintf(f, "%s%.4f", i ? "," : "", static_cast<double>(xy[i]));
+    std::fprintf(f, "]}");
+  }
+  std::fprintf(f, "]}\n");
+}
+
+bool save_render_json(const std::string &path, const poursim_config_t &config, const Recorder &rec,
+                      const std::string &title, const poursim_episode_t &m, std::string *err) {
+  AtomicFile out;
+  if (!out.open(path, err)) return false;
+  write_render_json(out.stream(), config, rec, title, m);
+  return out.commit(err);
+}
+
 } // namespace poursim

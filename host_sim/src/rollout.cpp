@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Whole episodes in C for the trainer: a float softmax-linear policy decides every P steps on the state the
 // firmware's own estimator makes of the rig's sensors, its torque passes through the firmware's own safety
-// envelope (the motion envelope included), and the arrays Python asked for are filled.
+// envelope (the motion envelope included), and the arrays Python asked for are filled. The episode itself is
+// run_episode's (episode_run.cpp), as host_sim's are.
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
@@ -16,6 +17,8 @@ extern "C" {
 #include "pour/safety.h"
 #include "pour/sensors.h"
 }
+#include "controllers.hpp"
+#include "episode_run.hpp"
 #include "metrics.hpp"
 #include "poursim/poursim.h"
 #include "poursim_internal.hpp"
@@ -69,89 +72,118 @@ extern "C" int16_t poursim_fraction_to_q15(double fraction) {
   return static_cast<int16_t>(q < -32768.0 ? -32768.0 : (q > 32767.0 ? 32767.0 : q));
 }
 
+namespace {
+
+// The trainer's float policy as a Controller: every decision_period steps it picks an action from the
+// features of the state the firmware's estimator makes of the rig's sensors (greedy or sampled), and its
+// level passes through the firmware's safety envelope. As a StepHook it fills the arrays Python asked for.
+class RolloutPolicy : public poursim::Controller, public poursim::StepHook {
+ public:
+  RolloutPolicy(const poursim_policy_t *policy, const poursim_config_t &config, const poursim_rollout_buffers_t *buf)
+      : p_(policy), buf_(buf), W_(policy->w, POURSIM_N_FEATURES, policy->n_actions), probs_(policy->n_actions) {
+    // The firmware's defaults, as the shipped controller runs them; the encoder as the rig has it.
+    fw_ = pour_control_default_config();
+    fw_.sensors.encoder_bits = static_cast<uint8_t>(config.encoder_bits);
+  }
+  std::string name() const override { return "rollout"; }
+  void reset(uint32_t seed) override {
+    init_failed_ = pour_safety_init(&safety_, &fw_.safety) != POUR_OK || pour_estimator_init(&est_, &fw_.sensors) != POUR_OK;
+    // Sampling draws from its own stream so that greedy and sampled runs share the liquid of a seed.
+    rng_ = poursim::Rng(0xA5A5A5A5ULL ^ (static_cast<unsigned long long>(seed) * 0x100000001B3ULL));
+    state_ = pour_state_t{};
+    action_ = 0;
+    decision_ = -1;
+    reversals_ = 0;
+    t_ = 0;
+  }
+  double command(const poursim_obs_t &o) override {
+    if (init_failed_) return 0.0;
+    t_ = static_cast<int>(o.step);
+    // A sample the estimator refuses (the firmware would fault) leaves the last state in place.
+    const pour_sensors_t sample = {o.step, o.encoder, o.scale_rotating_g, o.scale_target_g};
+    pour_estimator_update(&est_, &sample, &state_);
+    if (t_ % p_->decision_period == 0) decide();
+    const q15_t cmd = pour_safety_apply(&safety_, poursim_fraction_to_q15(p_->levels[action_]), state_.theta_urad,
+                                        state_.omega_urad_s);
+    return cmd / 32768.0;
+  }
+  int action() const override { return action_; }
+  bool failed() const override { return init_failed_; }
+  std::string failure() const override { return "the firmware's safety envelope or estimator refused its defaults"; }
+
+  void after_step(const poursim_obs_t &o, double, const poursim::EpisodeMeter &meter) override {
+    // Training's reward shaping: each torque reversal costs k_reversal (0: the world's reward as it is).
+    const int new_reversals = meter.reversals() - reversals_;
+    reversals_ += new_reversals;
+    const double r = o.reward - p_->k_reversal * new_reversals;
+    if (buf_ == nullptr) return;
+    if (decision_ < buf_->capacity && buf_->rewards != nullptr) buf_->rewards[decision_] += r;
+    if (t_ < buf_->step_capacity) {
+      if (buf_->step_rewards != nullptr) buf_->step_rewards[t_] = r;
+      if (buf_->step_theta != nullptr) buf_->step_theta[t_] = o.theta;
+    }
+  }
+  int decisions() const { return decision_ + 1; }
+
+ private:
+  void decide() {
+    ++decision_;
+    const int n_act = p_->n_actions;
+    Features x = features_of(p_, state_);
+    Eigen::VectorXd logits = (x * W_).transpose();
+    probs_ = (logits.array() - logits.maxCoeff()).exp();
+    probs_ /= probs_.sum();
+    if (p_->greedy) {
+      Eigen::Index best = 0;
+      logits.maxCoeff(&best); // first maximum: ties go to the lowest index
+      action_ = static_cast<int>(best);
+    } else {
+      double u = rng_.uniform(), acc = 0.0;
+      action_ = n_act - 1;
+      for (int i = 0; i < n_act; ++i) {
+        acc += probs_(i);
+        if (u < acc) {
+          action_ = i;
+          break;
+        }
+      }
+    }
+    if (buf_ != nullptr && decision_ < buf_->capacity) {
+      size_t d = static_cast<size_t>(decision_);
+      if (buf_->features != nullptr)
+        for (int k = 0; k < POURSIM_N_FEATURES; ++k) buf_->features[d * POURSIM_N_FEATURES + static_cast<size_t>(k)] = x(k);
+      if (buf_->actions != nullptr) buf_->actions[d] = action_;
+      if (buf_->rewards != nullptr) buf_->rewards[d] = 0.0;
+      if (buf_->probs != nullptr)
+        for (int k = 0; k < n_act; ++k) buf_->probs[d * static_cast<size_t>(n_act) + static_cast<size_t>(k)] = probs_(k);
+    }
+  }
+
+  const poursim_policy_t *p_;
+  const poursim_rollout_buffers_t *buf_;
+  Eigen::Map<const RowMatrix> W_;
+  Eigen::VectorXd probs_;
+  pour_control_config_t fw_;
+  pour_safety_t safety_;
+  pour_estimator_t est_;
+  poursim::Rng rng_{0};
+  pour_state_t state_{};
+  bool init_failed_ = false;
+  int action_ = 0, decision_ = -1, reversals_ = 0, t_ = 0;
+};
+
+} // namespace
+
 extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *policy, uint32_t seed,
                                const poursim_rollout_buffers_t *buf, poursim_episode_t *ep) {
   if (world == nullptr || ep == nullptr) return POURSIM_EINVAL;
   int rc = validate_policy(policy, nullptr, 0);
   if (rc != POURSIM_OK) return rc;
-  const poursim_config_t *cfg = poursim_world_config(world);
-  rc = poursim_reset(world, seed);
-  if (rc != POURSIM_OK) return rc;
-
-  // The firmware's defaults, as the shipped controller runs them; the encoder as the rig has it.
-  pour_control_config_t fw = pour_control_default_config();
-  fw.sensors.encoder_bits = static_cast<uint8_t>(cfg->encoder_bits);
-  pour_safety_t safety;
-  pour_estimator_t est;
-  if (pour_safety_init(&safety, &fw.safety) != POUR_OK || pour_estimator_init(&est, &fw.sensors) != POUR_OK)
-    return POURSIM_ESTATE;
-
-  const int n_act = policy->n_actions;
-  Eigen::Map<const RowMatrix> W(policy->w, POURSIM_N_FEATURES, n_act);
-  // Sampling draws from its own stream so that greedy and sampled runs share the liquid of a seed.
-  poursim::Rng rng(0xA5A5A5A5ULL ^ (static_cast<unsigned long long>(seed) * 0x100000001B3ULL));
-  const int n_steps = static_cast<int>(std::lround(cfg->episode_s / cfg->dt));
-
-  poursim_obs_t o;
-  poursim_observe(world, &o);
-  poursim::EpisodeMeter meter;
-  meter.reset(*poursim_episode_config(world), o);
-  pour_state_t state{};
-  int action = 0, decision = -1, reversals = 0;
-  Eigen::VectorXd probs(n_act);
-  for (int t = 0; t < n_steps; ++t) {
-    // A sample the estimator refuses (the firmware would fault) leaves the last state in place.
-    const pour_sensors_t sample = {static_cast<uint32_t>(t), o.encoder, o.scale_rotating_g, o.scale_target_g};
-    pour_estimator_update(&est, &sample, &state);
-    if (t % policy->decision_period == 0) {
-      ++decision;
-      Features x = features_of(policy, state);
-      Eigen::VectorXd logits = (x * W).transpose();
-      probs = (logits.array() - logits.maxCoeff()).exp();
-      probs /= probs.sum();
-      if (policy->greedy) {
-        Eigen::Index best = 0;
-        logits.maxCoeff(&best); // first maximum: ties go to the lowest index
-        action = static_cast<int>(best);
-      } else {
-        double u = rng.uniform(), acc = 0.0;
-        action = n_act - 1;
-        for (int i = 0; i < n_act; ++i) {
-          acc += probs(i);
-          if (u < acc) {
-            action = i;
-            break;
-          }
-        }
-      }
-      if (buf != nullptr && decision < buf->capacity) {
-        size_t d = static_cast<size_t>(decision);
-        if (buf->features != nullptr)
-          for (int k = 0; k < POURSIM_N_FEATURES; ++k) buf->features[d * POURSIM_N_FEATURES + static_cast<size_t>(k)] = x(k);
-        if (buf->actions != nullptr) buf->actions[d] = action;
-        if (buf->rewards != nullptr) buf->rewards[d] = 0.0;
-        if (buf->probs != nullptr)
-          for (int k = 0; k < n_act; ++k) buf->probs[d * static_cast<size_t>(n_act) + static_cast<size_t>(k)] = probs(k);
-      }
-    }
-    q15_t cmd = pour_safety_apply(&safety, poursim_fraction_to_q15(policy->levels[action]), state.theta_urad, state.omega_urad_s);
-    rc = poursim_step(world, cmd / 32768.0, &o);
-    if (rc != POURSIM_OK) return rc;
-    meter.add(o, cmd / 32768.0 * cfg->tau_max);
-    // Training's reward shaping: each torque reversal costs k_reversal (0: the world's reward as it is).
-    const int new_reversals = meter.reversals() - reversals;
-    reversals += new_reversals;
-    const double r = o.reward - policy->k_reversal * new_reversals;
-    if (buf != nullptr) {
-      if (decision < buf->capacity && buf->rewards != nullptr) buf->rewards[decision] += r;
-      if (t < buf->step_capacity) {
-        if (buf->step_rewards != nullptr) buf->step_rewards[t] = r;
-        if (buf->step_theta != nullptr) buf->step_theta[t] = o.theta;
-      }
-    }
-  }
-  *ep = meter.result();
-  ep->n_decisions = decision + 1;
+  RolloutPolicy ctl(policy, *poursim_world_config(world), buf);
+  const poursim::Episode e = poursim::run_episode(world, ctl, seed, nullptr, &ctl);
+  if (!e.error.empty()) return e.status;
+  *ep = e.m;
+  ep->n_decisions = ctl.decisions();
   return POURSIM_OK;
 }
 

@@ -150,6 +150,28 @@ static void test_rollout_IsDeterministicAndBatchMatchesSequential(void) {
   TEST_ASSERT_EQUAL_DOUBLE(a.ret, batch[0].ret);
 }
 
+/* The rollout ends where host_sim's episodes do: at the first observation that says done (12 steps for
+ * 12.5 ms, where rounding episode_s / dt would give 13). */
+static void test_rollout_EndsAtTheObservationThatSaysDone(void) {
+  poursim_destroy(world);
+  cfg.episode_s = 0.0125;
+  world = poursim_create(&cfg, err, sizeof err);
+  TEST_ASSERT_NOT_NULL_MESSAGE(world, err);
+  poursim_episode_t ep;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_rollout(world, &pol, 2, NULL, &ep));
+  poursim_obs_t o;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_reset(world, 2));
+  poursim_observe(world, &o);
+  int steps = 0;
+  while (!o.done) {
+    TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_step(world, 0.0, &o));
+    ++steps;
+  }
+  TEST_ASSERT_EQUAL_INT(12, steps);
+  TEST_ASSERT_EQUAL_INT(steps, ep.n_steps);
+  TEST_ASSERT_EQUAL_INT(2, ep.n_decisions); /* steps 0 and 10 */
+}
+
 static void test_rollout_RefusesBadPolicy(void) {
   poursim_episode_t ep;
   pol.n_actions = 1;
@@ -190,6 +212,7 @@ int main(void) {
   RUN_TEST(test_rollout_FillsArraysConsistently);
   RUN_TEST(test_rollout_MatchesManualLoopThroughSafetyEnvelope);
   RUN_TEST(test_rollout_IsDeterministicAndBatchMatchesSequential);
+  RUN_TEST(test_rollout_EndsAtTheObservationThatSaysDone);
   RUN_TEST(test_rollout_RefusesBadPolicy);
   RUN_TEST(test_fraction_to_q15_RoundsHalfUpSaturatesAndMapsNanToZero);
   return UNITY_END();

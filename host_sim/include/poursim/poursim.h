@@ -259,9 +259,9 @@ int poursim_rollout_batch(const poursim_config_t *config, const poursim_policy_t
                           char *err, size_t err_len);
 
 /* A torque fraction of tau_max as the firmware's Q15 command: the host's one rule, which Python's
- * pour.fixedpoint.float_to_q15 follows too. Rounds half up (floor(32768 x + 1/2)), as the firmware rounds;
- * saturates to [-32768, 32767] (+1.0 -> 32767, -1.0 -> -32768, +-inf to the limits); NaN -> 0 (no torque,
- * never a plausible command). */
+ * pour.policy.fixedpoint.float_to_q15 follows too. Rounds half up (floor(32768 x + 1/2)), as the firmware
+ * rounds; saturates to [-32768, 32767] (+1.0 -> 32767, -1.0 -> -32768, +-inf to the limits); NaN -> 0 (no
+ * torque, never a plausible command). */
 int16_t poursim_fraction_to_q15(double fraction);
 
 /* Library version string. */
