@@ -12,7 +12,7 @@ _Static_assert((-3 >> 1) == -2, "arithmetic right shift required");
 #define DEFAULT_SEED 2463534242u
 
 /* 2^(-j/64) in Q24 for j = 0..64: round(2^(-j/64) * 2^24), regenerated and checked by
- * tools/pour/fixedpoint.py (EXP2_TABLE_Q24). */
+ * tools/pour/policy/fixedpoint.py (EXP2_TABLE_Q24). */
 static const uint32_t exp2_neg_q24[65] = {
     16777216u, 16596492u, 16417715u, 16240863u, 16065917u, 15892855u, 15721658u, 15552304u,
     15384775u, 15219050u, 15055111u, 14892937u, 14732511u, 14573813u, 14416824u, 14261526u,

@@ -2,7 +2,7 @@
 // weights.h at run time: a tokenizer and a flat parser for the subset of C the exporter writes
 // (docs/weights-h.md, "Accepted subset"). Comments, whitespace and CRLF may be added by hand; anything the
 // firmware build would refuse is refused here too, naming the file, the line and the field.
-// tools/pour/weights_h.py implements the same grammar; tests/data/weights_cases/ holds the cases both
+// tools/pour/policy/weights_h.py implements the same grammar; tests/data/weights_cases/ holds the cases both
 // must agree on.
 //
 // Worst case: every byte is looked at a bounded number of times (a comment is skipped by one forward scan,

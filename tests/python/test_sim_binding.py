@@ -93,6 +93,21 @@ def test_rollout_arrays_and_determinism():
     assert np.array_equal(a.actions, b.actions) and a.ret == b.ret
 
 
+def test_rollout_runs_as_many_steps_as_the_world():
+    # 12.5 ms at 1 ms steps: the world says done at the first t >= episode_s - dt/2, after 12 steps; the
+    # per-step arrays hold exactly those, as stepping the world by hand does.
+    with poursim.World({"episode_s": 0.0125}) as w:
+        r = w.rollout(small_policy(), seed=2, record_steps=True)
+        w.reset(2)
+        steps = 0
+        o = w.observe()
+        while not o.done:
+            o = w.step(0.0)
+            steps += 1
+    assert steps == 12
+    assert r.step_rewards.shape == (12,) and r.step_theta.shape == (12,)
+
+
 def test_bad_policy_shape_raises():
     with pytest.raises(poursim.SimError, match="shape"):
         poursim.Policy(w=np.zeros((5, 11)), levels=poursim.uniform_levels(11))._struct()

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Regenerates the weights.h cases of this folder from policy/example_weights.h: one edit each.
 
-cases.tsv lists, per file: what host_sim's parser and pour.weights_h must both do (accept or refuse),
+cases.tsv lists, per file: what host_sim's parser and pour.policy.weights_h must both do (accept or refuse),
 a text their error message must contain, and what the firmware build does with it (ok: compiles and
 the core's init accepts it; build: the compiler refuses it; build-named: the compiler refuses it with a
 diagnostic that names that text too (the checks in firmware/src/weights_compiled.c); init: compiles, the core's init refuses it

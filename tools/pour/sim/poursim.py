@@ -17,6 +17,7 @@ the trainer's executors (pour.train.executors: a process pool, or Ray), one worl
 from __future__ import annotations
 
 import ctypes as C
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -305,7 +306,9 @@ class Rollout:
 
 
 def _n_steps(cfg: ConfigStruct) -> int:
-    return int(round(cfg.episode_s / cfg.dt))
+    """Room for the episode's steps: the world ends it at the first step with t >= episode_s - dt/2, so at most
+    ceil(episode_s/dt) of them (the rollout reports how many it ran)."""
+    return int(math.ceil(cfg.episode_s / cfg.dt))
 
 
 class _Buffers:
@@ -328,7 +331,7 @@ class _Buffers:
              "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta, "liquid_l": e.liquid_l,
              "peak_omega": e.peak_omega, "peak_alpha": e.peak_alpha, "reversals": e.reversals}
         return Rollout(seed, self.features[:d], self.actions[:d], self.rewards[:d], self.probs[:d],
-                       self.step_rewards, self.step_theta, e.poured, e.spilled, e.remaining, e.finish_time,
+                       self.step_rewards[:e.n_steps], self.step_theta[:e.n_steps], e.poured, e.spilled, e.remaining, e.finish_time,
                        e.ret, e.reward_sum, e.max_theta, m)
 
 
