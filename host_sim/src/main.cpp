@@ -8,6 +8,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench.hpp"
@@ -316,8 +317,8 @@ int main(int argc, char **argv) {
     }
     eps.push_back(e);
     if (!o.quiet) poursim::print_episode(per, k + 1, e);
-    if (k == 0 && !o.render.empty()) first = rec;
     if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
+    if (k == 0 && !o.render.empty()) first = std::move(rec);
   }
   poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps);
   if (lcm_ctl != nullptr) {

@@ -218,7 +218,7 @@ static void measure(poursim_world_t *w) {
   int counts[4] = {0, 0, 0, 0};
   uint64_t h = w->hash;
   for (size_t i = 0; i < n; ++i) {
-    const b2Vec2 p = {w->pos[2 * i], w->pos[2 * i + 1]};
+    const b2Vec2 p = {static_cast<float>(w->fx[i]), static_cast<float>(w->fy[i])}; // Box2D's floats, exactly
     static_assert(sizeof p == sizeof(uint64_t), "a position is one word");
     h = hash_words(h, &p, 1);
     const double px = p.x, py = p.y;
@@ -330,7 +330,6 @@ static void set_joint_friction(poursim_world_t *w) {
 static void read_circles(poursim_world_t *w) {
   for (size_t i = 0; i < w->circles.size(); ++i) {
     const b2Vec2 p = b2Body_GetPosition(w->circles[i]), v = b2Body_GetLinearVelocity(w->circles[i]);
-    w->pos[2 * i] = p.x, w->pos[2 * i + 1] = p.y;
     w->fx[i] = p.x, w->fy[i] = p.y, w->fvx[i] = v.x, w->fvy[i] = v.y;
   }
 }
@@ -375,7 +374,7 @@ void empty_bucket(poursim_world_t *w, bool free_spin) {
   for (b2BodyId b : w->circles) b2DestroyBody(b);
   w->circles.clear();
   w->radii.clear();
-  w->pos.clear();
+  for (std::vector<double> *v : {&w->fx, &w->fy, &w->fvx, &w->fvy}) v->clear();
   w->region.clear();
   if (free_spin) b2RevoluteJoint_EnableLimit(w->joint, false);
 }
@@ -423,7 +422,6 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   w->drive.reset(c);
   w->sensor_noise = poursim::Gauss(0x5E4507ULL ^ (static_cast<uint64_t>(seed) << 28));
   size_t n = w->circles.size();
-  w->pos.assign(2 * n, 0.0f);
   w->region.assign(n, 0);
   read_circles(w);
   // Settle with the bucket held by the joint motor, then release it at rest.
@@ -522,8 +520,8 @@ int poursim_particles(const poursim_world_t *w, float *xy, float *radius, int ca
   for (int i = 0; i < n; ++i) {
     size_t k = static_cast<size_t>(i);
     if (xy != nullptr) {
-      xy[2 * k] = w->pos[2 * k];
-      xy[2 * k + 1] = w->pos[2 * k + 1];
+      xy[2 * k] = static_cast<float>(w->fx[k]);
+      xy[2 * k + 1] = static_cast<float>(w->fy[k]);
     }
     if (radius != nullptr) radius[k] = w->radii[k];
   }
@@ -544,9 +542,9 @@ double poursim_max_overlap(const poursim_world_t *w) {
   double worst = 0.0;
   // Circles of the fluid meet through pressure, not contact: only the pile's circle pairs overlap.
   for (size_t i = 0; i < n && !c.fluid; ++i) {
-    Eigen::Vector2d pi(w->pos[2 * i], w->pos[2 * i + 1]);
+    Eigen::Vector2d pi(w->fx[i], w->fy[i]);
     for (size_t j = i + 1; j < n; ++j) {
-      Eigen::Vector2d pj(w->pos[2 * j], w->pos[2 * j + 1]);
+      Eigen::Vector2d pj(w->fx[j], w->fy[j]);
       double ov = static_cast<double>(w->radii[i] + w->radii[j]) - (pi - pj).norm();
       worst = std::max(worst, ov);
     }
@@ -557,7 +555,7 @@ double poursim_max_overlap(const poursim_world_t *w) {
   Eigen::Vector2d lo[3], hi[3];
   poursim::bucket_walls(c, lo, hi);
   for (size_t i = 0; i < n; ++i) {
-    Eigen::Vector2d p(w->pos[2 * i], w->pos[2 * i + 1]);
+    Eigen::Vector2d p(w->fx[i], w->fy[i]);
     Eigen::Vector2d local = to_bucket * (p - pivot), in_target = p - target_centre;
     double r = w->radii[i];
     for (int k = 0; k < 3; ++k) {

@@ -24,8 +24,9 @@ struct poursim_world {
   std::vector<b2BodyId> circles;
   std::vector<float> radii;   // [m]
   poursim::Fluid fluid;
-  std::vector<double> fx, fy, fvx, fvy; // the fluid layer's view of the circles (SoA) [m], [m/s]
-  std::vector<float> pos;     // x, y interleaved after the last measure [m]
+  // The circles as Box2D left them after the last step, read once a step (read_circles): positions [m] and
+  // velocities [m/s]; the fluid layer changes the velocities before the next step.
+  std::vector<double> fx, fy, fvx, fvy;
   std::vector<uint8_t> region; // 0 rotating, 1 target, 2 spilled, 3 in flight
   poursim_obs_t obs{};
   uint32_t step = 0;
