@@ -1,0 +1,21 @@
+/* SPDX-License-Identifier: MIT */
+/* Latched faults of the drive (the current loop, the power stage, the board's sensors), one word beside the
+ * core's POUR_FAULT_* bits. Any of them makes the core fault too (the drive is no longer trusted to follow a
+ * torque); which one is named here. */
+#ifndef POUR_DRIVE_FAULTS_H
+#define POUR_DRIVE_FAULTS_H
+
+#define POUR_DRIVE_FAULT_OVERCURRENT 0x0001u      /* a phase current above the software limit */
+#define POUR_DRIVE_FAULT_HW_OVERCURRENT 0x0002u   /* the comparators cut the PWM through TIM1's break input */
+#define POUR_DRIVE_FAULT_OVERVOLTAGE 0x0004u      /* bus voltage above its fault threshold */
+#define POUR_DRIVE_FAULT_UNDERVOLTAGE 0x0008u     /* bus voltage below its fault threshold */
+#define POUR_DRIVE_FAULT_OVERTEMP 0x0010u         /* power stage above its fault temperature */
+#define POUR_DRIVE_FAULT_CURRENT_OFFSET 0x0020u   /* a current-sense offset out of range at start-up */
+#define POUR_DRIVE_FAULT_PHASE 0x0040u            /* a motor phase open or shorted */
+#define POUR_DRIVE_FAULT_ENCODER_DIRECTION 0x0080u /* the motor encoder counts against the commanded motion */
+#define POUR_DRIVE_FAULT_ENCODER_MISMATCH 0x0100u /* motor and output encoders disagree beyond the backlash */
+#define POUR_DRIVE_FAULT_CALIBRATION 0x0200u      /* no valid calibration (missing, bad CRC, old version) */
+#define POUR_DRIVE_FAULT_I2T 0x0400u              /* the motor's thermal (I²t) budget is spent */
+#define POUR_DRIVE_FAULT_ALL 0x07FFu
+
+#endif /* POUR_DRIVE_FAULTS_H */
