@@ -175,11 +175,10 @@ static bool at_rest(const pour_stop_config_t *c, const pour_state_t *s) {
          s->omega_urad_s <= c->rest_omega_urad_s && s->omega_urad_s >= -c->rest_omega_urad_s;
 }
 
-/* FAULT: an active stop while the fault allows it and fresh states keep coming, else (and after it) the
- * safe torque with the brake engaged and the power cut. Returns the torque; *active tells which. */
-static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
+/* FAULT: an active stop while the fault allows it and fresh states keep coming; false once it is over (or
+ * never could act): then the safe torque with the brake engaged and the power cut. */
+static bool stop_active(pour_control_t *ctl) {
   const pour_stop_config_t *c = &ctl->config.stop;
-  *active = false;
   if (!ctl->stopped) {
     const bool can_act = (ctl->faults & ~(uint16_t)POUR_FAULT_ACTIVE_STOP) == 0u &&
                          ctl->ms_since_fresh <= ctl->config.input_timeout_ms && ctl->stop_ms < c->timeout_ms;
@@ -187,13 +186,9 @@ static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
       ctl->stopped = true;
     } else {
       ctl->stop_ms++;
-      *active = true;
-      /* Through the envelope: the stop never steps the torque by more than the slew limit. */
-      return pour_safety_apply(&ctl->safety, stop_request(c, &ctl->state), ctl->state.theta_urad,
-                               ctl->state.omega_urad_s);
     }
   }
-  return force_safe(ctl);
+  return !ctl->stopped;
 }
 
 static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_output_t *out) {
@@ -328,23 +323,28 @@ void pour_control_shape(pour_control_t *ctl, pour_control_output_t *out) {
   if (ctl->mode == POUR_MODE_ESTOP) {
     pour_safety_force(&ctl->safety, 0);
     fill_output(ctl, 0, out);
-  } else if (ctl->mode == POUR_MODE_RUN) {
-    if (!ctl->decision_due && ctl->probs_pending) {
-      pour_policy_fill_probs(&ctl->policy, &ctl->eval);
-      ctl->probs_pending = false;
-    }
-    const q15_t torque =
-        pour_safety_apply(&ctl->safety, ctl->request, ctl->state.theta_urad, ctl->state.omega_urad_s);
+    return;
+  }
+  const bool run = ctl->mode == POUR_MODE_RUN;
+  const bool stopping = ctl->mode == POUR_MODE_FAULT && stop_active(ctl);
+  if (!run && !stopping) {
+    fill_output(ctl, force_safe(ctl), out); /* IDLE, and FAULT once the stop is over */
+    return;
+  }
+  if (run && !ctl->decision_due && ctl->probs_pending) {
+    pour_policy_fill_probs(&ctl->policy, &ctl->eval);
+    ctl->probs_pending = false;
+  }
+  /* The one place a request becomes a command: the decision's in RUN, the stop's in FAULT; neither ever
+   * steps the torque by more than the slew limit. */
+  const q15_t request = run ? ctl->request : stop_request(&ctl->config.stop, &ctl->state);
+  const q15_t torque = pour_safety_apply(&ctl->safety, request, ctl->state.theta_urad, ctl->state.omega_urad_s);
+  fill_output(ctl, torque, out);
+  if (run) {
     pour_supervisor_record(&ctl->supervisor, &ctl->state, torque);
-    fill_output(ctl, torque, out);
-  } else if (ctl->mode == POUR_MODE_FAULT) {
-    bool active = false;
-    const q15_t torque = controlled_stop(ctl, &active);
-    fill_output(ctl, torque, out);
-    out->brake = !active;
-    out->power = active;
   } else {
-    fill_output(ctl, force_safe(ctl), out);
+    out->brake = false; /* the active stop drives the motor */
+    out->power = true;
   }
 }
 
