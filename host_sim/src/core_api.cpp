@@ -87,10 +87,6 @@ const Record kRecords[] = {
     {"poursim_sensor_check_t", sizeof(poursim_sensor_check_t)},
 };
 
-int refused(char *err, size_t err_len, const char *what, pour_status_t status) {
-  return set_error(err, err_len, POURSIM_EINVAL, "%s refused the config: %s", what, pour_status_name(status));
-}
-
 } // namespace
 
 struct poursim_envelope {
@@ -105,6 +101,32 @@ struct poursim_core {
   q15_t levels[POUR_POLICY_MAX_ACTIONS];
   pour_policy_weights_t weights;
 };
+
+namespace {
+
+// A new handle H whose state init sets up from the config; NULL with the reason in err (the core's status
+// name when it refuses).
+template <typename H, typename Init>
+H *create_handle(const void *config, const char *what, char *err, size_t err_len, Init init) {
+  if (config == nullptr) {
+    set_error(err, err_len, POURSIM_EINVAL, "%s: config is NULL", what);
+    return nullptr;
+  }
+  auto *h = new (std::nothrow) H;
+  if (h == nullptr) {
+    set_error(err, err_len, POURSIM_ESTATE, "%s: out of memory", what);
+    return nullptr;
+  }
+  const pour_status_t st = init(h, as_config(config));
+  if (st != POUR_OK) {
+    set_error(err, err_len, POURSIM_EINVAL, "%s refused the config: %s", what, pour_status_name(st));
+    delete h;
+    return nullptr;
+  }
+  return h;
+}
+
+} // namespace
 
 extern "C" size_t poursim_sizeof(const char *type_name) {
   if (type_name == nullptr) return 0;
@@ -153,19 +175,10 @@ extern "C" int poursim_fw_config_get(const void *config, const char *name, int64
 }
 
 extern "C" poursim_envelope_t *poursim_envelope_create(const void *config, char *err, size_t err_len) {
-  if (config == nullptr) {
-    set_error(err, err_len, POURSIM_EINVAL, "envelope: config is NULL");
-    return nullptr;
-  }
-  auto *env = new (std::nothrow) poursim_envelope;
-  if (env == nullptr) return nullptr;
-  const pour_status_t st = pour_safety_init(&env->s, &as_config(config).safety);
-  if (st != POUR_OK) {
-    refused(err, err_len, "pour_safety_init", st);
-    delete env;
-    return nullptr;
-  }
-  return env;
+  return create_handle<poursim_envelope>(config, "pour_safety_init", err, err_len,
+                                         [](poursim_envelope *h, const pour_control_config_t &c) {
+                                           return pour_safety_init(&h->s, &c.safety);
+                                         });
 }
 extern "C" void poursim_envelope_destroy(poursim_envelope_t *env) { delete env; }
 extern "C" int16_t poursim_envelope_apply(poursim_envelope_t *env, int16_t requested, int32_t theta_urad,
@@ -181,19 +194,10 @@ extern "C" void poursim_envelope_band(const poursim_envelope_t *env, int32_t *fl
 }
 
 extern "C" poursim_estimator_t *poursim_estimator_create(const void *config, char *err, size_t err_len) {
-  if (config == nullptr) {
-    set_error(err, err_len, POURSIM_EINVAL, "estimator: config is NULL");
-    return nullptr;
-  }
-  auto *est = new (std::nothrow) poursim_estimator;
-  if (est == nullptr) return nullptr;
-  const pour_status_t st = pour_estimator_init(&est->s, &as_config(config).sensors);
-  if (st != POUR_OK) {
-    refused(err, err_len, "pour_estimator_init", st);
-    delete est;
-    return nullptr;
-  }
-  return est;
+  return create_handle<poursim_estimator>(config, "pour_estimator_init", err, err_len,
+                                          [](poursim_estimator *h, const pour_control_config_t &c) {
+                                            return pour_estimator_init(&h->s, &c.sensors);
+                                          });
 }
 extern "C" void poursim_estimator_destroy(poursim_estimator_t *est) { delete est; }
 extern "C" void poursim_estimator_reset(poursim_estimator_t *est) { pour_estimator_reset(&est->s); }
@@ -215,12 +219,9 @@ extern "C" poursim_core_t *poursim_core_create(const void *config, int n_actions
               static_cast<unsigned>(POUR_POLICY_MAX_ACTIONS));
     return nullptr;
   }
-  auto *core = new (std::nothrow) poursim_core;
-  if (core == nullptr) return nullptr;
-  pour_status_t st;
-  if (n_actions == 0) {
-    st = pour_control_init_external(&core->ctl, &as_config(config), static_cast<uint16_t>(decision_period_ms));
-  } else {
+  const char *what = n_actions == 0 ? "pour_control_init_external" : "pour_control_init";
+  return create_handle<poursim_core>(config, what, err, err_len, [&](poursim_core *core, const pour_control_config_t &c) {
+    if (n_actions == 0) return pour_control_init_external(&core->ctl, &c, static_cast<uint16_t>(decision_period_ms));
     const size_t nw = static_cast<size_t>(POUR_POLICY_N_FEATURES) * static_cast<size_t>(n_actions);
     std::memcpy(core->w, w, nw * sizeof w[0]);
     std::memcpy(core->levels, levels, static_cast<size_t>(n_actions) * sizeof levels[0]);
@@ -233,14 +234,8 @@ extern "C" poursim_core_t *poursim_core_create(const void *config, int n_actions
     v.norm = pour_obs_norm_t{theta_min_urad, theta_max_urad, omega_max_urad_s};
     v.tau_max_mnm = tau_max_mnm;
     v.content_hash = content_hash;
-    st = pour_control_init(&core->ctl, &as_config(config), &core->weights);
-  }
-  if (st != POUR_OK) {
-    refused(err, err_len, n_actions == 0 ? "pour_control_init_external" : "pour_control_init", st);
-    delete core;
-    return nullptr;
-  }
-  return core;
+    return pour_control_init(&core->ctl, &c, &core->weights);
+  });
 }
 extern "C" void poursim_core_destroy(poursim_core_t *core) { delete core; }
 extern "C" int poursim_core_update(poursim_core_t *core, const pour_control_input_t *in) {

@@ -349,3 +349,30 @@ def test_control_step_holds_the_safety_rules_after_every_tick(example_weights, c
     again = core.Controller(example_weights, cfg)
     assert [again.step(tk["sample"], tk["estop"], tk["clear"], tk["link_fault"], tk["stop"], tk["reset"])
             for tk in ticks] == outs
+
+
+def test_the_core_handle_refuses_what_the_core_refuses(example_weights):
+    with pytest.raises(core.CoreError, match="decision_period_ms 1..65535"):
+        core.Controller(None, decision_period_ms=0)
+    bad = core.control_config(input_timeout_ms=0)
+    with pytest.raises(core.CoreError, match="pour_control_init_external refused the config: .*EINVAL"):
+        core.Controller(None, bad, decision_period_ms=10)
+    with pytest.raises(core.CoreError, match="pour_control_init refused the config: .*EINVAL"):
+        core.Controller(example_weights, bad)
+    with pytest.raises(core.CoreError, match="pour_estimator_init refused the config"):
+        core.Estimator(encoder_bits=40)
+
+
+def test_an_outside_request_runs_the_same_pipeline_as_the_policy(example_weights):
+    """The handle's stages with the policy's own choices give pour_control_step's outputs tick for tick."""
+    own = core.Controller(example_weights)
+    ext = core.Controller(None, decision_period_ms=example_weights.decision_period_ms)
+    levels = list(example_weights.levels_q15)
+    for t in range(120):
+        sample = (t, _count(2000 * t, 17), 10000 - 5 * t, 5 * t)
+        want = own.step(sample)
+        if ext.update(sample):
+            ext.request(want.action, levels[want.action])
+        got = ext.shape()
+        assert (got.torque, got.action, got.mode, got.faults, got.limits, got.brake) == \
+               (want.torque, want.action, want.mode, want.faults, want.limits, want.brake)
