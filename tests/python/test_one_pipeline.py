@@ -34,10 +34,10 @@ def host_sim_run(build_dir, source_dir, tmp_path, seed):
 
 
 def gym_replay(seed, actions):
-    """The Gymnasium env fed one action per decision: the core's torque of every tick, Q15."""
+    """The Gymnasium env, reset(seed=seed) as host_sim --seed seed, fed one action per decision: the core's
+    torque of every tick, Q15."""
     env = pour.sim.gym_env.PourEnv("sim", n_actions=11, decision_period_ms=PERIOD, episode_s=EPISODE_S)
-    env._plant.reset(seed)
-    env._k, env._started = 0, True
+    env.reset(seed=seed)
     for a in actions:
         env.step(int(a))
     return np.array(env._plant.torques, dtype=np.int64)

@@ -24,6 +24,35 @@ def test_sim_gym_env_passes_the_checker():
     check_env(env, skip_render_check=True)
 
 
+def test_sim_gym_env_follows_the_gymnasium_conventions():
+    """rgb_array rendering, max_episode_steps, the randomised rig's id, rig options at reset, refusals."""
+    import gymnasium as gym
+    env = gym.make("pour/Pour-v0", render_mode="rgb_array", episode_s=0.1)
+    assert env.spec.max_episode_steps == 1000
+    check_env(env.unwrapped)
+    env.reset(seed=3)
+    before = env.render()
+    for _ in range(10):
+        env.step(10)
+    after = env.render()
+    assert before.shape == (240, 320, 3) and before.dtype == np.uint8
+    assert np.any(before != after)  # the bucket tilted, the liquid moved
+    rand = gym.make("pour/PourRandomised-v0", episode_s=0.1)
+    rand.reset(seed=3)
+    assert rand.unwrapped._plant.world.episode_config()["fill_depth"] != \
+        env.unwrapped._plant.world.episode_config()["fill_depth"]  # the seed's draw of the rig
+    env.reset(seed=3, options={"rig": {"fill_depth": 0.15}})
+    assert env.unwrapped._plant.world.config.fill_depth == 0.15
+    with pytest.raises(envs.EnvError, match="the only option is 'rig'"):
+        env.reset(options={"fill_depth": 0.15})
+    with pytest.raises(envs.EnvError, match="simulator option no_such_key"):
+        env.reset(options={"rig": {"no_such_key": 1.0}})
+    with pytest.raises(envs.EnvError, match="render_mode 'human'"):
+        pour.sim.gym_env.PourEnv("sim", render_mode="human")
+    with pytest.raises(envs.EnvError, match="seed 4294967296"):
+        env.reset(seed=2**32)
+
+
 def test_gym_steps_reproduce_the_c_rollout():
     """Tick-by-tick stepping (the firmware's pipeline, in C through pour.policy.core) and the C whole-episode
     rollout agree exactly."""

@@ -3,6 +3,8 @@
 
     import gymnasium, pour.sim.gym_env
     env = gymnasium.make("pour/Pour-v0")            # Box2D simulator (libpoursim), 11 torque levels
+    env = gymnasium.make("pour.sim.gym_env:pour/Pour-v0", render_mode="rgb_array")  # imports pour itself
+    env = gymnasium.make("pour/PourRandomised-v0")  # the rig randomised as training randomises it
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 
@@ -26,20 +28,39 @@ from pour.policy import linear
 from pour.sim import envs
 
 
-class PourEnv(gym.Env):
-    """Pouring with a discrete torque action; backend 'sim' (Box2D) or 'toy' (the trainer's toy plant)."""
+# The rig's spread that training randomises over (configs/train/pour11.toml's [env.options]), for
+# pour/PourRandomised-v0.
+RANDOMISED_RIG = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0.02, "rand_motor": 0.15,
+                  "rand_bucket_mass": 0.2, "rand_liquid": 0.2, "rand_sensor": 0.5}
 
-    metadata = {"render_modes": []}
+
+class PourEnv(gym.Env):
+    """Pouring with a discrete torque action; backend 'sim' (Box2D) or 'toy' (the trainer's toy plant).
+
+    reset(seed=s) runs the plant of seed s, exactly as host_sim --seed s does; reset() without a seed goes on
+    with seeds drawn from the env's seeded generator. reset(options={"rig": {KEY: VALUE}}) sets simulator
+    config keys over the env's own options from that episode on (the same keys as host_sim --set)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
     def __init__(self, backend: str = "sim", n_actions: int = 11, decision_period_ms: int = 10,
-                 episode_s: float = 10.0, options: dict[str, Any] | None = None):
+                 episode_s: float = 10.0, options: dict[str, Any] | None = None, render_mode: str | None = None):
         if backend not in ("sim", "toy"):
             raise envs.EnvError(f"backend {backend!r}: expected 'sim' or 'toy'")
         if not 2 <= int(n_actions) <= 16:
             raise envs.EnvError(f"n_actions = {n_actions}: expected 2..16")
         if int(decision_period_ms) < 1 or round(episode_s * 1000) % int(decision_period_ms):
             raise envs.EnvError(f"episode_s = {episode_s} is not a whole number of {decision_period_ms} ms periods")
-        self._plant = envs.make_stepper(backend, int(n_actions), int(decision_period_ms), float(episode_s), options)
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise envs.EnvError(f"render_mode {render_mode!r}: expected one of {self.metadata['render_modes']}")
+        if render_mode is not None and backend != "sim":
+            raise envs.EnvError("render_mode: only the 'sim' backend has a scene to draw")
+        self._backend, self._n_actions, self._episode_s = backend, int(n_actions), float(episode_s)
+        self._options = dict(options or {})
+        self._plant = envs.make_stepper(backend, int(n_actions), int(decision_period_ms), float(episode_s),
+                                        self._options)
+        self.render_mode = render_mode
+        self.metadata = dict(self.metadata, render_fps=1000 // int(decision_period_ms))
         self.levels = linear.action_levels(int(n_actions))
         self.period = int(decision_period_ms)
         self.max_decisions = int(round(episode_s * 1000)) // self.period
@@ -53,9 +74,24 @@ class PourEnv(gym.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
-        # The plant's own seed comes from Gymnasium's seeded generator, so reset(seed=s) is reproducible
-        # and later resets without a seed continue the same sequence.
-        plant_seed = int(self.np_random.integers(0, 2**32 - 1))
+        unknown = set(options or {}) - {"rig"}
+        if unknown:
+            raise envs.EnvError(f"reset options {sorted(unknown)}: the only option is 'rig' (simulator config keys)")
+        rig = (options or {}).get("rig")
+        if rig:
+            if not isinstance(rig, dict):
+                raise envs.EnvError(f"reset option rig = {rig!r}: expected a dict of simulator config keys")
+            self._options.update(rig)
+            self._plant = envs.make_stepper(self._backend, self._n_actions, self.period, self._episode_s,
+                                            self._options)
+        # A given seed is the plant's seed, as host_sim's --seed; without one the next seed comes from the
+        # env's generator (seeded by the last reset with a seed), so a sequence of resets is reproducible.
+        if seed is not None:
+            if not 0 <= int(seed) < 2**32:
+                raise envs.EnvError(f"seed {seed}: expected 0 .. 2^32 - 1 (host_sim's --seed)")
+            plant_seed = int(seed)
+        else:
+            plant_seed = int(self.np_random.integers(0, 2**32 - 1))
         self._plant.reset(plant_seed)
         self._k = 0
         self._started = True
@@ -76,5 +112,52 @@ class PourEnv(gym.Env):
         return self._obs(), reward, False, truncated, info
 
 
-gym.register(id="pour/Pour-v0", entry_point="pour.sim.gym_env:PourEnv")
-gym.register(id="pour/PourToy-v0", entry_point="pour.sim.gym_env:PourEnv", kwargs={"backend": "toy"})
+    def render(self) -> np.ndarray | None:
+        """rgb_array: the scene now (uint8 [H, W, 3]), drawn from the world; None without a render_mode."""
+        if self.render_mode != "rgb_array":
+            return None
+        return scene_rgb(self._plant.world)
+
+
+# Liquid colours by where a circle is (poursim_particle_regions): bucket, target, spilled, in flight.
+_REGION_RGB = np.array([[245, 224, 178], [245, 224, 178], [200, 40, 40], [60, 110, 220]], dtype=np.uint8)
+
+
+def scene_rgb(world: Any, width: int = 320, height: int = 240) -> np.ndarray:
+    """A picture of the world: the ground, both buckets (grey) and the circles coloured by region."""
+    c = world.config
+    obs = world.observe()
+    wi, wall, hh = c.bucket_inner_width / 2, c.bucket_wall, c.bucket_height / 2
+    x0, x1, y0 = -0.30, c.target_dx + 0.30, -0.02
+    scale = min(width / (x1 - x0), height / (c.pivot_height + 0.30 - y0))
+    img = np.full((height, width, 3), 255, dtype=np.uint8)
+    ys, xs = np.mgrid[0:height, 0:width]
+    px, py = x0 + (xs + 0.5) / scale, y0 + (height - ys - 0.5) / scale  # pixel centres [m]
+    img[py < 0.0] = (140, 140, 140)
+    boxes = [(-wi - wall, -hh, wi + wall, -hh + wall), (-wi - wall, -hh, -wi, hh), (wi, -hh, wi + wall, hh)]
+    cos, sin = np.cos(obs.theta), np.sin(obs.theta)
+    # The rotating bucket in its own frame (θ tilts clockwise about the pivot), the target upright on the floor.
+    lx, ly = cos * px - sin * (py - c.pivot_height), sin * px + cos * (py - c.pivot_height)
+    for bx0, by0, bx1, by1 in boxes:
+        img[(lx >= bx0) & (lx <= bx1) & (ly >= by0) & (ly <= by1)] = (110, 110, 110)
+        tx, ty = px - c.target_dx, py - hh
+        img[(tx >= bx0) & (tx <= bx1) & (ty >= by0) & (ty <= by1)] = (110, 110, 110)
+    xy, radius = world.particles()
+    region = world.regions()
+    for (cx, cy), r, g in zip(xy, radius, region):
+        i0, i1 = int((cx - r - x0) * scale), int((cx + r - x0) * scale) + 1
+        j0, j1 = int(height - (cy + r - y0) * scale), int(height - (cy - r - y0) * scale) + 1
+        i0, j0, i1, j1 = max(i0, 0), max(j0, 0), min(i1, width), min(j1, height)
+        if i0 >= i1 or j0 >= j1:
+            continue
+        inside = (px[j0:j1, i0:i1] - cx) ** 2 + (py[j0:j1, i0:i1] - cy) ** 2 <= r * r
+        img[j0:j1, i0:i1][inside] = _REGION_RGB[min(int(g), 3)]
+    return img
+
+
+# max_episode_steps: decisions in the default 10 s episode at the default 10 ms period.
+gym.register(id="pour/Pour-v0", entry_point="pour.sim.gym_env:PourEnv", max_episode_steps=1000)
+gym.register(id="pour/PourRandomised-v0", entry_point="pour.sim.gym_env:PourEnv", max_episode_steps=1000,
+             kwargs={"options": RANDOMISED_RIG})
+gym.register(id="pour/PourToy-v0", entry_point="pour.sim.gym_env:PourEnv", kwargs={"backend": "toy"},
+             max_episode_steps=1000)
