@@ -12,6 +12,7 @@ import cantools
 import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
+from pour import libpoursim
 from pour.can import dbc
 
 SEED = 20261123
@@ -313,3 +314,11 @@ def test_harness_answers_bad_requests_without_dying(harness):
     assert harness.ask("unpack torque 4096 7 00").startswith("error")
     assert harness.ask("frobnicate x").startswith("error")
     assert harness.ask("pack sensors 64 0 0 0 0") == "einval"
+
+
+def test_the_heartbeat_carries_one_signal_per_fault_the_core_names(db):
+    """Each of the core's fault bits (its name table, pour_fault_name) has its Fault_ signal at bit 8 + i."""
+    hb = db.get_message_by_name("Heartbeat")
+    signals = {s.name: 1 << (s.start - 8) for s in hb.signals if s.name.startswith("Fault_")}
+    assert signals == FAULT_BITS
+    assert sorted(signals.values()) == [1 << i for i in range(16) if libpoursim.fault_name(1 << i) is not None]
