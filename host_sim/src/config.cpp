@@ -117,8 +117,6 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
     return set_error(err, err_len, POURSIM_EINVAL,
                      "config n_particles %d: too few for fill_depth %g m (spacing %.3f m > half the bucket width)",
                      c->n_particles, c->fill_depth, spacing);
-  if (c->obs_theta_max <= c->obs_theta_min)
-    return set_error(err, err_len, POURSIM_EINVAL, "config obs_theta_max must be > obs_theta_min");
   if (c->bucket_height <= 2.0 * c->bucket_wall)
     return set_error(err, err_len, POURSIM_EINVAL, "config bucket_height must exceed twice bucket_wall");
   if (c->scale_rate_hz * c->dt > 1.0 + 1e-9)

@@ -255,9 +255,10 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
   truth.v_target = obs.v_target;
   truth.v_spill = obs.v_spill;
   truth.motor_torque = obs.motor_torque;
-  for (int i = 0; i < 5; i++) {
-    truth.obs[i] = static_cast<float>(obs.obs[i]);
-  }
+  double x[POURSIM_N_FEATURES] = {};
+  if (s.def.truth_obs)
+    poursim_features(&s.def.truth_norm, obs.theta, obs.omega, obs.v_rotating, obs.v_target, obs.v_spill, x);
+  for (int i = 0; i < 5; i++) truth.obs[i] = static_cast<float>(x[i]);
   s.waiting_seq = seq;
   s.got_waited = false;
 

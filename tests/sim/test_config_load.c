@@ -111,13 +111,13 @@ static void test_config_load_RefusesAnEndlessFile(void) {
   expect_error(poursim_config_load("/dev/zero", &cfg, err, sizeof err), "/dev/zero", "larger than 1048576 bytes");
 }
 
-/* "seed = 7\0JUNK" used to read as seed 7. */
+/* "seed = 7\0JUNK" is refused, not read as seed 7: a NUL byte is not text. */
 static void test_config_load_RefusesNulBytes(void) {
   static const char text[] = "friction = 0.1\nseed = 7\0JUNK\n";
   expect_error(load_text("nul.cfg", text, sizeof text - 1), "nul.cfg:2:", "NUL byte");
 }
 
-/* The last of two settings used to win silently. */
+/* A key set twice is refused, not settled by the last one. */
 static void test_config_load_RefusesDuplicateKeys(void) {
   static const char text[] = "seed = 7\nfriction = 0.1\n  seed=8\n";
   expect_error(load_text("dup.cfg", text, sizeof text - 1), "dup.cfg:3:", "seed is set twice (first on line 1)");

@@ -68,14 +68,6 @@
   X(DOUBLE, rand_bucket_mass, 0.0, 0.0, 0.5, "relative", "bucket_mass") \
   X(DOUBLE, rand_liquid, 0.0, 0.0, 0.5, "relative", "fluid viscosity, stiffness, agitation, liquid density") \
   X(DOUBLE, rand_sensor, 0.0, 0.0, 0.9, "relative", "scale delay and noise; latency +0 or +1 tick") \
-  S("observation normalisation (must match the policy's weights.h)") \
-  X(DOUBLE, obs_theta_min, 0.0, -3.2, 3.2, "rad", "theta mapped to 0") \
-  X(DOUBLE, obs_theta_max, 2.356194, -3.2, 3.2, "rad", "theta mapped to 1") \
-  X(DOUBLE, obs_omega_max, 4.0, 1e-3, 1000.0, "rad/s", "theta-dot in [-max, max] maps to [0, 1]") \
-  S("reward r = k_target*V_target - k_spill*V_spill per step; return sum gamma^t r_t") \
-  X(DOUBLE, k_target, 1.0, 0.0, 1e6, "-", "weight of the poured share") \
-  X(DOUBLE, k_spill, 5.0, 0.0, 1e6, "-", "weight of the spilled share") \
-  X(DOUBLE, gamma, 0.9995, 0.0, 1.0, "-", "per-step discount of the return") \
   S("randomness") \
   X(U32, seed, 1, 0, 4294967295.0, "-", "default seed of reset() and the CLI")
 

@@ -50,8 +50,6 @@ typedef struct {
   double v_target;      /* fraction inside the target bucket */
   double v_spill;       /* fraction outside both and below the target's rim, or on the ground */
   double v_flight;      /* fraction in none of those (in the air) */
-  double obs[5];        /* normalised θ, θ̇, V_rot, V_tgt, V_spill, each in [0, 1] */
-  double reward;        /* K_target·V_target − K_spill·V_spill of this state */
   double torque;        /* torque commanded in the step that led here, a·tau_max [N·m] */
   int done;             /* 1 once t reaches episode_s */
   /* What the rig delivers and senses (docs/simulator.md, "The rig"). */
@@ -163,6 +161,24 @@ uint64_t poursim_trajectory_hash(const poursim_world_t *world);
 
 /* ---- Whole-episode rollout with a float softmax-linear policy (the trainer's model). ---- */
 
+/* The trainer's reward: r = k_target·V_target − k_spill·V_spill after each step, return Σ γ^t r_t. An
+ * episode's figure (poursim_episode_t.ret, reward_sum), not part of the world. */
+typedef struct {
+  double k_target; /* >= 0 */
+  double k_spill;  /* >= 0 */
+  double gamma;    /* per-step discount, in [0, 1] */
+} poursim_reward_t;
+
+/* host_sim's reward for its figures: k_target 1, k_spill 5, gamma 0.9995 (the trainer sets its own). */
+poursim_reward_t poursim_default_reward(void);
+
+/* POURSIM_EINVAL, naming the field, unless every field is finite and in its range. */
+int poursim_reward_validate(const poursim_reward_t *reward, char *err, size_t err_len);
+
+/* Sets k_target, k_spill or gamma from text (host_sim --set); POURSIM_EINVAL for another key or a value out
+ * of range, POURSIM_EPARSE for one that is not a number; *reward unchanged on error. */
+int poursim_reward_set(poursim_reward_t *reward, const char *key, const char *value, char *err, size_t err_len);
+
 /* A policy as weights.h describes it, in float: logits = x·W, x = [θn, ωn, Vr, Vt, Vs, 1]. */
 typedef struct {
   int n_actions;              /* 2..POURSIM_MAX_ACTIONS */
@@ -172,8 +188,15 @@ typedef struct {
   double theta_min, theta_max; /* normalisation [rad] */
   double omega_max;            /* [rad/s] */
   int greedy;                 /* 1: argmax (ties to lowest index); 0: sample with the seed */
+  poursim_reward_t reward;    /* the rollout's reward and return */
   double k_reversal;          /* training's reward shaping: cost of each torque reversal (0: none) */
 } poursim_policy_t;
+
+/* The policy's features, the float normalisation of docs/weights-h.md: x = [clip((θ − θmin)/(θmax − θmin)),
+ * clip((θ̇ + ωmax)/(2ωmax)), clip(V_rotating), clip(V_target), clip(V_spill), 1], clip to [0, 1], with the
+ * policy's theta_min, theta_max [rad] and omega_max [rad/s]. */
+void poursim_features(const poursim_policy_t *policy, double theta, double omega, double v_rotating,
+                      double v_target, double v_spill, double x[POURSIM_N_FEATURES]);
 
 /* Caller-provided arrays; any pointer may be NULL. Capacities: decisions = ceil(steps / period). */
 typedef struct {
@@ -223,6 +246,10 @@ int poursim_rollout_batch(const poursim_config_t *config, const poursim_policy_t
  * rounds; saturates to [-32768, 32767] (+1.0 -> 32767, -1.0 -> -32768, +-inf to the limits); NaN -> 0 (no
  * torque, never a plausible command). */
 int16_t poursim_fraction_to_q15(double fraction);
+
+/* sizeof the named plain record of the C API ("poursim_obs_t", ..., "poursim_weights_file_t"), 0 if unknown:
+ * Python's ctypes mirrors are checked against it. */
+size_t poursim_sizeof(const char *type_name);
 
 /* Library version string. */
 const char *poursim_version(void);

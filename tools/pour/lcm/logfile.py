@@ -165,17 +165,17 @@ def read_log(path: Path, encoder_bits: int = sensors.ENCODER_BITS) -> Log:
 
 
 def reward_params(k_target: float | None, k_spill: float | None, gamma: float | None):
-    """The simulator's reward constants unless given; None if neither given nor available."""
+    """libpoursim's default reward (host_sim's) where not given; None if neither given nor available."""
     if None not in (k_target, k_spill, gamma):
         return k_target, k_spill, gamma
     try:
         from pour.sim import poursim
 
-        d = poursim.default_config()
+        d = poursim.default_reward()
     except Exception:
         return None
-    return (d["k_target"] if k_target is None else k_target, d["k_spill"] if k_spill is None else k_spill,
-            d["gamma"] if gamma is None else gamma)
+    return (d.k_target if k_target is None else k_target, d.k_spill if k_spill is None else k_spill,
+            d.gamma if gamma is None else gamma)
 
 
 def episode_summary(ep: Episode, reward) -> dict:

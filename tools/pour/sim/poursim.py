@@ -41,17 +41,21 @@ class ObsStruct(C.Structure):
     _fields_ = [
         ("step", C.c_uint32), ("t", C.c_double), ("theta", C.c_double), ("omega", C.c_double),
         ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
-        ("obs", C.c_double * 5), ("reward", C.c_double), ("torque", C.c_double), ("done", C.c_int),
+        ("torque", C.c_double), ("done", C.c_int),
         ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
         ("scale_target_g", C.c_int32),
     ]
+
+
+class RewardStruct(C.Structure):
+    _fields_ = [("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double)]
 
 
 class PolicyStruct(C.Structure):
     _fields_ = [
         ("n_actions", C.c_int), ("decision_period", C.c_int), ("w", _DP), ("levels", _DP),
         ("theta_min", C.c_double), ("theta_max", C.c_double), ("omega_max", C.c_double), ("greedy", C.c_int),
-        ("k_reversal", C.c_double),
+        ("reward", RewardStruct), ("k_reversal", C.c_double),
     ]
 
 
@@ -168,6 +172,11 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
         "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
         "poursim_version": ([], C.c_char_p),
+        "poursim_sizeof": ([C.c_char_p], C.c_size_t),
+        "poursim_default_reward": ([], RewardStruct),
+        "poursim_reward_validate": ([P(RewardStruct)] + err, C.c_int),
+        "poursim_features": ([P(PolicyStruct), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
+                              P(C.c_double)], None),
         "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
     }
     for name, (args, res) in sig.items():
@@ -322,8 +331,6 @@ class Obs:
     v_target: float
     v_spill: float
     v_flight: float
-    obs: np.ndarray
-    reward: float
     torque: float              # commanded in this step [N·m]
     done: bool
     motor_torque: float = 0.0  # delivered by the drive in this step [N·m]
@@ -334,8 +341,38 @@ class Obs:
     @staticmethod
     def from_struct(o: ObsStruct) -> "Obs":
         return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
-                   np.array(o.obs[:], dtype=np.float64), o.reward, o.torque, bool(o.done), o.motor_torque,
+                   o.torque, bool(o.done), o.motor_torque,
                    int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g))
+
+
+@dataclass(frozen=True)
+class Reward:
+    """The trainer's reward, r = k_target·V_target − k_spill·V_spill per step, return Σ gamma^t r_t
+    (poursim_reward_t); not part of the world."""
+    k_target: float
+    k_spill: float
+    gamma: float
+
+    def step(self, v_target: float, v_spill: float) -> float:
+        """The reward of one step's shares, as the C rollout computes it."""
+        return self.k_target * v_target - self.k_spill * v_spill
+
+
+def default_reward() -> Reward:
+    """libpoursim's reward (poursim_default_reward), the one host_sim reports."""
+    r = load_library().poursim_default_reward()
+    return Reward(r.k_target, r.k_spill, r.gamma)
+
+
+def reward_from(options: dict) -> Reward:
+    """Pops k_target, k_spill and gamma from options (the rest are the world's), libpoursim's default for
+    each one absent; SimError names a value out of range."""
+    d = default_reward()
+    r = Reward(*(float(options.pop(k, getattr(d, k))) for k in ("k_target", "k_spill", "gamma")))
+    e = _err()
+    if load_library().poursim_reward_validate(C.byref(RewardStruct(r.k_target, r.k_spill, r.gamma)), e, ERR_LEN):
+        raise SimError(e.value.decode(errors="replace"), e.value.decode(errors="replace").split()[1])
+    return r
 
 
 @dataclass
@@ -349,6 +386,7 @@ class Policy:
     omega_max: float = 4.0             # [rad/s]
     greedy: bool = False               # argmax instead of sampling
     k_reversal: float = 0.0            # training's reward shaping: cost of each torque reversal
+    reward: Reward | None = None       # None: libpoursim's default_reward()
 
     def _struct(self) -> tuple[PolicyStruct, tuple[np.ndarray, np.ndarray]]:
         w = np.ascontiguousarray(self.w, dtype=np.float64)
@@ -357,9 +395,10 @@ class Policy:
             raise SimError(f"policy w has shape {w.shape}, expected (6, 2..16)")
         if lv.shape != (w.shape[1],):
             raise SimError(f"policy levels has shape {lv.shape}, expected ({w.shape[1]},)")
+        r = self.reward if self.reward is not None else default_reward()
         s = PolicyStruct(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
                          self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0,
-                         float(self.k_reversal))
+                         RewardStruct(r.k_target, r.k_spill, r.gamma), float(self.k_reversal))
         return s, (w, lv)  # the arrays must outlive the call
 
 
@@ -505,7 +544,8 @@ class World:
         rc = self._lib.poursim_rollout(self._check(), C.byref(ps), int(seed) & 0xFFFFFFFF, C.byref(bufs.struct),
                                        C.byref(e))
         if rc != 0:
-            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges and k_reversal")
+            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges, reward and "
+                           "k_reversal")
         del keep
         return bufs.result(seed, e)
 
@@ -584,6 +624,15 @@ def measure_sensors(config: Config | Mapping[str, float] | None = None, seed: in
     return _struct_dict(out)
 
 
+def features(theta_min: float, theta_max: float, omega_max: float, theta: float, omega: float, v_rotating: float,
+             v_target: float, v_spill: float) -> np.ndarray:
+    """poursim_features: the C rollout's normalisation of one state, [6] with the bias."""
+    p = PolicyStruct(theta_min=theta_min, theta_max=theta_max, omega_max=omega_max)
+    x = (C.c_double * N_FEATURES)()
+    load_library().poursim_features(C.byref(p), theta, omega, v_rotating, v_target, v_spill, x)
+    return np.array(x[:])
+
+
 def version() -> str:
     return load_library().poursim_version().decode()
 
@@ -593,6 +642,6 @@ def uniform_levels(n_actions: int) -> np.ndarray:
     return np.linspace(-1.0, 1.0, n_actions)
 
 
-__all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
+__all__: Sequence[str] = ("SimError", "World", "Policy", "Reward", "default_reward", "reward_from", "features", "Rollout", "Obs", "Retention", "Slosh", "default_config",
                           "make_config", "retention", "slosh", "measure_drive", "measure_sensors",
                           "load_library", "uniform_levels", "Config", "KeyInfo", "describe", "config_keys", "REGIONS", "version")
