@@ -31,7 +31,7 @@ struct LcmLinkDef {
 };
 
 struct LcmLinkStats {
-  int64_t states_sent = 0;   // distinct sensor samples (resends not counted)
+  int64_t samples_sent = 0;   // distinct sensor samples (resends not counted)
   int64_t resends = 0;       // lockstep: samples sent again after resend_ms
   int64_t answers = 0;       // decoded answers to our samples
   int64_t on_time = 0;       // answers that arrived before their tick's torque was applied

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "poursim/poursim.h"
+#include "read_text.h"
 #include "unity.h"
 
 static poursim_config_t cfg;
@@ -40,23 +41,15 @@ static void test_config_load_ReadsTheShippedConfig(void) {
   TEST_ASSERT_EQUAL_DOUBLE(0.1, cfg.friction);
 }
 
-static size_t read_all(const char *path, char *buf, size_t cap) {
-  FILE *f = fopen(path, "rb");
-  TEST_ASSERT_NOT_NULL_MESSAGE(f, path);
-  size_t n = fread(buf, 1, cap - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  return n;
-}
 
 /* configs/sim/default.cfg is what write_default_cfg writes (the target default_cfg regenerates it): every
  * key of config_fields.h once, at its default. */
 static void test_config_load_ShippedConfigIsTheGeneratedDefaults(void) {
   static char shipped[32768], written[32768];
-  const size_t n = read_all(POUR_SOURCE_DIR "/configs/sim/default.cfg", shipped, sizeof shipped);
+  const size_t n = read_text(POUR_SOURCE_DIR "/configs/sim/default.cfg", shipped, sizeof shipped);
   const poursim_config_t defaults = poursim_default_config();
   TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, poursim_config_write(&defaults, "defaults.cfg", err, sizeof err), err);
-  const size_t m = read_all("defaults.cfg", written, sizeof written);
+  const size_t m = read_text("defaults.cfg", written, sizeof written);
   TEST_ASSERT_EQUAL_size_t_MESSAGE(m, n, "configs/sim/default.cfg is stale: cmake --build --preset host --target default_cfg");
   TEST_ASSERT_EQUAL_STRING_MESSAGE(written, shipped, "configs/sim/default.cfg is stale: cmake --build --preset host --target default_cfg");
   int keys = 0;
