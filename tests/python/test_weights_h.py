@@ -195,3 +195,19 @@ def test_python_reads_weights_h_through_the_c_parser(tmp_path):
     assert str(exc.value) == err.value.decode() and "POUR_WEIGHTS_CONTENT_HASH" in str(exc.value)
     assert ctypes.sizeof(weights_h.WeightsFileStruct) == lib.poursim_sizeof(b"poursim_weights_file_t")
 
+
+
+def test_reading_without_the_library_says_it_needs_libpoursim(tmp_path, source_dir):
+    """Writing needs no library; reading does, and says so instead of failing somewhere inside ctypes."""
+    import os
+    import subprocess
+    import sys
+    code = ("from pour.policy import weights_h\ntry:\n    weights_h.parse_weights_h(%r)\n"
+            "except weights_h.WeightsHError as e:\n    print('WeightsHError:', e)\n"
+            % str(source_dir / "policy" / "weights.h"))
+    env = dict(os.environ, POUR_SIM_LIB=str(tmp_path / "nope.so"))
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, r.stderr
+    assert "WeightsHError: reading a weights.h needs libpoursim's parser: libpoursim.so not found" in r.stdout
+    text = weights_h.render_weights_h(np.zeros((6, 2)), norm=NORM)
+    assert text.startswith("/*") and "POUR_WEIGHTS_CONTENT_HASH" in text
