@@ -84,7 +84,7 @@ bench_core() {
 
 # --- section: lcm — host_sim and pour_controller as two processes over LCM (udpm, loopback) ------------
 # Lockstep: loop rate and round trip POUR_SENSORS -> POUR_TORQUE (median, p99) over 20,000 exchanges with
-# synthetic states (the transport and the controller alone), then a 10 s pour (10,000 steps, Box2D
+# synthetic samples (the transport and the controller alone), then a 10 s pour (10,000 steps, Box2D
 # included) next to the same pour in-process. Real time: a 60 s pour at 1 kHz wall clock against the
 # controller's own 1 kHz loop: late and missing answers, safe-torque ticks and overruns on both sides.
 # Wall-clock figures on a shared machine are noisy: they are printed, never judged.
@@ -102,7 +102,7 @@ bench_lcm() {
   bin=$build/bin
   hs=$build/bin/host_sim
   u="udpm://239.255.76.67:$((20000 + $$ % 20000))?ttl=0"
-  echo "-- lockstep, transport + controller only (20,000 synthetic states):"
+  echo "-- lockstep, transport + controller only (20,000 synthetic samples):"
   "$bin/pour_controller" --io "lcm:$u" --lockstep 2>/dev/null >/dev/null &
   ctl=$!
   "$bin/lcm_loop_driver" --mode lcm --url "$u" --no-sim --steps 20000 | grep -E '^(steps|lcm)' | sed 's/^/   /'

@@ -93,11 +93,12 @@ int bench_rollouts(const poursim_config_t &cfg, const std::string &policy_path) 
     for (int i = 0; i < 11; ++i) lbuf[static_cast<size_t>(i)] = -1.0 + 2.0 * i / 10.0;
     pol.w = wbuf.data();
     pol.levels = lbuf.data();
-    pol.theta_min = cfg.obs_theta_min;
-    pol.theta_max = cfg.obs_theta_max;
-    pol.omega_max = cfg.obs_omega_max;
+    // W = 0: every action equally likely whatever the features, so any non-empty normalisation does.
+    pol.theta_max = 1.0;
+    pol.omega_max = 1.0;
   }
   pol.greedy = 0;
+  pol.reward = poursim_default_reward();
   const int batch = 8;
   std::vector<uint32_t> seeds(batch);
   for (int i = 0; i < batch; ++i) seeds[static_cast<size_t>(i)] = static_cast<uint32_t>(100 + i);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The simulator's configuration: defaults, one table of fields (name, range), file I/O.
+// The simulator's configuration: config_fields.h as a table of fields (defaults, ranges, units), file I/O.
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <new>
 #include <sstream>
 #include <string>
 
@@ -18,75 +19,20 @@
 
 namespace {
 
-enum class Kind { Double, Int, U32 };
+enum class Kind { DOUBLE, INT, U32 };
 
 struct Field {
   const char *name;
   size_t offset;
   Kind kind;
-  double min, max; // inclusive range
-  const char *unit;
+  double def, min, max; // default; inclusive range
+  const char *unit, *doc;
 };
 
-#define F(name, kind, lo, hi, unit) {#name, offsetof(poursim_config_t, name), Kind::kind, lo, hi, unit}
-// Ranges: wide enough for experiments, narrow enough that the physics stays meaningful.
-const Field kFields[] = {
-    F(dt, Double, 1e-4, 0.01, "s"),
-    F(substeps, Int, 1, 16, "-"),
-    F(episode_s, Double, 0.01, 600.0, "s"),
-    F(settle_s, Double, 0.0, 10.0, "s"),
-    F(bucket_inner_width, Double, 0.05, 1.0, "m"),
-    F(bucket_height, Double, 0.05, 1.0, "m"),
-    F(bucket_wall, Double, 0.001, 0.05, "m"),
-    F(pivot_height, Double, 0.1, 5.0, "m"),
-    F(target_dx, Double, -2.0, 2.0, "m"),
-    F(bucket_mass, Double, 0.01, 100.0, "kg"),
-    F(fill_depth, Double, 0.01, 1.0, "m"),
-    F(liquid_density, Double, 500.0, 2000.0, "kg/m^3"),
-    F(n_particles, Int, 2, POURSIM_MAX_PARTICLES, "-"),
-    F(fluid, Int, 0, 1, "0/1"),
-    F(fluid_smoothing, Double, 1.2, 3.0, "-"),
-    F(fluid_contact_radius, Double, 0.1, 0.5, "-"),
-    F(fluid_stiffness, Double, 10.0, 1e5, "m/s^2"),
-    F(fluid_viscosity, Double, 0.0, 1e3, "1/s"),
-    F(fluid_agitation, Double, 0.0, 5.0, "m/s"),
-    F(restitution_liquid, Double, 0.0, 1.0, "-"),
-    F(restitution_wall, Double, 0.0, 1.0, "-"),
-    F(friction, Double, 0.0, 2.0, "-"),
-    F(restitution_threshold, Double, 0.0, 100.0, "m/s"),
-    F(contact_hertz, Double, 1.0, 10000.0, "Hz"),
-    F(tau_max, Double, 0.01, 1000.0, "N m"),
-    F(theta_min, Double, -1.0, 0.0, "rad"),
-    F(theta_max, Double, 0.1, 3.1, "rad"),
-    F(brake_torque, Double, 0.0, 1000.0, "N m"),
-    F(motor_peak_torque, Double, 0.1, 1000.0, "N m at the output"),
-    F(motor_no_load_speed, Double, 0.1, 1000.0, "rad/s at the output"),
-    F(motor_rotor_inertia, Double, 0.0, 0.1, "kg m^2 at the motor"),
-    F(gear_ratio, Double, 1.0, 1000.0, "-"),
-    F(friction_coulomb, Double, 0.0, 100.0, "N m"),
-    F(friction_viscous, Double, 0.0, 100.0, "N m s/rad"),
-    F(command_latency_ticks, Int, 1, 100, "steps"),
-    F(encoder_bits, Int, 8, 24, "bits"),
-    F(scale_rate_hz, Double, 1.0, 10000.0, "Hz"),
-    F(scale_delay_s, Double, 0.0, 1.0, "s"),
-    F(scale_noise_g, Double, 0.0, 1000.0, "g"),
-    F(scale_resolution_g, Double, 1.0, 1000.0, "g"),
-    F(rand_fill, Double, 0.0, 0.5, "relative"),
-    F(rand_target_dx, Double, 0.0, 0.1, "m"),
-    F(rand_pivot_height, Double, 0.0, 0.1, "m"),
-    F(rand_motor, Double, 0.0, 0.5, "relative"),
-    F(rand_bucket_mass, Double, 0.0, 0.5, "relative"),
-    F(rand_liquid, Double, 0.0, 0.5, "relative"),
-    F(rand_sensor, Double, 0.0, 0.9, "relative"),
-    F(obs_theta_min, Double, -3.2, 3.2, "rad"),
-    F(obs_theta_max, Double, -3.2, 3.2, "rad"),
-    F(obs_omega_max, Double, 1e-3, 1000.0, "rad/s"),
-    F(k_target, Double, 0.0, 1e6, "-"),
-    F(k_spill, Double, 0.0, 1e6, "-"),
-    F(gamma, Double, 0.0, 1.0, "-"),
-    F(seed, U32, 0, 4294967295.0, "-"),
-};
-#undef F
+#define POURSIM_FIELD(kind, name, d, lo, hi, unit, doc) {#name, offsetof(poursim_config_t, name), Kind::kind, d, lo, hi, unit, doc},
+#define POURSIM_NO_SECTION(title)
+const Field kFields[] = {POURSIM_CONFIG_FIELDS(POURSIM_FIELD, POURSIM_NO_SECTION)};
+#undef POURSIM_FIELD
 
 const Field *find_field(const char *name) {
   for (const Field &f : kFields) {
@@ -98,11 +44,21 @@ const Field *find_field(const char *name) {
 double get_value(const poursim_config_t *c, const Field &f) {
   const char *base = reinterpret_cast<const char *>(c) + f.offset;
   switch (f.kind) {
-    case Kind::Double: return *reinterpret_cast<const double *>(base);
-    case Kind::Int: return *reinterpret_cast<const int *>(base);
+    case Kind::DOUBLE: return *reinterpret_cast<const double *>(base);
+    case Kind::INT: return *reinterpret_cast<const int *>(base);
     case Kind::U32: return *reinterpret_cast<const uint32_t *>(base);
   }
   return 0.0;
+}
+
+// Stores v, which the caller has checked against the field's range (and, for integers, to be whole).
+void put_value(poursim_config_t *c, const Field &f, double v) {
+  char *base = reinterpret_cast<char *>(c) + f.offset;
+  switch (f.kind) {
+    case Kind::DOUBLE: *reinterpret_cast<double *>(base) = v; break;
+    case Kind::INT: *reinterpret_cast<int *>(base) = static_cast<int>(v); break;
+    case Kind::U32: *reinterpret_cast<uint32_t *>(base) = static_cast<uint32_t>(v); break;
+  }
 }
 
 std::string trim(const std::string &s) {
@@ -133,55 +89,7 @@ using poursim::set_error;
 extern "C" poursim_config_t poursim_default_config(void) {
   poursim_config_t c;
   std::memset(&c, 0, sizeof c);
-  c.dt = 0.001;
-  c.substeps = 1; // with the fluid, only circle-wall contacts: 1 sub-step keeps them within 0.3 mm
-  c.episode_s = 10.0;
-  c.settle_s = 0.6;
-  c.bucket_inner_width = 0.24;
-  c.bucket_height = 0.33;
-  c.bucket_wall = 0.005;
-  c.pivot_height = 0.56;
-  c.target_dx = 0.28; // under the stream of a slow pour (docs/simulator.md)
-  c.bucket_mass = 2.0;
-  c.fill_depth = 0.221;      // 10 L in a round bucket of 24 cm inner diameter
-  c.liquid_density = 1030.0; // soymilk
-  c.n_particles = 150;
-  c.fluid = 1;
-  c.fluid_smoothing = 1.8;
-  c.fluid_contact_radius = 0.5;
-  c.fluid_stiffness = 10000.0;
-  c.fluid_viscosity = 5.0;
-  c.fluid_agitation = 0.6;
-  c.restitution_liquid = 0.5;
-  c.restitution_wall = 0.1;
-  c.friction = 0.03; // low: the pile levels closer to a liquid (onset 60° vs 65° at 0.1)
-  c.restitution_threshold = 1.0;
-  c.contact_hertz = 240.0;
-  c.tau_max = 20.0;
-  c.theta_min = -0.0872664626; // -5°
-  c.theta_max = 2.35619449;    // 135°
-  c.brake_torque = 40.0;       // twice the drive's peak: holds the full bucket at any tilt (~15 N·m worst)
-  // A 48 V BLDC of the 57 mm (NEMA 23) class on a 2-stage 1:20 planetary gearhead; docs/simulator.md
-  // ("The rig") derives each number.
-  c.motor_peak_torque = 25.0;       // 1.35 N·m peak at the motor × 20 × 0.93 gearhead efficiency
-  c.motor_no_load_speed = 21.0;     // 4,000 rpm at 48 V / 20
-  c.motor_rotor_inertia = 2.4e-5;   // 240 g·cm² (a 57 mm rotor); × 20² = 0.0096 kg·m² at the output
-  c.gear_ratio = 20.0;
-  c.friction_coulomb = 0.6;         // the no-load loss split into Coulomb and viscous parts
-  c.friction_viscous = 0.02;        // 0.4 N·m at the no-load speed
-  c.command_latency_ticks = 1;      // one CAN frame: the torque of tick k acts in tick k + 1
-  c.encoder_bits = 17;
-  c.scale_rate_hz = 80.0;           // HX711 with RATE high: 80 samples/s
-  c.scale_delay_s = 0.05;           // HX711 output settling time at 80 samples/s: the filter's span
-  c.scale_noise_g = 0.5;
-  c.scale_resolution_g = 1.0;       // whole grams on the wire
-  c.obs_theta_min = 0.0;
-  c.obs_theta_max = 2.356194;
-  c.obs_omega_max = 4.0;
-  c.k_target = 1.0;
-  c.k_spill = 5.0;
-  c.gamma = 0.9995;
-  c.seed = 1;
+  for (const Field &f : kFields) put_value(&c, f, f.def);
   return c;
 }
 
@@ -209,8 +117,6 @@ extern "C" int poursim_config_validate(const poursim_config_t *c, char *err, siz
     return set_error(err, err_len, POURSIM_EINVAL,
                      "config n_particles %d: too few for fill_depth %g m (spacing %.3f m > half the bucket width)",
                      c->n_particles, c->fill_depth, spacing);
-  if (c->obs_theta_max <= c->obs_theta_min)
-    return set_error(err, err_len, POURSIM_EINVAL, "config obs_theta_max must be > obs_theta_min");
   if (c->bucket_height <= 2.0 * c->bucket_wall)
     return set_error(err, err_len, POURSIM_EINVAL, "config bucket_height must exceed twice bucket_wall");
   if (c->scale_rate_hz * c->dt > 1.0 + 1e-9)
@@ -287,19 +193,9 @@ extern "C" int poursim_config_set(poursim_config_t *c, const char *key, const ch
   if (v < f->min || v > f->max)
     return set_error(err, err_len, POURSIM_EINVAL, "config %s = %s is out of range [%g, %g] (unit: %s)", key, value,
                      f->min, f->max, f->unit);
-  char *base = reinterpret_cast<char *>(c) + f->offset;
-  switch (f->kind) {
-    case Kind::Double: *reinterpret_cast<double *>(base) = v; break;
-    case Kind::Int:
-    case Kind::U32:
-      if (v != std::floor(v))
-        return set_error(err, err_len, POURSIM_EPARSE, "config %s: '%s' is not an integer", key, value);
-      if (f->kind == Kind::Int)
-        *reinterpret_cast<int *>(base) = static_cast<int>(v);
-      else
-        *reinterpret_cast<uint32_t *>(base) = static_cast<uint32_t>(v);
-      break;
-  }
+  if (f->kind != Kind::DOUBLE && v != std::floor(v))
+    return set_error(err, err_len, POURSIM_EPARSE, "config %s: '%s' is not an integer", key, value);
+  put_value(c, *f, v);
   return POURSIM_OK;
 }
 
@@ -385,25 +281,116 @@ extern "C" int poursim_config_describe(char *buf, size_t len) {
   buf[0] = '\0';
   for (const Field &f : kFields) {
     int n = std::snprintf(buf + used, len - used, "  %-22s [%s] %g..%g%s, default %.6g\n", f.name, f.unit, f.min,
-                          f.max, f.kind == Kind::Double ? "" : " (integer)", get_value(&d, f));
+                          f.max, f.kind == Kind::DOUBLE ? "" : " (integer)", get_value(&d, f));
     if (n < 0 || static_cast<size_t>(n) >= len - used) return POURSIM_EINVAL;
     used += static_cast<size_t>(n);
   }
   return POURSIM_OK;
 }
 
-extern "C" int poursim_config_write(const poursim_config_t *c, const char *path, char *err, size_t err_len) {
-  std::ofstream out(path);
-  if (!out) return set_error(err, err_len, POURSIM_EIO, "cannot write config file '%s'", path);
-  out << "# poursim config (docs/simulator.md describes every key)\n";
-  for (const Field &f : kFields) {
-    char buf[64];
-    double v = get_value(c, f);
-    if (f.kind == Kind::Double)
-      std::snprintf(buf, sizeof buf, "%.17g", v);
-    else
-      std::snprintf(buf, sizeof buf, "%.0f", v);
-    out << f.name << " = " << buf << "  # [" << f.unit << "]\n";
+namespace {
+
+// The shortest text that reads back as the same double (integers as integers).
+std::string format_value(const Field &f, double v) {
+  char buf[40];
+  if (f.kind != Kind::DOUBLE || (v == std::floor(v) && std::fabs(v) < 1e15)) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+    return buf;
   }
-  return out ? POURSIM_OK : set_error(err, err_len, POURSIM_EIO, "error writing '%s'", path);
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
+uint64_t fnv1a64(const std::string &text) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (char ch : text) h = (h ^ static_cast<unsigned char>(ch)) * 0x100000001b3ULL;
+  return h;
+}
+
+// Every key in config_fields.h order under its section's heading, each with its unit and meaning.
+std::string config_text(const poursim_config_t *c) {
+  std::ostringstream body;
+  size_t i = 0;
+  auto field = [&](const Field &f) {
+    const std::string line = std::string(f.name) + " = " + format_value(f, get_value(c, f));
+    body << line << std::string(line.size() < 32 ? 32 - line.size() : 1, ' ') << "# [" << f.unit << "] " << f.doc
+         << "\n";
+  };
+#define POURSIM_WRITE_FIELD(kind, name, d, lo, hi, unit, doc) field(kFields[i++]);
+#define POURSIM_WRITE_SECTION(title) body << "\n# " << title << "\n";
+  POURSIM_CONFIG_FIELDS(POURSIM_WRITE_FIELD, POURSIM_WRITE_SECTION)
+#undef POURSIM_WRITE_FIELD
+#undef POURSIM_WRITE_SECTION
+  char banner[512];
+  std::snprintf(banner, sizeof banner,
+                "# poursim config, every key. Generated by poursim_config_write from the key list in\n"
+                "# host_sim/include/poursim/config_fields.h (body fnv1a64 %016llx): do not edit. From the defaults\n"
+                "# it is configs/sim/default.cfg: cmake --build --preset host --target default_cfg\n"
+                "# Format: one \"key = value\" per line, '#' starts a comment; units SI (m, kg, s, rad, N m).\n"
+                "# Load with host_sim --config FILE or pour.sim.poursim.make_config(path=FILE).\n",
+                static_cast<unsigned long long>(fnv1a64(body.str())));
+  return banner + body.str();
+}
+
+} // namespace
+
+// Written beside path and renamed over it, so that a failed write leaves the old file whole.
+extern "C" int poursim_config_write(const poursim_config_t *c, const char *path, char *err, size_t err_len) {
+  if (c == nullptr || path == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "config_write: NULL argument");
+  const std::string tmp = std::string(path) + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) return set_error(err, err_len, POURSIM_EIO, "cannot write config file '%s'", path);
+    out << config_text(c);
+    out.close();
+    if (!out) {
+      std::remove(tmp.c_str());
+      return set_error(err, err_len, POURSIM_EIO, "error writing '%s'", path);
+    }
+  }
+  if (std::rename(tmp.c_str(), path) != 0) {
+    std::remove(tmp.c_str());
+    return set_error(err, err_len, POURSIM_EIO, "cannot rename '%s' to '%s': %s", tmp.c_str(), path,
+                     std::strerror(errno));
+  }
+  return POURSIM_OK;
+}
+
+extern "C" poursim_config_t *poursim_config_new(const poursim_config_t *src) {
+  auto *c = new (std::nothrow) poursim_config_t;
+  if (c != nullptr) *c = src != nullptr ? *src : poursim_default_config();
+  return c;
+}
+
+extern "C" void poursim_config_free(poursim_config_t *c) { delete c; }
+
+extern "C" int poursim_config_get(const poursim_config_t *c, const char *key, double *value, char *err,
+                                  size_t err_len) {
+  if (c == nullptr || key == nullptr || value == nullptr)
+    return set_error(err, err_len, POURSIM_EINVAL, "config_get: NULL argument");
+  const Field *f = find_field(key);
+  if (f == nullptr) return set_error(err, err_len, POURSIM_EINVAL, "unknown config key '%s'", key);
+  *value = get_value(c, *f);
+  return POURSIM_OK;
+}
+
+extern "C" const char *poursim_config_key(int index) {
+  const int n = static_cast<int>(sizeof kFields / sizeof kFields[0]);
+  return index >= 0 && index < n ? kFields[index].name : nullptr;
+}
+
+extern "C" int poursim_config_key_info(const char *key, int *integer, double *min, double *max, double *def,
+                                       const char **unit, const char **doc) {
+  const Field *f = key != nullptr ? find_field(key) : nullptr;
+  if (f == nullptr) return POURSIM_EINVAL;
+  if (integer != nullptr) *integer = f->kind == Kind::DOUBLE ? 0 : 1;
+  if (min != nullptr) *min = f->min;
+  if (max != nullptr) *max = f->max;
+  if (def != nullptr) *def = f->def;
+  if (unit != nullptr) *unit = f->unit;
+  if (doc != nullptr) *doc = f->doc;
+  return POURSIM_OK;
 }

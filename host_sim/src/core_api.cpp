@@ -76,8 +76,8 @@ const Record kRecords[] = {
     {"pour_state_t", sizeof(pour_state_t)},
     {"pour_control_input_t", sizeof(pour_control_input_t)},
     {"pour_control_output_t", sizeof(pour_control_output_t)},
-    {"poursim_config_t", sizeof(poursim_config_t)},
     {"poursim_obs_t", sizeof(poursim_obs_t)},
+    {"poursim_reward_t", sizeof(poursim_reward_t)},
     {"poursim_policy_t", sizeof(poursim_policy_t)},
     {"poursim_rollout_buffers_t", sizeof(poursim_rollout_buffers_t)},
     {"poursim_episode_t", sizeof(poursim_episode_t)},
@@ -85,6 +85,7 @@ const Record kRecords[] = {
     {"poursim_slosh_t", sizeof(poursim_slosh_t)},
     {"poursim_drive_check_t", sizeof(poursim_drive_check_t)},
     {"poursim_sensor_check_t", sizeof(poursim_sensor_check_t)},
+    {"poursim_weights_file_t", sizeof(poursim_weights_file_t)},
 };
 
 } // namespace

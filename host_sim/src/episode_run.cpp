@@ -18,7 +18,8 @@ std::string world_failure(const poursim_world_t *world, const char *call, int st
 
 } // namespace
 
-Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec, StepHook *hook) {
+Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, const poursim_reward_t &reward,
+                    Recorder *rec, StepHook *hook) {
   Episode e;
   e.seed = seed;
   int rc = poursim_reset(world, seed);
@@ -33,7 +34,7 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
   poursim_obs_t o;
   poursim_observe(world, &o);
   EpisodeMeter meter;
-  meter.reset(*poursim_episode_config(world), o);
+  meter.reset(*poursim_episode_config(world), reward, o);
   auto keep_frame = [&](const poursim_obs_t &ob) {
     std::vector<float> xy(static_cast<size_t>(2 * n));
     poursim_particles(world, xy.data(), nullptr, n);
@@ -65,7 +66,7 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
     meter.add(o, a * cfg->tau_max);
     if (hook != nullptr) hook->after_step(o, a, meter);
     if (rec != nullptr) {
-      if (rec->steps) rec->samples.push_back({o, ctl.action()});
+      if (rec->steps) rec->samples.push_back({o, ctl.action(), meter.last_reward()});
       if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
     }
   }

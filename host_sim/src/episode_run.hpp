@@ -21,6 +21,7 @@ class Controller; // controllers.hpp
 struct Sample {
   poursim_obs_t obs;
   int action;
+  double reward; // of this step (poursim_reward_t)
 };
 
 // What run_episode keeps of an episode beyond its figures.
@@ -49,9 +50,10 @@ struct Episode {
 };
 
 // Resets world and controller to seed and steps until the observation says the episode is done, or until
-// the controller fails or the world refuses a call (the error then says why). rec and hook (either may be
-// null) receive what they ask for.
-Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Recorder *rec, StepHook *hook = nullptr);
+// the controller fails or the world refuses a call (the error then says why); reward makes the figures'
+// return. rec and hook (either may be null) receive what they ask for.
+Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, const poursim_reward_t &reward,
+                    Recorder *rec, StepHook *hook = nullptr);
 
 } // namespace poursim
 

@@ -112,8 +112,8 @@ struct LcmLink::Impl {
     }
     stats.answers++;
     stats.rtt_us.push_back(static_cast<int32_t>(std::min<int64_t>((now - sent_ns[slot]) / 1000, INT32_MAX)));
-    sent_ns[slot] = 0; // one round trip per state
-    // Real time uses the newest answer, whichever state it answers; lockstep only the awaited one.
+    sent_ns[slot] = 0; // one round trip per sample
+    // Real time uses the newest answer, whichever sample it answers; lockstep only the awaited one.
     if (!def.lockstep || msg.seq == waiting_seq) {
       answer_q15 = msg.torque_q15;
       stats.last_mode = msg.mode;
@@ -255,15 +255,16 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
   truth.v_target = obs.v_target;
   truth.v_spill = obs.v_spill;
   truth.motor_torque = obs.motor_torque;
-  for (int i = 0; i < 5; i++) {
-    truth.obs[i] = static_cast<float>(obs.obs[i]);
-  }
+  double x[POURSIM_N_FEATURES] = {};
+  if (s.def.truth_obs)
+    poursim_features(&s.def.truth_norm, obs.theta, obs.omega, obs.v_rotating, obs.v_target, obs.v_spill, x);
+  for (int i = 0; i < 5; i++) truth.obs[i] = static_cast<float>(x[i]);
   s.waiting_seq = seq;
   s.got_waited = false;
 
   if (s.def.lockstep) {
     m.utime = truth.utime = std::llround(obs.t * 1e6);
-    s.stats.states_sent++;
+    s.stats.samples_sent++;
     s.publish_sample(seq, truth);
     const int64_t start = mono_ns();
     const int64_t give_up = start + static_cast<int64_t>(s.def.answer_timeout_ms) * 1000000LL;
@@ -307,7 +308,7 @@ bool LcmLink::exchange(int episode, const poursim_obs_t &obs, int16_t *torque_q1
     s.stats.overruns++;
   }
   m.utime = truth.utime = wall_us();
-  s.stats.states_sent++;
+  s.stats.samples_sent++;
   s.publish_sample(seq, truth);
   s.poll_all();
   s.pump_until(slot_ns + static_cast<int64_t>(s.def.rt_budget_us) * 1000);
@@ -398,12 +399,12 @@ std::string LcmLink::summary() const {
   rtt_percentiles(&med, &p99);
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "lcm %s: states %lld answers %lld on_time %lld late %lld missing %lld resends %lld "
+                "lcm %s: samples %lld answers %lld on_time %lld late %lld missing %lld resends %lld "
                 "dropped %lld stale_answers %lld safe_ticks %lld overruns %lld late_max_us %lld particles %lld "
                 "rtt_median_us %.0f rtt_p99_us %.0f fault_answers %lld controller_faults 0x%04x",
-                impl_->def.lockstep ? "lockstep" : "realtime", static_cast<long long>(st.states_sent),
+                impl_->def.lockstep ? "lockstep" : "realtime", static_cast<long long>(st.samples_sent),
                 static_cast<long long>(st.answers), static_cast<long long>(st.on_time), static_cast<long long>(st.late),
-                static_cast<long long>(st.states_sent - st.on_time - st.late), static_cast<long long>(st.resends),
+                static_cast<long long>(st.samples_sent - st.on_time - st.late), static_cast<long long>(st.resends),
                 static_cast<long long>(st.dropped), static_cast<long long>(st.stale_answers),
                 static_cast<long long>(st.safe_ticks), static_cast<long long>(st.overruns),
                 static_cast<long long>(st.late_max_us), static_cast<long long>(st.particles_sent), med, p99,

@@ -24,12 +24,14 @@ struct LcmLinkDef {
   int rt_budget_us = 800;        // real time: how long a tick waits for the answer to its own sample
   int rt_safe_after_ms = 20;     // real time: no answer for this long → safe (zero) torque
   int particles_period_ms = 33;  // POUR_PARTICLES period in simulated time [ms]; 0: none
+  bool truth_obs = false;        // POUR_TRUTH.obs from truth_norm's normalisation; false: all 0
+  poursim_policy_t truth_norm{}; // the policy's theta_min, theta_max, omega_max (the rest unused)
   uint32_t expected_weights_hash = 0; // content hash the controller's policy must have; 0: any
                                       // (answers that report 0, e.g. from a CAN bridge, are not checked)
 };
 
 struct LcmLinkStats {
-  int64_t states_sent = 0;   // distinct sensor samples (resends not counted)
+  int64_t samples_sent = 0;   // distinct sensor samples (resends not counted)
   int64_t resends = 0;       // lockstep: samples sent again after resend_ms
   int64_t answers = 0;       // decoded answers to our samples
   int64_t on_time = 0;       // answers that arrived before their tick's torque was applied

@@ -65,7 +65,8 @@ const char *kUsage =
     "  spilled  % on the ground (outside both buckets, below the target's rim)\n"
     "  left     % still in the rotating bucket\n"
     "  finish   time until 99 % of what left the bucket had landed (in the target or spilled)\n"
-    "  return   sum over 1 ms steps of gamma^t (k_target*V_target - k_spill*V_spill)\n"
+    "  return   sum over 1 ms steps of gamma^t (k_target*V_target - k_spill*V_spill); --set k_target=, k_spill=,\n"
+    "           gamma= (defaults 1, 5, 0.9995) set the reward, which is not part of the world's config\n"
     "Outputs (--csv, --render and its .png and .json) are checked before the run: none may name an input\n"
     "or another output. Each is written beside its target and renamed over it when complete, so a failed\n"
     "or interrupted run leaves an existing file as it was.\n"
@@ -183,6 +184,7 @@ int main(int argc, char **argv) {
   if (rc >= 0) return rc;
   char err[POURSIM_ERR_LEN];
   poursim_config_t cfg = poursim_default_config();
+  poursim_reward_t reward = poursim_default_reward();
 
   // The policy first: the simulator runs at the tau_max the policy was trained with.
   poursim_weights_file_t weights;
@@ -201,7 +203,12 @@ int main(int argc, char **argv) {
   for (const std::string &s : o.sets) {
     size_t eq = s.find('=');
     if (eq == std::string::npos) return usage_error("--set wants KEY=VALUE, got '%s'", s.c_str());
-    if (poursim_config_set(&cfg, s.substr(0, eq).c_str(), s.substr(eq + 1).c_str(), err, sizeof err) != POURSIM_OK) {
+    const std::string key = s.substr(0, eq), value = s.substr(eq + 1);
+    // A key of the world's config, else one of the reward that makes the figures' return.
+    const bool world_key = poursim_config_key_info(key.c_str(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr) ==
+                           POURSIM_OK;
+    if ((world_key ? poursim_config_set(&cfg, key.c_str(), value.c_str(), err, sizeof err)
+                   : poursim_reward_set(&reward, key.c_str(), value.c_str(), err, sizeof err)) != POURSIM_OK) {
       std::fprintf(stderr, "host_sim: bad --set: %s\n", err);
       return 2;
     }
@@ -253,12 +260,17 @@ int main(int argc, char **argv) {
 
   std::unique_ptr<poursim::Controller> ctl;
   poursim::LcmController *lcm_ctl = nullptr;
+  std::vector<double> truth_w(POURSIM_N_FEATURES * POURSIM_MAX_ACTIONS), truth_levels(POURSIM_MAX_ACTIONS);
   if (o.lcm) {
     poursim::LcmLinkDef def;
     def.url = o.lcm_url;
     def.lockstep = !o.realtime;
     def.answer_timeout_ms = o.lcm_timeout_ms;
-    if (!o.policy.empty()) def.expected_weights_hash = weights.content_hash;
+    if (!o.policy.empty()) {
+      def.expected_weights_hash = weights.content_hash;
+      def.truth_obs = true;
+      poursim_weights_float_policy(&weights, truth_w.data(), truth_levels.data(), &def.truth_norm);
+    }
     std::string lerr;
     std::unique_ptr<poursim::LcmController> lc = poursim::LcmController::open(def, &lerr);
     if (!lc) {
@@ -302,7 +314,7 @@ int main(int argc, char **argv) {
     Recorder rec;
     rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
     rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEverySteps : 0;
-    Episode e = poursim::run_episode(world, *ctl, seed, &rec);
+    Episode e = poursim::run_episode(world, *ctl, seed, reward, &rec);
     if (!e.error.empty()) {
       int status = 1;
       if (lcm_ctl != nullptr && lcm_ctl->failed()) {

@@ -1,15 +1,68 @@
 // SPDX-License-Identifier: MIT
 #include "metrics.hpp"
 
+#include "poursim_internal.hpp"
+
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
 #include <cmath>
 #include <iterator>
 
+namespace {
+
+// The reward's keys for host_sim --set and their ranges.
+struct RewardKey {
+  const char *name;
+  double poursim_reward_t::*field;
+  double max;
+};
+constexpr RewardKey kRewardKeys[] = {{"k_target", &poursim_reward_t::k_target, 1e6},
+                                     {"k_spill", &poursim_reward_t::k_spill, 1e6},
+                                     {"gamma", &poursim_reward_t::gamma, 1.0}};
+
+} // namespace
+
+extern "C" poursim_reward_t poursim_default_reward(void) { return poursim_reward_t{1.0, 5.0, 0.9995}; }
+
+extern "C" int poursim_reward_validate(const poursim_reward_t *r, char *err, size_t err_len) {
+  if (r == nullptr) return poursim::set_error(err, err_len, POURSIM_EINVAL, "reward is NULL");
+  for (const RewardKey &k : kRewardKeys) {
+    const double v = r->*k.field;
+    if (!(v >= 0.0 && v <= k.max))
+      return poursim::set_error(err, err_len, POURSIM_EINVAL, "reward %s = %g is out of range [0, %g]", k.name, v,
+                                k.max);
+  }
+  return POURSIM_OK;
+}
+
+extern "C" int poursim_reward_set(poursim_reward_t *r, const char *key, const char *value, char *err,
+                                  size_t err_len) {
+  if (r == nullptr || key == nullptr || value == nullptr)
+    return poursim::set_error(err, err_len, POURSIM_EINVAL, "reward_set: NULL argument");
+  for (const RewardKey &k : kRewardKeys) {
+    if (std::strcmp(k.name, key) != 0) continue;
+    char *end = nullptr;
+    errno = 0;
+    const double v = std::strtod(value, &end);
+    if (end == value || *end != '\0' || errno != 0 || !std::isfinite(v))
+      return poursim::set_error(err, err_len, POURSIM_EPARSE, "reward %s: '%s' is not a number", key, value);
+    poursim_reward_t next = *r;
+    next.*k.field = v;
+    const int rc = poursim_reward_validate(&next, err, err_len);
+    if (rc == POURSIM_OK) *r = next;
+    return rc;
+  }
+  return poursim::set_error(err, err_len, POURSIM_EINVAL, "unknown key '%s': not a config key (host_sim --help) nor one of the reward's (k_target, k_spill, gamma)", key);
+}
+
 namespace poursim {
 
-void EpisodeMeter::reset(const poursim_config_t &config, const poursim_obs_t &first) {
+void EpisodeMeter::reset(const poursim_config_t &config, const poursim_reward_t &reward, const poursim_obs_t &first) {
   dt_ = config.dt;
-  gamma_ = config.gamma;
+  reward_ = reward;
+  last_reward_ = 0.0;
   // The fill of a round bucket of the cross-section's width (poursim_config_t.liquid_density) [L].
   const double r = 0.5 * config.bucket_inner_width;
   litres_ = 1000.0 * M_PI * r * r * config.fill_depth;
@@ -42,9 +95,10 @@ void EpisodeMeter::add(const poursim_obs_t &obs, double command_nm) {
     if (last_sign_ != 0 && sign != last_sign_) ++reversals_;
     last_sign_ = sign;
   }
-  ret_ += disc_ * obs.reward;
-  disc_ *= gamma_;
-  sum_ += obs.reward;
+  last_reward_ = reward_.k_target * obs.v_target - reward_.k_spill * obs.v_spill;
+  ret_ += disc_ * last_reward_;
+  disc_ *= reward_.gamma;
+  sum_ += last_reward_;
 }
 
 poursim_episode_t EpisodeMeter::result() const {

@@ -192,7 +192,7 @@ void write_csv_episode(std::FILE *f, int episode, uint32_t seed, const std::vect
   for (const Sample &s : samples)
     std::fprintf(f, "%d,%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.4f,%.6f,%.6f\n", episode, seed, s.obs.step,
                  s.obs.t, s.obs.theta, s.obs.omega, s.obs.v_rotating, s.obs.v_target, s.obs.v_spill, s.obs.v_flight,
-                 s.action, s.obs.torque, s.obs.torque / tau_max, s.obs.reward);
+                 s.action, s.obs.torque, s.obs.torque / tau_max, s.reward);
 }
 
 void write_render_json(std::FILE *f, const poursim_config_t &config, const Recorder &rec, const std::string &title,

@@ -47,18 +47,14 @@ int validate_policy(const poursim_policy_t *p, char *err, size_t err_len) {
     return set_error(err, err_len, POURSIM_EINVAL, "policy normalisation ranges are empty");
   if (!(std::isfinite(p->k_reversal) && p->k_reversal >= 0.0))
     return set_error(err, err_len, POURSIM_EINVAL, "policy k_reversal %g: want a finite value >= 0", p->k_reversal);
-  return POURSIM_OK;
+  return poursim_reward_validate(&p->reward, err, err_len);
 }
-
-double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
 
 // The features of the weights.h spec, from the state the firmware's estimator makes of the sensors.
 Features features_of(const poursim_policy_t *p, const pour_state_t &s) {
-  const double theta = s.theta_urad * 1e-6, omega = s.omega_urad_s * 1e-6;
   Features x;
-  x << clamp01((theta - p->theta_min) / (p->theta_max - p->theta_min)),
-      clamp01((omega + p->omega_max) / (2.0 * p->omega_max)), clamp01(s.v_rotating / 32768.0),
-      clamp01(s.v_target / 32768.0), clamp01(s.v_spill / 32768.0), 1.0;
+  poursim_features(p, s.theta_urad * 1e-6, s.omega_urad_s * 1e-6, s.v_rotating / 32768.0, s.v_target / 32768.0,
+                   s.v_spill / 32768.0, x.data());
   return x;
 }
 
@@ -97,13 +93,14 @@ class RolloutPolicy : public poursim::CoreController, public poursim::StepHook {
     pour_control_request(ctl, static_cast<uint8_t>(action_), poursim_fraction_to_q15(p_->levels[action_]));
   }
 
+
  public:
   void after_step(const poursim_obs_t &o, double a, const poursim::EpisodeMeter &meter) override {
     t_ = static_cast<int>(o.step) - 1;
-    // Training's reward shaping: each torque reversal costs k_reversal (0: the world's reward as it is).
+    // The policy's reward, and training's shaping: each torque reversal costs k_reversal (0: none).
     const int new_reversals = meter.reversals() - reversals_;
     reversals_ += new_reversals;
-    const double r = o.reward - p_->k_reversal * new_reversals;
+    const double r = meter.last_reward() - p_->k_reversal * new_reversals;
     if (buf_ == nullptr) return;
     if (decision_ >= 0 && decision_ < buf_->capacity && buf_->rewards != nullptr) buf_->rewards[decision_] += r;
     if (t_ < buf_->step_capacity) {
@@ -164,7 +161,7 @@ extern "C" int poursim_rollout(poursim_world_t *world, const poursim_policy_t *p
   int rc = validate_policy(policy, nullptr, 0);
   if (rc != POURSIM_OK) return rc;
   RolloutPolicy ctl(policy, *poursim_world_config(world), buf);
-  const poursim::Episode e = poursim::run_episode(world, ctl, seed, nullptr, &ctl);
+  const poursim::Episode e = poursim::run_episode(world, ctl, seed, policy->reward, nullptr, &ctl);
   if (!e.error.empty()) return e.status;
   *ep = e.m;
   ep->n_decisions = ctl.decisions();

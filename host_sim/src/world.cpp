@@ -32,8 +32,6 @@ constexpr uint64_t kLiquidCategory = 0x2;
 constexpr double kGravity = 9.81;     // [m/s²]
 constexpr double kRunawaySpeed = 50.0; // [m/s]: no particle of a pour gets near this; beyond it the step failed
 
-double clamp01(double x) { return x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x); }
-
 // Signed distance from p to an axis-aligned box (negative inside).
 double box_sdf(const Eigen::Vector2d &p, const Eigen::Vector2d &lo, const Eigen::Vector2d &hi) {
   Eigen::Vector2d c = 0.5 * (lo + hi), h = 0.5 * (hi - lo);
@@ -255,16 +253,9 @@ static void measure(poursim_world_t *w) {
   o.v_target = counts[1] * inv;
   o.v_spill = counts[2] * inv;
   o.v_flight = counts[3] * inv;
-  o.obs[0] = clamp01((o.theta - c.obs_theta_min) / (c.obs_theta_max - c.obs_theta_min));
-  o.obs[1] = clamp01((o.omega + c.obs_omega_max) / (2.0 * c.obs_omega_max));
-  o.obs[2] = clamp01(o.v_rotating);
-  o.obs[3] = clamp01(o.v_target);
-  o.obs[4] = clamp01(o.v_spill);
-  o.reward = c.k_target * o.v_target - c.k_spill * o.v_spill;
   o.done = (o.t >= c.episode_s - 0.5 * c.dt) ? 1 : 0;
   // Physics only: the sensors' noise, lag and rate leave the hash as it is (docs/simulator.md).
-  double scalars[9] = {o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight, o.reward, o.torque,
-                       o.motor_torque};
+  double scalars[8] = {o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight, o.torque, o.motor_torque};
   w->hash = hash_words(h, scalars, sizeof scalars / sizeof(uint64_t));
 }
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pour.policy import fixedpoint as fp
-from pour.policy import golden, weights_h
+from pour.policy import golden, linear, weights_h
 from pour.sim import poursim
 
 
@@ -92,7 +92,7 @@ def test_quantize_obs_is_within_half_an_lsb_of_the_float_normalisation():
         omega = int(rng.integers(-5000000, 5000000))
         vols = [int(v) for v in rng.integers(0, 32768, size=3)]
         q = fp.quantize_obs(norm, theta, omega, *vols)
-        x = fp.obs_float(norm, theta * 1e-6, omega * 1e-6, *(v / 32768 for v in vols))
+        x = linear.features(theta * 1e-6, omega * 1e-6, *(v / 32768 for v in vols), *norm.rad())[:5]
         exact = np.minimum(x * 32768, 32767)
         assert np.all(np.abs(np.array(q[:2]) - exact[:2]) <= 0.5 + 1e-6)
         assert q[2:] == vols
@@ -178,7 +178,7 @@ def test_fixed_policy_agrees_with_the_float_policy(source_dir):
         vols = [int(v) for v in rng.integers(0, 32768, size=3)]
         q = fp.quantize_obs(ex.norm, theta, omega, *vols)
         e = pol.eval(q)
-        x = fp.obs_float(ex.norm, theta * 1e-6, omega * 1e-6, *(v / 32768 for v in vols))
+        x = linear.features(theta * 1e-6, omega * 1e-6, *(v / 32768 for v in vols), *ex.norm.rad())[:5]
         pf = fp.float_policy_probs(ex.w_float, x)
         worst = max(worst, float(np.max(np.abs(np.array(e.probs) / 32768 - pf))))
         agree += int(e.action == int(np.argmax(pf)))

@@ -49,7 +49,7 @@ def test_lockstep_loop_is_bit_identical_to_in_process(tools, tmp_path):
     assert (tmp_path / "lcm.txt").read_text() == (tmp_path / "inproc.txt").read_text()
     assert hash_of(r.stdout) == hash_of(ref.stdout)
     s = stats_of(r.stdout)
-    assert s["states"] == 2 * int(STEPS) and s["on_time"] == s["states"] and s["missing"] == 0
+    assert s["samples"] == 2 * int(STEPS) and s["on_time"] == s["samples"] and s["missing"] == 0
     assert "resets 2" in c.out
     # The policy acted: some torque was non-zero.
     assert any(line.split()[-1] != "0" for line in (tmp_path / "lcm.txt").read_text().splitlines())
@@ -100,8 +100,8 @@ def test_real_time_loop_counts_every_state(tools):
         c.stop()
     assert r.returncode == 0, r.stderr
     s = stats_of(r.stdout)
-    # No timing asserted: only that every state is accounted for.
-    assert s["states"] == 500
+    # No timing asserted: only that every sample is accounted for.
+    assert s["samples"] == 500
     assert s["on_time"] + s["late"] + s["missing"] == 500
     assert s["answers"] == s["on_time"] + s["late"]
 
@@ -146,7 +146,7 @@ def test_host_sim_lockstep_over_lcm_is_bit_identical_to_in_process(build_dir, so
     inproc, lcm_csv = (tmp_path / "inproc.csv").read_text(), (tmp_path / "lcm.csv").read_text()
     assert len(inproc.splitlines()) == 1 + 2 * 3000
     assert lcm_csv == inproc  # every step: state, action, torque, reward
-    assert "lcm lockstep: states 6000 answers 6000 on_time 6000" in r.stdout
+    assert "lcm lockstep: samples 6000 answers 6000 on_time 6000" in r.stdout
     summary = [x for x in r.stdout.splitlines() if x.startswith("summary")]
     assert summary == [x for x in ref.stdout.splitlines() if x.startswith("summary")]
     assert "answers 6000" in c.out and "resets 2" in c.out
@@ -168,7 +168,7 @@ def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build
              "--lcm", url(18), "--realtime"])
     assert r.returncode == 0, r.stderr
     line = [x for x in r.stdout.splitlines() if x.startswith("lcm realtime")][0]
-    assert "states 300 answers 0" in line and "missing 300" in line and "safe_ticks 300" in line
+    assert "samples 300 answers 0" in line and "missing 300" in line and "safe_ticks 300" in line
 
 
 @pytest.mark.parametrize("argv, needle", [

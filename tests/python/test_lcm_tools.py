@@ -95,7 +95,7 @@ def test_lcm_run_pours_through_two_processes(build_dir, source_dir):
                         "--policy", compiled_weights(build_dir), "--set", "episode_s=0.5"],
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr
-    assert "lcm lockstep: states 500 answers 500 on_time 500" in r.stdout
+    assert "lcm lockstep: samples 500 answers 500 on_time 500" in r.stdout
     assert "pour_controller: ticks" in r.stdout and "answers 500" in r.stdout
 
 

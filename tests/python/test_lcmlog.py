@@ -75,10 +75,10 @@ def test_log_summary_matches_the_simulated_pour(recorded):
     spilled = float(re.search(r"spilled\s+([\d.]+) %", line).group(1)) / 100
     assert abs(ep["poured"] - poured) <= 1 / 150 + 1e-9 and abs(ep["spilled"] - spilled) <= 1 / 150 + 1e-9
     # UDP multicast to the logger may drop a few datagrams on a loaded machine, anywhere in the stream
-    # (the end included), states and answers alike.
+    # (the end included), samples and answers alike.
     assert ep["first_seq"] <= 100 and ep["last_seq"] >= 1900
-    assert s["states"] >= 1900 and s["unanswered"] <= 100
-    assert s["latency_us"]["n"] == s["states"] - s["unanswered"] and s["latency_us"]["median"] > 0
+    assert s["samples"] >= 1900 and s["unanswered"] <= 100
+    assert s["latency_us"]["n"] == s["samples"] - s["unanswered"] and s["latency_us"]["median"] > 0
     assert s["particle_frames"] > 0 and s["undecodable"] == {} and s["refused"] == {}
     assert ep["source"] == channels.TRUTH
     # The tools read the encoder as the simulator writes it: every logged count is the count of the true
@@ -129,7 +129,7 @@ def test_log_with_garbage_counts_it_and_still_analyses(tmp_path):
     w.close()
     s = logfile.analyse(path, None)
     assert s["undecodable"] == {channels.TORQUE: 20, channels.SENSORS: 1}
-    assert s["states"] == 20 and s["unanswered"] == 0
+    assert s["samples"] == 20 and s["unanswered"] == 0
     assert s["latency_us"]["median"] == 80
 
 
@@ -227,7 +227,7 @@ def test_log_prefers_truth_and_refuses_impossible_values(tmp_path):
                       (2, (float("nan"), 0.0, 0.5, 0.5, 0.0)), (3, (0.2, float("inf"), 0.5, 0.5, 0.0))])
     s = logfile.analyse(path, None)
     (ep,) = s["episodes"]
-    assert ep["source"] == channels.TRUTH and ep["states"] == 4
+    assert ep["source"] == channels.TRUTH and ep["samples"] == 4
     assert ep["poured"] == 0.25 and ep["spilled"] == 0.05  # the last plausible truth, not the scales
     assert s["refused"] == {channels.SENSORS: 2, channels.TRUTH: 2}
     r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=60)

@@ -12,7 +12,7 @@ import pytest
 import pour.sim.gym_env
 from pour.policy import fixedpoint as fp
 from pour.policy import linear, weights_h
-from pour.sim import poursim
+from pour.sim import episode, poursim
 
 EPISODE_S = 2.0
 PERIOD = 10
@@ -46,9 +46,8 @@ def gym_replay(seed, actions):
 def rollout_run(header, seed):
     """poursim_rollout with the float policy of the header (greedy): its torques, Q15, and its actions."""
     world = poursim.World({"episode_s": EPISODE_S})
-    c = world.config
     pol = poursim.Policy(header.w_dequantized, header.levels_q15 / 32768.0, header.decision_period_ms,
-                         c.obs_theta_min, c.obs_theta_max, c.obs_omega_max, True, 0.0)
+                         episode.THETA_MIN_RAD, episode.THETA_MAX_RAD, episode.OMEGA_MAX_RAD_S, True, 0.0)
     ro = world.rollout(pol, seed, record_steps=True)
     assert ro.metrics["faults"] == 0  # a plain pour: the core stayed in RUN
     return np.round(ro.step_torque * 32768).astype(np.int64), ro.actions

@@ -91,8 +91,7 @@ def test_episode_metrics_count_reversals_and_litres():
     levels = np.array([-1.0, 1.0])
 
     def run(w):
-        pol = poursim.Policy(np.asarray(w, dtype=float), levels, 10, cfg.obs_theta_min, cfg.obs_theta_max,
-                         cfg.obs_omega_max, True)
+        pol = poursim.Policy(np.asarray(w, dtype=float), levels, 10, 0.0, 2.356194, 4.0, True)
         with poursim.World(cfg) as world:
             return world.rollout(pol, 5).metrics
 
@@ -114,7 +113,6 @@ def test_a_bad_reversal_cost_is_refused_by_the_c_rollout():
     from pour.sim import poursim
     cfg = poursim.make_config({"episode_s": 0.1})
     for bad in (float("nan"), -1.0):
-        pol = poursim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, cfg.obs_theta_min, cfg.obs_theta_max,
-                         cfg.obs_omega_max, True, bad)
+        pol = poursim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, 0.0, 2.356194, 4.0, True, bad)
         with pytest.raises(poursim.SimError, match="k_reversal"):
             poursim.World(cfg).rollout(pol, 1)

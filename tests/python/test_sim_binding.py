@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
 """tools/pour/sim/poursim.py: the ctypes binding of libpoursim."""
+import ctypes as C
 import os
 import subprocess
 import sys
@@ -24,7 +25,7 @@ def small_policy(greedy=False):
 
 def test_default_config_has_the_documented_scene():
     c = poursim.default_config()
-    assert set(c) == set(poursim.CONFIG_KEYS)
+    assert tuple(c) == poursim.config_keys() and len(c) > 40
     assert c["n_particles"] == 150 and c["bucket_inner_width"] == 0.24 and c["bucket_height"] == 0.33
     assert c["bucket_wall"] == 0.005 and c["dt"] == 0.001 and c["episode_s"] == 10.0
     assert c["restitution_liquid"] == 0.5 and c["restitution_wall"] == 0.1
@@ -35,7 +36,7 @@ def test_rig_keys_and_readings_cross_the_binding_with_the_c_layout():
     c = poursim.default_config()
     assert (c["motor_peak_torque"], c["motor_no_load_speed"], c["gear_ratio"]) == (25.0, 21.0, 20.0)
     assert (c["command_latency_ticks"], c["encoder_bits"], c["scale_rate_hz"]) == (1, 17, 80.0)
-    assert c["rand_sensor"] == 0.0 and c["k_target"] == 1.0 and c["seed"] == 1
+    assert c["rand_sensor"] == 0.0 and c["seed"] == 1
     with poursim.World(seed=3) as w:
         o = w.observe()
         assert o.encoder in (0, (1 << 17) - 1) or o.encoder < 50 or o.encoder > (1 << 17) - 50
@@ -54,11 +55,27 @@ def test_rig_keys_and_readings_cross_the_binding_with_the_c_layout():
         poursim.make_config({"encoder_bits": 40})
 
 
+def test_config_keys_come_from_the_library_with_their_declaration(tmp_path):
+    keys = poursim.describe()
+    assert keys["command_latency_ticks"] == poursim.KeyInfo(True, 1.0, 100.0, 1.0, "steps", keys["command_latency_ticks"].doc)
+    assert not keys["tau_max"].integer and keys["tau_max"].unit == "N m" and keys["tau_max"].doc
+    assert {k: i.default for k, i in keys.items()} == poursim.default_config()
+    cfg = poursim.make_config({"tau_max": 12.5, "n_particles": 120})
+    assert cfg["tau_max"] == 12.5 and cfg.tau_max == 12.5 and cfg["n_particles"] == 120
+    assert isinstance(cfg["n_particles"], int) and isinstance(cfg["dt"], float)
+    with pytest.raises(AttributeError):
+        cfg.no_such_key
+    cfg.write(tmp_path / "sim.cfg")
+    assert poursim.make_config(path=tmp_path / "sim.cfg").as_dict() == cfg.as_dict()
+
+
 def test_bad_config_key_or_value_raises_naming_it():
     with pytest.raises(poursim.SimError, match="no_such_key"):
         poursim.make_config({"no_such_key": 1})
+    with pytest.raises(poursim.SimError, match="unknown config key 'gamma'"):
+        poursim.make_config({"gamma": 0.9})  # the reward's, not the world's
     with pytest.raises(poursim.SimError, match="gamma"):
-        poursim.make_config({"gamma": 2.0})
+        poursim.reward_from({"gamma": 2.0})
     with pytest.raises(poursim.SimError, match="cannot read config file"):
         poursim.make_config(path="/nonexistent/sim.cfg")
 
@@ -133,3 +150,40 @@ def test_library_that_fails_to_load_gives_a_clear_error(tmp_path):
     bad.write_text("not a shared library")
     r = _load_in_subprocess(bad)
     assert r.returncode == 0 and "failed to load" in r.stdout
+
+
+def test_reward_and_normalisation_are_the_policys_not_the_worlds():
+    assert "k_spill" not in poursim.config_keys() and "obs_omega_max" not in poursim.config_keys()
+    assert poursim.default_reward() == poursim.Reward(1.0, 5.0, 0.9995)
+    opts = {"k_spill": 10.0, "tau_max": 15.0}
+    assert poursim.reward_from(opts) == poursim.Reward(1.0, 10.0, 0.9995) and opts == {"tau_max": 15.0}
+    lv = poursim.uniform_levels(5)
+    with poursim.World({"episode_s": 1.0}) as w:
+        base = w.rollout(small_policy(greedy=True), seed=4, record_steps=True)
+        pol = small_policy(greedy=True)
+        pol.reward = poursim.Reward(2.0, 0.0, 1.0)
+        ro = w.rollout(pol, seed=4, record_steps=True)
+    assert np.array_equal(base.step_theta, ro.step_theta)  # the reward does not touch the world
+    assert ro.step_rewards[-1] == pol.reward.step(ro.poured, ro.spilled) == 2.0 * ro.poured
+    assert ro.ret == pytest.approx(ro.reward_sum) and lv.size == 5
+
+
+def test_python_features_equal_the_c_normalisation_bit_for_bit():
+    from pour.policy import linear
+    rng = np.random.default_rng(11)
+    for _ in range(2000):
+        norm = (float(rng.uniform(-0.2, 0.2)), float(rng.uniform(1.0, 3.0)), float(rng.uniform(0.5, 8.0)))
+        state = (float(rng.uniform(-0.5, 3.2)), float(rng.uniform(-10, 10)), *map(float, rng.uniform(-0.1, 1.1, 3)))
+        assert np.array_equal(linear.features(*state, *norm), poursim.features(*norm, *state))
+
+
+def test_every_ctypes_mirror_has_the_size_of_its_c_record():
+    lib = poursim.load_library()
+    mirrors = {"poursim_obs_t": poursim.ObsStruct, "poursim_reward_t": poursim.RewardStruct,
+               "poursim_policy_t": poursim.PolicyStruct, "poursim_rollout_buffers_t": poursim.BuffersStruct,
+               "poursim_episode_t": poursim.EpisodeStruct, "poursim_retention_t": poursim.RetentionStruct,
+               "poursim_slosh_t": poursim.SloshStruct, "poursim_drive_check_t": poursim.DriveCheckStruct,
+               "poursim_sensor_check_t": poursim.SensorCheckStruct}
+    for name, mirror in mirrors.items():
+        assert C.sizeof(mirror) == lib.poursim_sizeof(name.encode()), name
+    assert lib.poursim_sizeof(b"poursim_config_t") == 0  # a handle, never mirrored

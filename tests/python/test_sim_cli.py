@@ -41,6 +41,9 @@ def test_help_explains_the_modes(host_sim):
     (("--baseline", "rate", "--seed"), "--seed needs a value"),
     (("--baseline", "rate", "--render", "out.png"), "--render wants a .gif or .mp4"),
     (("--baseline", "rate", "--set", "tau_max"), "--set wants KEY=VALUE"),
+    (("--baseline", "rate", "--set", "gamma=2"), "reward gamma = 2 is out of range [0, 1]"),
+    (("--baseline", "rate", "--set", "k_spill=lots"), "reward k_spill: 'lots' is not a number"),
+    (("--baseline", "rate", "--set", "wobble=1"), "unknown key 'wobble'"),
 ])
 def test_bad_arguments_exit_2_with_a_message(host_sim, args, message):
     r = host_sim(*args)
@@ -188,6 +191,16 @@ def test_unwritable_output_is_refused_before_running(host_sim, tmp_path, flag, n
 def test_out_of_range_set_is_refused(host_sim):
     r = host_sim("--baseline", "rate", "--set", "n_particles=5000")
     assert r.returncode == 2 and "n_particles" in r.stderr
+
+
+def test_reward_keys_set_the_return_not_the_world(host_sim):
+    """k_spill weighs the spilled share in the return; the pour itself is the same."""
+    args = ("--baseline", "full", "--json", "--quiet", "--set", "episode_s=1.5")
+    a, b = host_sim(*args), host_sim(*args, "--set", "k_spill=10")
+    assert a.returncode == 0 and b.returncode == 0, a.stderr + b.stderr
+    ja, jb = json.loads(a.stdout), json.loads(b.stdout)
+    assert ja["spilled_pct"] == jb["spilled_pct"] > 0 and ja["poured_pct"] == jb["poured_pct"]
+    assert jb["return"] < ja["return"]
 
 
 def test_config_tau_max_must_match_the_policy(host_sim, tmp_path, source_dir):

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "poursim/poursim.h"
+#include "read_text.h"
 #include "unity.h"
 
 static poursim_config_t cfg;
@@ -40,18 +41,76 @@ static void test_config_load_ReadsTheShippedConfig(void) {
   TEST_ASSERT_EQUAL_DOUBLE(0.1, cfg.friction);
 }
 
+
+/* configs/sim/default.cfg is what write_default_cfg writes (the target default_cfg regenerates it): every
+ * key of config_fields.h once, at its default. */
+static void test_config_load_ShippedConfigIsTheGeneratedDefaults(void) {
+  static char shipped[32768], written[32768];
+  const size_t n = read_text(POUR_SOURCE_DIR "/configs/sim/default.cfg", shipped, sizeof shipped);
+  const poursim_config_t defaults = poursim_default_config();
+  TEST_ASSERT_EQUAL_INT_MESSAGE(POURSIM_OK, poursim_config_write(&defaults, "defaults.cfg", err, sizeof err), err);
+  const size_t m = read_text("defaults.cfg", written, sizeof written);
+  TEST_ASSERT_EQUAL_size_t_MESSAGE(m, n, "configs/sim/default.cfg is stale: cmake --build --preset host --target default_cfg");
+  TEST_ASSERT_EQUAL_STRING_MESSAGE(written, shipped, "configs/sim/default.cfg is stale: cmake --build --preset host --target default_cfg");
+  int keys = 0;
+  for (const char *key; (key = poursim_config_key(keys)) != NULL; ++keys) {
+    char line[64];
+    snprintf(line, sizeof line, "\n%s = ", key);
+    const char *at = strstr(shipped, line);
+    TEST_ASSERT_NOT_NULL_MESSAGE(at, key);
+    TEST_ASSERT_NULL_MESSAGE(strstr(at + 1, line), key);
+  }
+  TEST_ASSERT_TRUE(keys > 40);
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_load("defaults.cfg", &cfg, err, sizeof err));
+  TEST_ASSERT_EQUAL_MEMORY(&defaults, &cfg, sizeof cfg);
+  remove("defaults.cfg");
+}
+
+/* The handle API Python uses: a heap config read and set by key, each key's declaration. */
+static void test_config_load_KeysAreReadByNameWithTheirDeclaration(void) {
+  poursim_config_t *c = poursim_config_new(NULL);
+  TEST_ASSERT_NOT_NULL(c);
+  double v = 0.0;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_get(c, "n_particles", &v, err, sizeof err));
+  TEST_ASSERT_EQUAL_DOUBLE(150.0, v);
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_set(c, "tau_max", "12.5", err, sizeof err));
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_get(c, "tau_max", &v, err, sizeof err));
+  TEST_ASSERT_EQUAL_DOUBLE(12.5, v);
+  poursim_config_t *copy = poursim_config_new(c);
+  TEST_ASSERT_EQUAL_MEMORY(c, copy, sizeof *c);
+  poursim_config_free(copy);
+  poursim_config_free(c);
+  TEST_ASSERT_EQUAL_INT(POURSIM_EINVAL, poursim_config_get(&cfg, "sead", &v, err, sizeof err));
+  TEST_ASSERT_NOT_NULL(strstr(err, "unknown config key 'sead'"));
+  int integer = -1;
+  double lo = 0, hi = 0, def = 0;
+  const char *unit = NULL, *doc = NULL;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_key_info("command_latency_ticks", &integer, &lo, &hi, &def, &unit, &doc));
+  TEST_ASSERT_EQUAL_INT(1, integer);
+  TEST_ASSERT_EQUAL_DOUBLE(1.0, lo);
+  TEST_ASSERT_EQUAL_DOUBLE(100.0, hi);
+  TEST_ASSERT_EQUAL_DOUBLE(1.0, def);
+  TEST_ASSERT_EQUAL_STRING("steps", unit);
+  TEST_ASSERT_TRUE(strlen(doc) > 10);
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_config_key_info("tau_max", &integer, NULL, NULL, NULL, NULL, NULL));
+  TEST_ASSERT_EQUAL_INT(0, integer);
+  TEST_ASSERT_EQUAL_INT(POURSIM_EINVAL, poursim_config_key_info("sead", NULL, NULL, NULL, NULL, NULL, NULL));
+  TEST_ASSERT_NULL(poursim_config_key(-1));
+  TEST_ASSERT_NULL(poursim_config_key(100000));
+}
+
 /* /dev/zero: refused at the size cap, not read until memory runs out. */
 static void test_config_load_RefusesAnEndlessFile(void) {
   expect_error(poursim_config_load("/dev/zero", &cfg, err, sizeof err), "/dev/zero", "larger than 1048576 bytes");
 }
 
-/* "seed = 7\0JUNK" used to read as seed 7. */
+/* "seed = 7\0JUNK" is refused, not read as seed 7: a NUL byte is not text. */
 static void test_config_load_RefusesNulBytes(void) {
   static const char text[] = "friction = 0.1\nseed = 7\0JUNK\n";
   expect_error(load_text("nul.cfg", text, sizeof text - 1), "nul.cfg:2:", "NUL byte");
 }
 
-/* The last of two settings used to win silently. */
+/* A key set twice is refused, not settled by the last one. */
 static void test_config_load_RefusesDuplicateKeys(void) {
   static const char text[] = "seed = 7\nfriction = 0.1\n  seed=8\n";
   expect_error(load_text("dup.cfg", text, sizeof text - 1), "dup.cfg:3:", "seed is set twice (first on line 1)");
@@ -73,6 +132,8 @@ static void test_config_load_NamesFileAndLineInEveryError(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_config_load_ReadsTheShippedConfig);
+  RUN_TEST(test_config_load_ShippedConfigIsTheGeneratedDefaults);
+  RUN_TEST(test_config_load_KeysAreReadByNameWithTheirDeclaration);
   RUN_TEST(test_config_load_RefusesAnEndlessFile);
   RUN_TEST(test_config_load_RefusesNulBytes);
   RUN_TEST(test_config_load_RefusesDuplicateKeys);

@@ -60,7 +60,7 @@ static void test_episode_run_RecordsEveryStepAndTheFramesAskedFor(void) {
   poursim::Recorder rec;
   rec.steps = true;
   rec.frame_every = 80;
-  poursim::Episode e = poursim::run_episode(w, ctl, 3u, &rec);
+  poursim::Episode e = poursim::run_episode(w, ctl, 3u, poursim_default_reward(), &rec);
   TEST_ASSERT_EQUAL_STRING("", e.error.c_str());
   TEST_ASSERT_EQUAL_UINT32(3u, e.seed);
   TEST_ASSERT_EQUAL_UINT32(3u, ctl.seed_);
@@ -80,8 +80,10 @@ static void test_episode_run_RecordsEveryStepAndTheFramesAskedFor(void) {
   TEST_ASSERT_EQUAL_size_t(static_cast<size_t>(n), rec.radius.size());
   TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.16, rec.frame_t[2]);
   TEST_ASSERT_TRUE(rec.radius[0] > 0.0f);
-  // The figures are the last observation's.
+  // The figures are the last observation's; each sample's reward is the reward's of its observation.
   TEST_ASSERT_EQUAL_DOUBLE(rec.samples.back().obs.v_target, e.m.poured);
+  for (const poursim::Sample &s : rec.samples)
+    TEST_ASSERT_EQUAL_DOUBLE(1.0 * s.obs.v_target - 5.0 * s.obs.v_spill, s.reward);
   TEST_ASSERT_EQUAL_DOUBLE(rec.samples.back().obs.v_rotating, e.m.remaining);
   poursim_destroy(w);
 }
@@ -92,9 +94,9 @@ static void test_episode_run_IsTheSameWithAndWithoutARecorder(void) {
   poursim::Recorder rec;
   rec.steps = true;
   rec.frame_every = 7;
-  const poursim::Episode a = poursim::run_episode(w, ctl, 5u, &rec);
+  const poursim::Episode a = poursim::run_episode(w, ctl, 5u, poursim_default_reward(), &rec);
   const uint64_t hash_a = poursim_trajectory_hash(w);
-  const poursim::Episode b = poursim::run_episode(w, ctl, 5u, nullptr);
+  const poursim::Episode b = poursim::run_episode(w, ctl, 5u, poursim_default_reward(), nullptr);
   TEST_ASSERT_EQUAL_STRING("", b.error.c_str());
   TEST_ASSERT_EQUAL_DOUBLE(a.m.ret, b.m.ret);
   TEST_ASSERT_EQUAL_DOUBLE(a.m.peak_omega, b.m.peak_omega);
@@ -111,7 +113,7 @@ static void test_episode_run_ReportsTheWorldsErrorWhenAStepFails(void) {
   Constant ctl(0.5);
   poursim::Recorder rec;
   rec.steps = true;
-  poursim::Episode e = poursim::run_episode(w, ctl, cfg.seed, &rec);
+  poursim::Episode e = poursim::run_episode(w, ctl, cfg.seed, poursim_default_reward(), &rec);
   TEST_ASSERT_NOT_EQUAL_MESSAGE(std::string::npos, e.error.find("blew up"), e.error.c_str());
   TEST_ASSERT_EQUAL_STRING(poursim_world_error(w), e.error.c_str());
   TEST_ASSERT_TRUE(rec.samples.size() < 2000u); // stopped at the failing step
@@ -121,7 +123,7 @@ static void test_episode_run_ReportsTheWorldsErrorWhenAStepFails(void) {
 static void test_episode_run_ReportsARefusedCommand(void) {
   poursim_world_t *w = make_world(short_config());
   Constant ctl(NAN);
-  poursim::Episode e = poursim::run_episode(w, ctl, 1u, nullptr);
+  poursim::Episode e = poursim::run_episode(w, ctl, 1u, poursim_default_reward(), nullptr);
   TEST_ASSERT_FALSE(e.error.empty()); // the world keeps no message for a refused argument
   TEST_ASSERT_NOT_EQUAL_MESSAGE(std::string::npos, e.error.find("poursim_step"), e.error.c_str());
   TEST_ASSERT_EQUAL_INT(1, ctl.calls_);
@@ -133,7 +135,7 @@ static void test_episode_run_StopsWithTheControllersFailure(void) {
   Constant ctl(0.5, 10);
   poursim::Recorder rec;
   rec.steps = true;
-  poursim::Episode e = poursim::run_episode(w, ctl, 1u, &rec);
+  poursim::Episode e = poursim::run_episode(w, ctl, 1u, poursim_default_reward(), &rec);
   TEST_ASSERT_EQUAL_STRING("no answer", e.error.c_str());
   TEST_ASSERT_EQUAL_size_t(10, rec.samples.size()); // the failed command is not stepped
   poursim_destroy(w);

@@ -49,7 +49,6 @@ poursim_obs_t obs(uint32_t step, double theta, double v_target, double torque) {
   o.v_spill = 0.05;
   o.v_flight = 0.0;
   o.torque = torque;
-  o.reward = v_target - 0.05;
   return o;
 }
 
@@ -58,7 +57,7 @@ poursim::Recorder two_step_recording() {
   poursim::Recorder rec;
   rec.steps = true;
   rec.frame_every = 2;
-  rec.samples = {{obs(1, 0.5, 0.25, 10.0), 3}, {obs(2, 0.625, 0.5, -20.0), -1}};
+  rec.samples = {{obs(1, 0.5, 0.25, 10.0), 3, 0.25 - 0.05}, {obs(2, 0.625, 0.5, -20.0), -1, 0.5 - 0.05}};
   rec.radius = {0.01f, 0.0125f};
   rec.frames = {{0.0f, 0.5f, 0.25f, 0.5f}, {0.0f, 0.25f, 0.5f, 0.125f}};
   rec.frame_t = {0.0, 0.002};

@@ -46,6 +46,7 @@ void setUp(void) {
   pol.theta_min = 0.0;
   pol.theta_max = 2.356194;
   pol.omega_max = 4.0;
+  pol.reward = poursim_default_reward();
   pol.greedy = 1;
 }
 
@@ -75,12 +76,33 @@ static void test_rollout_FillsArraysConsistently(void) {
   for (int t = 0; t < ep.n_steps; ++t) {
     step_sum += step_rewards[t];
     ret += disc * step_rewards[t];
-    disc *= cfg.gamma;
+    disc *= pol.reward.gamma;
   }
   TEST_ASSERT_DOUBLE_WITHIN(1e-9, ep.reward_sum, sum);
   TEST_ASSERT_DOUBLE_WITHIN(1e-9, ep.reward_sum, step_sum);
   TEST_ASSERT_DOUBLE_WITHIN(1e-9, ret, ep.ret); /* R = Σ γ^t r_t */
   TEST_ASSERT_TRUE(ep.max_theta > 0.2); /* the policy did tilt the bucket */
+}
+
+/* The policy's reward makes the rollout's: each term alone is its weight times the final share. */
+static void test_rollout_RewardIsThePolicysWeightedShares(void) {
+  poursim_rollout_buffers_t b = buffers();
+  poursim_episode_t ep;
+  pol.reward.k_target = 2.5;
+  pol.reward.k_spill = 0.0;
+  pol.reward.gamma = 1.0;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_rollout(world, &pol, 5, &b, &ep));
+  TEST_ASSERT_TRUE(ep.poured > 0.0);
+  TEST_ASSERT_EQUAL_DOUBLE(2.5 * ep.poured, step_rewards[ep.n_steps - 1]);
+  double sum = 0.0;
+  for (int t = 0; t < ep.n_steps; ++t) sum += step_rewards[t];
+  TEST_ASSERT_DOUBLE_WITHIN(1e-9, sum, ep.ret); /* gamma 1: the return is the sum */
+  pol.reward.k_target = 0.0;
+  pol.reward.k_spill = 7.0;
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_rollout(world, &pol, 5, &b, &ep));
+  TEST_ASSERT_EQUAL_DOUBLE(-7.0 * ep.spilled, step_rewards[ep.n_steps - 1]);
+  pol.reward.gamma = 1.5;
+  TEST_ASSERT_EQUAL_INT(POURSIM_EINVAL, poursim_rollout(world, &pol, 5, &b, &ep));
 }
 
 /* The rollout must equal a hand-written loop around the firmware's pipeline: each step's sensor sample into
@@ -234,6 +256,7 @@ static void test_rollout_ReportsTheCoresFaultAndItsStop(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_rollout_FillsArraysConsistently);
+  RUN_TEST(test_rollout_RewardIsThePolicysWeightedShares);
   RUN_TEST(test_rollout_MatchesManualLoopThroughTheFirmwarePipeline);
   RUN_TEST(test_rollout_ReportsTheCoresFaultAndItsStop);
   RUN_TEST(test_rollout_IsDeterministicAndBatchMatchesSequential);

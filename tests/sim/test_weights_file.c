@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "poursim/weights_file.h"
+#include "read_text.h"
 #include "unity.h"
 
 static poursim_weights_file_t wf;
@@ -14,14 +15,6 @@ static char err[POURSIM_ERR_LEN];
 static char good[16384];
 static size_t good_len;
 
-static size_t read_text(const char *path, char *buf, size_t cap) {
-  FILE *f = fopen(path, "rb");
-  TEST_ASSERT_NOT_NULL_MESSAGE(f, path);
-  size_t n = fread(buf, 1, cap - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  return n;
-}
 
 void setUp(void) {
   err[0] = '\0';

@@ -9,6 +9,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "poursim/config_fields.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -28,73 +30,14 @@ typedef enum {
   POURSIM_ENUMERIC = -5 /* the simulation blew up numerically (poursim_world_error says where) */
 } poursim_status_t;
 
-/* The whole configuration. poursim_default_config() documents each default (docs/simulator.md). */
+/* The whole configuration: one field per key of config_fields.h, which holds each one's type, default,
+ * range, unit and meaning. */
 typedef struct {
-  /* time */
-  double dt;              /* physics step [s], 0.001 (the 1 kHz control tick) */
-  int substeps;           /* Box2D sub-steps per step, 1..16 */
-  double episode_s;       /* episode length [s] */
-  double settle_s;        /* liquid settles this long, bucket held upright, before t = 0 [s] */
-  /* geometry (both buckets are the same U of three boxes) */
-  double bucket_inner_width; /* [m] */
-  double bucket_height;      /* outer height [m] */
-  double bucket_wall;        /* wall and bottom thickness [m] */
-  double pivot_height;       /* rotating bucket's centre (pivot) above the ground [m] */
-  double target_dx;          /* target bucket's centre x minus pivot x [m] (> 0: the pouring side) */
-  /* masses */
-  double bucket_mass;     /* rotating bucket (steel) [kg] */
-  /* liquid: n_particles circles share the fill's cross-section, spacing s = √(width·fill_depth/n) */
-  double fill_depth;      /* depth of the liquid at rest in the upright bucket [m] */
-  double liquid_density;  /* [kg/m³]; mass = density·fill_depth·π·(width/2)² (a round bucket) */
-  int n_particles;        /* circles, 2..POURSIM_MAX_PARTICLES */
-  int fluid;              /* 1: particle fluid (pressure, viscosity); 0: rigid circle pile, no fluid layer */
-  double fluid_smoothing;      /* interaction radius h / spacing s [-] */
-  double fluid_contact_radius; /* Box2D circle radius / spacing s (contacts with the buckets) [-] */
-  double fluid_stiffness;      /* pressure stiffness k [m/s²] */
-  double fluid_viscosity;      /* pair viscosity σ [1/s] */
-  double fluid_agitation;      /* thermal speed v_T of the pairs [m/s]: keeps 150 particles liquid */
-  /* contact model */
-  double restitution_liquid; /* circle–circle, the pile only (fluid = 0) */
-  double restitution_wall;   /* circle–wall (mixed with min, so it wins) */
-  double friction;
-  double restitution_threshold; /* collisions slower than this do not bounce [m/s] */
-  double contact_hertz;         /* contact stiffness [Hz] */
-  /* actuation */
-  double tau_max;         /* torque of action level 1.0 [N·m] */
-  double theta_min;       /* lower hard stop [rad] */
-  double theta_max;       /* upper hard stop [rad] */
-  double brake_torque;    /* holding brake's rating [N·m] (poursim_set_brake) */
-  /* the drive between the command and the bucket (docs/simulator.md, "The rig": defaults and sources) */
-  double motor_peak_torque;   /* peak torque at the output [N·m]: the command is clamped to it */
-  double motor_no_load_speed; /* output speed at which the available motoring torque reaches 0 [rad/s] */
-  double motor_rotor_inertia; /* rotor inertia at the motor [kg·m²]; J·N² is added to the bucket's */
-  double gear_ratio;          /* motor turns per output turn [-] */
-  double friction_coulomb;    /* the drive's Coulomb friction at the output, holds at standstill [N·m] */
-  double friction_viscous;    /* viscous friction at the output [N·m·s/rad] */
-  int command_latency_ticks;  /* a command acts this many steps after the step it is given in (>= 1) */
-  /* the rig's sensors (poursim_obs_t.encoder, scale_rotating_g, scale_target_g) */
-  int encoder_bits;           /* single-turn absolute encoder on the output shaft [bits] */
-  double scale_rate_hz;       /* load cells' conversion rate [Hz]; readings held between conversions */
-  double scale_delay_s;       /* lag: a conversion reports the mean load over this span before it (settling) [s] */
-  double scale_noise_g;       /* Gaussian noise of a conversion, standard deviation [g] */
-  double scale_resolution_g;  /* readings are multiples of this [g] */
-  /* domain randomisation: uniform ± around the nominal, drawn from the reset seed; 0 = off */
-  double rand_fill;           /* fill_depth, relative [-] */
-  double rand_target_dx;      /* target_dx [m] */
-  double rand_pivot_height;   /* pivot_height [m] */
-  double rand_motor;          /* peak torque, no-load speed, both frictions, rotor inertia, relative [-] */
-  double rand_bucket_mass;    /* bucket_mass, relative [-] */
-  double rand_liquid;         /* fluid viscosity, stiffness, agitation, liquid density, relative [-] */
-  double rand_sensor;         /* scale delay and noise, relative [-]; latency +0 or +1 tick */
-  /* observation normalisation (must match the policy's weights.h) */
-  double obs_theta_min;   /* [rad] */
-  double obs_theta_max;   /* [rad] */
-  double obs_omega_max;   /* [rad/s] */
-  /* reward */
-  double k_target;
-  double k_spill;
-  double gamma;           /* per-step discount of the return */
-  uint32_t seed;          /* default seed of reset() and the CLI */
+#define POURSIM_CONFIG_MEMBER(kind, name, def, lo, hi, unit, doc) POURSIM_CONFIG_CTYPE_##kind name;
+#define POURSIM_CONFIG_NO_SECTION(title)
+  POURSIM_CONFIG_FIELDS(POURSIM_CONFIG_MEMBER, POURSIM_CONFIG_NO_SECTION)
+#undef POURSIM_CONFIG_MEMBER
+#undef POURSIM_CONFIG_NO_SECTION
 } poursim_config_t;
 
 /* Everything measured after a step (or at reset). */
@@ -107,8 +50,6 @@ typedef struct {
   double v_target;      /* fraction inside the target bucket */
   double v_spill;       /* fraction outside both and below the target's rim, or on the ground */
   double v_flight;      /* fraction in none of those (in the air) */
-  double obs[5];        /* normalised θ, θ̇, V_rot, V_tgt, V_spill, each in [0, 1] */
-  double reward;        /* K_target·V_target − K_spill·V_spill of this state */
   double torque;        /* torque commanded in the step that led here, a·tau_max [N·m] */
   int done;             /* 1 once t reaches episode_s */
   /* What the rig delivers and senses (docs/simulator.md, "The rig"). */
@@ -138,8 +79,25 @@ int poursim_config_set(poursim_config_t *config, const char *key, const char *va
  * too small (8 KiB is plenty). */
 int poursim_config_describe(char *buf, size_t len);
 
-/* Writes the config as a loadable file. */
+/* Writes the config as a loadable file: a banner, then every key with its unit and meaning, in the order
+ * of config_fields.h. Written from poursim_default_config() it is configs/sim/default.cfg. */
 int poursim_config_write(const poursim_config_t *config, const char *path, char *err, size_t err_len);
+
+/* A config on the heap, for callers that hold it as an opaque handle (Python): the defaults, or a copy of
+ * src when src is not NULL. NULL if out of memory. Free with poursim_config_free. */
+poursim_config_t *poursim_config_new(const poursim_config_t *src);
+void poursim_config_free(poursim_config_t *config);
+
+/* Reads one field by name into *value (integers exactly); POURSIM_EINVAL naming the key if unknown. */
+int poursim_config_get(const poursim_config_t *config, const char *key, double *value, char *err, size_t err_len);
+
+/* The name of key number index (0, 1, ... in config_fields.h order); NULL past the last. */
+const char *poursim_config_key(int index);
+
+/* A key's declaration: integer (1) or real (0), inclusive range, default, unit and one line on its meaning.
+ * Any output pointer may be NULL; POURSIM_EINVAL if the key is unknown. */
+int poursim_config_key_info(const char *key, int *integer, double *min, double *max, double *def,
+                            const char **unit, const char **doc);
 
 /* Creates a world (validates the config) and resets it with config->seed. NULL on error. */
 poursim_world_t *poursim_create(const poursim_config_t *config, char *err, size_t err_len);
@@ -203,6 +161,24 @@ uint64_t poursim_trajectory_hash(const poursim_world_t *world);
 
 /* ---- Whole-episode rollout with a float softmax-linear policy (the trainer's model). ---- */
 
+/* The trainer's reward: r = k_target·V_target − k_spill·V_spill after each step, return Σ γ^t r_t. An
+ * episode's figure (poursim_episode_t.ret, reward_sum), not part of the world. */
+typedef struct {
+  double k_target; /* >= 0 */
+  double k_spill;  /* >= 0 */
+  double gamma;    /* per-step discount, in [0, 1] */
+} poursim_reward_t;
+
+/* host_sim's reward for its figures: k_target 1, k_spill 5, gamma 0.9995 (the trainer sets its own). */
+poursim_reward_t poursim_default_reward(void);
+
+/* POURSIM_EINVAL, naming the field, unless every field is finite and in its range. */
+int poursim_reward_validate(const poursim_reward_t *reward, char *err, size_t err_len);
+
+/* Sets k_target, k_spill or gamma from text (host_sim --set); POURSIM_EINVAL for another key or a value out
+ * of range, POURSIM_EPARSE for one that is not a number; *reward unchanged on error. */
+int poursim_reward_set(poursim_reward_t *reward, const char *key, const char *value, char *err, size_t err_len);
+
 /* A policy as weights.h describes it, in float: logits = x·W, x = [θn, ωn, Vr, Vt, Vs, 1]. */
 typedef struct {
   int n_actions;              /* 2..POURSIM_MAX_ACTIONS */
@@ -212,8 +188,15 @@ typedef struct {
   double theta_min, theta_max; /* normalisation [rad] */
   double omega_max;            /* [rad/s] */
   int greedy;                 /* 1: argmax (ties to lowest index); 0: sample with the seed */
+  poursim_reward_t reward;    /* the rollout's reward and return */
   double k_reversal;          /* training's reward shaping: cost of each torque reversal (0: none) */
 } poursim_policy_t;
+
+/* The policy's features, the float normalisation of docs/weights-h.md: x = [clip((θ − θmin)/(θmax − θmin)),
+ * clip((θ̇ + ωmax)/(2ωmax)), clip(V_rotating), clip(V_target), clip(V_spill), 1], clip to [0, 1], with the
+ * policy's theta_min, theta_max [rad] and omega_max [rad/s]. */
+void poursim_features(const poursim_policy_t *policy, double theta, double omega, double v_rotating,
+                      double v_target, double v_spill, double x[POURSIM_N_FEATURES]);
 
 /* Caller-provided arrays; any pointer may be NULL. Capacities: decisions = ceil(steps / period). */
 typedef struct {
@@ -267,6 +250,10 @@ int poursim_rollout_batch(const poursim_config_t *config, const poursim_policy_t
  * rounds; saturates to [-32768, 32767] (+1.0 -> 32767, -1.0 -> -32768, +-inf to the limits); NaN -> 0 (no
  * torque, never a plausible command). */
 int16_t poursim_fraction_to_q15(double fraction);
+
+/* sizeof the named plain record of the C API ("poursim_obs_t", ..., "poursim_weights_file_t"), 0 if unknown:
+ * Python's ctypes mirrors are checked against it. */
+size_t poursim_sizeof(const char *type_name);
 
 /* Library version string. */
 const char *poursim_version(void);

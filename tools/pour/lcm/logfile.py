@@ -41,7 +41,7 @@ class LogError(RuntimeError):
 class Episode:
     index: int
     seq: list[int] = field(default_factory=list)             # sensor samples, in the order they were logged
-    state_ts: dict[int, int] = field(default_factory=dict)   # seq → logger time of its first sample [µs]
+    sample_ts: dict[int, int] = field(default_factory=dict)   # seq → logger time of its first sample [µs]
     raw: dict[int, tuple[int, int, int]] = field(default_factory=dict)  # seq → (encoder, rotating g, target g)
     truth: dict[int, tuple[float, ...]] = field(default_factory=dict)   # seq → (θ, θ̇, v_rot, v_tgt, v_spill)
     torque: dict[int, tuple[float, int, int, int]] = field(default_factory=dict)  # seq → (N·m, action, mode, faults)
@@ -128,9 +128,9 @@ def read_log(path: Path, encoder_bits: int = sensors.ENCODER_BITS) -> Log:
                 continue
             if ev.channel == channels.SENSORS:
                 ep = eps.setdefault(msg.episode, Episode(msg.episode))
-                if msg.seq in ep.state_ts:
+                if msg.seq in ep.sample_ts:
                     continue  # a resend
-                ep.state_ts[msg.seq] = ev.timestamp
+                ep.sample_ts[msg.seq] = ev.timestamp
                 ep.seq.append(msg.seq)
                 if _plausible_sample(msg, encoder_bits):
                     ep.raw[msg.seq] = (msg.encoder, msg.scale_rotating_g, msg.scale_target_g)
@@ -165,17 +165,17 @@ def read_log(path: Path, encoder_bits: int = sensors.ENCODER_BITS) -> Log:
 
 
 def reward_params(k_target: float | None, k_spill: float | None, gamma: float | None):
-    """The simulator's reward constants unless given; None if neither given nor available."""
+    """libpoursim's default reward (host_sim's) where not given; None if neither given nor available."""
     if None not in (k_target, k_spill, gamma):
         return k_target, k_spill, gamma
     try:
         from pour.sim import poursim
 
-        d = poursim.default_config()
+        d = poursim.default_reward()
     except Exception:
         return None
-    return (d["k_target"] if k_target is None else k_target, d["k_spill"] if k_spill is None else k_spill,
-            d["gamma"] if gamma is None else gamma)
+    return (d.k_target if k_target is None else k_target, d.k_spill if k_spill is None else k_spill,
+            d.gamma if gamma is None else gamma)
 
 
 def episode_summary(ep: Episode, reward) -> dict:
@@ -189,9 +189,9 @@ def episode_summary(ep: Episode, reward) -> dict:
     if final >= 0.01:
         k = int(np.argmax(moved >= 0.99 * final))
         finish = float(seq[k]) * 1e-3
-    states = np.sort(np.asarray(ep.seq))
-    out = {"episode": ep.index, "source": ep.source, "states": int(len(states)), "first_seq": int(states[0]),
-           "last_seq": int(states[-1]), "gaps": int(states[-1] - states[0] + 1 - len(states)),
+    samples = np.sort(np.asarray(ep.seq))
+    out = {"episode": ep.index, "source": ep.source, "samples": int(len(samples)), "first_seq": int(samples[0]),
+           "last_seq": int(samples[-1]), "gaps": int(samples[-1] - samples[0] + 1 - len(samples)),
            "poured": float(v[-1, 1]), "spilled": float(v[-1, 2]),
            "left": float(v[-1, 0]), "finish_s": finish, "max_theta_deg": float(np.degrees(np.max(ep.theta)))}
     if reward is not None:
@@ -202,8 +202,8 @@ def episode_summary(ep: Episode, reward) -> dict:
 
 
 def latencies_us(log: Log) -> np.ndarray:
-    """Logger time of each answer minus that of the state it answers [µs]."""
-    lat = [ep.torque_ts[s] - ep.state_ts[s] for ep in log.episodes for s in ep.torque_ts if s in ep.state_ts]
+    """Logger time of each answer minus that of the sample it answers [µs]."""
+    lat = [ep.torque_ts[s] - ep.sample_ts[s] for ep in log.episodes for s in ep.torque_ts if s in ep.sample_ts]
     return np.asarray(lat, dtype=float)
 
 
@@ -292,15 +292,15 @@ def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = s
     log = read_log(path, encoder_bits)
     eps = [episode_summary(ep, reward) for ep in log.episodes]
     lat = latencies_us(log)
-    answered = sum(len(set(ep.torque_ts) & set(ep.state_ts)) for ep in log.episodes)
-    states = sum(len(ep.seq) for ep in log.episodes)
+    answered = sum(len(set(ep.torque_ts) & set(ep.sample_ts)) for ep in log.episodes)
+    samples = sum(len(ep.seq) for ep in log.episodes)
     summary = {
         "log": str(path), "events": log.events, "episodes": eps,
         "latency_us": {"n": int(len(lat)),
                        "median": float(np.median(lat)) if len(lat) else None,
                        "p99": float(np.percentile(lat, 99)) if len(lat) else None,
                        "max": float(np.max(lat)) if len(lat) else None},
-        "states": states, "unanswered": states - answered, "undecodable": log.undecodable, "refused": log.refused,
+        "samples": samples, "unanswered": samples - answered, "undecodable": log.undecodable, "refused": log.refused,
         "particle_frames": sum(len(ep.frames) for ep in log.episodes),
     }
     if log.status:
@@ -367,7 +367,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if L["n"]:
         print(f"latency {channels.SENSORS} -> {channels.TORQUE}: median {L['median']:.0f} us  p99 {L['p99']:.0f} us"
               f"  max {L['max']:.0f} us over {L['n']} answers")
-    print(f"states {s['states']}  unanswered {s['unanswered']}  undecodable {sum(s['undecodable'].values())}"
+    print(f"samples {s['samples']}  unanswered {s['unanswered']}  undecodable {sum(s['undecodable'].values())}"
           f"  refused {sum(s['refused'].values())}  particle frames {s['particle_frames']}")
     print(f"plant from {eps[0]['source']}")
     if "controller" in s:

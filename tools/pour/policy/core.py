@@ -163,10 +163,10 @@ class Config:
     cfg.safety.tau_limit (the groups are the nested configs). Unknown names and values a field's type cannot
     hold raise CoreError."""
 
-    def __init__(self, rig: C.Structure | None = None):
+    def __init__(self, rig: Any = None):
         lib = load()
         object.__setattr__(self, "_buf", (C.c_uint8 * lib.poursim_fw_config_size())())
-        lib.poursim_fw_config_init(self._buf, C.byref(rig) if rig is not None else None)
+        lib.poursim_fw_config_init(self._buf, rig.handle if rig is not None else None)
         names = _names(lib.poursim_fw_config_field, 4096).values()
         object.__setattr__(self, "_fields", tuple(names))
 
@@ -226,7 +226,7 @@ class _Group:
         self._config.set(f"{self._prefix}.{name}", value)
 
 
-def control_config(rig: C.Structure | None = None, **overrides: int) -> Config:
+def control_config(rig: Any = None, **overrides: int) -> Config:
     """pour_control_default_config(), or with rig (a poursim config) the firmware's config for that simulated
     rig (the one function the rollouts and host_sim use too), with the named top-level fields replaced."""
     c = Config(rig)

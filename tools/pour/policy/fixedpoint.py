@@ -41,6 +41,10 @@ class ObsNorm:
     theta_max_urad: int
     omega_max_urad_s: int
 
+    def rad(self) -> tuple[float, float, float]:
+        """theta_min, theta_max [rad] and omega_max [rad/s], as the float policy takes them."""
+        return self.theta_min_urad * 1e-6, self.theta_max_urad * 1e-6, self.omega_max_urad_s * 1e-6
+
     def validate(self) -> None:
         if self.theta_max_urad <= self.theta_min_urad:
             raise ValueError(f"norm: theta_max_urad ({self.theta_max_urad}) must exceed theta_min_urad "
@@ -99,20 +103,6 @@ def quantize_obs(norm: ObsNorm, theta_urad: int, omega_urad_s: int, v_rotating: 
         max(int(v_target), 0),
         max(int(v_spill), 0),
     ]
-
-
-def obs_float(norm: ObsNorm, theta_rad: float, omega_rad_s: float, v_rotating: float, v_target: float,
-              v_spill: float) -> np.ndarray:
-    """The trainer's float normalisation (docs/weights-h.md), features without the bias."""
-    tmin, tmax = norm.theta_min_urad * 1e-6, norm.theta_max_urad * 1e-6
-    wmax = norm.omega_max_urad_s * 1e-6
-    return np.array([
-        np.clip((theta_rad - tmin) / (tmax - tmin), 0.0, 1.0),
-        np.clip((omega_rad_s + wmax) / (2.0 * wmax), 0.0, 1.0),
-        np.clip(v_rotating, 0.0, 1.0),
-        np.clip(v_target, 0.0, 1.0),
-        np.clip(v_spill, 0.0, 1.0),
-    ])
 
 
 def logits_q15(w_q: np.ndarray, frac_bits: int, obs_q15: Sequence[int]) -> list[int]:

@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: MIT
-"""Writer, parser and content hash of weights.h, the policy file format v1 (docs/weights-h.md)."""
+"""Writer and content hash of weights.h, the policy file format v1 (docs/weights-h.md), and its reader:
+libpoursim's parser through ctypes (the one host_sim and the tests' accept/refuse table use)."""
 from __future__ import annotations
 
+import ctypes
 import hashlib
-import math
 import os
-import re
 import struct
 from dataclasses import dataclass
 from pathlib import Path
@@ -13,7 +13,7 @@ from typing import Mapping, Sequence, Union
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, libpoursim
 from pour.policy import fixedpoint as fp
 
 FORMAT = 1
@@ -216,420 +216,57 @@ def write_weights_h(path: PathLike, w_float: np.ndarray, levels: Sequence[float]
     return parse_weights_h(path)
 
 
-MAX_FILE_BYTES = 1 << 20
-_MACROS = (("FORMAT", 1, 1, "only format 1 is supported"),
-           ("N_FEATURES", N_FEATURES, N_FEATURES, "must be 6"),
-           ("N_ACTIONS", fp.MIN_ACTIONS, fp.MAX_ACTIONS, "must be 2..16"),
-           ("W_FRAC_BITS", 0, 15, "must be 0..15"),
-           ("DECISION_PERIOD_MS", 1, 65535, "must be 1..65535"),
-           ("THETA_MIN_URAD", fp.INT32_MIN, fp.INT32_MAX, "must fit int32"),
-           ("THETA_MAX_URAD", fp.INT32_MIN, fp.INT32_MAX, "must fit int32"),
-           ("OMEGA_MAX_URAD_S", 1, fp.INT32_MAX, "must be > 0"),
-           ("TAU_MAX_MNM", 1, fp.INT32_MAX, "must be > 0"),
-           ("CONTENT_HASH", 0, 0xFFFFFFFF, "must fit uint32"))
-_MACRO_NAMES = tuple(b"POUR_WEIGHTS_" + m[0].encode() for m in _MACROS)
-_HASH = len(_MACROS) - 1
-# (name, element type, dimensions, inside #ifdef POUR_WEIGHTS_FLOAT_REFERENCE, required)
-_ARRAYS = ((b"pour_weights_w", b"int16_t", 2, False, True),
-           (b"pour_weights_action_levels_q15", b"int16_t", 1, False, True),
-           (b"pour_weights_w_float", b"float", 2, True, False))
-_MAX_ROWS, _MAX_COLS, _MAX_FLOAT_CHARS = N_FEATURES, fp.MAX_ACTIONS, 64
-_INT64_BEYOND = 1 << 63  # stands for any literal C's conversion stops on as an overflow
-
-# The tokenizer of host_sim/src/weights_file.cpp, as regular expressions that cannot backtrack: each
-# alternative is a single character class or a fixed prefix, so a match costs its length.
-_SPACE = re.compile(rb"[ \t\r\f\v]+")
-_IDENT = re.compile(rb"[A-Za-z_][A-Za-z0-9_]*")
-_NUMBER = re.compile(rb"(?:[0-9]|[-.][0-9]|-\.)[A-Za-z0-9_.]*(?:(?<=[eE])[+-][A-Za-z0-9_.]*)*")
-_LONE_CR = re.compile(rb"\r(?!\n)")
-_CONTINUATION = re.compile(rb"(?:\\|\?\?/)\r?\n")
-_INT = re.compile(rb"-?(?:0|[1-9][0-9]*)")
-_HASH_INT = re.compile(rb"(?:0|[1-9][0-9]*|0[xX][0-9a-fA-F]+)[uU]?")
-_FLOAT_CHARS = re.compile(rb"-?(?:[0-9.eE]|(?<=[eE])[+-])*")
+class WeightsFileStruct(ctypes.Structure):
+    """poursim_weights_file_t (host_sim/include/poursim/weights_file.h), the parsed record the C API fills."""
+    _fields_ = [(name, ctypes.c_int32) for name in ("format", "n_features", "n_actions", "w_frac_bits",
+                                                    "decision_period_ms", "theta_min_urad", "theta_max_urad",
+                                                    "omega_max_urad_s", "tau_max_mnm")] + [
+        ("content_hash", ctypes.c_uint32), ("w", ctypes.c_int16 * (N_FEATURES * fp.MAX_ACTIONS)),
+        ("levels", ctypes.c_int16 * fp.MAX_ACTIONS), ("has_float_reference", ctypes.c_int),
+        ("w_float", ctypes.c_float * (N_FEATURES * fp.MAX_ACTIONS))]
 
 
-class _Tok:
-    __slots__ = ("kind", "text", "line")
-
-    def __init__(self, kind: str, text: bytes, line: int):
-        self.kind, self.text, self.line = kind, text, line  # kind: end, newline, hash, ident, number, punct
-
-    def quoted(self) -> str:
-        if self.kind == "end":
-            return "end of file"
-        if self.kind == "newline":
-            return "end of line"
-        t = self.text.decode("latin-1")
-        return f"'{t[:40]}...'" if len(t) > 40 else f"'{t}'"
+_ERR_LEN = 256  # POURSIM_ERR_LEN
 
 
-def _int_literal(text: bytes, hash_: bool) -> int | None:
-    """The value of a plain decimal integer (the hash: also hex, with an optional u), else None."""
-    if not (_HASH_INT if hash_ else _INT).fullmatch(text):
-        return None
-    text = text.rstrip(b"uU")
-    neg, hexa = text[:1] == b"-", text[:2] in (b"0x", b"0X")
-    digits = text[2:].lstrip(b"0") if hexa else text.lstrip(b"-")
-    if len(digits) > (15 if hexa else 19):  # beyond int64 (as C's overflow stop), without a long conversion
-        return -_INT64_BEYOND if neg else _INT64_BEYOND
-    return int(text, 16 if hexa else 10)
-
-
-def _float_literal(text: bytes) -> float | None:
-    """[-]digits[.digits][e[+-]digits][f], at most 64 characters, finite as a float32, else None."""
-    if not 0 < len(text) <= _MAX_FLOAT_CHARS:
-        return None
-    if text[-1:] in (b"f", b"F"):
-        text = text[:-1]
-    if not _FLOAT_CHARS.fullmatch(text) or not any(48 <= c <= 57 for c in text):
-        return None
+def _parser() -> ctypes.CDLL:
+    """libpoursim with its weights.h loader declared: the one parser, shared with host_sim."""
     try:
-        v = float(text)
-    except ValueError:
-        return None
-    if not math.isfinite(v) or abs(v) > 3.4028234663852886e38:
-        return None
-    return float(np.float32(v))
+        lib = libpoursim.load()
+    except libpoursim.SimError as e:
+        raise WeightsHError(f"reading a weights.h needs libpoursim's parser: {e}") from None
+    lib.poursim_weights_parse.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p,
+                                          ctypes.POINTER(WeightsFileStruct), ctypes.c_char_p, ctypes.c_size_t]
+    lib.poursim_weights_load.argtypes = [ctypes.c_char_p, ctypes.POINTER(WeightsFileStruct), ctypes.c_char_p,
+                                         ctypes.c_size_t]
+    lib.poursim_weights_parse.restype = lib.poursim_weights_load.restype = ctypes.c_int
+    return lib
 
 
-class _Reader:
-    """The parser of host_sim/src/weights_file.cpp, message for message (tests/data/weights_cases)."""
-
-    def __init__(self, data: bytes, name: str):
-        self.s, self.name, self.p, self.line = data, name, 0, 1
-        self.tok = _Tok("end", b"", 1)
-        self.macros: list[tuple[int, int] | None] = [None] * len(_MACROS)  # (value, line)
-        self.arrays: list[dict | None] = [None] * len(_ARRAYS)
-        self.stack: list[tuple[str, int]] = []  # ('g' guard | 'f' float reference, line)
-
-    def fail(self, line: int, msg: str) -> WeightsHError:
-        return WeightsHError(f"{self.name}:{line}: {msg}" if line > 0 else f"{self.name}: {msg}")
-
-    def fail_tok(self, what: str) -> WeightsHError:
-        return self.fail(self.tok.line, f"{what}, got {self.tok.quoted()}")
-
-    def check_bytes(self) -> None:
-        s, found = self.s, []
-        nul = s.find(b"\0")
-        if nul >= 0:
-            found.append((nul, "contains a NUL byte (not a text file)"))
-        m = _LONE_CR.search(s)
-        if m:
-            found.append((m.start(), "a carriage return not followed by a newline"))
-        m = _CONTINUATION.search(s)
-        if m:
-            found.append((m.end() - 1, "a line continuation (backslash or ??/ before the newline) is not allowed"))
-        if found:
-            at, msg = min(found)
-            raise self.fail(s.count(b"\n", 0, at) + 1, msg)
-
-    def next(self) -> _Tok:
-        s, n = self.s, len(self.s)
-        while self.p < n:
-            m = _SPACE.match(s, self.p)
-            if m:
-                self.p = m.end()
-            elif s.startswith(b"/*", self.p):
-                end = s.find(b"*/", self.p + 2)
-                if end < 0:
-                    raise self.fail(self.line, "a comment is not closed (truncated?)")
-                self.line += s.count(b"\n", self.p, end)
-                self.p = end + 2
-            elif s.startswith(b"//", self.p):
-                end = s.find(b"\n", self.p)
-                self.p = n if end < 0 else end
-            else:
-                break
-        if self.p >= n:
-            self.tok = _Tok("end", b"", self.line)
-            return self.tok
-        c = s[self.p]
-        if c == 0x0A:
-            self.tok = _Tok("newline", b"\n", self.line)
-            self.line += 1
-            self.p += 1
-            return self.tok
-        m = _IDENT.match(s, self.p) or _NUMBER.match(s, self.p)
-        if m:
-            kind = "ident" if m.re is _IDENT else "number"
-            text = m.group(0)
-        elif c in b"#{}[]=,;<>.":
-            kind, text = ("hash" if c == 0x23 else "punct"), s[self.p:self.p + 1]
-        elif c >= 0x80:
-            raise self.fail(self.line, "a non-ASCII byte outside a comment")
-        else:
-            raise self.fail(self.line, f"unexpected character '{chr(c)}'")
-        self.p += len(text)
-        self.tok = _Tok(kind, text, self.line)
-        return self.tok
-
-    def next_code(self) -> _Tok:
-        while self.next().kind == "newline":
-            pass
-        return self.tok
-
-    def directive(self) -> None:
-        d = self.next()
-        if d.kind != "ident":
-            raise self.fail_tok("expected a directive after '#'")
-        if d.text == b"include":
-            for want in (b"<", b"stdint", b".", b"h", b">"):
-                if self.next().text != want or self.tok.kind in ("end", "newline"):
-                    raise self.fail_tok("only #include <stdint.h> is allowed")
-        elif d.text in (b"ifndef", b"ifdef"):
-            t = self.next()
-            guard = d.text == b"ifndef" and t.text == b"POUR_WEIGHTS_H" and not self.stack
-            fref = (d.text == b"ifdef" and t.text == b"POUR_WEIGHTS_FLOAT_REFERENCE"
-                    and (not self.stack or self.stack[-1][0] == "g"))
-            if t.kind != "ident" or not (guard or fref):
-                raise self.fail_tok("only '#ifndef POUR_WEIGHTS_H' around the file and "
-                                    "'#ifdef POUR_WEIGHTS_FLOAT_REFERENCE' inside it are allowed")
-            self.stack.append(("g" if guard else "f", d.line))
-        elif d.text == b"endif":
-            if not self.stack:
-                raise self.fail(d.line, "#endif without #ifndef or #ifdef")
-            self.stack.pop()
-        elif d.text == b"define":
-            key = self.next()
-            if key.kind != "ident":
-                raise self.fail_tok("expected a macro name after #define")
-            v = self.next()
-            if key.text == b"POUR_WEIGHTS_H":
-                if v.kind not in ("newline", "end"):
-                    raise self.fail_tok("POUR_WEIGHTS_H takes no value")
-                return
-            if key.text not in _MACRO_NAMES:
-                raise self.fail(key.line, f"unknown macro {key.quoted()} (docs/weights-h.md lists the allowed ones)")
-            m = _MACRO_NAMES.index(key.text)
-            mname = key.text.decode()
-            if self.stack and self.stack[-1][0] == "f":
-                raise self.fail(key.line, f"{mname} is inside #ifdef POUR_WEIGHTS_FLOAT_REFERENCE")
-            if self.macros[m] is not None:
-                raise self.fail(key.line, f"{mname} is defined twice")
-            if v.kind in ("newline", "end"):
-                raise self.fail(key.line, f"{mname} has no value")
-            value = _int_literal(v.text, m == _HASH) if v.kind == "number" else None
-            if value is None:
-                kind = "decimal or hex" if m == _HASH else "decimal"
-                raise self.fail(key.line, f"{mname}: {v.quoted()} is not a plain {kind} integer "
-                                          "(no suffix, no leading 0)")
-            _, lo, hi, rng = _MACROS[m]
-            if not lo <= value <= hi:
-                raise self.fail(key.line, f"{mname} = {v.quoted()} is out of range: {rng}")
-            self.macros[m] = (value, key.line)
-            self.next()
-        else:
-            raise self.fail(d.line, f"directive #{d.text[:40].decode('latin-1')} is not allowed in a weights.h")
-        if d.text != b"define":
-            self.next()
-        if self.tok.kind not in ("newline", "end"):
-            raise self.fail_tok("expected the end of the directive")
-
-    def value(self, ai: int, row: int, col: int):
-        name, typ, nd = _ARRAYS[ai][0].decode(), _ARRAYS[ai][1], _ARRAYS[ai][2]
-        where = f"{name}[{row}][{col}]" if nd == 2 else f"{name}[{col}]"
-        t = self.tok
-        if t.kind == "end":
-            raise self.fail(t.line, f"{name} ends before its closing '}}' (truncated)")
-        if typ == b"float":
-            v = _float_literal(t.text) if t.kind == "number" else None
-            if v is None:
-                raise self.fail(t.line, f"{where} = {t.quoted()} is not a finite float")
-        else:
-            v = _int_literal(t.text, False) if t.kind == "number" else None
-            if v is None or not -32768 <= v <= 32767:
-                raise self.fail(t.line, f"{where} = {t.quoted()} is not an int16 (plain decimal, no suffix)")
-        return v, t.line
-
-    def list_(self, ai: int, row: int) -> list:
-        name, nd = _ARRAYS[ai][0].decode(), _ARRAYS[ai][2]
-        out: list = []
-        while True:
-            self.next_code()
-            if self.punct(b"}"):
-                return out
-            if len(out) == _MAX_COLS:
-                raise self.fail(self.tok.line, f"{name}{f' row {row}' if nd == 2 else ''} has more than "
-                                               f"{_MAX_COLS} values")
-            out.append(self.value(ai, row, len(out)))
-            t = self.next_code()
-            if self.punct(b"}"):
-                return out
-            if t.kind == "end":
-                raise self.fail(t.line, f"{name} ends before its closing '}}' (truncated)")
-            if not self.punct(b","):
-                raise self.fail_tok(f"{name}: expected ',' or '}}'")
-
-    def punct(self, c: bytes) -> bool:
-        return self.tok.kind == "punct" and self.tok.text == c
-
-    def declaration(self) -> None:
-        line = self.tok.line
-        if self.next_code().text != b"const" or self.tok.kind != "ident":
-            raise self.fail_tok("expected 'static const'")
-        typ = self.next_code()
-        nm = self.next_code()
-        names = [a[0] for a in _ARRAYS]
-        if typ.kind != "ident" or nm.kind != "ident" or nm.text not in names:
-            raise self.fail(line, "unexpected declaration (only the arrays of docs/weights-h.md are allowed)")
-        ai = names.index(nm.text)
-        name_b, want_type, nd, in_block, _ = _ARRAYS[ai]
-        name = name_b.decode()
-        if self.arrays[ai] is not None:
-            raise self.fail(line, f"{name} is defined twice")
-        if typ.text != want_type:
-            raise self.fail(line, f"{name} is declared {typ.quoted()}, expected {want_type.decode()}")
-        if bool(self.stack and self.stack[-1][0] == "f") != in_block:
-            raise self.fail(line, f"{name} must be {'inside' if in_block else 'outside'} "
-                                  "#ifdef POUR_WEIGHTS_FLOAT_REFERENCE")
-        a = {"line": line, "dims": [], "rows": [], "values": []}
-        self.arrays[ai] = a
-        while self.next_code() and self.punct(b"["):
-            if len(a["dims"]) == nd:
-                raise self.fail(line, f"{name} has more than {nd} dimension{'s' if nd > 1 else ''}")
-            d = self.next_code()
-            dim = -1
-            if self.punct(b"]"):
-                if a["dims"]:
-                    raise self.fail(line, f"{name}: only the first dimension may be empty")
-            else:
-                k = _MACRO_NAMES.index(d.text) if d.kind == "ident" and d.text in _MACRO_NAMES[:_HASH] else -1
-                if k >= 0 and self.macros[k] is not None:
-                    dim = self.macros[k][0]
-                else:
-                    dim = _int_literal(d.text, False) if d.kind == "number" else None
-                    if dim is None or not 0 < dim < _INT64_BEYOND:
-                        raise self.fail(line, f"{name} has an unknown dimension {d.quoted()} "
-                                              "(a positive number or a macro defined above)")
-                self.next_code()
-                if not self.punct(b"]"):
-                    raise self.fail_tok(f"{name}: expected ']'")
-            a["dims"].append(dim)
-        if len(a["dims"]) != nd:
-            n = len(a["dims"])
-            raise self.fail(line, f"{name} has {n} dimension{'' if n == 1 else 's'}, expected {nd}")
-        if self.tok.kind == "end":
-            raise self.fail(line, f"{name} ends early (truncated)")
-        if not self.punct(b"="):
-            raise self.fail_tok(f"{name}: expected '='")
-        self.next_code()
-        if self.tok.kind == "end":
-            raise self.fail(self.tok.line, f"{name} ends early (truncated)")
-        if not self.punct(b"{"):
-            raise self.fail_tok(f"{name}: expected '{{'")
-        if nd == 1:
-            a["rows"] = [self.list_(ai, 0)]
-        else:
-            while True:
-                t = self.next_code()
-                if self.punct(b"}"):
-                    break
-                if t.kind == "end":
-                    raise self.fail(t.line, f"{name} ends before its closing '}}' (truncated)")
-                if not self.punct(b"{"):
-                    raise self.fail_tok(f"{name}: each row must be a '{{...}}' list")
-                if len(a["rows"]) == _MAX_ROWS:
-                    raise self.fail(t.line, f"{name} has more than {_MAX_ROWS} rows")
-                a["rows"].append(self.list_(ai, len(a["rows"])))
-                t = self.next_code()
-                if self.punct(b"}"):
-                    break
-                if t.kind == "end":
-                    raise self.fail(t.line, f"{name} ends before its closing '}}' (truncated)")
-                if not self.punct(b","):
-                    raise self.fail_tok(f"{name}: expected ',' or '}}' after a row")
-        t = self.next_code()
-        if t.kind == "end":
-            raise self.fail(t.line, f"{name}: no ';' at the end (truncated)")
-        if not self.punct(b";"):
-            raise self.fail_tok(f"{name}: expected ';'")
-
-    def read(self) -> None:
-        self.check_bytes()
-        line_start = True
-        while True:
-            t = self.next()
-            if t.kind == "end":
-                break
-            if t.kind == "newline":
-                line_start = True
-            elif t.kind == "hash":
-                if not line_start:
-                    raise self.fail_tok("a '#' must start its line")
-                self.directive()
-                line_start = True
-            elif t.kind == "ident" and t.text == b"static":
-                self.declaration()
-                line_start = False
-            else:
-                raise self.fail_tok("expected a #directive or a 'static const' array")
-        if self.stack:
-            what = "#ifndef POUR_WEIGHTS_H" if self.stack[-1][0] == "g" else "#ifdef POUR_WEIGHTS_FLOAT_REFERENCE"
-            raise self.fail(self.stack[-1][1], f"{what} is never closed by #endif (truncated?)")
-
-    def check_shape(self, ai: int, n: int) -> None:
-        name, nd = _ARRAYS[ai][0].decode(), _ARRAYS[ai][2]
-        a = self.arrays[ai]
-        want = [N_FEATURES, n] if nd == 2 else [n]
-        for k, (d, w) in enumerate(zip(a["dims"], want)):
-            if d != -1 and d != w:
-                raise self.fail(a["line"], f"{name} dimension {k} is {d}, expected {w}")
-        if nd == 1:
-            if len(a["rows"][0]) != n:
-                raise self.fail(a["line"], f"{name} has {len(a['rows'][0])} values, expected {n}")
-            return
-        if len(a["rows"]) != N_FEATURES:
-            raise self.fail(a["line"], f"{name} has {len(a['rows'])} rows, expected {N_FEATURES}")
-        for r, row in enumerate(a["rows"]):
-            if len(row) != n:
-                raise self.fail(a["line"], f"{name} row {r} has {len(row)} values, expected {n}")
+def _from_struct(f: WeightsFileStruct) -> WeightsH:
+    n = f.n_actions
+    w_q = np.array(f.w[:N_FEATURES * n], dtype=np.int16).reshape(N_FEATURES, n)
+    w_float = None
+    if f.has_float_reference:
+        w_float = np.array(f.w_float[:N_FEATURES * n], dtype=np.float64).reshape(N_FEATURES, n)
+    norm = fp.ObsNorm(f.theta_min_urad, f.theta_max_urad, f.omega_max_urad_s)
+    return WeightsH(n, f.w_frac_bits, f.decision_period_ms, norm, f.tau_max_mnm, w_q,
+                    np.array(f.levels[:n], dtype=np.int16), f.content_hash, w_float)
 
 
 def parse_weights_h_bytes(data: bytes, name: str = "weights.h") -> WeightsH:
     """Parses and checks the text of a weights.h (name is used in messages); see parse_weights_h."""
-    rd = _Reader(data, name)
-    rd.read()
-    for k, (key, *_rest) in enumerate(_MACROS):
-        if rd.macros[k] is None:
-            raise rd.fail(0, f"POUR_WEIGHTS_{key} is missing")
-    ints = {key: rd.macros[k][0] for k, (key, *_rest) in enumerate(_MACROS)}
-    if ints["THETA_MAX_URAD"] <= ints["THETA_MIN_URAD"]:
-        raise rd.fail(rd.macros[6][1], f"POUR_WEIGHTS_THETA_MAX_URAD = {ints['THETA_MAX_URAD']} must be > "
-                                       f"POUR_WEIGHTS_THETA_MIN_URAD = {ints['THETA_MIN_URAD']}")
-    n = ints["N_ACTIONS"]
-    for ai, (aname, _typ, _nd, _blk, required) in enumerate(_ARRAYS):
-        if rd.arrays[ai] is None:
-            if required:
-                raise rd.fail(0, f"{aname.decode()} is missing")
-            continue
-        rd.check_shape(ai, n)
-    w_q = np.array([[v for v, _ in row] for row in rd.arrays[0]["rows"]], dtype=np.int16)
-    levels = rd.arrays[1]["rows"][0]
-    for i in range(1, n):
-        if levels[i][0] <= levels[i - 1][0]:
-            raise rd.fail(levels[i][1], f"pour_weights_action_levels_q15 must be strictly increasing (index {i})")
-    levels_q = np.array([v for v, _ in levels], dtype=np.int16)
-    w_float = None
-    if rd.arrays[2] is not None:
-        w_float = np.array([[v for v, _ in row] for row in rd.arrays[2]["rows"]], dtype=np.float64)
-    norm = fp.ObsNorm(ints["THETA_MIN_URAD"], ints["THETA_MAX_URAD"], ints["OMEGA_MAX_URAD_S"])
-    f, period, tau = ints["W_FRAC_BITS"], ints["DECISION_PERIOD_MS"], ints["TAU_MAX_MNM"]
-    h = content_hash(n, f, period, norm, tau, w_q, levels_q)
-    if h != ints["CONTENT_HASH"]:
-        raise rd.fail(rd.macros[_HASH][1], f"POUR_WEIGHTS_CONTENT_HASH is 0x{ints['CONTENT_HASH']:08x} but the "
-                                           f"content hashes to 0x{h:08x} (edited or corrupted)")
-    return WeightsH(n, f, period, norm, tau, w_q, levels_q, h, w_float)
+    lib, out, err = _parser(), WeightsFileStruct(), ctypes.create_string_buffer(_ERR_LEN)
+    if lib.poursim_weights_parse(data, len(data), name.encode(), ctypes.byref(out), err, _ERR_LEN) != 0:
+        raise WeightsHError(err.value.decode(errors="replace"))
+    return _from_struct(out)
 
 
 def parse_weights_h(path: PathLike) -> WeightsH:
-    """Reads and checks a weights.h with the grammar of host_sim's loader (docs/weights-h.md): every field
-    present and in range, array shapes, content hash. Raises WeightsHError naming file, line and field."""
-    path = Path(path)
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(MAX_FILE_BYTES + 1)
-    except OSError as e:
-        raise WeightsHError(f"{path}: cannot read: {e.strerror}") from None
-    if len(data) > MAX_FILE_BYTES:
-        raise WeightsHError(f"{path}: larger than {MAX_FILE_BYTES} bytes, not a weights.h")
-    return parse_weights_h_bytes(data, str(path))
+    """Reads and checks a weights.h with libpoursim's loader, host_sim's own (docs/weights-h.md): every field
+    present and in range, array shapes, content hash. Raises WeightsHError naming file, line and field (and
+    saying so when the library is not built)."""
+    lib, out, err = _parser(), WeightsFileStruct(), ctypes.create_string_buffer(_ERR_LEN)
+    if lib.poursim_weights_load(os.fsencode(path), ctypes.byref(out), err, _ERR_LEN) != 0:
+        raise WeightsHError(err.value.decode(errors="replace"))
+    return _from_struct(out)

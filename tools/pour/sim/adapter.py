@@ -29,21 +29,20 @@ def _env_errors(what: str) -> Iterator[None]:
         raise episode.EnvError(f"{what}: {exc}") from exc
 
 
-def _open_world(options: dict[str, Any]) -> poursim.World:
-    """A world with the simulator's defaults and options set over them, normalised as the trainer expects."""
+def _open_world(options: dict[str, Any]) -> tuple[poursim.World, poursim.Reward]:
+    """A world with the simulator's defaults and options set over them, and the reward: options k_target,
+    k_spill and gamma are the trainer's (libpoursim's defaults where absent), not the world's."""
     with _env_errors("cannot load the simulator library"):
         poursim.load_library()
+    opts = dict(options)
     try:
-        cfg = poursim.make_config(options)
+        reward = poursim.reward_from(opts)
+        cfg = poursim.make_config(opts)
     except poursim.SimError as exc:
         what = f"option {exc.key} = {options[exc.key]!r}" if exc.key in options else "config"
         raise episode.EnvError(f"simulator {what}: {exc}") from exc
-    want = (episode.THETA_MIN_RAD, episode.THETA_MAX_RAD, episode.OMEGA_MAX_RAD_S)
-    have = (cfg.obs_theta_min, cfg.obs_theta_max, cfg.obs_omega_max)
-    if any(abs(a - b) > 1e-9 for a, b in zip(want, have)):
-        raise episode.EnvError(f"simulator normalisation {have} differs from the trainer's {want}")
     with _env_errors("poursim_create"):
-        return poursim.World(cfg)
+        return poursim.World(cfg), reward
 
 
 class SimEnv:
@@ -57,7 +56,7 @@ class SimEnv:
         self.k_reversal = float(opts.pop("k_reversal", 0.0))
         if not (math.isfinite(self.k_reversal) and self.k_reversal >= 0.0):
             raise episode.EnvError(f"option k_reversal = {self.k_reversal!r}: want a finite value >= 0")
-        self.world = _open_world(opts)
+        self.world, self.reward = _open_world(opts)
         cfg = self.world.config
         if abs(cfg.dt - 1e-3) > 1e-12:
             raise episode.EnvError(f"simulator dt = {cfg.dt}: the policy's decision period assumes 1 ms ticks")
@@ -69,9 +68,8 @@ class SimEnv:
         w = np.asarray(w, dtype=np.float64)
         if w.shape != (poursim.N_FEATURES, self.n_actions):
             raise episode.EnvError(f"W has shape {w.shape}, expected ({poursim.N_FEATURES}, {self.n_actions})")
-        cfg = self.world.config
-        pol = poursim.Policy(w, self.levels, self.period, cfg.obs_theta_min, cfg.obs_theta_max, cfg.obs_omega_max,
-                         bool(greedy), self.k_reversal)
+        pol = poursim.Policy(w, self.levels, self.period, episode.THETA_MIN_RAD, episode.THETA_MAX_RAD,
+                             episode.OMEGA_MAX_RAD_S, bool(greedy), self.k_reversal, self.reward)
         with _env_errors(f"poursim_rollout (seed {seed})"):
             ro = self.world.rollout(pol, seed)
         metrics = {"v_target": ro.poured, "v_spill": ro.spilled, "v_rotating": ro.remaining,
@@ -90,7 +88,7 @@ class SimStepper:
     stepped episode equals the C rollout's tick for tick. The core's fault bits are in .faults."""
 
     def __init__(self, options: dict[str, Any] | None = None, decision_period_ms: int = 1):
-        self.world = _open_world(dict(options or {}))
+        self.world, self.reward = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
         self.period = int(decision_period_ms)
         with _env_errors("the firmware core in libpoursim"):
@@ -143,5 +141,5 @@ class SimStepper:
                 self.world.set_brake(self.out.brake)
                 self.obs = self.world.step(self.out.torque / 32768.0)
                 self._sense()
-                r += self.obs.reward
+                r += self.reward.step(self.obs.v_target, self.obs.v_spill)
         return r

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from pour.policy import linear
+from pour.sim.poursim import Reward
 from pour.sim.episode import (N_FEATURES, OMEGA_MAX_RAD_S, THETA_MAX_RAD, THETA_MIN_RAD, EnvError,  # noqa: F401
                               Episode, normalise)
 
@@ -46,6 +47,7 @@ class ToyEnv:
                 raise EnvError(f"toy env: unknown option {k!r}; known: {', '.join(sorted(self.DEFAULTS))}")
             opts[k] = float(v)
         self.o = opts
+        self.reward = Reward(opts["k_target"], opts["k_spill"], 1.0)  # the trainer discounts
         self.tau_max_nm = opts["tau_max"]
         self.levels = linear.action_levels(n_actions)
         self.period = decision_period_ms
@@ -86,7 +88,7 @@ class ToyEnv:
                 v_rot -= dv
                 v_spill += dv * spill
                 v_tgt += dv * (1.0 - spill)
-            r_sum += o["k_target"] * v_tgt - o["k_spill"] * v_spill
+            r_sum += self.reward.step(v_tgt, v_spill)
         self.theta, self.omega, self.v_rot, self.v_tgt, self.v_spill = theta, omega, v_rot, v_tgt, v_spill
         return r_sum
 

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pour.policy import linear
+
 # Normalisation the policy is trained with (weights.h carries the same numbers).
 THETA_MIN_RAD = 0.0
 THETA_MAX_RAD = 2.356194        # 135 deg
@@ -33,9 +35,5 @@ class Episode:
 
 
 def normalise(theta: float, omega: float, v_rot: float, v_tgt: float, v_spill: float) -> np.ndarray:
-    """Float normalisation of the spec: clip to [0, 1]; bias feature 1.0 last."""
-    def c(v: float) -> float:
-        return 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)
-    return np.array([c((theta - THETA_MIN_RAD) / (THETA_MAX_RAD - THETA_MIN_RAD)),
-                     c((omega + OMEGA_MAX_RAD_S) / (2 * OMEGA_MAX_RAD_S)),
-                     c(v_rot), c(v_tgt), c(v_spill), 1.0])
+    """The features of one state with the normalisation the policy is trained with, bias 1.0 last."""
+    return linear.features(theta, omega, v_rot, v_tgt, v_spill, THETA_MIN_RAD, THETA_MAX_RAD, OMEGA_MAX_RAD_S)

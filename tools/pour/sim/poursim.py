@@ -37,46 +37,25 @@ REGIONS = ("rotating", "target", "spilled", "flight")
 _DP = C.POINTER(C.c_double)
 
 
-class ConfigStruct(C.Structure):
-    _fields_ = [
-        ("dt", C.c_double), ("substeps", C.c_int), ("episode_s", C.c_double), ("settle_s", C.c_double),
-        ("bucket_inner_width", C.c_double), ("bucket_height", C.c_double), ("bucket_wall", C.c_double),
-        ("pivot_height", C.c_double), ("target_dx", C.c_double),
-        ("bucket_mass", C.c_double), ("fill_depth", C.c_double), ("liquid_density", C.c_double),
-        ("n_particles", C.c_int), ("fluid", C.c_int), ("fluid_smoothing", C.c_double),
-        ("fluid_contact_radius", C.c_double), ("fluid_stiffness", C.c_double), ("fluid_viscosity", C.c_double),
-        ("fluid_agitation", C.c_double), ("restitution_liquid", C.c_double), ("restitution_wall", C.c_double), ("friction", C.c_double),
-        ("restitution_threshold", C.c_double), ("contact_hertz", C.c_double),
-        ("tau_max", C.c_double), ("theta_min", C.c_double), ("theta_max", C.c_double),
-        ("brake_torque", C.c_double),
-        ("motor_peak_torque", C.c_double), ("motor_no_load_speed", C.c_double), ("motor_rotor_inertia", C.c_double),
-        ("gear_ratio", C.c_double), ("friction_coulomb", C.c_double), ("friction_viscous", C.c_double),
-        ("command_latency_ticks", C.c_int),
-        ("encoder_bits", C.c_int), ("scale_rate_hz", C.c_double), ("scale_delay_s", C.c_double),
-        ("scale_noise_g", C.c_double), ("scale_resolution_g", C.c_double),
-        ("rand_fill", C.c_double), ("rand_target_dx", C.c_double), ("rand_pivot_height", C.c_double),
-        ("rand_motor", C.c_double), ("rand_bucket_mass", C.c_double), ("rand_liquid", C.c_double),
-        ("rand_sensor", C.c_double),
-        ("obs_theta_min", C.c_double), ("obs_theta_max", C.c_double), ("obs_omega_max", C.c_double),
-        ("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double), ("seed", C.c_uint32),
-    ]
-
-
 class ObsStruct(C.Structure):
     _fields_ = [
         ("step", C.c_uint32), ("t", C.c_double), ("theta", C.c_double), ("omega", C.c_double),
         ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
-        ("obs", C.c_double * 5), ("reward", C.c_double), ("torque", C.c_double), ("done", C.c_int),
+        ("torque", C.c_double), ("done", C.c_int),
         ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
         ("scale_target_g", C.c_int32),
     ]
+
+
+class RewardStruct(C.Structure):
+    _fields_ = [("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double)]
 
 
 class PolicyStruct(C.Structure):
     _fields_ = [
         ("n_actions", C.c_int), ("decision_period", C.c_int), ("w", _DP), ("levels", _DP),
         ("theta_min", C.c_double), ("theta_max", C.c_double), ("omega_max", C.c_double), ("greedy", C.c_int),
-        ("k_reversal", C.c_double),
+        ("reward", RewardStruct), ("k_reversal", C.c_double),
     ]
 
 
@@ -135,10 +114,9 @@ class SensorCheckStruct(C.Structure):
     ]
 
 
-CONFIG_KEYS: tuple[str, ...] = tuple(name for name, _ in ConfigStruct._fields_)
-
-# The plain records that cross the C API on purpose, by their C names (poursim_sizeof checks each).
-RECORDS = {"poursim_config_t": ConfigStruct, "poursim_obs_t": ObsStruct, "poursim_policy_t": PolicyStruct,
+# The plain records that cross the C API on purpose, by their C names (poursim_sizeof checks each); the
+# config is a handle, not a record.
+RECORDS = {"poursim_obs_t": ObsStruct, "poursim_policy_t": PolicyStruct,
            "poursim_rollout_buffers_t": BuffersStruct, "poursim_episode_t": EpisodeStruct,
            "poursim_retention_t": RetentionStruct, "poursim_slosh_t": SloshStruct,
            "poursim_drive_check_t": DriveCheckStruct, "poursim_sensor_check_t": SensorCheckStruct}
@@ -170,25 +148,31 @@ def _declare(lib: C.CDLL) -> None:
     P = C.POINTER
     err = [C.c_char_p, C.c_size_t]
     sig = {
-        "poursim_default_config": ([], ConfigStruct),
-        "poursim_config_validate": ([P(ConfigStruct)] + err, C.c_int),
-        "poursim_config_load": ([C.c_char_p, P(ConfigStruct)] + err, C.c_int),
-        "poursim_config_set": ([P(ConfigStruct), C.c_char_p, C.c_char_p] + err, C.c_int),
-        "poursim_create": ([P(ConfigStruct)] + err, C.c_void_p),
+        "poursim_config_new": ([C.c_void_p], C.c_void_p),
+        "poursim_config_free": ([C.c_void_p], None),
+        "poursim_config_key": ([C.c_int], C.c_char_p),
+        "poursim_config_key_info": ([C.c_char_p, P(C.c_int), P(C.c_double), P(C.c_double), P(C.c_double),
+                                     P(C.c_char_p), P(C.c_char_p)], C.c_int),
+        "poursim_config_get": ([C.c_void_p, C.c_char_p, P(C.c_double)] + err, C.c_int),
+        "poursim_config_validate": ([C.c_void_p] + err, C.c_int),
+        "poursim_config_load": ([C.c_char_p, C.c_void_p] + err, C.c_int),
+        "poursim_config_set": ([C.c_void_p, C.c_char_p, C.c_char_p] + err, C.c_int),
+        "poursim_config_write": ([C.c_void_p, C.c_char_p] + err, C.c_int),
+        "poursim_create": ([C.c_void_p] + err, C.c_void_p),
         "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
         "poursim_step": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
         "poursim_step_servo": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
         "poursim_set_brake": ([C.c_void_p, C.c_int], C.c_int),
         "poursim_world_error": ([C.c_void_p], C.c_char_p),
         "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
-        "poursim_measure_retention": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double,
+        "poursim_measure_retention": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double,
                                        P(RetentionStruct)] + err, C.c_int),
-        "poursim_measure_slosh": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
+        "poursim_measure_slosh": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
                                    P(C.c_double), C.c_int, P(SloshStruct)] + err, C.c_int),
         "poursim_observe": ([C.c_void_p, P(ObsStruct)], None),
-        "poursim_episode_config": ([C.c_void_p], P(ConfigStruct)),
-        "poursim_measure_drive": ([P(ConfigStruct), P(DriveCheckStruct)] + err, C.c_int),
-        "poursim_measure_sensors": ([P(ConfigStruct), C.c_uint32, P(SensorCheckStruct)] + err, C.c_int),
+        "poursim_episode_config": ([C.c_void_p], C.c_void_p),
+        "poursim_measure_drive": ([C.c_void_p, P(DriveCheckStruct)] + err, C.c_int),
+        "poursim_measure_sensors": ([C.c_void_p, C.c_uint32, P(SensorCheckStruct)] + err, C.c_int),
         "poursim_destroy": ([C.c_void_p], None),
         "poursim_particle_count": ([C.c_void_p], C.c_int),
         "poursim_particles": ([C.c_void_p, P(C.c_float), P(C.c_float), C.c_int], C.c_int),
@@ -198,6 +182,11 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
         "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
         "poursim_version": ([], C.c_char_p),
+        "poursim_sizeof": ([C.c_char_p], C.c_size_t),
+        "poursim_default_reward": ([], RewardStruct),
+        "poursim_reward_validate": ([P(RewardStruct)] + err, C.c_int),
+        "poursim_features": ([P(PolicyStruct), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
+                              P(C.c_double)], None),
         "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
     }
     for name, (args, res) in sig.items():
@@ -210,25 +199,84 @@ def _err() -> C.Array:
     return C.create_string_buffer(ERR_LEN)
 
 
-def default_config() -> dict[str, float]:
-    """The simulator's defaults (docs/simulator.md), as a dict of config keys."""
-    s = load_library().poursim_default_config()
-    return {k: getattr(s, k) for k in CONFIG_KEYS}
+@dataclass(frozen=True)
+class KeyInfo:
+    """One config key as host_sim/include/poursim/config_fields.h declares it."""
+    integer: bool
+    min: float
+    max: float
+    default: float
+    unit: str
+    doc: str
 
 
-def make_config(overrides: Mapping[str, float | str] | None = None,
-                path: str | os.PathLike | None = None) -> ConfigStruct:
-    """Defaults, then a config file (if any), then overrides (numbers, or text passed as is); validated.
+_keys: dict[str, KeyInfo] | None = None
 
-    SimError names a bad key, and carries it in .key when an override was refused.
-    """
-    lib = load_library()
-    cfg = lib.poursim_default_config()
-    e = _err()
-    if path is not None and lib.poursim_config_load(str(path).encode(), C.byref(cfg), e, ERR_LEN) != 0:
-        raise SimError(e.value.decode())
-    for key, value in (overrides or {}).items():
-        if key not in CONFIG_KEYS:
+
+def describe() -> dict[str, KeyInfo]:
+    """Every config key in the library's order, with its declaration (poursim_config_key_info)."""
+    global _keys
+    if _keys is None:
+        lib, keys = load_library(), {}
+        while (name := lib.poursim_config_key(len(keys))) is not None:
+            integer, lo, hi, default = C.c_int(), C.c_double(), C.c_double(), C.c_double()
+            unit, doc = C.c_char_p(), C.c_char_p()
+            if lib.poursim_config_key_info(name, C.byref(integer), C.byref(lo), C.byref(hi), C.byref(default),
+                                           C.byref(unit), C.byref(doc)) != 0:
+                raise SimError(f"libpoursim lists config key {name!r} but does not describe it")
+            keys[name.decode()] = KeyInfo(bool(integer.value), lo.value, hi.value, default.value,
+                                          unit.value.decode(), doc.value.decode())
+        _keys = keys
+    return _keys
+
+
+def config_keys() -> tuple[str, ...]:
+    """The names of every config key, in the library's order."""
+    return tuple(describe())
+
+
+def _read(ptr: int, key: str) -> float | int:
+    v, e = C.c_double(), _err()
+    if load_library().poursim_config_get(ptr, key.encode(), C.byref(v), e, ERR_LEN) != 0:
+        raise SimError(e.value.decode(errors="replace"), key)
+    return int(v.value) if describe()[key].integer else v.value
+
+
+def _read_all(ptr: int) -> dict[str, float | int]:
+    return {k: _read(ptr, k) for k in describe()}
+
+
+class Config:
+    """A simulator config held by libpoursim (poursim_config_new): read by key or attribute, set by key.
+
+    Python keeps no copy of the C struct: the keys, their types and ranges come from the library."""
+
+    def __init__(self, src: int | None = None):
+        self._lib = load_library()
+        self._ptr = self._lib.poursim_config_new(src)
+        if not self._ptr:
+            raise SimError("poursim_config_new: out of memory")
+
+    @property
+    def handle(self) -> int:
+        """The poursim_config_t * to pass to the C API."""
+        return self._ptr
+
+    def __del__(self) -> None:
+        if getattr(self, "_ptr", None):
+            self._lib.poursim_config_free(self._ptr)
+            self._ptr = None
+
+    def __getitem__(self, key: str) -> float | int:
+        return _read(self._ptr, key)
+
+    def __getattr__(self, key: str) -> float | int:
+        if key.startswith("_") or key not in describe():
+            raise AttributeError(key)
+        return _read(self._ptr, key)
+
+    def __setitem__(self, key: str, value: float | str) -> None:
+        if key not in describe():
             raise SimError(f"unknown config key '{key}'", key)
         if isinstance(value, str):
             text = value
@@ -236,11 +284,51 @@ def make_config(overrides: Mapping[str, float | str] | None = None,
             text = str(int(value))
         else:
             text = format(float(value), ".17g")
-        if lib.poursim_config_set(C.byref(cfg), key.encode(), text.encode(), e, ERR_LEN) != 0:
+        e = _err()
+        if self._lib.poursim_config_set(self._ptr, key.encode(), text.encode(), e, ERR_LEN) != 0:
             raise SimError(e.value.decode(errors="replace"), key)
-    if lib.poursim_config_validate(C.byref(cfg), e, ERR_LEN) != 0:
+
+    def keys(self) -> tuple[str, ...]:
+        return config_keys()
+
+    def as_dict(self) -> dict[str, float | int]:
+        return _read_all(self._ptr)
+
+    def validate(self) -> None:
+        e = _err()
+        if self._lib.poursim_config_validate(self._ptr, e, ERR_LEN) != 0:
+            raise SimError(e.value.decode(errors="replace"))
+
+    def write(self, path: str | os.PathLike) -> None:
+        """A loadable config file of every key (poursim_config_write: temp file, then renamed)."""
+        e = _err()
+        if self._lib.poursim_config_write(self._ptr, str(path).encode(), e, ERR_LEN) != 0:
+            raise SimError(e.value.decode(errors="replace"))
+
+
+def default_config() -> dict[str, float | int]:
+    """The simulator's defaults (config_fields.h), as a dict of config keys."""
+    return Config().as_dict()
+
+
+def make_config(overrides: Mapping[str, float | str] | None = None,
+                path: str | os.PathLike | None = None) -> Config:
+    """Defaults, then a config file (if any), then overrides (numbers, or text passed as is); validated.
+
+    SimError names a bad key, and carries it in .key when an override was refused.
+    """
+    cfg = Config()
+    e = _err()
+    if path is not None and cfg._lib.poursim_config_load(str(path).encode(), cfg.handle, e, ERR_LEN) != 0:
         raise SimError(e.value.decode())
+    for key, value in (overrides or {}).items():
+        cfg[key] = value
+    cfg.validate()
     return cfg
+
+
+def _as_config(config: Config | Mapping[str, float] | None) -> Config:
+    return config if isinstance(config, Config) else make_config(config)
 
 
 @dataclass
@@ -253,8 +341,6 @@ class Obs:
     v_target: float
     v_spill: float
     v_flight: float
-    obs: np.ndarray
-    reward: float
     torque: float              # commanded in this step [N·m]
     done: bool
     motor_torque: float = 0.0  # delivered by the drive in this step [N·m]
@@ -265,8 +351,38 @@ class Obs:
     @staticmethod
     def from_struct(o: ObsStruct) -> "Obs":
         return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
-                   np.array(o.obs[:], dtype=np.float64), o.reward, o.torque, bool(o.done), o.motor_torque,
+                   o.torque, bool(o.done), o.motor_torque,
                    int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g))
+
+
+@dataclass(frozen=True)
+class Reward:
+    """The trainer's reward, r = k_target·V_target − k_spill·V_spill per step, return Σ gamma^t r_t
+    (poursim_reward_t); not part of the world."""
+    k_target: float
+    k_spill: float
+    gamma: float
+
+    def step(self, v_target: float, v_spill: float) -> float:
+        """The reward of one step's shares, as the C rollout computes it."""
+        return self.k_target * v_target - self.k_spill * v_spill
+
+
+def default_reward() -> Reward:
+    """libpoursim's reward (poursim_default_reward), the one host_sim reports."""
+    r = load_library().poursim_default_reward()
+    return Reward(r.k_target, r.k_spill, r.gamma)
+
+
+def reward_from(options: dict) -> Reward:
+    """Pops k_target, k_spill and gamma from options (the rest are the world's), libpoursim's default for
+    each one absent; SimError names a value out of range."""
+    d = default_reward()
+    r = Reward(*(float(options.pop(k, getattr(d, k))) for k in ("k_target", "k_spill", "gamma")))
+    e = _err()
+    if load_library().poursim_reward_validate(C.byref(RewardStruct(r.k_target, r.k_spill, r.gamma)), e, ERR_LEN):
+        raise SimError(e.value.decode(errors="replace"), e.value.decode(errors="replace").split()[1])
+    return r
 
 
 @dataclass
@@ -280,6 +396,7 @@ class Policy:
     omega_max: float = 4.0             # [rad/s]
     greedy: bool = False               # argmax instead of sampling
     k_reversal: float = 0.0            # training's reward shaping: cost of each torque reversal
+    reward: Reward | None = None       # None: libpoursim's default_reward()
 
     def _struct(self) -> tuple[PolicyStruct, tuple[np.ndarray, np.ndarray]]:
         w = np.ascontiguousarray(self.w, dtype=np.float64)
@@ -288,9 +405,10 @@ class Policy:
             raise SimError(f"policy w has shape {w.shape}, expected (6, 2..16)")
         if lv.shape != (w.shape[1],):
             raise SimError(f"policy levels has shape {lv.shape}, expected ({w.shape[1]},)")
+        r = self.reward if self.reward is not None else default_reward()
         s = PolicyStruct(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
                          self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0,
-                         float(self.k_reversal))
+                         RewardStruct(r.k_target, r.k_spill, r.gamma), float(self.k_reversal))
         return s, (w, lv)  # the arrays must outlive the call
 
 
@@ -315,7 +433,7 @@ class Rollout:
     metrics: dict = field(default_factory=dict)
 
 
-def _n_steps(cfg: ConfigStruct) -> int:
+def _n_steps(cfg: Config) -> int:
     """Room for the episode's steps: the world ends it at the first step with t >= episode_s - dt/2, so at most
     ceil(episode_s/dt) of them (the rollout reports how many it ran)."""
     return int(math.ceil(cfg.episode_s / cfg.dt))
@@ -351,11 +469,11 @@ class _Buffers:
 class World:
     """One simulated scene. Not shared between threads; make one per thread or process."""
 
-    def __init__(self, config: ConfigStruct | Mapping[str, float] | None = None, seed: int | None = None):
+    def __init__(self, config: Config | Mapping[str, float] | None = None, seed: int | None = None):
         self._lib = load_library()
-        self.config = config if isinstance(config, ConfigStruct) else make_config(config)
+        self.config = _as_config(config)
         e = _err()
-        self._w = self._lib.poursim_create(C.byref(self.config), e, ERR_LEN)
+        self._w = self._lib.poursim_create(self.config.handle, e, ERR_LEN)
         if not self._w:
             raise SimError(e.value.decode())
         if seed is not None:
@@ -403,10 +521,9 @@ class World:
         self._lib.poursim_observe(self._check(), C.byref(o))
         return Obs.from_struct(o)
 
-    def episode_config(self) -> dict[str, float]:
+    def episode_config(self) -> dict[str, float | int]:
         """This episode's config: the world's with the reset seed's rand_* draws applied."""
-        c = self._lib.poursim_episode_config(self._check()).contents
-        return {k: getattr(c, k) for k in CONFIG_KEYS}
+        return _read_all(self._lib.poursim_episode_config(self._check()))
 
     @property
     def n_particles(self) -> int:
@@ -446,7 +563,8 @@ class World:
         rc = self._lib.poursim_rollout(self._check(), C.byref(ps), int(seed) & 0xFFFFFFFF, C.byref(bufs.struct),
                                        C.byref(e))
         if rc != 0:
-            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges and k_reversal")
+            raise SimError(f"rollout failed (status {rc}): check the policy's shape, levels, ranges, reward and "
+                           "k_reversal")
         del keep
         return bufs.result(seed, e)
 
@@ -462,13 +580,13 @@ class Retention:
     rms_gap: float
 
 
-def retention(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 3,
+def retention(config: Config | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 3,
               rate: float = 0.02, theta_end: float = np.radians(125)) -> Retention:
     """Servo-tilts the bucket at rate [rad/s] to theta_end [rad] once per seed; docs/simulator.md."""
     lib = load_library()
-    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cfg = _as_config(config)
     r, e = RetentionStruct(), _err()
-    if lib.poursim_measure_retention(C.byref(cfg), int(seed), int(n_seeds), float(rate), float(theta_end),
+    if lib.poursim_measure_retention(cfg.handle, int(seed), int(n_seeds), float(rate), float(theta_end),
                                      C.byref(r), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     n = r.n
@@ -487,14 +605,14 @@ class Slosh:
     trace: np.ndarray    # [m], one sample a step, the oscillation about its equilibrium
 
 
-def slosh(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 16,
+def slosh(config: Config | Mapping[str, float] | None = None, seed: int = 1, n_seeds: int = 16,
           tilt: float = np.radians(12), ramp_s: float = 0.3, hold_s: float = 4.0) -> Slosh:
     """Tilts to tilt [rad] in ramp_s, holds hold_s, averages n_seeds; docs/simulator.md."""
     lib = load_library()
-    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cfg = _as_config(config)
     cap = int(round(hold_s / cfg.dt)) + 1
     trace, out, e = (C.c_double * cap)(), SloshStruct(), _err()
-    if lib.poursim_measure_slosh(C.byref(cfg), int(seed), int(n_seeds), float(tilt), float(ramp_s), float(hold_s),
+    if lib.poursim_measure_slosh(cfg.handle, int(seed), int(n_seeds), float(tilt), float(ramp_s), float(hold_s),
                                  trace, cap, C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     return Slosh(out.freq, out.freq_theory, out.damping, out.amplitude, out.noise, np.array(trace[:out.n]))
@@ -505,24 +623,33 @@ def _struct_dict(st: C.Structure) -> dict:
             for name, _ in st._fields_}
 
 
-def measure_drive(config: ConfigStruct | Mapping[str, float] | None = None) -> dict:
+def measure_drive(config: Config | Mapping[str, float] | None = None) -> dict:
     """The drive on the empty bucket against Newton and its datasheet line (poursim_measure_drive)."""
     lib = load_library()
-    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cfg = _as_config(config)
     out, e = DriveCheckStruct(), _err()
-    if lib.poursim_measure_drive(C.byref(cfg), C.byref(out), e, ERR_LEN) != 0:
+    if lib.poursim_measure_drive(cfg.handle, C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     return _struct_dict(out)
 
 
-def measure_sensors(config: ConfigStruct | Mapping[str, float] | None = None, seed: int = 1) -> dict:
+def measure_sensors(config: Config | Mapping[str, float] | None = None, seed: int = 1) -> dict:
     """Encoder and load cells against mass, momentum and their config (poursim_measure_sensors)."""
     lib = load_library()
-    cfg = config if isinstance(config, ConfigStruct) else make_config(config)
+    cfg = _as_config(config)
     out, e = SensorCheckStruct(), _err()
-    if lib.poursim_measure_sensors(C.byref(cfg), int(seed), C.byref(out), e, ERR_LEN) != 0:
+    if lib.poursim_measure_sensors(cfg.handle, int(seed), C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     return _struct_dict(out)
+
+
+def features(theta_min: float, theta_max: float, omega_max: float, theta: float, omega: float, v_rotating: float,
+             v_target: float, v_spill: float) -> np.ndarray:
+    """poursim_features: the C rollout's normalisation of one state, [6] with the bias."""
+    p = PolicyStruct(theta_min=theta_min, theta_max=theta_max, omega_max=omega_max)
+    x = (C.c_double * N_FEATURES)()
+    load_library().poursim_features(C.byref(p), theta, omega, v_rotating, v_target, v_spill, x)
+    return np.array(x[:])
 
 
 def version() -> str:
@@ -534,6 +661,6 @@ def uniform_levels(n_actions: int) -> np.ndarray:
     return np.linspace(-1.0, 1.0, n_actions)
 
 
-__all__: Sequence[str] = ("SimError", "World", "Policy", "Rollout", "Obs", "Retention", "Slosh", "default_config",
+__all__: Sequence[str] = ("SimError", "World", "Policy", "Reward", "default_reward", "reward_from", "features", "Rollout", "Obs", "Retention", "Slosh", "default_config",
                           "make_config", "retention", "slosh", "measure_drive", "measure_sensors",
-                          "load_library", "uniform_levels", "CONFIG_KEYS", "REGIONS", "version")
+                          "load_library", "uniform_levels", "Config", "KeyInfo", "describe", "config_keys", "REGIONS", "version")
