@@ -17,7 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import paths
+from pour import cli, paths
 from pour.policy import fixedpoint as fp
 from pour.policy import weights_h
 from pour.sim import envs
@@ -71,7 +71,7 @@ def run_host_sim(args: Sequence[str], build_dir: str | Path | None = None) -> An
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-eval", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-eval", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     ag = sub.add_parser("agree", help="greedy float vs fixed-point agreement on held-out visited states")
     ag.add_argument("run", help="run directory (its policy.json gives the float W)")

@@ -9,7 +9,6 @@
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import sys
 from pathlib import Path
@@ -21,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pour import atomic  # noqa: E402
+from pour import atomic, cli  # noqa: E402
 from pour.sim import envs  # noqa: E402
 
 
@@ -173,7 +172,7 @@ def liquid(out_dir: Path, prefix: str = "") -> list[Path]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
+    ap = cli.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"),
                     help="a label and its run directories (repeat per method)")
     ap.add_argument("--liquid", action="store_true",

@@ -9,7 +9,6 @@ same seeds. Writes results/results.md and results/results.json.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import multiprocessing as mp
 import os
@@ -19,7 +18,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
 from pour.sim import envs
@@ -111,7 +110,7 @@ def markdown(rows: list[dict[str, Any]], n: int) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-results", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-results", description=__doc__.split("\n")[0])
     ap.add_argument("--header", default="policy/weights.h")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), default=[],
                     help="a label and its training runs (their final greedy float policies); repeatable")

@@ -15,7 +15,6 @@ Every node needs host_sim at the path the driver resolves (--build-dir, $POUR_BU
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -25,7 +24,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import evaluate, robustness
 from pour.train import executors
 
@@ -116,7 +115,7 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-robust-scale", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-robust-scale", description=__doc__.split("\n")[0])
     ap.add_argument("--header", default="policy/weights.h", help="the policy (firmware core in the loop)")
     ap.add_argument("--rigs", type=int, default=100, help="randomised rigs (episodes), e.g. 10000 on a cluster")
     ap.add_argument("--seed", type=int, default=FIRST_SEED, help=f"first seed (default {FIRST_SEED})")

@@ -24,7 +24,6 @@ pandas, pyarrow, tensorboardX) in the pinned environment. Tune is the tool for a
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import itertools
@@ -38,7 +37,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import results
 from pour.sim import envs
 from pour.train import config as cfgmod, executors
@@ -238,7 +237,7 @@ def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-sweep", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-sweep", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="the base TOML config (configs/train/*.toml)")
     ap.add_argument("--out", required=True, type=Path, help="sweep folder (runs/, table, plots); re-run to resume")
     ap.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",

@@ -16,7 +16,6 @@ defines them). Each episode's summary names its source.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -30,6 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from pour import cli  # noqa: E402
 from pour.lcm import channels, messages, sensors  # noqa: E402
 
 
@@ -319,7 +319,7 @@ def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = s
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
+    ap = cli.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path, help="LCM log file (lcm-logger)")
     ap.add_argument("--out", type=Path, help="folder for traces.png, latency.png, summary.json")
     ap.add_argument("--render", type=Path, help="also animate the first episode: FILE.gif (+ FILE.png)")

@@ -9,7 +9,6 @@ never from the worker that runs them, so the number of workers does not change t
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -22,6 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pour import cli
 from pour.policy import linear
 from pour.sim import envs
 from pour.train import config as cfgmod
@@ -328,7 +328,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="TOML config (configs/train/*.toml)")
     ap.add_argument("--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
     ap.add_argument("--seed", type=int, help="override the config's seed")
