@@ -7,31 +7,15 @@ import re
 import signal
 import subprocess
 import sys
-import sysconfig
 import time
 from pathlib import Path
 
 import lcm
 import pytest
 
-from conftest import BUILD_DIR, SOURCE_DIR
-from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
+from conftest import BUILD_DIR
+from lcm_helpers import LOGGER, Bus, msgs, record_pour, url
 from pour.lcm import channels, logfile, sensors
-
-LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
-
-
-def wait_until_still(path: Path, quiet_s: float = 0.5, limit_s: float = 10.0) -> None:
-    """Wait until lcm-logger has written everything it received: the file stops growing."""
-    deadline, size, since = time.monotonic() + limit_s, -1, time.monotonic()
-    while time.monotonic() < deadline:
-        now = path.stat().st_size if path.exists() else 0
-        if now != size:
-            size, since = now, time.monotonic()
-        elif time.monotonic() - since >= quiet_s:
-            return
-        time.sleep(0.05)
-
 
 def summary_line(text: str) -> str:
     return [x for x in text.splitlines() if x.startswith("summary")][0]
@@ -40,25 +24,9 @@ def summary_line(text: str) -> str:
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """One lockstep pour (2 s) through pour_controller, recorded with lcm-logger."""
-    build_dir, source_dir = BUILD_DIR, SOURCE_DIR
     tmp = tmp_path_factory.mktemp("log")
-    log = tmp / "pour.lcmlog"
-    u = url(31)
-    logger = subprocess.Popen([LOGGER, "-q", "-f", f"--lcm-url={u}", log])
-    try:
-        with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]) as c:
-            bus = Bus(u)
-            bus.wait_up()
-            r = subprocess.run([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir),
-                                "--set", "episode_s=2", "--seed", "3", "--lcm", u],
-                               capture_output=True, text=True, timeout=120)
-            assert r.returncode == 0, r.stderr
-            wait_until_still(log)
-            c.stop()
-    finally:
-        logger.send_signal(signal.SIGINT)
-        logger.wait(timeout=10)
-    return log, r.stdout, tmp
+    log, stdout = record_pour(BUILD_DIR, tmp / "pour.lcmlog", url(31))
+    return log, stdout, tmp
 
 
 def test_log_summary_matches_the_simulated_pour(recorded):
