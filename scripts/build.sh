@@ -8,10 +8,10 @@
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+. scripts/lib/cli.sh
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 TARGETS=(poursim_shared host_sim pour_controller can_bridge fault_pour pour_lcmtypes_py pour_lcmtypes_jar)
 case "${1:-}" in
-  -h|--help) sed -n '3,7s/^# \{0,1\}//p' "$0"; exit 0 ;;
-  --version) echo "build.sh (pour) $(sed -n 's/^version = "\(.*\)"/\1/p' tools/pyproject.toml)"; exit 0 ;;
   --all) TARGETS=(all) ;;
   "") ;;
   *) echo "build.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;

@@ -6,6 +6,8 @@ set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+. scripts/lib/cli.sh
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 

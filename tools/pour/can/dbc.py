@@ -11,7 +11,7 @@ import re
 import sys
 from pathlib import Path
 
-from pour import cli, paths
+from pour import atomic, cli, paths
 
 NODE_ID_MAX = 63
 CMD_MASK = 0x1F
@@ -61,7 +61,7 @@ def dbc_for_node(node_id: int, source: Path | None = None) -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-can-dbc", description=__doc__.splitlines()[0])
     ap.add_argument("--node-id", required=True, help="controller node id, 0..63")
-    ap.add_argument("-o", "--output", help="file to write (default: standard output)")
+    ap.add_argument("-o", "--out", "--output", dest="output", help="file to write (default: standard output)")
     args = ap.parse_args(argv)
     try:
         node_id = int(args.node_id, 0)
@@ -70,7 +70,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pour-can-dbc: error: {e}", file=sys.stderr)
         return 2
     if args.output:
-        Path(args.output).write_text(text, encoding="ascii")
+        try:
+            atomic.write_atomic(Path(args.output), text)
+        except OSError as e:
+            print(f"pour-can-dbc: error: cannot write {args.output}: {e}", file=sys.stderr)
+            return 1
     else:
         sys.stdout.write(text)
     return 0

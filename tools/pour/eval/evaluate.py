@@ -81,7 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ag.add_argument("--episode-s", type=float, default=10.0, help="held-out episode length [s]")
     rb = sub.add_parser("robust", help="the robustness table: nominal and each edge of the rig's uncertainty")
     rb.add_argument("--header", default="policy/weights.h", help="the policy (firmware core in the loop)")
-    rb.add_argument("--out", default="results/robustness", type=Path, help="folder for the table, JSON and plot")
+    rb.add_argument("-o", "--out", default="results/robustness", type=Path, help="folder for the table, JSON and plot")
     rb.add_argument("--nominal-episodes", type=int, default=100)
     rb.add_argument("--edge-episodes", type=int, default=30)
     rb.add_argument("--seed", type=int, default=held_out_seeds(2)[1], help="first held-out seed")

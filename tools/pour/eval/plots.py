@@ -177,7 +177,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                     help="a label and its run directories (repeat per method)")
     ap.add_argument("--liquid", action="store_true",
                     help="plot the liquid against physics instead (retention, sloshing; ~1 min)")
-    ap.add_argument("--out", required=True, help="output folder for the PNGs")
+    ap.add_argument("-o", "--out", required=True, help="output folder for the PNGs")
     ap.add_argument("--prefix", default="", help="file name prefix")
     ap.add_argument("--period-ms", type=int, default=10)
     args = ap.parse_args(argv)

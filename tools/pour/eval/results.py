@@ -119,7 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--init", metavar="CONFIG", help="also evaluate the initial policy of this training config")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
-    ap.add_argument("--out", default="results", type=Path)
+    ap.add_argument("-o", "--out", default="results", type=Path)
     args = ap.parse_args(argv)
     try:
         hdr = weights_h.parse_weights_h(args.header)

@@ -122,7 +122,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--per-task", type=int, help="rigs per Ray task (default: 2 tasks a CPU, at most 200)")
     ap.add_argument("--set", action="append", default=[], metavar="rand_KEY=VALUE",
                     help="override a randomisation range (0 turns it off); repeatable")
-    ap.add_argument("--out", default="results/robust_scale", type=Path)
+    ap.add_argument("-o", "--out", default="results/robust_scale", type=Path)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim")
     ap.add_argument("--ray-address", default="local", metavar="local|auto|HOST:PORT")
     ap.add_argument("--num-cpus", type=int, help="CPUs of a local Ray instance (default: all)")

@@ -239,7 +239,7 @@ def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-sweep", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="the base TOML config (configs/train/*.toml)")
-    ap.add_argument("--out", required=True, type=Path, help="sweep folder (runs/, table, plots); re-run to resume")
+    ap.add_argument("-o", "--out", required=True, type=Path, help="sweep folder (runs/, table, plots); re-run to resume")
     ap.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",
                     help="a grid axis, e.g. algo.lr=0.03,0.1 (repeatable: the product)")
     ap.add_argument("--random", type=int, default=0, metavar="N", help="N random points over the --range axes")

@@ -17,7 +17,7 @@ from pour.lcm import channels, messages
 
 def main(argv: list[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-lcm-cmd", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--url", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
     g = ap.add_mutually_exclusive_group(required=True)
     g.add_argument("--clear", action="store_true", help="clear latched faults")
     g.add_argument("--estop", action="store_true", help="assert the e-stop")

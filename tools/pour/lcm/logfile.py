@@ -321,7 +321,7 @@ def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = s
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path, help="LCM log file (lcm-logger)")
-    ap.add_argument("--out", type=Path, help="folder for traces.png, latency.png, summary.json")
+    ap.add_argument("-o", "--out", type=Path, help="folder for traces.png, latency.png, summary.json")
     ap.add_argument("--render", type=Path, help="also animate the first episode: FILE.gif (+ FILE.png)")
     ap.add_argument("--json", action="store_true", help="print the summary as JSON")
     ap.add_argument("--k-target", type=float)

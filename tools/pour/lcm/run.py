@@ -38,7 +38,7 @@ def private_url() -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-lcm-run", description=__doc__.split("\n\n")[0])
     ap.add_argument("--realtime", action="store_true", help="1 kHz wall clock on both sides")
-    ap.add_argument("--url", help="LCM URL (default: a private port on loopback)")
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", help="LCM URL (default: a private port on loopback)")
     ap.add_argument("--build-dir", help="CMake build tree (default $POUR_BUILD_DIR or build/host)")
     ap.add_argument("host_sim_args", nargs=argparse.REMAINDER, help="arguments for host_sim, after --")
     a = ap.parse_args(argv)

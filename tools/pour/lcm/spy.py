@@ -118,7 +118,7 @@ def stop(p: subprocess.Popen) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-lcm-spy", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--url", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
     ap.add_argument("--build-dir", help="CMake build tree holding lcmtypes/pour_lcmtypes.jar")
     ap.add_argument("--screenshot", type=Path, help="run under a private Xvfb and save a PNG of the screen")
     ap.add_argument("--seconds", type=float, default=5.0, help="with --screenshot: wait this long first")

@@ -141,7 +141,7 @@ def export(policy: str | Path, out: str | Path, which: str = "best", frac_bits: 
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-export", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="run directory (or its policy.json)")
-    ap.add_argument("--out", required=True, help="weights.h to write (e.g. policy/weights.h)")
+    ap.add_argument("-o", "--out", required=True, help="weights.h to write (e.g. policy/weights.h)")
     ap.add_argument("--which", default="best", choices=("best", "last"),
                     help="best: the weights with the best greedy validation score (default); last: the final ones")
     ap.add_argument("--frac-bits", type=int, help="fraction bits of W (default: the most that fit)")

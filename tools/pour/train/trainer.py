@@ -330,7 +330,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="TOML config (configs/train/*.toml)")
-    ap.add_argument("--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
+    ap.add_argument("-o", "--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
     ap.add_argument("--seed", type=int, help="override the config's seed")
     ap.add_argument("--iterations", type=int, help="override the config's iterations")
     ap.add_argument("--workers", type=int, help="override the config's workers")
