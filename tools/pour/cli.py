@@ -33,3 +33,15 @@ def progress(items: Iterable[T], total: int | None = None, desc: str | None = No
              unit: str = "it") -> Iterable[T]:
     """items, with a progress bar on stderr (done, rate and time left) unless quiet."""
     return tqdm(items, total=total, desc=desc, unit=unit, disable=quiet, file=sys.stderr, dynamic_ncols=True)
+
+
+def bar(total: int, desc: str | None = None, quiet: bool = False, unit: str = "it") -> tqdm:
+    """A progress bar on stderr for work counted by hand (bar.update(n)); a context manager."""
+    return tqdm(total=total, desc=desc, unit=unit, disable=quiet, file=sys.stderr, dynamic_ncols=True)
+
+
+def time_left(done: int, total: int, elapsed_s: float) -> str:
+    """The time left at this rate, as tqdm writes it (m:ss or h:mm:ss), for progress printed as log lines."""
+    if done <= 0:
+        return "?"
+    return tqdm.format_interval(max(0.0, elapsed_s / done * (total - done)))

@@ -87,6 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     rb.add_argument("--seed", type=int, default=held_out_seeds(2)[1], help="first held-out seed")
     rb.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
     rb.add_argument("--workers", type=int, default=2, help="host_sim processes at once")
+    rb.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     if args.cmd == "robust":
         return robust(args)
@@ -120,7 +121,8 @@ def robust(args: argparse.Namespace) -> int:
         if not args.out.parent.is_dir():
             raise ValueError(f"--out: folder {args.out.parent} does not exist")
         rows = robustness.run(args.header, args.out, args.nominal_episodes, args.edge_episodes, args.seed,
-                              lambda a: run_host_sim(a, args.build_dir), poursim.default_config(), args.workers)
+                              lambda a: run_host_sim(a, args.build_dir), poursim.default_config(), args.workers,
+                              args.quiet)
     except (OSError, RuntimeError, ValueError, weights_h.WeightsHError, poursim.SimError) as exc:
         print(f"pour-eval: error: {exc}", file=sys.stderr)
         return 2

@@ -320,7 +320,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
-                      f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]",
+                      f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s, "
+                      f"{cli.time_left(done, cfg.iterations - start, time.monotonic() - t0)} left]",
                       file=sys.stderr, flush=True)
         runner.close()
     final = load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
@@ -335,7 +336,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--iterations", type=int, help="override the config's iterations")
     ap.add_argument("--workers", type=int, help="override the config's workers")
     ap.add_argument("--fresh", action="store_true", help="discard an existing checkpoint in --out")
-    ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--quiet", action="store_true", help="no progress lines (iteration, return, time left) on stderr")
     ap.add_argument("--executor", choices=("local", "ray"), default="local",
                     help="where episodes run: 'local' process pool (default) or Ray tasks (pip install './tools[ray]')")
     ap.add_argument("--ray-address", default="local", metavar="auto|HOST:PORT",
