@@ -224,12 +224,12 @@ def test_sigint_leaves_a_run_that_resumes_to_the_uninterrupted_result(tmp_path):
 
 
 @pytest.mark.parametrize("extra", [[], ["--json", "--quiet"]])
-def test_robust_scale_prints_a_table_or_json_never_both(tmp_path, extra):
+def test_robust_scale_prints_a_table_or_json_never_both(tmp_path, source_dir, extra):
     """pour-robust-scale: the table alone on stdout (progress with the time left on stderr), or with --json one
     JSON document alone (and --quiet: nothing on stderr)."""
     out = tmp_path / "r"
-    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", "--rigs", "2", "--per-task", "1",
-                        "--num-cpus", "1", "-o", str(out), *extra], capture_output=True, text=True, timeout=300)
+    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", "--header", source_dir / "policy" / "weights.h",
+                        "--rigs", "2", "--per-task", "1", "--num-cpus", "1", "-o", out, *extra], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     if extra:
         doc = json.loads(r.stdout)
