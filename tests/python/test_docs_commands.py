@@ -19,11 +19,14 @@ from conftest import BUILD_DIR, SOURCE_DIR
 
 # Substitutions that make a written command cheap; (pattern, replacement, why).
 CHEAPER = [
-    (r"^(\.venv/bin/pour-train .*)$", r"\1 --iterations 1", "a full stage trains for 75-90 s"),
-    (r"^(\.venv/bin/pour-eval robust .*?)(\s+#.*)?$", r"\1 --nominal-episodes 2 --edge-episodes 1",
+    (r"^(\.venv/bin/pour-train [^#]*?)(\s+#.*)?$", r"\1 --iterations 1", "a full stage trains for 75-90 s"),
+    (r"^(\.venv/bin/pour-eval robust [^#]*?)(\s+#.*)?$", r"\1 --nominal-episodes 2 --edge-episodes 1",
      "the full table is 2 min of pours"),
     (r"--episodes 20\b", "--episodes 2", "20 held-out pours where 2 show the command works"),
 ]
+# Commands whose exit status 1 is a verdict, not a failure: (prefix, what stdout then holds, why).
+VERDICT_1 = [(".venv/bin/pour-eval robust", "| scene |",
+              "exit 1 says a bar is missed, which 2 episodes of a one-iteration policy may do; the table is printed")]
 # Command lines that are not run, with the reason (matched as prefixes of the logical line).
 SKIPPED = {
     "./scripts/build.sh": "rebuilds the checkout this test runs from (its programs are what the test uses); "
@@ -68,12 +71,10 @@ def block_with(md: Path, needle: str) -> list[str]:
     return b
 
 
-@pytest.fixture(scope="module")
-def ws(tmp_path_factory) -> Path:
+def make_workspace(root: Path) -> Path:
     """A checkout's layout for outputs: runs/ and out/ appear as the commands make them; results/ exists in
-    a checkout, so it does here (empty). One for the module: the training doc's first commands are the
-    README's, and a pour-train on a finished run folder resumes it (nothing to train)."""
-    ws = tmp_path_factory.mktemp("docs") / "ws"
+    a checkout, so it does here (empty)."""
+    ws = root / "ws"
     ws.mkdir()
     (ws / "results").mkdir()
     for name in (".venv", "configs"):
@@ -82,6 +83,13 @@ def ws(tmp_path_factory) -> Path:
     (ws / "build" / "host").symlink_to(BUILD_DIR)
     shutil.copytree(SOURCE_DIR / "policy", ws / "policy")
     return ws
+
+
+@pytest.fixture(scope="module")
+def ws(tmp_path_factory) -> Path:
+    """One for the training commands: the training doc's first commands are the README's, and a pour-train
+    on a finished run folder resumes it (nothing to train)."""
+    return make_workspace(tmp_path_factory.mktemp("docs"))
 
 
 def run_commands(ws: Path, commands: list[str]) -> list[str]:
@@ -96,7 +104,9 @@ def run_commands(ws: Path, commands: list[str]) -> list[str]:
             cheap = re.sub(pattern, repl, cheap)
         r = subprocess.run(["bash", "-c", "set -euo pipefail; " + cheap], cwd=ws, env=env, capture_output=True,
                            text=True, timeout=600)
-        assert r.returncode == 0 and "Traceback" not in r.stderr, f"{cmd!r} (run as {cheap!r}):\n{r.stderr[-2000:]}"
+        verdict = any(cmd.startswith(p) and table in r.stdout for p, table, _ in VERDICT_1)
+        ok = r.returncode == 0 or (r.returncode == 1 and verdict)
+        assert ok and "Traceback" not in r.stderr, f"{cmd!r} (run as {cheap!r}):\n{r.stderr[-2000:]}"
         ran.append(cmd)
     return ran
 
@@ -119,9 +129,11 @@ def test_training_doc_first_commands_run(ws):
     assert any("pour-eval agree" in c for c in ran) and any("host_sim" in c for c in ran)
 
 
-def test_bench_doc_one_command_pour_runs(ws):
-    """docs/bench.md: the whole pour over LCM in one command (the recipe's steps run until Ctrl-C or need a
-    display; tests/python/test_lcm_*.py run them one by one)."""
+def test_bench_doc_one_command_pour_runs(tmp_path):
+    """docs/bench.md: the whole pour over LCM in one command, with the shipped policy that pour_controller
+    compiles in (the recipe's steps run until Ctrl-C or need a display; tests/python/test_lcm_*.py run them
+    one by one)."""
+    ws = make_workspace(tmp_path)
     text = (SOURCE_DIR / "docs" / "bench.md").read_text()
     (cmd,) = re.findall(r"`(\.venv/bin/pour-lcm-run -- [^`]+)`", text)
     run_commands(ws, [cmd])
