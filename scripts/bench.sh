@@ -7,6 +7,8 @@
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+. scripts/lib/cli.sh
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 
 # --- section: core — the firmware core on an emulated Cortex-M4 -----------------------------------
 # Instructions per control step under qemu-system-arm -icount shift=0 (one instruction per virtual ns,

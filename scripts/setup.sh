@@ -6,6 +6,8 @@ set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+. scripts/lib/cli.sh
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 
@@ -48,7 +50,8 @@ if [ "$(cat .venv/.pour-stamp 2>/dev/null)" != "$stamp_want" ]; then
   log "venv: installing tools/requirements.lock"
   # Every file checked against the lock's sha256 (pip refuses an unpinned or unhashed package).
   .venv/bin/python -m pip install -q --disable-pip-version-check --require-hashes -r tools/requirements.lock
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps -e tools
+  # The build runs in the venv (setuptools, wheel and lcm from the lock): nothing unpinned is fetched for it.
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e tools
   echo "$stamp_want" > .venv/.pour-stamp
 fi
 

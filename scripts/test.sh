@@ -9,6 +9,8 @@
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
+. scripts/lib/cli.sh
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 ./scripts/setup.sh || exit 1
 export POUR_WERROR=ON
 

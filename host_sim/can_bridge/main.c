@@ -3,6 +3,7 @@
  * CAN as if it spoke LCM. POUR_SENSORS/POUR_COMMAND go out as frames; Torque and Heartbeat frames come back
  * as POUR_TORQUE and POUR_STATUS. The mapping is bridge.c; this file only moves bytes. */
 #include <errno.h>
+#include <getopt.h>
 #include <linux/can.h>
 #include <linux/can/raw.h>
 #include <net/if.h>
@@ -152,7 +153,8 @@ static void usage(FILE *f) {
              "  Torque, Heartbeat (CAN)        -> POUR_TORQUE, POUR_STATUS (LCM)\n"
              "  the torque scale [N.m] and policy hash come from the controller's Identity frame\n"
              "  defaults: LCM %s, node 0, 11 actions (the length of POUR_TORQUE's probabilities)\n"
-             "  numbers are decimal (--node 010 is node 10)\n"
+             "  numbers are decimal (--node 010 is node 10); --key VALUE or --key=VALUE\n"
+             "  --help, --version: this text; the version\n"
              "exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
              "CAN interface or LCM cannot be opened, or fails while bridging); 2 bad command line\n",
           POUR_LCM_DEFAULT_URL);
@@ -163,30 +165,57 @@ int main(int argc, char **argv) {
   const char *url = NULL;
   long duration_s = 0;
   pour_bridge_config_t cfg = pour_bridge_default_config();
-  for (int i = 1; i < argc; ++i) {
-    const char *a = argv[i];
-    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+  enum { OPT_IFACE = 256, OPT_LCM, OPT_NODE, OPT_N_ACTIONS, OPT_DURATION, OPT_VERSION };
+  static const struct option options[] = {
+      {"help", no_argument, NULL, 'h'},
+      {"version", no_argument, NULL, OPT_VERSION},
+      {"iface", required_argument, NULL, OPT_IFACE},
+      {"lcm", required_argument, NULL, OPT_LCM},
+      {"node", required_argument, NULL, OPT_NODE},
+      {"n-actions", required_argument, NULL, OPT_N_ACTIONS},
+      {"duration", required_argument, NULL, OPT_DURATION},
+      {NULL, 0, NULL, 0},
+  };
+  opterr = 0; /* our own messages */
+  int opt;
+  while ((opt = getopt_long(argc, argv, "+:h", options, NULL)) != -1) {
+    const char *a = argv[optind - 1];
     long n = 0;
-    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    switch (opt) {
+    case 'h':
       usage(stdout);
       return 0;
-    } else if (strcmp(a, "--iface") == 0 && v != NULL) {
-      iface = v;
-    } else if (strcmp(a, "--lcm") == 0 && v != NULL) {
-      url = v;
-    } else if (strcmp(a, "--node") == 0) {
-      if (parse_long(a, v, 0, POUR_CAN_NODE_ID_MAX, &n) != 0) return 2;
+    case OPT_VERSION:
+      printf("can_bridge %s\n", POUR_VERSION);
+      return 0;
+    case OPT_IFACE:
+      iface = optarg;
+      break;
+    case OPT_LCM:
+      url = optarg;
+      break;
+    case OPT_NODE:
+      if (parse_long("--node", optarg, 0, POUR_CAN_NODE_ID_MAX, &n) != 0) return 2;
       cfg.node_id = (uint8_t)n;
-    } else if (strcmp(a, "--n-actions") == 0) {
-      if (parse_long(a, v, 2, 16, &n) != 0) return 2;
+      break;
+    case OPT_N_ACTIONS:
+      if (parse_long("--n-actions", optarg, 2, 16, &n) != 0) return 2;
       cfg.n_actions = (uint8_t)n;
-    } else if (strcmp(a, "--duration") == 0) {
-      if (parse_long(a, v, 1, 10000000, &duration_s) != 0) return 2;
-    } else {
-      fprintf(stderr, "can_bridge: unknown option or missing value '%s' (see --help)\n", a);
+      break;
+    case OPT_DURATION:
+      if (parse_long("--duration", optarg, 1, 10000000, &duration_s) != 0) return 2;
+      break;
+    case ':':
+      fprintf(stderr, "can_bridge: %s needs a value (see --help)\n", a);
+      return 2;
+    default:
+      fprintf(stderr, "can_bridge: unknown option '%s' (see --help)\n", a);
       return 2;
     }
-    ++i;
+  }
+  if (optind < argc) {
+    fprintf(stderr, "can_bridge: unexpected argument '%s' (see --help)\n", argv[optind]);
+    return 2;
   }
   if (iface == NULL) {
     fprintf(stderr, "can_bridge: --iface IFACE is required (e.g. --iface vcan0)\n");

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // host_sim: runs pours in the Box2D world with the firmware core in-process (or a baseline), prints
 // results, writes trajectories and renders them. `host_sim --help` explains the flags.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <getopt.h>
 
 #include "bench.hpp"
 #include "controllers.hpp"
@@ -58,7 +61,9 @@ const char *kUsage =
     "  --quiet             only the summary\n"
     "  --realtime          with --lcm: pace at 1 kHz wall clock, use the latest torque, count misses\n"
     "  --lcm-timeout-ms T  with --lcm in lockstep: give up after T ms without an answer (default 2000)\n"
-    "  --help              this text\n"
+    "  --list-config       every config key with its unit, range and default\n"
+    "  --help, --version   this text; the version\n"
+    "Options take their value as --key VALUE or --key=VALUE (--lcm: --lcm=URL, --lcm URL or --lcm alone).\n"
     "\n"
     "Results, per episode and as a summary over episodes:\n"
     "  poured   % of the liquid in the target bucket at the end of the episode (10 s)\n"
@@ -111,58 +116,148 @@ bool parse_long(const char *s, long long lo, long long hi, long long &out) {
   return true;
 }
 
+// Levenshtein distance, for the suggestion on an unknown config key.
+size_t edit_distance(const std::string &a, const std::string &b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// poursim_config_describe's text: one key a line, the key first.
+std::string config_description() {
+  std::vector<char> buf(16384);
+  if (poursim_config_describe(buf.data(), buf.size()) != POURSIM_OK) return "";
+  return buf.data();
+}
+
+// The config key nearest to key (at most a third of its letters off), or "" when none is near.
+std::string nearest_config_key(const std::string &key) {
+  const std::string text = config_description();
+  std::string best;
+  size_t best_d = key.size() / 3 + 1;
+  for (size_t at = 0; at < text.size();) {
+    size_t eol = text.find('\n', at);
+    if (eol == std::string::npos) eol = text.size();
+    const size_t b = text.find_first_not_of(' ', at);
+    const size_t e = text.find(' ', b);
+    if (b < eol && e != std::string::npos) {
+      const std::string name = text.substr(b, std::min(e, eol) - b);
+      const size_t d = edit_distance(key, name);
+      if (d < best_d) best_d = d, best = name;
+    }
+    at = eol + 1;
+  }
+  return best;
+}
+
+// For an error on --set KEY=...: a hint when KEY is no config key (the nearest one, or where the list is).
+std::string key_hint(const std::string &key) {
+  const std::string near = nearest_config_key(key);
+  if (near == key) return "";
+  if (near.empty()) return " (host_sim --list-config lists the keys)";
+  return " (did you mean '" + near + "'? host_sim --list-config lists the keys)";
+}
+
+enum {
+  kOptPolicy = 256, kOptBaseline, kOptConfig, kOptCsv, kOptRender, kOptEpisodes, kOptSeed, kOptSet, kOptRate,
+  kOptLcm, kOptRealtime, kOptLcmTimeout, kOptBench, kOptSampled, kOptJson, kOptQuiet, kOptListConfig, kOptVersion
+};
+
+const option kOptions[] = {
+    {"help", no_argument, nullptr, 'h'},
+    {"version", no_argument, nullptr, kOptVersion},
+    {"list-config", no_argument, nullptr, kOptListConfig},
+    {"policy", required_argument, nullptr, kOptPolicy},
+    {"baseline", required_argument, nullptr, kOptBaseline},
+    {"config", required_argument, nullptr, kOptConfig},
+    {"csv", required_argument, nullptr, kOptCsv},
+    {"render", required_argument, nullptr, kOptRender},
+    {"episodes", required_argument, nullptr, kOptEpisodes},
+    {"seed", required_argument, nullptr, kOptSeed},
+    {"set", required_argument, nullptr, kOptSet},
+    {"rate", required_argument, nullptr, kOptRate},
+    {"lcm", optional_argument, nullptr, kOptLcm},
+    {"realtime", no_argument, nullptr, kOptRealtime},
+    {"lcm-timeout-ms", required_argument, nullptr, kOptLcmTimeout},
+    {"bench", no_argument, nullptr, kOptBench},
+    {"sampled", no_argument, nullptr, kOptSampled},
+    {"json", no_argument, nullptr, kOptJson},
+    {"quiet", no_argument, nullptr, kOptQuiet},
+    {nullptr, 0, nullptr, 0},
+};
+
 // Returns -1 to continue, else the exit code.
 int parse_args(int argc, char **argv, Options &o) {
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    auto value = [&](const char *flag) -> const char * {
-      if (i + 1 >= argc) return nullptr;
-      (void)flag;
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  opterr = 0;  // our own messages
+  int opt;
+  while ((opt = getopt_long(argc, argv, "+:h", kOptions, nullptr)) != -1) {
+    const char *a = argv[optind - 1];
+    const char *v = optarg;
+    long long n = 0;
+    switch (opt) {
+    case 'h':
       std::fputs(kUsage, stdout);
       return 0;
-    } else if (a == "--policy" || a == "--baseline" || a == "--config" || a == "--csv" || a == "--render" ||
-               a == "--episodes" || a == "--seed" || a == "--set" || a == "--rate") {
-      const char *v = value(a.c_str());
-      if (v == nullptr) return usage_error("%s needs a value", a.c_str());
-      long long n = 0;
-      if (a == "--policy") o.policy = v;
-      else if (a == "--baseline") o.baseline = v;
-      else if (a == "--config") o.config_path = v;
-      else if ((a == "--csv" || a == "--render") && *v == '\0') return usage_error("%s: the file name is empty", a.c_str());
-      else if (a == "--csv") o.csv = v;
-      else if (a == "--render") o.render = v;
-      else if (a == "--set") o.sets.push_back(v);
-      else if (a == "--episodes") {
-        if (!parse_long(v, 1, 100000, n)) return usage_error("--episodes wants an integer 1..100000, got '%s'", v);
-        o.episodes = static_cast<int>(n);
-      } else if (a == "--seed") {
-        if (!parse_long(v, 0, 4294967295LL, n)) return usage_error("--seed wants an integer 0..4294967295, got '%s'", v);
-        o.seed = n;
-      } else if (a == "--rate") {
-        char *end = nullptr;
-        o.rate = std::strtod(v, &end);
-        if (end == v || *end != '\0' || !(o.rate > 0.0 && o.rate < 100.0))
-          return usage_error("--rate wants a rate in (0, 100) rad/s, got '%s'", v);
-      }
-    } else if (a == "--lcm") {
+    case kOptVersion:
+      std::printf("host_sim %s (policies are parsed at run time: --policy FILE)\n", POUR_VERSION);
+      return 0;
+    case kOptListConfig:
+      std::printf("Simulator config keys (--set KEY=VALUE, or 'key = value' lines in --config FILE):\n%s",
+                  config_description().c_str());
+      return 0;
+    case kOptPolicy: o.policy = v; break;
+    case kOptBaseline: o.baseline = v; break;
+    case kOptConfig: o.config_path = v; break;
+    case kOptCsv:
+    case kOptRender:
+      if (*v == '\0') return usage_error("%s: the file name is empty", opt == kOptCsv ? "--csv" : "--render");
+      (opt == kOptCsv ? o.csv : o.render) = v;
+      break;
+    case kOptSet: o.sets.push_back(v); break;
+    case kOptEpisodes:
+      if (!parse_long(v, 1, 100000, n)) return usage_error("--episodes wants an integer 1..100000, got '%s'", v);
+      o.episodes = static_cast<int>(n);
+      break;
+    case kOptSeed:
+      if (!parse_long(v, 0, 4294967295LL, n)) return usage_error("--seed wants an integer 0..4294967295, got '%s'", v);
+      o.seed = n;
+      break;
+    case kOptRate: {
+      char *end = nullptr;
+      o.rate = std::strtod(v, &end);
+      if (end == v || *end != '\0' || !(o.rate > 0.0 && o.rate < 100.0))
+        return usage_error("--rate wants a rate in (0, 100) rad/s, got '%s'", v);
+      break;
+    }
+    case kOptLcm:
       o.lcm = true;
-      if (i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0) o.lcm_url = argv[++i];
-    } else if (a == "--realtime") o.realtime = true;
-    else if (a == "--lcm-timeout-ms") {
-      long long n = 0;
-      if (i + 1 >= argc || !parse_long(argv[i + 1], 1, 3600000, n))
-        return usage_error("--lcm-timeout-ms wants an integer 1..3600000, got '%s'", i + 1 < argc ? argv[i + 1] : "");
+      // --lcm=URL, --lcm URL (a next word that is not an option), or --lcm alone (the default URL).
+      if (v != nullptr) o.lcm_url = v;
+      else if (optind < argc && argv[optind][0] != '-') o.lcm_url = argv[optind++];
+      break;
+    case kOptRealtime: o.realtime = true; break;
+    case kOptLcmTimeout:
+      if (!parse_long(v, 1, 3600000, n)) return usage_error("--lcm-timeout-ms wants an integer 1..3600000, got '%s'", v);
       o.lcm_timeout_ms = static_cast<int>(n);
-      ++i;
-    } else if (a == "--bench") o.bench = true;
-    else if (a == "--sampled") o.sampled = true;
-    else if (a == "--json") o.json = true;
-    else if (a == "--quiet") o.quiet = true;
-    else return usage_error("unknown option '%s'", a.c_str());
+      break;
+    case kOptBench: o.bench = true; break;
+    case kOptSampled: o.sampled = true; break;
+    case kOptJson: o.json = true; break;
+    case kOptQuiet: o.quiet = true; break;
+    case ':': return usage_error("%s needs a value", a);
+    default: return usage_error("unknown option '%s'", a);
+    }
   }
+  if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   // --bench may take a --policy (its rollouts then run that policy).
   int modes = (o.policy.empty() || o.bench ? 0 : 1) + (o.baseline.empty() ? 0 : 1) + (o.bench ? 1 : 0);
   if (o.lcm && (o.bench || !o.baseline.empty())) return usage_error("%s", "--lcm goes with --policy FILE or alone");
@@ -209,7 +304,7 @@ int main(int argc, char **argv) {
                            POURSIM_OK;
     if ((world_key ? poursim_config_set(&cfg, key.c_str(), value.c_str(), err, sizeof err)
                    : poursim_reward_set(&reward, key.c_str(), value.c_str(), err, sizeof err)) != POURSIM_OK) {
-      std::fprintf(stderr, "host_sim: bad --set: %s\n", err);
+      std::fprintf(stderr, "host_sim: bad --set: %s%s\n", err, key_hint(key).c_str());
       return 2;
     }
   }

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sysconfig
 import time
 from pathlib import Path
 from typing import Callable
@@ -17,6 +18,8 @@ msgs = messages.load()
 
 LIQUID_G = 10300
 """Scripted samples weigh 10 L of soymilk (1.03 kg/L) in all."""
+
+LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
 
 
 def url(offset: int) -> str:
@@ -160,3 +163,34 @@ class Bus:
         m.utime, m.estop, m.clear_faults = int(time.time() * 1e6), estop, clear_faults
         m.stop, m.reset = stop, reset
         self.lc.publish(channels.COMMAND, m.encode())
+
+
+def wait_until_still(path: Path, quiet_s: float = 0.5, limit_s: float = 10.0) -> None:
+    """Wait until lcm-logger has written everything it received: the file stops growing."""
+    deadline, size, since = time.monotonic() + limit_s, -1, time.monotonic()
+    while time.monotonic() < deadline:
+        now = path.stat().st_size if path.exists() else 0
+        if now != size:
+            size, since = now, time.monotonic()
+        elif time.monotonic() - since >= quiet_s:
+            return
+        time.sleep(0.05)
+
+
+def record_pour(build_dir: Path, log: Path, u: str, seconds: float = 2, seed: int = 3) -> tuple[Path, str]:
+    """One lockstep pour through pour_controller, recorded with lcm-logger into log: (log, host_sim's stdout)."""
+    logger = subprocess.Popen([LOGGER, "-q", "-f", f"--lcm-url={u}", log])
+    try:
+        with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]) as c:
+            bus = Bus(u)
+            bus.wait_up()
+            r = subprocess.run([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir),
+                                "--set", f"episode_s={seconds}", "--seed", str(seed), "--lcm", u],
+                               capture_output=True, text=True, timeout=120)
+            assert r.returncode == 0, r.stderr
+            wait_until_still(log)
+            c.stop()
+    finally:
+        logger.send_signal(signal.SIGINT)
+        logger.wait(timeout=10)
+    return log, r.stdout

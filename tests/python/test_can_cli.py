@@ -50,7 +50,9 @@ def test_controller_without_the_interface_says_so():
     (["--iface", "vcan0", "--node", "64"], "--node needs an integer in [0, 63]"),
     (["--iface", "vcan0", "--n-actions", "1"], "--n-actions needs an integer in [2, 16]"),
     (["--iface", "vcan0", "--frobnicate"], "unknown option"),
-    (["--iface"], "unknown option or missing value"),
+    (["--iface"], "--iface needs a value"),
+    (["--iface=vcan0", "--node=64"], "--node needs an integer in [0, 63]"),  # --key=value as --key value
+    (["--iface", "vcan0", "stray"], "unexpected argument 'stray'"),
 ])
 def test_bridge_rejects_bad_arguments(argv, needle):
     r = run(exe("can_bridge"), *argv)
@@ -58,8 +60,17 @@ def test_bridge_rejects_bad_arguments(argv, needle):
     assert needle in r.stderr
 
 
-def test_bridge_without_the_interface_says_so():
-    r = run(exe("can_bridge"), "--iface", "nosuchcan0")
+@pytest.mark.parametrize("iface", [["--iface", "nosuchcan0"], ["--iface=nosuchcan0"]])
+def test_bridge_without_the_interface_says_so(iface):
+    r = run(exe("can_bridge"), *iface)
+    assert r.returncode == 1
+    assert "no CAN support" in r.stderr or "no such CAN interface" in r.stderr
+
+
+@pytest.mark.parametrize("argv", [["--iface", "nosuchcan0"], ["--iface=nosuchcan0", "--node=3"]])
+def test_controller_takes_the_bridges_can_flags(argv):
+    """pour_controller --iface IFACE [--node N] is its --io can:IFACE[,node=N]."""
+    r = run(exe("pour_controller"), *argv)
     assert r.returncode == 1
     assert "no CAN support" in r.stderr or "no such CAN interface" in r.stderr
 

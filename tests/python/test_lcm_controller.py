@@ -174,6 +174,9 @@ def test_controller_real_time_ticks_without_states_and_counts(controller):
     (["--encoder-bits", "7"], "--encoder-bits needs an integer in [8, 24]"),
     (["--encoder-bits", "25"], "--encoder-bits needs an integer in [8, 24]"),
     (["--frobnicate"], "unknown option"),
+    (["--seed=-3"], "--seed needs"),  # --key=value as --key value
+    (["--node", "3"], "--node goes with --iface"),
+    (["stray"], "unexpected argument 'stray'"),
 ])
 def test_controller_rejects_bad_arguments(controller, argv, needle):
     r = subprocess.run([controller, *argv], capture_output=True, text=True, timeout=10)
@@ -181,8 +184,10 @@ def test_controller_rejects_bad_arguments(controller, argv, needle):
     assert needle in r.stderr
 
 
-def test_controller_rejects_an_unusable_url(controller):
-    r = subprocess.run([controller, "--io", "lcm:nosuchprovider://x"], capture_output=True, text=True, timeout=10)
+@pytest.mark.parametrize("io", [["--io", "lcm:nosuchprovider://x"], ["--lcm", "nosuchprovider://x"],
+                                ["--lcm=nosuchprovider://x"]])
+def test_controller_rejects_an_unusable_url(controller, io):
+    r = subprocess.run([controller, *io], capture_output=True, text=True, timeout=10)
     assert r.returncode == 1
     assert "cannot open LCM" in r.stderr
 

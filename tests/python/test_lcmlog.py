@@ -7,31 +7,15 @@ import re
 import signal
 import subprocess
 import sys
-import sysconfig
 import time
 from pathlib import Path
 
 import lcm
 import pytest
 
-from conftest import BUILD_DIR, SOURCE_DIR
-from lcm_helpers import Bus, Proc, binary, compiled_weights, msgs, url
+from conftest import BUILD_DIR
+from lcm_helpers import LOGGER, Bus, msgs, record_pour, url
 from pour.lcm import channels, logfile, sensors
-
-LOGGER = Path(sysconfig.get_paths()["purelib"]) / "bin" / "lcm-logger"  # the real binary: it stops on SIGINT
-
-
-def wait_until_still(path: Path, quiet_s: float = 0.5, limit_s: float = 10.0) -> None:
-    """Wait until lcm-logger has written everything it received: the file stops growing."""
-    deadline, size, since = time.monotonic() + limit_s, -1, time.monotonic()
-    while time.monotonic() < deadline:
-        now = path.stat().st_size if path.exists() else 0
-        if now != size:
-            size, since = now, time.monotonic()
-        elif time.monotonic() - since >= quiet_s:
-            return
-        time.sleep(0.05)
-
 
 def summary_line(text: str) -> str:
     return [x for x in text.splitlines() if x.startswith("summary")][0]
@@ -40,25 +24,9 @@ def summary_line(text: str) -> str:
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory):
     """One lockstep pour (2 s) through pour_controller, recorded with lcm-logger."""
-    build_dir, source_dir = BUILD_DIR, SOURCE_DIR
     tmp = tmp_path_factory.mktemp("log")
-    log = tmp / "pour.lcmlog"
-    u = url(31)
-    logger = subprocess.Popen([LOGGER, "-q", "-f", f"--lcm-url={u}", log])
-    try:
-        with Proc([binary(build_dir, "pour_controller"), "--io", f"lcm:{u}", "--lockstep"]) as c:
-            bus = Bus(u)
-            bus.wait_up()
-            r = subprocess.run([binary(build_dir, "host_sim"), "--policy", compiled_weights(build_dir),
-                                "--set", "episode_s=2", "--seed", "3", "--lcm", u],
-                               capture_output=True, text=True, timeout=120)
-            assert r.returncode == 0, r.stderr
-            wait_until_still(log)
-            c.stop()
-    finally:
-        logger.send_signal(signal.SIGINT)
-        logger.wait(timeout=10)
-    return log, r.stdout, tmp
+    log, stdout = record_pour(BUILD_DIR, tmp / "pour.lcmlog", url(31))
+    return log, stdout, tmp
 
 
 def test_log_summary_matches_the_simulated_pour(recorded):
@@ -73,7 +41,8 @@ def test_log_summary_matches_the_simulated_pour(recorded):
     line = summary_line(host_out)
     poured = float(re.search(r"poured\s+([\d.]+) %", line).group(1)) / 100
     spilled = float(re.search(r"spilled\s+([\d.]+) %", line).group(1)) / 100
-    assert abs(ep["poured"] - poured) <= 1 / 150 + 1e-9 and abs(ep["spilled"] - spilled) <= 1 / 150 + 1e-9
+    assert abs(ep["poured_pct"] / 100 - poured) <= 1 / 150 + 1e-9
+    assert abs(ep["spilled_pct"] / 100 - spilled) <= 1 / 150 + 1e-9
     # UDP multicast to the logger may drop a few datagrams on a loaded machine, anywhere in the stream
     # (the end included), samples and answers alike.
     assert ep["first_seq"] <= 100 and ep["last_seq"] >= 1900
@@ -211,8 +180,8 @@ def test_log_without_truth_reads_the_plant_from_the_sensors(tmp_path):
     s = logfile.analyse(path, None)
     (ep,) = s["episodes"]
     assert ep["source"].startswith(channels.SENSORS)
-    assert ep["poured"] == pytest.approx(0.6, abs=1e-4) and ep["spilled"] == pytest.approx(0.05, abs=1e-4)
-    assert ep["left"] == pytest.approx(0.35, abs=1e-4)
+    assert ep["poured_pct"] == pytest.approx(60, abs=1e-2) and ep["spilled_pct"] == pytest.approx(5, abs=1e-2)
+    assert ep["left_pct"] == pytest.approx(35, abs=1e-2)
     assert ep["max_theta_deg"] == pytest.approx(100.27, abs=0.01)  # 1.75 rad to one count (47.9 µrad)
     log = s["_log"]
     assert log.episodes[0].theta[-1] == pytest.approx(-0.02, abs=5e-5)  # below upright: the count wrapped
@@ -228,7 +197,7 @@ def test_log_prefers_truth_and_refuses_impossible_values(tmp_path):
     s = logfile.analyse(path, None)
     (ep,) = s["episodes"]
     assert ep["source"] == channels.TRUTH and ep["samples"] == 4
-    assert ep["poured"] == 0.25 and ep["spilled"] == 0.05  # the last plausible truth, not the scales
+    assert ep["poured_pct"] == pytest.approx(25) and ep["spilled_pct"] == pytest.approx(5)  # the last plausible truth
     assert s["refused"] == {channels.SENSORS: 2, channels.TRUTH: 2}
     r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and "refused 4" in r.stdout
@@ -266,3 +235,18 @@ def test_sensor_readings_in_physical_units_and_their_bad_input():
         sensors.encoder_count(float("nan"))
     with pytest.raises(ValueError, match="must be positive"):
         sensors.volumes(1, 1, 0)
+
+
+def test_lost_samples_are_warned_about(tmp_path):
+    """Samples missing between the first and the last seq (gaps) are named on stderr, in text and JSON mode."""
+    path = tmp_path / "gappy.lcmlog"
+    sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 0.5, (0.9, 0.1), {}), (4, 1.0, (0.5, 0.5), {})])
+    for extra in ([], ["--json"]):
+        r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path, *extra], capture_output=True, text=True,
+                           timeout=120)
+        assert r.returncode == 0, r.stderr
+        assert "pour-lcmlog: warning: episode 1: 2 of the samples 0..4 are not in the log" in r.stderr, r.stderr
+    assert json.loads(r.stdout)["episodes"][0]["poured_pct"] == pytest.approx(50)
+    sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 0.5, (0.9, 0.1), {}), (2, 1.0, (0.5, 0.5), {})])
+    r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and "warning" not in r.stderr, r.stderr

@@ -221,3 +221,21 @@ def test_sigint_leaves_a_run_that_resumes_to_the_uninterrupted_result(tmp_path):
     assert resumed.iterations == 12
     trainer.train(cfg, tmp_path / "ref", quiet=True)
     assert_same_run(run, tmp_path / "ref")
+
+
+@pytest.mark.parametrize("extra", [[], ["--json", "--quiet"]])
+def test_robust_scale_prints_a_table_or_json_never_both(tmp_path, source_dir, extra):
+    """pour-robust-scale: the table alone on stdout (progress with the time left on stderr), or with --json one
+    JSON document alone (and --quiet: nothing on stderr)."""
+    out = tmp_path / "r"
+    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", "--header", source_dir / "policy" / "weights.h",
+                        "--rigs", "2", "--per-task", "1", "--num-cpus", "1", "-o", out, *extra], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    if extra:
+        doc = json.loads(r.stdout)
+        assert doc["rigs"] == 2 and doc["tasks"] == 2 and doc["rows"][0]["episodes"] == 2
+        assert "2/2" not in r.stderr
+    else:
+        assert r.stdout == (out / "robust_scale.md").read_text()
+        assert not any(line.lstrip().startswith("{") for line in r.stdout.splitlines())
+        assert "2 rigs" in r.stderr and "2/2" in r.stderr and "<" in r.stderr

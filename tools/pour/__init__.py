@@ -1,6 +1,8 @@
 """pour: offline tools for the soymilk-pouring controller.
 
-    pour.paths, pour.atomic, pour.libpoursim   shared: the build tree, atomic writes, libpoursim.so opened once
+    pour.paths, pour.atomic, pour.libpoursim   shared: the build tree and the package data, atomic writes,
+                  libpoursim.so opened once
+    pour.cli      shared: every program's --version and its progress bars (tqdm, off with --quiet)
     pour.policy   the policy as the firmware runs it: float softmax-linear (linear), its bit-exact
                   fixed-point reference (fixedpoint), weights.h (weights_h), policy.json -> weights.h
                   (export), the firmware core through ctypes (core), golden vectors (golden)

@@ -5,7 +5,12 @@
 A build tree is looked for, in order, at an explicit --build-dir, at $POUR_BUILD_DIR (ctest sets it), then
 at <source>/build/host (the `host` preset), then, for callers that accept any preset, at the other
 <source>/build/* folders. libpoursim alone can also be named directly with $POUR_SIM_LIB (Ray workers, a
-library built elsewhere). Nothing here imports the rest of the package.
+library built elsewhere).
+
+Data that has its one source in the checkout (the DBC, the generated LCM Python types) is found through
+data_file() and lcmtypes_python_dirs(): first in the package's own data/ folder, which a wheel carries
+(tools/setup.py copies and generates it at build time), then in the checkout and its build trees. Nothing
+here imports the rest of the package.
 """
 from __future__ import annotations
 
@@ -17,6 +22,11 @@ from pathlib import Path
 # "source dir" holds no build tree, so only $POUR_BUILD_DIR / $POUR_SIM_LIB / --build-dir find one there.
 SOURCE_DIR = Path(__file__).resolve().parents[2]
 SIM_LIB_REL = Path("lib") / "libpoursim.so"
+# The package's data folder: filled in a built wheel, absent from a checkout (nothing there is a copy).
+PACKAGE_DATA = Path(__file__).resolve().parent / "data"
+# Each data file a wheel ships, by its name in PACKAGE_DATA, and the one source it is copied from.
+DATA_SOURCES = {"pour.dbc": Path("can") / "pour.dbc"}
+LCMTYPES_DIR = "lcmtypes"  # PACKAGE_DATA/lcmtypes/pour_lcm/pour/*.py in a wheel
 
 
 def build_dirs(build_dir: str | os.PathLike | None = None, any_preset: bool = False) -> list[Path]:
@@ -63,3 +73,21 @@ def sim_library_candidates() -> list[Path]:
     if os.environ.get("POUR_SIM_LIB"):
         return [Path(os.environ["POUR_SIM_LIB"])]
     return candidates(SIM_LIB_REL, any_preset=True)
+
+
+def data_file(name: str) -> Path:
+    """The data file NAME (a key of DATA_SOURCES): the package's copy, else the checkout's source.
+    FileNotFoundError naming every place tried otherwise."""
+    tried = [PACKAGE_DATA / name, SOURCE_DIR / DATA_SOURCES[name]]
+    for p in tried:
+        if p.is_file():
+            return p
+    raise FileNotFoundError(f"{name} not found (tried {', '.join(map(str, tried))}): reinstall the package "
+                            "from its wheel or run from a checkout")
+
+
+def lcmtypes_python_dirs() -> list[Path]:
+    """Folders that may hold the generated Python LCM types (pour_lcm/pour/*.py), in the order tried:
+    $POUR_LCMTYPES_PYTHON, the package's data, then lcmtypes/python of every build tree."""
+    out = [Path(os.environ["POUR_LCMTYPES_PYTHON"])] if os.environ.get("POUR_LCMTYPES_PYTHON") else []
+    return out + [PACKAGE_DATA / LCMTYPES_DIR] + candidates(Path("lcmtypes") / "python")

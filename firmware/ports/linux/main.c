@@ -2,6 +2,7 @@
 /* pour_controller: the firmware core as a Linux process, talking to host_sim (or a bench) over a
  * transport chosen with --io. */
 #include <errno.h>
+#include <getopt.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,7 +26,10 @@ static void usage(FILE *f) {
           "  --io lcm[:URL]         transport (default lcm with its default URL)\n"
           "  --io can:IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n"
           "                         SocketCAN, the protocol of can/pour.dbc (defaults 0, 100, 50)\n"
-          "  --lockstep             one tick per sensor sample (deterministic; host_sim --lockstep)\n"
+          "  --lcm URL              the same as --io lcm:URL (the LCM URL's flag in every pour program)\n"
+          "  --iface IFACE [--node N]  the same as --io can:IFACE[,node=N] (as can_bridge spells them)\n"
+          "  --lockstep             one tick per sensor sample (deterministic: what host_sim --lcm runs\n"
+          "                         unless --realtime)\n"
           "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a sample (2000)\n"
           "  --duration S           stop after S seconds (default: run until SIGINT/SIGTERM)\n"
           "  --max-states N         stop after answering N sensor samples\n"
@@ -35,7 +39,8 @@ static void usage(FILE *f) {
           "  --sampled              sample actions instead of the greedy argmax\n"
           "  --seed N               seed of the sampled mode\n"
           "  --verbose              a status line on stderr every 100 ms\n"
-          "  --help\n"
+          "  --help, --version      this text; the version and the compiled-in weights' hash\n"
+          "Options take their value as --key VALUE or --key=VALUE.\n"
           "Weights: the weights.h named by CMake's POUR_WEIGHTS (compiled in, hash 0x%08x).\n"
           "Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (the\n"
           "transport cannot be opened, the core refuses its configuration); 2 bad command line (an unknown\n"
@@ -95,70 +100,134 @@ static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *c
   return -2;
 }
 
+/* Long options; the values of `val` past the ASCII range name the ones without a short form. */
+enum {
+  OPT_IO = 256, OPT_LCM, OPT_IFACE, OPT_NODE, OPT_LOCKSTEP, OPT_STALL_MS, OPT_DURATION, OPT_MAX_STATES,
+  OPT_INPUT_TIMEOUT_MS, OPT_ENCODER_BITS, OPT_SAMPLED, OPT_SEED, OPT_VERBOSE, OPT_VERSION
+};
+
+static const struct option kOptions[] = {
+    {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, OPT_VERSION},
+    {"io", required_argument, NULL, OPT_IO},
+    {"lcm", required_argument, NULL, OPT_LCM},
+    {"iface", required_argument, NULL, OPT_IFACE},
+    {"node", required_argument, NULL, OPT_NODE},
+    {"lockstep", no_argument, NULL, OPT_LOCKSTEP},
+    {"stall-ms", required_argument, NULL, OPT_STALL_MS},
+    {"duration", required_argument, NULL, OPT_DURATION},
+    {"max-states", required_argument, NULL, OPT_MAX_STATES},
+    {"input-timeout-ms", required_argument, NULL, OPT_INPUT_TIMEOUT_MS},
+    {"encoder-bits", required_argument, NULL, OPT_ENCODER_BITS},
+    {"sampled", no_argument, NULL, OPT_SAMPLED},
+    {"seed", required_argument, NULL, OPT_SEED},
+    {"verbose", no_argument, NULL, OPT_VERBOSE},
+    {NULL, 0, NULL, 0},
+};
+
 int main(int argc, char **argv) {
   pour_linux_config_t cfg = pour_linux_default_config();
   cfg.weights = &pour_weights_compiled;
   const char *io_spec = "lcm";
-  for (int i = 1; i < argc; i++) {
-    const char *a = argv[i];
-    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+  const char *iface = NULL, *node = NULL;
+  char spec_buf[256];
+  opterr = 0; /* our own messages, in the words of the other pour programs */
+  int c;
+  while ((c = getopt_long(argc, argv, "+:h", kOptions, NULL)) != -1) {
     long long n = 0;
-    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    const char *a = argv[optind - 1];
+    switch (c) {
+    case 'h':
       usage(stdout);
       return 0;
-    } else if (strcmp(a, "--io") == 0) {
-      if (v == NULL) {
-        fprintf(stderr, "pour_controller: --io needs a transport, e.g. lcm or lcm:URL\n");
+    case OPT_VERSION:
+      printf("pour_controller %s, weights hash 0x%08x\n", POUR_VERSION, (unsigned)pour_weights_compiled.content_hash);
+      return 0;
+    case OPT_IO:
+      io_spec = optarg;
+      break;
+    case OPT_LCM:
+      if (snprintf(spec_buf, sizeof spec_buf, "lcm:%s", optarg) >= (int)sizeof spec_buf) {
+        fprintf(stderr, "pour_controller: --lcm: the URL is longer than %u characters\n", (unsigned)sizeof spec_buf - 5u);
         return 2;
       }
-      io_spec = v;
-      i++;
-    } else if (strcmp(a, "--lockstep") == 0) {
+      io_spec = spec_buf;
+      break;
+    case OPT_IFACE:
+      iface = optarg;
+      break;
+    case OPT_NODE:
+      node = optarg;
+      break;
+    case OPT_LOCKSTEP:
       cfg.lockstep = true;
-    } else if (strcmp(a, "--stall-ms") == 0) {
-      if (parse_int(a, v, 1, 3600000, &n) != 0) {
+      break;
+    case OPT_STALL_MS:
+      if (parse_int("--stall-ms", optarg, 1, 3600000, &n) != 0) {
         return 2;
       }
       cfg.stall_ms = n;
-      i++;
-    } else if (strcmp(a, "--duration") == 0) {
-      if (parse_seconds(a, v, &n) != 0) {
+      break;
+    case OPT_DURATION:
+      if (parse_seconds("--duration", optarg, &n) != 0) {
         return 2;
       }
       cfg.duration_ms = n;
-      i++;
-    } else if (strcmp(a, "--max-states") == 0) {
-      if (parse_int(a, v, 1, INT64_MAX, &n) != 0) {
+      break;
+    case OPT_MAX_STATES:
+      if (parse_int("--max-states", optarg, 1, INT64_MAX, &n) != 0) {
         return 2;
       }
       cfg.max_states = n;
-      i++;
-    } else if (strcmp(a, "--input-timeout-ms") == 0) {
-      if (parse_int(a, v, 1, UINT16_MAX, &n) != 0) {
+      break;
+    case OPT_INPUT_TIMEOUT_MS:
+      if (parse_int("--input-timeout-ms", optarg, 1, UINT16_MAX, &n) != 0) {
         return 2;
       }
       cfg.control.input_timeout_ms = (uint16_t)n;
-      i++;
-    } else if (strcmp(a, "--encoder-bits") == 0) {
-      if (parse_int(a, v, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, &n) != 0) {
+      break;
+    case OPT_ENCODER_BITS:
+      if (parse_int("--encoder-bits", optarg, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, &n) != 0) {
         return 2;
       }
       cfg.control.sensors.encoder_bits = (uint8_t)n;
-      i++;
-    } else if (strcmp(a, "--sampled") == 0) {
+      break;
+    case OPT_SAMPLED:
       cfg.control.policy_mode = POUR_POLICY_SAMPLED;
-    } else if (strcmp(a, "--seed") == 0) {
-      if (parse_int(a, v, 0, UINT32_MAX, &n) != 0) {
+      break;
+    case OPT_SEED:
+      if (parse_int("--seed", optarg, 0, UINT32_MAX, &n) != 0) {
         return 2;
       }
       cfg.control.seed = (uint32_t)n;
-      i++;
-    } else if (strcmp(a, "--verbose") == 0) {
+      break;
+    case OPT_VERBOSE:
       cfg.verbose = true;
-    } else {
+      break;
+    case ':':
+      fprintf(stderr, "pour_controller: %s needs a value (see --help)\n", a);
+      return 2;
+    default:
       fprintf(stderr, "pour_controller: unknown option '%s' (see --help)\n", a);
       return 2;
     }
+  }
+  if (optind < argc) {
+    fprintf(stderr, "pour_controller: unexpected argument '%s' (see --help)\n", argv[optind]);
+    return 2;
+  }
+  if (node != NULL && iface == NULL) {
+    fprintf(stderr, "pour_controller: --node goes with --iface IFACE\n");
+    return 2;
+  }
+  if (iface != NULL) {
+    const int len = node != NULL ? snprintf(spec_buf, sizeof spec_buf, "can:%s,node=%s", iface, node)
+                                 : snprintf(spec_buf, sizeof spec_buf, "can:%s", iface);
+    if (len >= (int)sizeof spec_buf) {
+      fprintf(stderr, "pour_controller: --iface/--node: longer than %u characters\n", (unsigned)sizeof spec_buf - 1u);
+      return 2;
+    }
+    io_spec = spec_buf;
   }
 
   pour_io_t io;

@@ -9,14 +9,14 @@ CRC 15 = 34 + 8n bits that can be stuffed, then CRC delimiter, ACK slot and deli
 """
 from __future__ import annotations
 
-import argparse
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import cantools
 
-from pour.can.dbc import DBC_PATH
+from pour import cli
+from pour.can.dbc import default_dbc
 
 BITRATE = 1_000_000
 BAR = 0.50
@@ -61,9 +61,9 @@ def wire_bits(frame_id: int, data: bytes) -> int:
     return len(bits) + stuffed + 13
 
 
-def measured(candump_log: Path, dbc: Path = DBC_PATH) -> tuple[int, int, int]:
+def measured(candump_log: Path, dbc: Path | None = None) -> tuple[int, int, int]:
     """From a `candump -L` capture: (frames, exact bits on the wire, control ticks = Torque frames)."""
-    torque_cmd = cantools.database.load_file(str(dbc)).get_message_by_name("Torque").frame_id
+    torque_cmd = cantools.database.load_file(str(dbc or default_dbc())).get_message_by_name("Torque").frame_id
     frames = bits = ticks = 0
     for line in candump_log.read_text().splitlines():
         parts = line.split()
@@ -90,10 +90,10 @@ class Row:
         return self.rate_hz * self.bits / BITRATE
 
 
-def cyclic_messages(dbc: Path = DBC_PATH, heartbeat_ms: float | None = None) -> list[Row]:
+def cyclic_messages(dbc: Path | None = None, heartbeat_ms: float | None = None) -> list[Row]:
     """One row per message with a cycle time in the DBC (heartbeat_ms overrides the heartbeat's, and the
     identity frame's, which goes out with every heartbeat)."""
-    db = cantools.database.load_file(str(dbc))
+    db = cantools.database.load_file(str(dbc or default_dbc()))
     rows = []
     for m in db.messages:
         cycle = m.cycle_time
@@ -118,8 +118,8 @@ def report(rows: list[Row]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-can-bus-load", description=__doc__.splitlines()[0])
-    ap.add_argument("--dbc", default=str(DBC_PATH), help="DBC file (default can/pour.dbc)")
+    ap = cli.ArgumentParser(prog="pour-can-bus-load", description=__doc__.splitlines()[0])
+    ap.add_argument("--dbc", help="DBC file (default: can/pour.dbc, or the installed package's copy)")
     ap.add_argument("--heartbeat-ms", type=float, default=None, help="heartbeat period instead of the DBC's [ms]")
     ap.add_argument("--candump", help="also measure a `candump -L` capture: exact bits per control tick")
     args = ap.parse_args(argv)
@@ -127,14 +127,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pour-can-bus-load: error: --heartbeat-ms must be positive, got {args.heartbeat_ms}", file=sys.stderr)
         return 2
     try:
-        rows = cyclic_messages(Path(args.dbc), args.heartbeat_ms)
+        dbc = Path(args.dbc) if args.dbc else default_dbc()
+        rows = cyclic_messages(dbc, args.heartbeat_ms)
     except (OSError, cantools.database.UnsupportedDatabaseFormatError) as e:
-        print(f"pour-can-bus-load: error: cannot read {args.dbc}: {e}", file=sys.stderr)
+        print(f"pour-can-bus-load: error: cannot read {args.dbc or 'the DBC'}: {e}", file=sys.stderr)
         return 2
     print(report(rows))
     if args.candump:
         try:
-            frames, bits, ticks = measured(Path(args.candump), Path(args.dbc))
+            frames, bits, ticks = measured(Path(args.candump), dbc)
         except (OSError, ValueError) as e:
             print(f"pour-can-bus-load: error: cannot read {args.candump}: {e}", file=sys.stderr)
             return 2

@@ -7,18 +7,21 @@ decodes a controller configured with that node id.
 """
 from __future__ import annotations
 
-import argparse
 import re
 import sys
 from pathlib import Path
 
-from pour import paths
+from pour import atomic, cli, paths
 
 NODE_ID_MAX = 63
 CMD_MASK = 0x1F
 NODE_SHIFT = 5
 
-DBC_PATH = paths.SOURCE_DIR / "can" / "pour.dbc"
+
+
+def default_dbc() -> Path:
+    """The protocol's DBC (can/pour.dbc, or the installed package's copy); FileNotFoundError if neither."""
+    return paths.data_file("pour.dbc")
 
 
 def can_id(node_id: int, cmd: int) -> int:
@@ -38,9 +41,11 @@ def check_node_id(node_id: int) -> int:
 _ID_LINE = re.compile(r"^(BO_|CM_ BO_|CM_ SG_|BA_ \"[A-Za-z]+\" BO_|VAL_) (\d+)\b", re.MULTILINE)
 
 
-def dbc_for_node(node_id: int, source: Path = DBC_PATH) -> str:
-    """The DBC text for node_id: every frame id of the node-0 file, with the node id in bits 5..10."""
+def dbc_for_node(node_id: int, source: Path | None = None) -> str:
+    """The DBC text for node_id: every frame id of the node-0 file (default_dbc()), with the node id in bits
+    5..10."""
     check_node_id(node_id)
+    source = source or default_dbc()
     text = source.read_text(encoding="ascii")
 
     def shift(m: re.Match[str]) -> str:
@@ -54,18 +59,22 @@ def dbc_for_node(node_id: int, source: Path = DBC_PATH) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-can-dbc", description=__doc__.splitlines()[0])
+    ap = cli.ArgumentParser(prog="pour-can-dbc", description=__doc__.splitlines()[0])
     ap.add_argument("--node-id", required=True, help="controller node id, 0..63")
-    ap.add_argument("-o", "--output", help="file to write (default: standard output)")
+    ap.add_argument("-o", "--out", "--output", dest="output", help="file to write (default: standard output)")
     args = ap.parse_args(argv)
     try:
         node_id = int(args.node_id, 0)
         text = dbc_for_node(node_id)
-    except ValueError as e:
+    except (ValueError, OSError) as e:
         print(f"pour-can-dbc: error: {e}", file=sys.stderr)
         return 2
     if args.output:
-        Path(args.output).write_text(text, encoding="ascii")
+        try:
+            atomic.write_atomic(Path(args.output), text)
+        except OSError as e:
+            print(f"pour-can-dbc: error: cannot write {args.output}: {e}", file=sys.stderr)
+            return 1
     else:
         sys.stdout.write(text)
     return 0

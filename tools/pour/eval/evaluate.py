@@ -17,7 +17,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import paths
+from pour import cli, paths
 from pour.policy import fixedpoint as fp
 from pour.policy import weights_h
 from pour.sim import envs
@@ -71,7 +71,7 @@ def run_host_sim(args: Sequence[str], build_dir: str | Path | None = None) -> An
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-eval", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-eval", description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     ag = sub.add_parser("agree", help="greedy float vs fixed-point agreement on held-out visited states")
     ag.add_argument("run", help="run directory (its policy.json gives the float W)")
@@ -81,12 +81,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     ag.add_argument("--episode-s", type=float, default=10.0, help="held-out episode length [s]")
     rb = sub.add_parser("robust", help="the robustness table: nominal and each edge of the rig's uncertainty")
     rb.add_argument("--header", default="policy/weights.h", help="the policy (firmware core in the loop)")
-    rb.add_argument("--out", default="results/robustness", type=Path, help="folder for the table, JSON and plot")
+    rb.add_argument("-o", "--out", default="results/robustness", type=Path, help="folder for the table, JSON and plot")
     rb.add_argument("--nominal-episodes", type=int, default=100)
     rb.add_argument("--edge-episodes", type=int, default=30)
     rb.add_argument("--seed", type=int, default=held_out_seeds(2)[1], help="first held-out seed")
     rb.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
     rb.add_argument("--workers", type=int, default=2, help="host_sim processes at once")
+    rb.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     if args.cmd == "robust":
         return robust(args)
@@ -120,7 +121,8 @@ def robust(args: argparse.Namespace) -> int:
         if not args.out.parent.is_dir():
             raise ValueError(f"--out: folder {args.out.parent} does not exist")
         rows = robustness.run(args.header, args.out, args.nominal_episodes, args.edge_episodes, args.seed,
-                              lambda a: run_host_sim(a, args.build_dir), poursim.default_config(), args.workers)
+                              lambda a: run_host_sim(a, args.build_dir), poursim.default_config(), args.workers,
+                              args.quiet)
     except (OSError, RuntimeError, ValueError, weights_h.WeightsHError, poursim.SimError) as exc:
         print(f"pour-eval: error: {exc}", file=sys.stderr)
         return 2

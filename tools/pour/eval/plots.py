@@ -9,11 +9,10 @@
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import sys
 from pathlib import Path
-from typing import Sequence
+from typing import Any, Sequence
 
 import matplotlib
 
@@ -21,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pour import atomic  # noqa: E402
+from pour import atomic, cli  # noqa: E402
 from pour.sim import envs  # noqa: E402
 
 
@@ -128,21 +127,29 @@ def best_episode(run_dir: Path) -> np.ndarray:
         return np.array(z["best_ep_x"])
 
 
-def liquid(out_dir: Path, prefix: str = "") -> list[Path]:
-    """liquid_retention.png and liquid_slosh.png: the measurements host_sim --bench prints."""
+def liquid(out_dir: Path, prefix: str = "", quiet: bool = False) -> list[Path]:
+    """liquid_retention.png and liquid_slosh.png: the measurements host_sim --bench prints (progress on
+    stderr by measurement unless quiet)."""
     from pour.sim import poursim
 
+    with cli.bar(5, "liquid", quiet, unit="measurement") as progress:
+        return _liquid(out_dir, prefix, poursim, progress)
+
+
+def _liquid(out_dir: Path, prefix: str, poursim: Any, progress: Any) -> list[Path]:
     base = poursim.default_config()
     depth = base["bucket_height"] - base["bucket_wall"]
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for share, colour in ((0.60, "tab:blue"), (0.70, "tab:green"), (0.85, "tab:red")):
         r = poursim.retention({"fill_depth": share * depth})
+        progress.update(1)
         deg = np.degrees(r.theta)
         ax.plot(deg, 100 * r.ideal, "--", color=colour, lw=1)
         ax.plot(deg, 100 * r.kept, color=colour,
                 label=f"fill {100 * share:.0f} %: onset {np.degrees(r.onset):.0f} deg "
                       f"(ideal {np.degrees(r.ideal_onset):.0f}), RMS gap {100 * r.rms_gap:.1f} %")
     pile = poursim.retention({"fill_depth": 0.70 * depth, "fluid": 0}, n_seeds=1)
+    progress.update(1)
     ax.plot(np.degrees(pile.theta), 100 * pile.kept, ":", color="0.3",
             label=f"rigid pile (fluid = 0), fill 70 %: RMS gap {100 * pile.rms_gap:.0f} %")
     ax.set(xlabel="tilt [deg] (servo, 0.02 rad/s)", ylabel="liquid left in the bucket [%]", xlim=(0, 125),
@@ -155,6 +162,7 @@ def liquid(out_dir: Path, prefix: str = "") -> list[Path]:
     plt.close(fig)
 
     s = poursim.slosh()
+    progress.update(1)
     t = np.arange(len(s.trace)) * base["dt"]
     fig, ax = plt.subplots(figsize=(7, 3.5))
     ax.plot(t, 1e3 * s.trace, lw=1, label="centre of mass across the bucket, mean of 16 seeds")
@@ -173,21 +181,22 @@ def liquid(out_dir: Path, prefix: str = "") -> list[Path]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
+    ap = cli.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"),
                     help="a label and its run directories (repeat per method)")
     ap.add_argument("--liquid", action="store_true",
                     help="plot the liquid against physics instead (retention, sloshing; ~1 min)")
-    ap.add_argument("--out", required=True, help="output folder for the PNGs")
+    ap.add_argument("-o", "--out", required=True, help="output folder for the PNGs")
     ap.add_argument("--prefix", default="", help="file name prefix")
     ap.add_argument("--period-ms", type=int, default=10)
+    ap.add_argument("--quiet", action="store_true", help="no progress bar on stderr (--liquid)")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.liquid:
         from pour.sim.poursim import SimError
         try:
-            for p in liquid(out, args.prefix):
+            for p in liquid(out, args.prefix, args.quiet):
                 print(f"pour-plots: wrote {p}")
         except SimError as exc:
             print(f"pour-plots: error: {exc}", file=sys.stderr)

@@ -11,7 +11,6 @@ bucket, blue in the air, red once spilled), and beside it θ and the three volum
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import shutil
@@ -27,7 +26,7 @@ from matplotlib import animation  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Polygon, Rectangle  # noqa: E402
 
-from pour import atomic  # noqa: E402
+from pour import atomic, cli  # noqa: E402
 
 COLOURS = np.array([[0.96, 0.88, 0.70, 1.0],   # in the rotating bucket
                     [0.96, 0.88, 0.70, 1.0],   # in the target
@@ -207,7 +206,7 @@ def render(traj: Path, out: Path, fps: float | None = None) -> tuple[Path, Path]
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-render", description="Render a host_sim trajectory (JSON) as GIF/MP4 + PNG.",
+    ap = cli.ArgumentParser(prog="pour-render", description="Render a host_sim trajectory (JSON) as GIF/MP4 + PNG.",
                                  epilog="exit status (the same meanings in every pour program): 0 written; 1 a write "
                                         "failed; 2 bad input (the trajectory, the output name)")
     ap.add_argument("trajectory", type=Path, help="JSON written by host_sim --render")

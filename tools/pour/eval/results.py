@@ -9,7 +9,6 @@ same seeds. Writes results/results.md and results/results.json.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import multiprocessing as mp
 import os
@@ -19,7 +18,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
 from pour.sim import envs
@@ -111,7 +110,7 @@ def markdown(rows: list[dict[str, Any]], n: int) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-results", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-results", description=__doc__.split("\n")[0])
     ap.add_argument("--header", default="policy/weights.h")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"), default=[],
                     help="a label and its training runs (their final greedy float policies); repeatable")
@@ -120,26 +119,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--init", metavar="CONFIG", help="also evaluate the initial policy of this training config")
     ap.add_argument("--episodes", type=int, default=20)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
-    ap.add_argument("--out", default="results", type=Path)
+    ap.add_argument("-o", "--out", default="results", type=Path)
+    ap.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     try:
         hdr = weights_h.parse_weights_h(args.header)
         n = args.episodes
-        rows = [host_sim_row("baseline: constant tilt rate", ["--baseline", "rate"], n, args.build_dir),
-                host_sim_row("baseline: full torque", ["--baseline", "full"], n, args.build_dir)]
-        rows.append(host_sim_row("baseline: hand-written pour (host_sim)", ["--baseline", "hand"], n, args.build_dir))
+        for flag, groups in (("--group", args.group), ("--group-last", args.group_last)):
+            for g in groups:
+                if len(g) < 2:
+                    raise ValueError(f"{flag} {g[0]} has no run directory")
+        # Each row, in the table's order, as work to do (the progress bar counts rows).
+        todo = [lambda: host_sim_row("baseline: constant tilt rate", ["--baseline", "rate"], n, args.build_dir),
+                lambda: host_sim_row("baseline: full torque", ["--baseline", "full"], n, args.build_dir),
+                lambda: host_sim_row("baseline: hand-written pour (host_sim)", ["--baseline", "hand"], n,
+                                     args.build_dir)]
         if args.init:
-            rows.append(init_row(args.init, n))
-        for g in args.group:
-            if len(g) < 2:
-                raise ValueError(f"--group {g[0]} has no run directory")
-            rows.append(float_rows(g[0], [Path(d) for d in g[1:]], n))
-        for g in args.group_last:
-            if len(g) < 2:
-                raise ValueError(f"--group-last {g[0]} has no run directory")
-            rows.append(float_rows(g[0], [Path(d) for d in g[1:]], n, "last"))
-        rows.append(host_sim_row(f"ours, shipped {Path(args.header).name} (firmware core, fixed point)",
-                                 ["--policy", args.header], n, args.build_dir))
+            todo.append(lambda: init_row(args.init, n))
+        todo += [lambda g=g: float_rows(g[0], [Path(d) for d in g[1:]], n) for g in args.group]
+        todo += [lambda g=g: float_rows(g[0], [Path(d) for d in g[1:]], n, "last") for g in args.group_last]
+        todo.append(lambda: host_sim_row(f"ours, shipped {Path(args.header).name} (firmware core, fixed point)",
+                                         ["--policy", args.header], n, args.build_dir))
+        rows = [make() for make in cli.progress(todo, len(todo), "results", args.quiet, unit="row")]
     except (OSError, RuntimeError, ValueError, envs.EnvError, weights_h.WeightsHError, export.ExportError) as exc:
         print(f"pour-results: error: {exc}", file=sys.stderr)
         return 2

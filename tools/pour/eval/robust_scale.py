@@ -15,7 +15,6 @@ Every node needs host_sim at the path the driver resolves (--build-dir, $POUR_BU
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -25,7 +24,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import evaluate, robustness
 from pour.train import executors
 
@@ -78,7 +77,8 @@ def reduce(per: list[dict[str, Any]], sets: Sequence[str]) -> list[dict[str, Any
 
 
 def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None, rand: dict[str, float],
-        build_dir: str | None, address: str | None, num_cpus: int | None) -> tuple[list[dict[str, Any]], dict]:
+        build_dir: str | None, address: str | None, num_cpus: int | None,
+        quiet: bool = False) -> tuple[list[dict[str, Any]], dict]:
     exe = str(evaluate.host_sim_binary(build_dir).resolve())
     header = str(Path(header).resolve())
     sets = [f"{k}={v:g}" for k, v in rand.items()]
@@ -92,13 +92,7 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
         t0 = time.monotonic()
         refs = [task.remote(exe, header, s, min(k, first_seed + rigs - s), sets)
                 for s in range(first_seed, first_seed + rigs, k)]
-        try:
-            per = [e for batch in ray.get(refs) for e in batch]
-        except BaseException as exc:
-            executors.cancel_all(ray, refs)
-            if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(getattr(exc, "cause", None), Exception):
-                raise exc.cause from None
-            raise
+        per = [e for batch in executors.gather(ray, refs, f"{rigs} rigs", quiet) for e in batch]
         wall = time.monotonic() - t0
     finally:
         if owns:
@@ -116,17 +110,20 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-robust-scale", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-robust-scale", description=__doc__.split("\n")[0])
     ap.add_argument("--header", default="policy/weights.h", help="the policy (firmware core in the loop)")
     ap.add_argument("--rigs", type=int, default=100, help="randomised rigs (episodes), e.g. 10000 on a cluster")
     ap.add_argument("--seed", type=int, default=FIRST_SEED, help=f"first seed (default {FIRST_SEED})")
     ap.add_argument("--per-task", type=int, help="rigs per Ray task (default: 2 tasks a CPU, at most 200)")
     ap.add_argument("--set", action="append", default=[], metavar="rand_KEY=VALUE",
                     help="override a randomisation range (0 turns it off); repeatable")
-    ap.add_argument("--out", default="results/robust_scale", type=Path)
+    ap.add_argument("-o", "--out", default="results/robust_scale", type=Path)
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim")
     ap.add_argument("--ray-address", default="local", metavar="local|auto|HOST:PORT")
     ap.add_argument("--num-cpus", type=int, help="CPUs of a local Ray instance (default: all)")
+    ap.add_argument("--json", action="store_true",
+                    help="print the run's figures as one JSON object instead of the table (both are written to --out)")
+    ap.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     try:
         if not 1 <= args.rigs <= 10_000_000:
@@ -147,12 +144,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not Path(args.header).is_file():
             raise ValueError(f"--header {args.header}: no such file")
         rows, meta = run(args.header, args.out, args.rigs, args.seed, args.per_task, rand, args.build_dir,
-                         args.ray_address, args.num_cpus)
+                         args.ray_address, args.num_cpus, args.quiet)
     except (OSError, RuntimeError, ValueError) as exc:   # ExecutorError is a RuntimeError
         print(f"pour-robust-scale: error: {exc}", file=sys.stderr)
         return 2
-    print((args.out / "robust_scale.md").read_text(), end="")
-    print(json.dumps({k: meta[k] for k in ("rigs", "tasks", "per_task", "cluster_cpus", "wall_s")}))
+    if args.json:
+        print(json.dumps({**{k: meta[k] for k in ("rigs", "tasks", "per_task", "cluster_cpus", "wall_s")},
+                          "rows": rows, "out": str(args.out)}))
+    else:
+        print((args.out / "robust_scale.md").read_text(), end="")
     return 0
 
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
-from pour import atomic
+from pour import atomic, cli
 
 # The issue's bars (README, "Robustness").
 NOMINAL_POURED_PCT, NOMINAL_SPILLED_PCT, NOMINAL_FINISH_S, NOMINAL_ALL_THREE = 98.0, 1.0, 6.0, 0.90
@@ -132,19 +132,23 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
 
 def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed: int,
         run_host_sim: Callable[[Sequence[str]], Any], nominal_config: dict[str, float],
-        workers: int = 2) -> list[dict[str, Any]]:
+        workers: int = 2, quiet: bool = False) -> list[dict[str, Any]]:
+    """Every scene's row (and the table, JSON and plot in out); progress on stderr by episodes unless quiet."""
     out.mkdir(parents=True, exist_ok=True)
     todo = scenes()
+    episodes = {sc.name: nominal_episodes if sc.nominal else edge_episodes for sc in todo}
 
-    def one(scene: Scene) -> dict[str, Any]:
-        n = nominal_episodes if scene.nominal else edge_episodes
-        sets = scene_args(scene, nominal_config)
-        s = run_host_sim(["--policy", header, "--episodes", str(n), "--seed", str(seed), "--quiet", *sets])
-        s["sets"] = sets[1::2]
-        return judge(scene, s)
+    with cli.bar(sum(episodes.values()), f"{len(todo)} scenes", quiet, unit="episode") as progress:
+        def one(scene: Scene) -> dict[str, Any]:
+            sets = scene_args(scene, nominal_config)
+            s = run_host_sim(["--policy", header, "--episodes", str(episodes[scene.name]), "--seed", str(seed),
+                              "--quiet", *sets])
+            s["sets"] = sets[1::2]
+            progress.update(episodes[scene.name])
+            return judge(scene, s)
 
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
-        rows = list(ex.map(one, todo))
+        with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
+            rows = list(ex.map(one, todo))
     doc = {"header": header, "seed": seed, "nominal_episodes": nominal_episodes, "edge_episodes": edge_episodes,
            "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
     atomic.write_atomic(out / "robustness.json", json.dumps(doc, indent=1) + "\n")

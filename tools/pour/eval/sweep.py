@@ -24,7 +24,6 @@ pandas, pyarrow, tensorboardX) in the pinned environment. Tune is the tool for a
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import itertools
@@ -38,7 +37,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.eval import results
 from pour.sim import envs
 from pour.train import config as cfgmod, executors
@@ -156,7 +155,7 @@ def run_trial(doc: dict[str, Any], run_dir: str, held_out: int) -> dict[str, Any
 
 def run(config_path: str, out: Path, pts: list[dict[str, Any]], seeds: Sequence[int], iterations: int | None,
         held_out: int, executor: str, address: str | None, num_cpus: int | None,
-        command: str | None = None) -> dict[str, Any]:
+        command: str | None = None, quiet: bool = False) -> dict[str, Any]:
     try:
         base = tomllib.loads(Path(config_path).read_text())
     except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -172,21 +171,16 @@ def run(config_path: str, out: Path, pts: list[dict[str, Any]], seeds: Sequence[
             trials.append({"trial": f"p{i:02d}-s{s}", "point": i, "seed": s, "params": p, "doc": doc})
     out.mkdir(parents=True, exist_ok=True)
     jobs = [(t["doc"], str((out / "runs" / t["trial"]).resolve()), held_out) for t in trials]
+    desc = f"{len(jobs)} trials"
     if executor == "local":
-        outs = [run_trial(*j) for j in jobs]
+        outs = [run_trial(*j) for j in cli.progress(jobs, len(jobs), desc, quiet, unit="trial")]
     else:
         ray = executors.import_ray()
         owns = executors.connect(address, num_cpus)
-        refs: list[Any] = []
         try:
             task = ray.remote(num_cpus=1, max_retries=executors.MAX_RETRIES, retry_exceptions=False)(run_trial)
-            refs = [task.remote(*j) for j in jobs]
-            outs = ray.get(refs)
-        except BaseException as exc:
-            executors.cancel_all(ray, refs)   # an error or Ctrl-C: the other trials stop (each resumes on re-run)
-            if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(getattr(exc, "cause", None), Exception):
-                raise exc.cause from None
-            raise
+            # An error or Ctrl-C stops the other trials (each resumes on re-run).
+            outs = executors.gather(ray, [task.remote(*j) for j in jobs], desc, quiet)
         finally:
             if owns:
                 ray.shutdown()
@@ -238,9 +232,9 @@ def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-sweep", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-sweep", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="the base TOML config (configs/train/*.toml)")
-    ap.add_argument("--out", required=True, type=Path, help="sweep folder (runs/, table, plots); re-run to resume")
+    ap.add_argument("-o", "--out", required=True, type=Path, help="sweep folder (runs/, table, plots); re-run to resume")
     ap.add_argument("--grid", action="append", default=[], metavar="KEY=V1,V2",
                     help="a grid axis, e.g. algo.lr=0.03,0.1 (repeatable: the product)")
     ap.add_argument("--random", type=int, default=0, metavar="N", help="N random points over the --range axes")
@@ -254,6 +248,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                     help="'ray' (default): one task per trial; 'local': trials one after another in this process")
     ap.add_argument("--ray-address", default="local", metavar="local|auto|HOST:PORT")
     ap.add_argument("--num-cpus", type=int, help="CPUs of a local Ray instance (default: all)")
+    ap.add_argument("--json", action="store_true",
+                    help="print where the sweep went and its rows as one JSON object instead of the table")
+    ap.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
     args = ap.parse_args(argv)
     try:
         try:
@@ -267,12 +264,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         pts = points(parse_grid(args.grid), parse_range(args.range), args.random, args.search_seed)
         doc = run(args.config, args.out, pts, seeds, args.iterations, args.held_out, args.executor,
                   args.ray_address, args.num_cpus,
-                  shlex.join(["pour-sweep", *(sys.argv[1:] if argv is None else argv)]))
+                  shlex.join(["pour-sweep", *(sys.argv[1:] if argv is None else argv)]), args.quiet)
     except (SweepError, cfgmod.ConfigError, envs.EnvError, executors.ExecutorError) as exc:
         print(f"pour-sweep: error: {exc}", file=sys.stderr)
         return 2
-    print((args.out / "sweep.md").read_text(), end="")
-    print(json.dumps({"out": str(args.out), "trials": len(doc["trials"])}))
+    if args.json:
+        print(json.dumps({"out": str(args.out), "trials": len(doc["trials"]), "rows": doc["rows"]}))
+    else:
+        print((args.out / "sweep.md").read_text(), end="")
     return 0
 
 

@@ -8,16 +8,16 @@
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 
+from pour import cli
 from pour.lcm import channels, messages
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-lcm-cmd", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--url", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
+    ap = cli.ArgumentParser(prog="pour-lcm-cmd", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
     g = ap.add_mutually_exclusive_group(required=True)
     g.add_argument("--clear", action="store_true", help="clear latched faults")
     g.add_argument("--estop", action="store_true", help="assert the e-stop")

@@ -10,7 +10,6 @@ was sent (POUR_SENSORS: encoder count, the two scales) and the controller's last
 """
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import sys
@@ -19,7 +18,7 @@ from pathlib import Path
 
 import matplotlib
 
-from pour import libpoursim
+from pour import cli, libpoursim
 from pour.lcm import channels, messages, sensors
 
 
@@ -103,8 +102,8 @@ class LiveView:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-live-view", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--url", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
+    ap = cli.ArgumentParser(prog="pour-live-view", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
     ap.add_argument("--save", type=Path, help="headless: save the --frames-th frame as a PNG and exit")
     ap.add_argument("--frames", type=int, default=30, help="with --save: frames to wait for (default 30)")
     ap.add_argument("--timeout", type=float, default=10.0, help="give up after this long without a frame [s]")

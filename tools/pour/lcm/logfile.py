@@ -16,7 +16,6 @@ defines them). Each episode's summary names its source.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -30,6 +29,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from pour import atomic, cli  # noqa: E402
 from pour.lcm import channels, messages, sensors  # noqa: E402
 
 
@@ -192,8 +192,8 @@ def episode_summary(ep: Episode, reward) -> dict:
     samples = np.sort(np.asarray(ep.seq))
     out = {"episode": ep.index, "source": ep.source, "samples": int(len(samples)), "first_seq": int(samples[0]),
            "last_seq": int(samples[-1]), "gaps": int(samples[-1] - samples[0] + 1 - len(samples)),
-           "poured": float(v[-1, 1]), "spilled": float(v[-1, 2]),
-           "left": float(v[-1, 0]), "finish_s": finish, "max_theta_deg": float(np.degrees(np.max(ep.theta)))}
+           "poured_pct": 100 * float(v[-1, 1]), "spilled_pct": 100 * float(v[-1, 2]),
+           "left_pct": 100 * float(v[-1, 0]), "finish_s": finish, "max_theta_deg": float(np.degrees(np.max(ep.theta)))}
     if reward is not None:
         kt, ks, g = reward
         r = kt * v[1:, 1] - ks * v[1:, 2]
@@ -268,7 +268,8 @@ def render_json(log: Log, summary: dict) -> dict:
             frames.append({"t": fr.seq * 1e-3, "theta": fr.theta, "xy": np.column_stack([fr.x, fr.y]).ravel().tolist()})
             next_t = fr.seq * 1e-3 + 0.08
     dt = np.diff([fr["t"] for fr in frames])
-    return {"title": f"LCM log, episode {ep.index}", "poured": summary["poured"], "spilled": summary["spilled"],
+    return {"title": f"LCM log, episode {ep.index}", "poured": summary["poured_pct"] / 100,
+            "spilled": summary["spilled_pct"] / 100,
             "finish_s": -1 if summary["finish_s"] is None else summary["finish_s"],
             "fps": float(1.0 / np.median(dt)) if len(dt) else 12.5,
             "scene": {"inner_width": f0.bucket_inner_width, "height": f0.bucket_height, "wall": f0.bucket_wall,
@@ -284,8 +285,8 @@ def render_json(log: Log, summary: dict) -> dict:
 def fmt_episode(s: dict) -> str:
     fin = "  -   " if s["finish_s"] is None else f"{s['finish_s']:.3f} s"
     ret = f"  return {s['return']:.1f}" if "return" in s else ""
-    return (f"episode {s['episode'] + 1}: poured {100 * s['poured']:5.1f} %  spilled {100 * s['spilled']:4.1f} %  "
-            f"left {100 * s['left']:4.1f} %  finish {fin}{ret}")
+    return (f"episode {s['episode'] + 1}: poured {s['poured_pct']:5.1f} %  spilled {s['spilled_pct']:4.1f} %  "
+            f"left {s['left_pct']:4.1f} %  finish {fin}{ret}")
 
 
 def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = sensors.ENCODER_BITS) -> dict:
@@ -319,9 +320,9 @@ def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = s
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
+    ap = cli.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path, help="LCM log file (lcm-logger)")
-    ap.add_argument("--out", type=Path, help="folder for traces.png, latency.png, summary.json")
+    ap.add_argument("-o", "--out", type=Path, help="folder for traces.png, latency.png, summary.json")
     ap.add_argument("--render", type=Path, help="also animate the first episode: FILE.gif (+ FILE.png)")
     ap.add_argument("--json", action="store_true", help="print the summary as JSON")
     ap.add_argument("--k-target", type=float)
@@ -347,11 +348,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             from pour.eval import render
 
             traj = a.render.with_suffix(".json")
-            traj.write_text(json.dumps(render_json(log, s["episodes"][0])))
+            atomic.write_atomic(traj, json.dumps(render_json(log, s["episodes"][0])))
             render.render(traj, a.render)
     except LogError as e:
         print(f"pour-lcmlog: error: {e}", file=sys.stderr)
         return 1
+    for e in s["episodes"]:
+        if e["gaps"]:
+            print(f"pour-lcmlog: warning: episode {e['episode'] + 1}: {e['gaps']} of the samples "
+                  f"{e['first_seq']}..{e['last_seq']} are not in the log (lost by the logger or the link)",
+                  file=sys.stderr)
     if a.json:
         print(json.dumps(s))
         return 0
@@ -360,8 +366,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     eps = s["episodes"]
     fins = [e["finish_s"] for e in eps if e["finish_s"] is not None]
     ret = f"  return {np.mean([e['return'] for e in eps]):.1f}" if "return" in eps[0] else ""
-    print(f"summary ({len(eps)} episode{'s' if len(eps) > 1 else ''}): poured {100 * np.mean([e['poured'] for e in eps]):.1f} %"
-          f"  spilled {100 * np.mean([e['spilled'] for e in eps]):.1f} %"
+    print(f"summary ({len(eps)} episode{'s' if len(eps) > 1 else ''}): poured {np.mean([e['poured_pct'] for e in eps]):.1f} %"
+          f"  spilled {np.mean([e['spilled_pct'] for e in eps]):.1f} %"
           f"  finish {f'{np.mean(fins):.3f} s' if fins else '-'}{ret}")
     L = s["latency_us"]
     if L["n"]:

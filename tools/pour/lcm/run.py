@@ -17,7 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from pour import paths
+from pour import cli, paths
 
 
 def find_binary(name: str, build_dir: str | None) -> Path:
@@ -36,9 +36,9 @@ def private_url() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-lcm-run", description=__doc__.split("\n\n")[0])
+    ap = cli.ArgumentParser(prog="pour-lcm-run", description=__doc__.split("\n\n")[0])
     ap.add_argument("--realtime", action="store_true", help="1 kHz wall clock on both sides")
-    ap.add_argument("--url", help="LCM URL (default: a private port on loopback)")
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", help="LCM URL (default: a private port on loopback)")
     ap.add_argument("--build-dir", help="CMake build tree (default $POUR_BUILD_DIR or build/host)")
     ap.add_argument("host_sim_args", nargs=argparse.REMAINDER, help="arguments for host_sim, after --")
     a = ap.parse_args(argv)

@@ -8,7 +8,6 @@ The jar of the generated Java classes is built by CMake (lcmtypes/pour_lcmtypes.
 """
 from __future__ import annotations
 
-import argparse
 import os
 import shutil
 import signal
@@ -20,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pour import paths
+from pour import cli, paths
 from pour.lcm import channels
 
 def find_jar(build_dir: str | None = None) -> Path:
@@ -118,8 +117,8 @@ def stop(p: subprocess.Popen) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-lcm-spy", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--url", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
+    ap = cli.ArgumentParser(prog="pour-lcm-spy", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--lcm", "--url", dest="url", metavar="URL", default=channels.DEFAULT_URL, help="LCM URL (default %(default)s)")
     ap.add_argument("--build-dir", help="CMake build tree holding lcmtypes/pour_lcmtypes.jar")
     ap.add_argument("--screenshot", type=Path, help="run under a private Xvfb and save a PNG of the screen")
     ap.add_argument("--seconds", type=float, default=5.0, help="with --screenshot: wait this long first")

@@ -6,7 +6,6 @@ training config, so exporting twice (or re-training and exporting) gives byte-id
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
@@ -15,7 +14,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import atomic
+from pour import atomic, cli
 from pour.policy import fixedpoint as fp
 from pour.policy import weights_h
 
@@ -140,9 +139,9 @@ def export(policy: str | Path, out: str | Path, which: str = "best", frac_bits: 
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-export", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-export", description=__doc__.split("\n")[0])
     ap.add_argument("run", help="run directory (or its policy.json)")
-    ap.add_argument("--out", required=True, help="weights.h to write (e.g. policy/weights.h)")
+    ap.add_argument("-o", "--out", required=True, help="weights.h to write (e.g. policy/weights.h)")
     ap.add_argument("--which", default="best", choices=("best", "last"),
                     help="best: the weights with the best greedy validation score (default); last: the final ones")
     ap.add_argument("--frac-bits", type=int, help="fraction bits of W (default: the most that fit)")

@@ -36,6 +36,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pour import cli
 from pour.sim import envs
 from pour.train import config as cfgmod
 
@@ -335,6 +336,24 @@ class RayRunner:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def gather(ray: Any, refs: Sequence[Any], desc: str, quiet: bool = False) -> list[Any]:
+    """ray.get(refs), in their order, with a progress bar on stderr (tasks done, time left) as they finish.
+    On an error or Ctrl-C the unfinished tasks are cancelled, and a task's own exception is raised as itself."""
+    try:
+        pending = list(refs)
+        with cli.bar(len(pending), desc, quiet, unit="task") as b:
+            while pending:
+                ready, pending = ray.wait(pending, num_returns=1)
+                ray.get(ready)  # a task's error now, not after the rest
+                b.update(len(ready))
+        return ray.get(list(refs))
+    except BaseException as exc:
+        cancel_all(ray, refs)
+        if isinstance(exc, ray.exceptions.RayTaskError) and isinstance(getattr(exc, "cause", None), Exception):
+            raise exc.cause from None
+        raise
 
 
 def cancel_all(ray: Any, refs: Sequence[Any]) -> None:

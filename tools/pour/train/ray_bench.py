@@ -11,13 +11,13 @@ load average is printed before and after: the figures move with it.
 """
 from __future__ import annotations
 
-import argparse
 import multiprocessing as mp
 import os
 import time
 
 import numpy as np
 
+from pour import cli
 from pour.sim import envs
 from pour.train import config as cfgmod
 from pour.train import executors
@@ -90,7 +90,7 @@ def throughput(runner, n_eps: int, reps: int = 3) -> float:
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(prog="python -m pour.train.ray_bench", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="python -m pour.train.ray_bench", description=__doc__.split("\n")[0])
     ap.add_argument("--env", choices=("toy", "sim"), default="toy")
     ap.add_argument("--episodes", type=int, default=64, help="episodes per measured call")
     ap.add_argument("--episode-s", type=float, default=10.0)

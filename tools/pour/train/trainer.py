@@ -9,7 +9,6 @@ never from the worker that runs them, so the number of workers does not change t
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import json
@@ -22,6 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from pour import cli
 from pour.policy import linear
 from pour.sim import envs
 from pour.train import config as cfgmod
@@ -320,7 +320,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
-                      f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]",
+                      f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s, "
+                      f"{cli.time_left(done, cfg.iterations - start, time.monotonic() - t0)} left]",
                       file=sys.stderr, flush=True)
         runner.close()
     final = load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
@@ -328,14 +329,14 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
+    ap = cli.ArgumentParser(prog="pour-train", description=__doc__.split("\n")[0])
     ap.add_argument("config", help="TOML config (configs/train/*.toml)")
-    ap.add_argument("--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
+    ap.add_argument("-o", "--out", required=True, help="run directory (created; resumed if it holds a checkpoint)")
     ap.add_argument("--seed", type=int, help="override the config's seed")
     ap.add_argument("--iterations", type=int, help="override the config's iterations")
     ap.add_argument("--workers", type=int, help="override the config's workers")
     ap.add_argument("--fresh", action="store_true", help="discard an existing checkpoint in --out")
-    ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--quiet", action="store_true", help="no progress lines (iteration, return, time left) on stderr")
     ap.add_argument("--executor", choices=("local", "ray"), default="local",
                     help="where episodes run: 'local' process pool (default) or Ray tasks (pip install './tools[ray]')")
     ap.add_argument("--ray-address", default="local", metavar="auto|HOST:PORT",

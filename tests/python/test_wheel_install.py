@@ -1,0 +1,117 @@
+# SPDX-License-Identifier: MIT
+"""The package as a user installs it: a wheel built from the checkout, installed into a fresh venv in a
+folder outside the source tree, with no build tree to lean on. Every pour-* entry point answers --help and
+--version; the DBC and the LCM types come from the wheel's package data (pour-can-dbc, pour-can-bus-load,
+pour-lcm-cmd, pour-lcmlog on a log recorded with lcm-logger).
+
+No network: the wheel builds without build isolation in the project's venv, installs with --no-index
+--no-deps, and the fresh venv sees its dependencies (the lock's packages) through a .pth line to the
+project venv's site-packages, after its own, so `pour` itself comes from the wheel alone."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from conftest import BUILD_DIR, SOURCE_DIR
+from lcm_helpers import record_pour, url
+
+
+def run(argv, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([str(a) for a in argv], capture_output=True, text=True, timeout=300, **kw)
+
+
+@pytest.fixture(scope="module")
+def installed():
+    """(venv bin folder, a working folder outside the checkout, an environment without our build tree)."""
+    root = Path(tempfile.mkdtemp(prefix="pour-wheel-"))
+    assert SOURCE_DIR.resolve() not in root.resolve().parents
+    try:
+        # The checkout's parts the wheel is made from, copied, so that the build leaves the source tree as it was.
+        src = root / "src"
+        shutil.copytree(SOURCE_DIR / "tools", src / "tools", ignore=shutil.ignore_patterns(
+            "*.egg-info", "build", "__pycache__"))
+        (src / "can").mkdir()
+        shutil.copyfile(SOURCE_DIR / "can" / "pour.dbc", src / "can" / "pour.dbc")
+        shutil.copytree(SOURCE_DIR / "lcmtypes" / "pour", src / "lcmtypes" / "pour")
+        r = run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "--no-build-isolation",
+                 "--disable-pip-version-check", src / "tools", "-w", root / "wheels"])
+        assert r.returncode == 0, r.stderr
+        (wheel,) = (root / "wheels").glob("pour_tools-*.whl")
+        venv = root / "venv"
+        r = run(["/usr/bin/python3", "-m", "venv", venv])
+        assert r.returncode == 0, r.stderr
+        r = run([venv / "bin" / "python", "-m", "pip", "install", "-q", "--no-index", "--no-deps",
+                 "--disable-pip-version-check", wheel])
+        assert r.returncode == 0, r.stderr
+        site = Path(run([venv / "bin" / "python", "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"])
+                    .stdout.strip())
+        (site / "zz_pour_deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+        work = root / "work"
+        work.mkdir()
+        env = {k: v for k, v in os.environ.items()
+               if k not in ("POUR_BUILD_DIR", "POUR_SOURCE_DIR", "POUR_SIM_LIB", "POUR_LCMTYPES_PYTHON",
+                            "PYTHONPATH", "VIRTUAL_ENV")}
+        env["PATH"] = f"{venv / 'bin'}:/usr/bin:/bin"
+        yield venv / "bin", work, env
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+def entry_points(bin_dir: Path) -> list[str]:
+    code = ("from importlib import metadata; "
+            "print('\\n'.join(sorted(e.name for e in metadata.distribution('pour-tools').entry_points "
+            "if e.group == 'console_scripts')))")
+    return run([bin_dir / "python", "-c", code]).stdout.split()
+
+
+def test_pour_is_imported_from_the_wheel(installed):
+    bin_dir, work, env = installed
+    r = run([bin_dir / "python", "-c", "import pour, pour.paths as p; print(pour.__file__); print(p.data_file('pour.dbc'))"],
+            cwd=work, env=env)
+    assert r.returncode == 0, r.stderr
+    module, dbc = r.stdout.split()
+    assert Path(module).is_relative_to(bin_dir.parent) and Path(dbc).is_relative_to(bin_dir.parent)
+
+
+def test_every_entry_point_answers_help_and_version(installed):
+    bin_dir, work, env = installed
+    names = entry_points(bin_dir)
+    assert len(names) >= 15 and "pour-train" in names and "pour-lcmlog" in names
+    for name in names:
+        for flag in ("--help", "--version"):
+            r = run([bin_dir / name, flag], cwd=work, env=env)
+            assert r.returncode == 0 and "Traceback" not in r.stderr, f"{name} {flag}: {r.stderr}"
+            assert name in r.stdout, f"{name} {flag}: {r.stdout}"
+
+
+def test_can_tools_read_the_packaged_dbc(installed):
+    bin_dir, work, env = installed
+    r = run([bin_dir / "pour-can-dbc", "--node-id", "1"], cwd=work, env=env)
+    assert r.returncode == 0, r.stderr
+    assert "This file is for node id 1." in r.stdout and "BO_ 33 Heartbeat" in r.stdout  # cmd 1 of node 1
+    r = run([bin_dir / "pour-can-bus-load"], cwd=work, env=env)
+    assert r.returncode == 0, r.stderr
+    assert "bus load at 1 Mbit/s" in r.stdout
+
+
+def test_lcm_tools_read_the_packaged_types(installed, tmp_path):
+    bin_dir, work, env = installed
+    r = run([bin_dir / "pour-lcm-cmd", "--help"], cwd=work, env=env)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    r = run([bin_dir / "pour-lcm-cmd", "--clear", "--url", "memq://"], cwd=work, env=env)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    r = run([bin_dir / "python", "-c", "from pour.lcm import messages; print(messages.load().__file__)"],
+            cwd=work, env=env)
+    assert r.returncode == 0, r.stderr
+    assert Path(r.stdout.strip()).is_relative_to(bin_dir.parent)
+    log, _ = record_pour(BUILD_DIR, tmp_path / "pour.lcmlog", url(47), seconds=1)
+    r = run([bin_dir / "pour-lcmlog", log, "--json"], cwd=work, env=env)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    (ep,) = json.loads(r.stdout)["episodes"]
+    assert ep["last_seq"] >= 900
