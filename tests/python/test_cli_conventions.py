@@ -75,7 +75,7 @@ def test_host_sim_lists_config_keys():
     rows = [x for x in r.stdout.splitlines() if x.startswith("  ")]
     assert len(rows) >= 20
     assert any(re.match(r"^  substeps +\[-\] 1\.\.16 \(integer\), default \d+$", x) for x in rows), r.stdout
-    for key in ("dt", "episode_s", "tau_max", "k_spill"):
+    for key in ("dt", "episode_s", "tau_max", "encoder_bits"):
         assert any(x.split()[0] == key for x in rows), key
 
 
@@ -86,7 +86,7 @@ def test_host_sim_lists_config_keys():
 ])
 def test_host_sim_suggests_a_key(key, hint):
     r = run(BUILD_DIR / "bin" / "host_sim", "--baseline", "rate", "--set", f"{key}=1")
-    assert r.returncode == 2 and f"unknown config key '{key}'" in r.stderr and hint in r.stderr, r.stderr
+    assert r.returncode == 2 and f"unknown key '{key}'" in r.stderr and hint in r.stderr, r.stderr
 
 
 def test_host_sim_bad_value_of_a_known_key_has_no_suggestion():

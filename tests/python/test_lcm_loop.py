@@ -176,7 +176,7 @@ def test_host_sim_real_time_without_controller_carries_on_with_safe_torque(build
     (["--bench", "--lcm"], "--lcm goes with --policy FILE or alone"),
     (["--baseline", "hand", "--realtime"], "--realtime needs --lcm"),
     (["--lcm", "--lcm-timeout-ms", "0"], "--lcm-timeout-ms wants an integer"),
-    (["--lcm", "--lcm-timeout-ms"], "--lcm-timeout-ms wants an integer"),
+    (["--lcm", "--lcm-timeout-ms"], "--lcm-timeout-ms needs a value"),
     (["--lcm", "nosuchprovider://x"], "cannot open LCM"),
 ])
 def test_host_sim_rejects_bad_lcm_arguments(build_dir, argv, needle):
