@@ -66,6 +66,11 @@ const Field kFields[] = {
     F(friction_coulomb, Double, 0.0, 100.0, "N m"),
     F(friction_viscous, Double, 0.0, 100.0, "N m s/rad"),
     F(command_latency_ticks, Int, 1, 100, "steps"),
+    F(drive, Int, 0, 1, "0 ideal / 1 foc"),
+    F(drive_regen, Int, 0, 1, "0/1"),
+    F(drive_fault, Int, 0, 4, "0 none, 1 open, 2 short, 3 encoder, 4 offset"),
+    F(supply_voltage, Double, 12.0, 26.0, "V"),
+    F(bus_capacitance, Double, 1e-5, 0.1, "F"),
     F(encoder_bits, Int, 8, 24, "bits"),
     F(scale_rate_hz, Double, 1.0, 10000.0, "Hz"),
     F(scale_delay_s, Double, 0.0, 1.0, "s"),
@@ -170,6 +175,11 @@ extern "C" poursim_config_t poursim_default_config(void) {
   c.friction_coulomb = 0.6;         // the no-load loss split into Coulomb and viscous parts
   c.friction_viscous = 0.02;        // 0.4 N·m at the no-load speed
   c.command_latency_ticks = 1;      // one CAN frame: the torque of tick k acts in tick k + 1
+  c.drive = 0;                      // the torque–speed line: the fast default for training
+  c.drive_regen = 1;
+  c.drive_fault = 0;
+  c.supply_voltage = 24.0;          // docs/motor.md: a 24 V bench supply on the B-G431B-ESC1
+  c.bus_capacitance = 200e-6;       // docs/motor.md
   c.encoder_bits = 17;
   c.scale_rate_hz = 80.0;           // HX711 with RATE high: 80 samples/s
   c.scale_delay_s = 0.05;           // HX711 output settling time at 80 samples/s: the filter's span

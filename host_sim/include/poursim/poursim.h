@@ -72,6 +72,13 @@ typedef struct {
   double friction_coulomb;    /* the drive's Coulomb friction at the output, holds at standstill [N·m] */
   double friction_viscous;    /* viscous friction at the output [N·m·s/rad] */
   int command_latency_ticks;  /* a command acts this many steps after the step it is given in (>= 1) */
+  /* the full drive (docs/motor.md): the firmware's current loop around a motor, inverter and bus model */
+  int drive;                  /* 0: the torque–speed line above; 1: field-oriented control at 20 kHz */
+  int drive_regen;            /* 1: the drive's flux braking on; 0: off (regeneration charges the bus) */
+  int drive_fault;            /* injected: 0 none, 1 phase open, 2 phases shorted, 3 encoder reversed,
+                                 4 a current amplifier's offset broken */
+  double supply_voltage;      /* bench supply of the drive's bus [V] (it cannot sink current) */
+  double bus_capacitance;     /* the drive's bus capacitance [F] */
   /* the rig's sensors (poursim_obs_t.encoder, scale_rotating_g, scale_target_g) */
   int encoder_bits;           /* single-turn absolute encoder on the output shaft [bits] */
   double scale_rate_hz;       /* load cells' conversion rate [Hz]; readings held between conversions */
@@ -121,6 +128,15 @@ typedef struct {
 
 typedef struct poursim_world poursim_world_t;
 
+/* What the full drive (config drive = 1) saw since the last reset; zeros with the ideal drive. */
+typedef struct {
+  double peak_current;  /* largest |phase current| [A] */
+  double peak_vbus;     /* highest bus voltage [V] */
+  double min_vbus;      /* lowest bus voltage [V] */
+  uint32_t faults;      /* the drive's latched faults (firmware/motor/include/pour/drive_faults.h) */
+  uint32_t limits;      /* every POUR_DRIVE_LIMIT_* flag raised (pour/drive.h) */
+} poursim_drive_telemetry_t;
+
 /* Defaults of the paper's scene (docs/simulator.md). */
 poursim_config_t poursim_default_config(void);
 
@@ -163,6 +179,9 @@ int poursim_set_brake(poursim_world_t *world, int engaged);
 /* One dt step with the bucket driven toward theta_ref [rad] by a stiff servo (the joint's motor) instead
  * of a torque: for measurements that need a prescribed tilt (retention curve, sloshing). */
 int poursim_step_servo(poursim_world_t *world, double theta_ref, poursim_obs_t *out);
+
+/* The full drive's peaks and faults since the last reset (docs/motor.md). */
+int poursim_drive_telemetry(const poursim_world_t *world, poursim_drive_telemetry_t *out);
 
 /* The reason of the last failed step, "" if none. */
 const char *poursim_world_error(const poursim_world_t *world);

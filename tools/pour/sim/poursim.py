@@ -52,6 +52,8 @@ class ConfigStruct(C.Structure):
         ("motor_peak_torque", C.c_double), ("motor_no_load_speed", C.c_double), ("motor_rotor_inertia", C.c_double),
         ("gear_ratio", C.c_double), ("friction_coulomb", C.c_double), ("friction_viscous", C.c_double),
         ("command_latency_ticks", C.c_int),
+        ("drive", C.c_int), ("drive_regen", C.c_int), ("drive_fault", C.c_int),
+        ("supply_voltage", C.c_double), ("bus_capacitance", C.c_double),
         ("encoder_bits", C.c_int), ("scale_rate_hz", C.c_double), ("scale_delay_s", C.c_double),
         ("scale_noise_g", C.c_double), ("scale_resolution_g", C.c_double),
         ("rand_fill", C.c_double), ("rand_target_dx", C.c_double), ("rand_pivot_height", C.c_double),

@@ -1,0 +1,116 @@
+// SPDX-License-Identifier: MIT
+// The motor, inverter and bus model (motor_model.hpp).
+#include "motor_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace poursim {
+
+namespace {
+constexpr double kTwoPi = 6.283185307179586;
+constexpr double kSqrt3 = 1.7320508075688772;
+constexpr int kSubsteps = 8; // 6.25 µs: L/R is 760 µs, ωe·Ts stays below 0.02 rad up to base speed
+// dead-time error: the sign of the current, ramped over this band so that a current near 0 does not chatter
+constexpr double kDeadtimeBand = 0.05; // [A]
+} // namespace
+
+void MotorModel::reset(const MotorParams &p, uint64_t seed, MotorFault fault) {
+  p_ = p;
+  fault_ = fault;
+  rng_.seed(seed ^ 0xD21E5EEDULL);
+  id_ = iq_ = i_open_ = i_short_ = peak_phase_ = theta_m_ = 0.0;
+  for (double &i : i_abc_) i = 0.0;
+  vbus_ = p.supply_v;
+  // each amplifier's bias within ±10 counts of nominal; a broken one sits at 400 counts off
+  std::uniform_real_distribution<double> bias(-10.0, 10.0);
+  for (double &o : offset_) o = p.adc_bias + bias(rng_);
+  if (fault == MotorFault::AmplifierOffset) offset_[1] += 400.0;
+}
+
+void MotorModel::abc_from_dq() {
+  const double th = p_.pole_pairs * theta_m_;
+  const double ia = id_ * std::cos(th) - iq_ * std::sin(th);
+  const double ib_beta = id_ * std::sin(th) + iq_ * std::cos(th);
+  i_abc_[0] = ia;
+  i_abc_[1] = -0.5 * ia + 0.5 * kSqrt3 * ib_beta;
+  i_abc_[2] = -0.5 * ia - 0.5 * kSqrt3 * ib_beta;
+}
+
+MotorSample MotorModel::sample() {
+  MotorSample s{};
+  const double counts_per_amp = p_.shunt * p_.amp_gain * 4096.0 / p_.adc_vref;
+  for (int k = 0; k < 3; ++k) {
+    double i = i_abc_[k];
+    if (fault_ == MotorFault::PhaseShort) i += (k == 0 ? i_short_ : (k == 1 ? -i_short_ : 0.0));
+    const double c = std::round(offset_[k] + i * counts_per_amp + p_.adc_noise * noise_(rng_));
+    s.adc_phase[k] = static_cast<uint16_t>(std::clamp(c, 0.0, 4095.0));
+  }
+  const double v = std::round(vbus_ / p_.vbus_divider * 4096.0 / p_.adc_vref + p_.adc_noise * noise_(rng_));
+  s.adc_vbus = static_cast<uint16_t>(std::clamp(v, 0.0, 4095.0));
+  const double turns = theta_m_ / kTwoPi;
+  const int64_t count = static_cast<int64_t>(std::floor(turns * p_.encoder_cpr));
+  const int64_t signed_count = fault_ == MotorFault::EncoderReversed ? -count : count;
+  s.encoder = static_cast<uint16_t>(((signed_count % p_.encoder_cpr) + p_.encoder_cpr) % p_.encoder_cpr);
+  return s;
+}
+
+double MotorModel::period(const double d_in[3], bool pwm_on, double omega_m) {
+  const double ts = 1.0 / p_.pwm_hz, h = ts / kSubsteps;
+  const double we = p_.pole_pairs * omega_m;
+  double torque_sum = 0.0;
+  peak_phase_ = 0.0;
+  for (int s = 0; s < kSubsteps; ++s) {
+    const double th = p_.pole_pairs * theta_m_;
+    // leg voltages over the negative rail: the duty's share of the bus, less the dead time's share with the
+    // sign of the current leaving the leg; with the switches off, the diodes clamp a leg to the rail its
+    // current flows toward (the windings then see at most the bus: regeneration through the diodes)
+    double v[3];
+    for (int k = 0; k < 3; ++k) {
+      const double sgn = std::clamp(i_abc_[k] / kDeadtimeBand, -1.0, 1.0);
+      if (pwm_on) {
+        const double d = std::clamp(d_in[k], 0.0, 1.0) - sgn * p_.deadtime_s * p_.pwm_hz;
+        v[k] = std::clamp(d, 0.0, 1.0) * vbus_;
+      } else {
+        v[k] = sgn > 0.0 ? 0.0 : (sgn < 0.0 ? vbus_ : 0.5 * vbus_);
+      }
+    }
+    double i_dc = 0.0; // current drawn from the bus capacitor by the bridge
+    if (fault_ == MotorFault::PhaseOpen) {
+      // phase c open: one current through a and b, i_a = −i_b = i; back-EMF e_x = −ωe·ψ·sin(θe − 2πx/3)
+      const double ea = -we * p_.flux * std::sin(th), eb = -we * p_.flux * std::sin(th - kTwoPi / 3.0);
+      const double l = 0.5 * (p_.ld + p_.lq);
+      i_open_ += h * ((v[0] - v[1]) - 2.0 * p_.r_phase * i_open_ - (ea - eb)) / (2.0 * l);
+      i_abc_[0] = i_open_;
+      i_abc_[1] = -i_open_;
+      i_abc_[2] = 0.0;
+      const double ialpha = i_open_, ibeta = -i_open_ / kSqrt3; // (2a − b − c)/3 and (b − c)/√3
+      id_ = ialpha * std::cos(th) + ibeta * std::sin(th);
+      iq_ = -ialpha * std::sin(th) + ibeta * std::cos(th);
+    } else {
+      const double va = (2.0 * v[0] - v[1] - v[2]) / 3.0, vb = (v[1] - v[2]) / kSqrt3;
+      const double vd = va * std::cos(th) + vb * std::sin(th), vq = -va * std::sin(th) + vb * std::cos(th);
+      const double did = (vd - p_.r_phase * id_ + we * p_.lq * iq_) / p_.ld;
+      const double diq = (vq - p_.r_phase * iq_ - we * (p_.ld * id_ + p_.flux)) / p_.lq;
+      id_ += h * did;
+      iq_ += h * diq;
+      abc_from_dq();
+    }
+    for (int k = 0; k < 3; ++k) i_dc += (v[k] / std::max(vbus_, 1e-3)) * i_abc_[k];
+    if (fault_ == MotorFault::PhaseShort) {
+      // terminals a and b shorted: the legs drive the short directly
+      i_short_ = pwm_on ? (v[0] - v[1]) / p_.short_r : 0.0;
+      i_dc += (v[0] / std::max(vbus_, 1e-3)) * i_short_ - (v[1] / std::max(vbus_, 1e-3)) * i_short_;
+    }
+    for (int k = 0; k < 3; ++k) peak_phase_ = std::max(peak_phase_, std::fabs(i_abc_[k]));
+    peak_phase_ = std::max(peak_phase_, std::fabs(i_short_));
+    const double i_supply = std::max(0.0, (p_.supply_v - vbus_) / p_.supply_r); // a diode: no sinking
+    vbus_ += h * (i_supply - i_dc) / p_.bus_c;
+    vbus_ = std::max(vbus_, 0.0);
+    torque_sum += 1.5 * p_.pole_pairs * (p_.flux * iq_ + (p_.ld - p_.lq) * id_ * iq_);
+    theta_m_ += omega_m * h;
+  }
+  return torque_sum / kSubsteps;
+}
+
+} // namespace poursim
