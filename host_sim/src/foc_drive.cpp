@@ -43,6 +43,7 @@ void FocDrive::reset(const poursim_config_t &c, uint32_t seed) {
   for (double &d : duty_) d = 0.5;
   for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES + 1 && drv_.state == POUR_DRIVE_CALIBRATING; ++k) period(0.0);
   tel_.peak_current = 0.0;
+  vbus_trace_.clear();
 }
 
 double FocDrive::period(double omega) {
@@ -58,15 +59,24 @@ double FocDrive::period(double omega) {
   tel_.min_vbus = std::min(tel_.min_vbus, model_.vbus());
   tel_.faults = static_cast<uint16_t>(tel_.faults | out_.faults);
   tel_.limits = static_cast<uint16_t>(tel_.limits | out_.limits);
-  return tau_m * gear_ * eff_;
+  // the gearbox loses (1 − η) of the power that crosses it, whichever way it flows
+  return tau_m * omega >= 0.0 ? tau_m * gear_ * eff_ : tau_m * gear_ / eff_;
+}
+
+void FocDrive::command(double tau_cmd, double omega, double dt) {
+  const double mnm = std::clamp(tau_cmd * 1000.0, -2.0e9, 2.0e9);
+  pour_drive_tick(&drv_, static_cast<int32_t>(std::lround(mnm)), static_cast<int32_t>(std::lround(omega * dt * 1e6)));
 }
 
 double FocDrive::step(double tau_cmd, double omega, double dt) {
-  const double mnm = std::clamp(tau_cmd * 1000.0, -2.0e9, 2.0e9);
-  pour_drive_tick(&drv_, static_cast<int32_t>(std::lround(mnm)), static_cast<int32_t>(std::lround(omega * dt * 1e6)));
+  command(tau_cmd, omega, dt);
   const int n = std::max(1, static_cast<int>(std::lround(dt * drv_.config.pwm_hz)));
-  double sum = 0.0;
-  for (int k = 0; k < n; ++k) sum += period(omega);
+  double sum = 0.0, vmax = 0.0;
+  for (int k = 0; k < n; ++k) {
+    sum += period(omega);
+    vmax = std::max(vmax, model_.vbus());
+  }
+  vbus_trace_.push_back(static_cast<float>(vmax));
   return sum / n;
 }
 

@@ -6,6 +6,7 @@
 #define POURSIM_FOC_DRIVE_HPP
 
 #include <cstdint>
+#include <vector>
 
 #include "motor_model.hpp"
 #include "poursim/poursim.h"
@@ -33,10 +34,14 @@ class FocDrive {
   // One step of dt: the command [N·m at the output] to the 1 kHz tick, then the periods of the current
   // loop at output speed omega [rad/s]. Returns the mean torque at the output [N·m].
   double step(double tau_cmd, double omega, double dt);
+  // The 1 kHz tick alone (step's first half): the command and the output's motion over dt.
+  void command(double tau_cmd, double omega, double dt);
   // One PWM period at output speed omega (the step above is made of these); the torque at the output.
   double period(double omega);
   bool brake_requested() const { return out_.brake != 0 && drv_.state != POUR_DRIVE_CALIBRATING; }
   const FocTelemetry &telemetry() const { return tel_; }
+  // The highest bus voltage of each step since the reset [V] (for plots).
+  const std::vector<float> &vbus_trace() const { return vbus_trace_; }
   const pour_drive_output_t &output() const { return out_; }
   const MotorModel &model() const { return model_; }
   const pour_drive_config_t &firmware_config() const { return drv_.config; }
@@ -52,6 +57,7 @@ class FocDrive {
   double gear_ = 20.0, eff_ = 0.9;
   double duty_[3] = {0.5, 0.5, 0.5}; // the compares loaded at the next period's start
   bool pwm_on_ = false;
+  std::vector<float> vbus_trace_;
 };
 
 // The model's parameters from the firmware's configuration (one source for the motor's numbers) and the

@@ -10,7 +10,7 @@ namespace poursim {
 namespace {
 constexpr double kTwoPi = 6.283185307179586;
 constexpr double kSqrt3 = 1.7320508075688772;
-constexpr int kSubsteps = 8; // 6.25 µs: L/R is 760 µs, ωe·Ts stays below 0.02 rad up to base speed
+constexpr int kSubsteps = 4; // 12.5 µs: L/R is 760 µs, and ωe·Lq·h < 0.01 up to the base speed
 // dead-time error: the sign of the current, ramped over this band so that a current near 0 does not chatter
 constexpr double kDeadtimeBand = 0.05; // [A]
 } // namespace
@@ -58,59 +58,80 @@ MotorSample MotorModel::sample() {
 double MotorModel::period(const double d_in[3], bool pwm_on, double omega_m) {
   const double ts = 1.0 / p_.pwm_hz, h = ts / kSubsteps;
   const double we = p_.pole_pairs * omega_m;
-  double torque_sum = 0.0;
-  peak_phase_ = 0.0;
-  for (int s = 0; s < kSubsteps; ++s) {
-    const double th = p_.pole_pairs * theta_m_;
-    // leg voltages over the negative rail: the duty's share of the bus, less the dead time's share with the
-    // sign of the current leaving the leg; with the switches off, the diodes clamp a leg to the rail its
-    // current flows toward (the windings then see at most the bus: regeneration through the diodes)
-    double v[3];
-    for (int k = 0; k < 3; ++k) {
-      const double sgn = std::clamp(i_abc_[k] / kDeadtimeBand, -1.0, 1.0);
-      if (pwm_on) {
-        const double d = std::clamp(d_in[k], 0.0, 1.0) - sgn * p_.deadtime_s * p_.pwm_hz;
-        v[k] = std::clamp(d, 0.0, 1.0) * vbus_;
-      } else {
-        v[k] = sgn > 0.0 ? 0.0 : (sgn < 0.0 ? vbus_ : 0.5 * vbus_);
-      }
-    }
-    double i_dc = 0.0; // current drawn from the bus capacitor by the bridge
-    if (fault_ == MotorFault::PhaseOpen) {
-      // phase c open: one current through a and b, i_a = −i_b = i; back-EMF e_x = −ωe·ψ·sin(θe − 2πx/3)
-      const double ea = -we * p_.flux * std::sin(th), eb = -we * p_.flux * std::sin(th - kTwoPi / 3.0);
-      const double l = 0.5 * (p_.ld + p_.lq);
-      i_open_ += h * ((v[0] - v[1]) - 2.0 * p_.r_phase * i_open_ - (ea - eb)) / (2.0 * l);
-      i_abc_[0] = i_open_;
-      i_abc_[1] = -i_open_;
-      i_abc_[2] = 0.0;
-      const double ialpha = i_open_, ibeta = -i_open_ / kSqrt3; // (2a − b − c)/3 and (b − c)/√3
-      id_ = ialpha * std::cos(th) + ibeta * std::sin(th);
-      iq_ = -ialpha * std::sin(th) + ibeta * std::cos(th);
+  // The rotor turns ωe·Ts ≈ 0.05 rad a period at the base speed: the transforms take the period's mid angle.
+  const double th = p_.pole_pairs * (theta_m_ + 0.5 * omega_m * ts);
+  const double co = std::cos(th), si = std::sin(th);
+  // leg voltages over the negative rail: the duty's share of the bus, less the dead time's share with the
+  // sign of the current leaving the leg; with the switches off, the diodes clamp a leg to the rail its
+  // current flows toward (the windings then see at most the bus: regeneration through the diodes)
+  double v[3];
+  for (int k = 0; k < 3; ++k) {
+    const double sgn = std::clamp(i_abc_[k] / kDeadtimeBand, -1.0, 1.0);
+    if (pwm_on) {
+      const double d = std::clamp(d_in[k], 0.0, 1.0) - sgn * p_.deadtime_s * p_.pwm_hz;
+      v[k] = std::clamp(d, 0.0, 1.0) * vbus_;
     } else {
-      const double va = (2.0 * v[0] - v[1] - v[2]) / 3.0, vb = (v[1] - v[2]) / kSqrt3;
-      const double vd = va * std::cos(th) + vb * std::sin(th), vq = -va * std::sin(th) + vb * std::cos(th);
+      v[k] = sgn > 0.0 ? 0.0 : (sgn < 0.0 ? vbus_ : 0.5 * vbus_);
+    }
+  }
+  double iq_sum = 0.0, id_sum = 0.0;
+  if (fault_ == MotorFault::PhaseOpen) {
+    // phase c open: one current through a and b, i_a = −i_b = i; back-EMF e_x = −ωe·ψ·sin(θe − 2πx/3)
+    const double ea = -we * p_.flux * si;
+    const double eb = -we * p_.flux * std::sin(th - kTwoPi / 3.0);
+    const double l = 0.5 * (p_.ld + p_.lq);
+    for (int s = 0; s < kSubsteps; ++s) {
+      i_open_ += h * ((v[0] - v[1]) - 2.0 * p_.r_phase * i_open_ - (ea - eb)) / (2.0 * l);
+      const double ialpha = i_open_, ibeta = -i_open_ / kSqrt3; // (2a − b − c)/3 and (b − c)/√3
+      id_ = ialpha * co + ibeta * si;
+      iq_ = -ialpha * si + ibeta * co;
+      iq_sum += iq_, id_sum += id_;
+    }
+    i_abc_[0] = i_open_;
+    i_abc_[1] = -i_open_;
+    i_abc_[2] = 0.0;
+  } else {
+    const double va = (2.0 * v[0] - v[1] - v[2]) / 3.0, vb = (v[1] - v[2]) / kSqrt3;
+    const double vd = va * co + vb * si, vq = -va * si + vb * co;
+    for (int s = 0; s < kSubsteps; ++s) {
       const double did = (vd - p_.r_phase * id_ + we * p_.lq * iq_) / p_.ld;
       const double diq = (vq - p_.r_phase * iq_ - we * (p_.ld * id_ + p_.flux)) / p_.lq;
       id_ += h * did;
       iq_ += h * diq;
-      abc_from_dq();
+      iq_sum += iq_, id_sum += id_;
     }
-    for (int k = 0; k < 3; ++k) i_dc += (v[k] / std::max(vbus_, 1e-3)) * i_abc_[k];
-    if (fault_ == MotorFault::PhaseShort) {
-      // terminals a and b shorted: the legs drive the short directly
-      i_short_ = pwm_on ? (v[0] - v[1]) / p_.short_r : 0.0;
-      i_dc += (v[0] / std::max(vbus_, 1e-3)) * i_short_ - (v[1] / std::max(vbus_, 1e-3)) * i_short_;
-    }
-    for (int k = 0; k < 3; ++k) peak_phase_ = std::max(peak_phase_, std::fabs(i_abc_[k]));
-    peak_phase_ = std::max(peak_phase_, std::fabs(i_short_));
-    const double i_supply = std::max(0.0, (p_.supply_v - vbus_) / p_.supply_r); // a diode: no sinking
-    vbus_ += h * (i_supply - i_dc) / p_.bus_c;
-    vbus_ = std::max(vbus_, 0.0);
-    torque_sum += 1.5 * p_.pole_pairs * (p_.flux * iq_ + (p_.ld - p_.lq) * id_ * iq_);
-    theta_m_ += omega_m * h;
+    theta_m_ += omega_m * ts;
+    abc_from_dq();
+    theta_m_ -= omega_m * ts;
   }
-  return torque_sum / kSubsteps;
+  // the bridge's draw on the bus capacitor, averaged over the period
+  const double vb_safe = std::max(vbus_, 1e-3);
+  double i_dc = 0.0;
+  for (int k = 0; k < 3; ++k) i_dc += (v[k] / vb_safe) * i_abc_[k];
+  if (fault_ == MotorFault::PhaseShort) {
+    // terminals a and b shorted: the legs drive the short directly
+    i_short_ = pwm_on ? (v[0] - v[1]) / p_.short_r : 0.0;
+    i_dc += ((v[0] - v[1]) / vb_safe) * i_short_;
+  }
+  peak_phase_ = std::fabs(i_short_);
+  for (int k = 0; k < 3; ++k) peak_phase_ = std::max(peak_phase_, std::fabs(i_abc_[k]));
+  // The bus: with the supply conducting it relaxes toward V_s − R_s·i_dc with τ = R_s·C (10 µs, shorter than
+  // the period: solved exactly); the supply cannot sink, so above V_s only the capacitor takes the current.
+  const double decay = std::exp(-ts / (p_.supply_r * p_.bus_c));
+  if (i_dc <= 0.0) {
+    // regenerating: the capacitor takes the current; below V_s the supply also lifts it back toward V_s
+    vbus_ -= ts * i_dc / p_.bus_c;
+    if (vbus_ < p_.supply_v) vbus_ = p_.supply_v + (vbus_ - p_.supply_v) * decay;
+  } else if (vbus_ > p_.supply_v) {
+    vbus_ = std::max(vbus_ - ts * i_dc / p_.bus_c, p_.supply_v); // the capacitor alone, down to V_s
+  } else {
+    const double v_eq = p_.supply_v - p_.supply_r * i_dc;
+    vbus_ = v_eq + (vbus_ - v_eq) * decay;
+  }
+  vbus_ = std::max(vbus_, 0.0);
+  theta_m_ += omega_m * ts;
+  const double iq_mean = iq_sum / kSubsteps, id_mean = id_sum / kSubsteps;
+  return 1.5 * p_.pole_pairs * (p_.flux * iq_mean + (p_.ld - p_.lq) * id_mean * iq_mean);
 }
 
 } // namespace poursim

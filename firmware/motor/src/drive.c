@@ -29,10 +29,10 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.overcurrent_ma = 45000;
   c.i_cont_ma = 4000;
   c.i2t_budget_a2s = 4000;
-  c.vbus_ov_mv = 30000;
+  c.vbus_ov_mv = 28000;
   c.vbus_uv_mv = 10000;
-  c.regen_on_mv = 26000;
-  c.regen_full_mv = 27500;
+  c.regen_on_mv = 24500;
+  c.regen_full_mv = 25000;
   c.flux_brake_ma = 20000;
   c.regen_enabled = 1;
   c.shunt_uohm = 3000;
@@ -269,7 +269,14 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
     drv->i2_n = 0;
     return;
   }
-  const int64_t iq = ((int64_t)torque_mnm * drv->torque_to_iq_q16 + (1 << 15)) >> 16;
+  /* Braking (the load drives the motor through the gearbox) the gearbox's loss helps: the motor then needs
+   * η² less current than motoring for the same torque at the output. */
+  int64_t gain = drv->torque_to_iq_q16;
+  if ((torque_mnm > 0 && output_delta_urad < 0) || (torque_mnm < 0 && output_delta_urad > 0)) {
+    const int64_t eff = c->gear_efficiency_q15;
+    gain = (gain * eff * eff + (1LL << 29)) >> 30;
+  }
+  const int64_t iq = ((int64_t)torque_mnm * gain + (1 << 15)) >> 16;
   drv->iq_cmd_q15 = (int32_t)(iq > drv->limit_q15 ? drv->limit_q15 : (iq < -drv->limit_q15 ? -drv->limit_q15 : iq));
   /* I²t: the mean i² of this millisecond above the continuous current's, accrued; cooling below it */
   if (drv->i2_n > 0u) {

@@ -132,7 +132,7 @@ const char *pour_drive_config_check(const pour_drive_config_t *config);
 void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive_output_t *out);
 
 /* The 1 kHz step's command: torque at the output [mN·m] → q current reference (torque constant, gear ratio,
- * efficiency), clamped to the current limit; the I²t budget; the motor encoder's direction against the
+ * efficiency: τ/(N·η·Kt) motoring, τ·η/(N·Kt) braking, as the output's motion says), clamped to the current limit; the I²t budget; the motor encoder's direction against the
  * output's motion since the last tick output_delta_urad [µrad]. */
 void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta_urad);
 
