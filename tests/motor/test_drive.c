@@ -120,10 +120,10 @@ static void test_drive_BusOutOfRangeTrips(void) {
 
 static void test_drive_FluxBrakingStartsAboveRegenOn(void) {
   run_calibration();
-  pour_drive_sample_t s = sample(0, 0, 0, 25500, 0);
+  pour_drive_sample_t s = sample(0, 0, 0, 24400, 0);
   pour_drive_isr(&drv, &s, &out);
   TEST_ASSERT_EQUAL_INT16(0, out.id_ref);
-  s = sample(0, 0, 0, 27500, 0);
+  s = sample(0, 0, 0, 25100, 0);
   pour_drive_isr(&drv, &s, &out);
   TEST_ASSERT_TRUE((out.limits & POUR_DRIVE_LIMIT_FLUX_BRAKE) != 0u);
   TEST_ASSERT_INT_WITHIN(400, 20000 * 32768 / 64000, out.id_ref); /* the ADC's 15 mV steps */
