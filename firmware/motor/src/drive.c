@@ -45,7 +45,7 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.encoder_offset = 0;
   c.phase_sum_ma = 4000;
   c.phase_loss_ms = 20;
-  c.encoder_check_urad = 20000;
+  c.encoder_check_urad = 3000;
   return c;
 }
 
@@ -293,12 +293,11 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
   drv->output_urad += output_delta_urad;
   if (abs_i32(drv->output_urad) >= (int32_t)c->encoder_check_urad) {
     const int64_t expected = (int64_t)drv->output_urad * c->gear_ratio * c->encoder_cpr / TWO_PI_URAD;
+    /* Only a clear reversal trips: at least half the expected counts the other way. A motor that moved less
+     * (the gearbox's backlash taken up, the output falling through it) is no evidence either way. */
     const int64_t seen = drv->motor_counts;
-    if ((expected > 0 && seen < 0) || (expected < 0 && seen > 0)) {
+    if ((expected > 0 && 2 * seen <= -expected) || (expected < 0 && 2 * seen >= -expected))
       pour_drive_trip(drv, POUR_DRIVE_FAULT_ENCODER_DIRECTION);
-    } else if ((seen < 0 ? -seen : seen) * 2 < (expected < 0 ? -expected : expected)) {
-      pour_drive_trip(drv, POUR_DRIVE_FAULT_ENCODER_MISMATCH);
-    }
     drv->output_urad = 0;
     drv->motor_counts = 0;
   }

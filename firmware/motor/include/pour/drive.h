@@ -70,7 +70,8 @@ typedef struct {
   uint32_t phase_sum_ma;       /* |ia + ib + ic| above this: a phase shorted to a rail or a bad shunt [mA] */
   uint32_t phase_loss_ms;      /* the loop saturated and its error above 1/4 of a reference above 1/10 of the
                                   limit this long: a phase open [ms] */
-  uint32_t encoder_check_urad; /* output motion over which the motor encoder's direction is compared [µrad] */
+  uint32_t encoder_check_urad; /* output motion over which the motor encoder's direction is compared [µrad]:
+                                  small, because a reversed encoder stalls the motor within a pole pitch */
 } pour_drive_config_t;
 
 /* One sample, taken at the PWM's centre (counter underflow). */
