@@ -27,8 +27,9 @@ MotorParams motor_params(const pour_drive_config_t &fw, const poursim_config_t &
   return p;
 }
 
-void FocDrive::reset(const poursim_config_t &c, uint32_t seed) {
+void FocDrive::reset(const poursim_config_t &c, uint32_t seed, uint32_t bandwidth_rad_s) {
   pour_drive_config_t fw = pour_drive_default_config();
+  if (bandwidth_rad_s != 0u) fw.bandwidth_rad_s = bandwidth_rad_s;
   fw.regen_enabled = static_cast<uint32_t>(c.drive_regen);
   fw.gear_ratio = static_cast<uint32_t>(std::lround(c.gear_ratio));
   (void)pour_drive_init(&drv_, &fw); // the defaults with a rig's gear ratio: validated by the config's range

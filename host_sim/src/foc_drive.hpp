@@ -28,9 +28,9 @@ struct FocTelemetry {
 
 class FocDrive {
  public:
-  // The firmware's default drive, flux braking per regen, the model's fault; the start-up offset
-  // calibration runs here (the PWM off, 12.8 ms) before the first step.
-  void reset(const poursim_config_t &c, uint32_t seed);
+  // The firmware's default drive (its current loop tuned for bandwidth_rad_s if not 0), flux braking per
+  // drive_regen, the model's fault; the start-up offset calibration runs here (the PWM off, 12.8 ms).
+  void reset(const poursim_config_t &c, uint32_t seed, uint32_t bandwidth_rad_s = 0);
   // One step of dt: the command [N·m at the output] to the 1 kHz tick, then the periods of the current
   // loop at output speed omega [rad/s]. Returns the mean torque at the output [N·m].
   double step(double tau_cmd, double omega, double dt);

@@ -37,9 +37,9 @@ double delayed_loop_rise(double wc, double td) {
 
 } // namespace
 
-CurrentStep measure_current_step(const poursim_config_t &c, double amps) {
+CurrentStep measure_current_step(const poursim_config_t &c, double amps, uint32_t bandwidth_rad_s) {
   FocDrive f;
-  f.reset(c, c.seed);
+  f.reset(c, c.seed, bandwidth_rad_s);
   CurrentStep r;
   r.ref = amps;
   r.first_order_rise_s = std::log(9.0) / f.firmware_config().bandwidth_rad_s;
@@ -88,6 +88,17 @@ double base_speed(const poursim_config_t &c, double torque) {
   return we / p.pole_pairs / f.gear();
 }
 
+double measure_shaft_torque(const poursim_config_t &c, double torque, double omega) {
+  FocDrive f;
+  f.reset(c, c.seed);
+  double sum = 0;
+  for (int ms = 0; ms < 40; ++ms) {
+    const double t = f.step(torque, omega, 0.001);
+    if (ms >= 30) sum += t;
+  }
+  return sum / 10.0;
+}
+
 std::vector<TorquePoint> measure_torque_speed(const poursim_config_t &c, double torque, int n_speeds) {
   std::vector<TorquePoint> pts;
   const double w_base = base_speed(c, torque);
@@ -95,14 +106,7 @@ std::vector<TorquePoint> measure_torque_speed(const poursim_config_t &c, double 
     TorquePoint p;
     p.omega = n_speeds > 1 ? w_base * k / (n_speeds - 1) : 0.0;
     p.command = torque;
-    FocDrive f;
-    f.reset(c, c.seed);
-    double sum = 0;
-    for (int ms = 0; ms < 40; ++ms) {
-      const double t = f.step(torque, p.omega, 0.001);
-      if (ms >= 30) sum += t;
-    }
-    p.delivered = sum / 10.0;
+    p.delivered = measure_shaft_torque(c, torque, p.omega);
     pts.push_back(p);
   }
   return pts;

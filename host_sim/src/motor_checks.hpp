@@ -5,6 +5,7 @@
 #ifndef POURSIM_MOTOR_CHECKS_HPP
 #define POURSIM_MOTOR_CHECKS_HPP
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,8 +23,9 @@ struct CurrentStep {
   std::vector<double> t, iq; // the trace, one sample a PWM period [s], [A]
 };
 
-// A q-current step of amps [A] on the locked rotor (ω = 0), 1 ms at zero then 9 ms at the step.
-CurrentStep measure_current_step(const poursim_config_t &c, double amps);
+// A q-current step of amps [A] on the locked rotor (ω = 0), 1 ms at zero then 9 ms at the step; the loop
+// tuned for bandwidth_rad_s (0: the firmware's default).
+CurrentStep measure_current_step(const poursim_config_t &c, double amps, uint32_t bandwidth_rad_s = 0);
 
 struct TorquePoint {
   double omega = 0;    // output speed [rad/s]
@@ -34,6 +36,9 @@ struct TorquePoint {
 // The base speed for a torque [N·m at the output]: the output speed at which the current loop's voltage
 // limit is just enough for it [rad/s] (from the motor's R, L, ψ and the bus).
 double base_speed(const poursim_config_t &c, double torque);
+
+// The mean shaft torque over 10 ms after 30 ms of commanding torque at output speed omega [N·m].
+double measure_shaft_torque(const poursim_config_t &c, double torque, double omega);
 
 // The torque at the shaft at n_speeds speeds from 0 to the base speed of torque.
 std::vector<TorquePoint> measure_torque_speed(const poursim_config_t &c, double torque, int n_speeds);
