@@ -28,18 +28,20 @@ pour_status_t pour_current_pi_init(pour_current_pi_t *pi, uint32_t bandwidth_rad
   return POUR_OK;
 }
 
-static int64_t clamp_i64(int64_t x, int64_t lo, int64_t hi) { return x < lo ? lo : (x > hi ? hi : x); }
+static int32_t clamp_i32(int32_t x, int32_t lo, int32_t hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
 q15_t pour_current_pi_step(pour_current_pi_t *pi, int32_t e, int32_t limit) {
-  const int64_t lim = limit < 0 ? 0 : (limit > POUR_Q15_MAX ? POUR_Q15_MAX : limit);
-  const int64_t p = clamp_i64(((int64_t)pi->kp_q16 * e + (1 << 15)) >> 16, -lim, lim);
-  /* the integrator may hold what the output has left after the proportional part, no more */
+  const int32_t lim = clamp_i32(limit, 0, POUR_Q15_MAX);
+  /* kp·e: Q16 × (|e| < 2^17) needs 64 bits (one SMULL); the rest stays in int32 */
+  const int32_t p = clamp_i32((int32_t)(((int64_t)pi->kp_q16 * e + (1 << 15)) >> 16), -lim, lim);
+  /* the integrator may hold what the output has left after the proportional part, and within ±limit itself,
+   * so that (bound << 16) fits in int32 */
+  const int32_t hi = lim - p < lim ? lim - p : lim;
+  const int32_t lo = -lim - p > -lim ? -lim - p : -lim;
   const int64_t integ = (int64_t)pi->integ_q16 + (int64_t)pi->ki_q16 * e;
-  const int64_t hi = lim - p < lim ? lim - p : lim; /* and within ±limit itself, so int32 holds it */
-  const int64_t lo = -lim - p > -lim ? -lim - p : -lim;
-  pi->integ_q16 = (int32_t)clamp_i64(integ, lo * 65536, hi * 65536);
-  const int64_t u = p + (((int64_t)pi->integ_q16 + (1 << 15)) >> 16);
-  return (q15_t)clamp_i64(u, -lim, lim);
+  const int64_t hi16 = (int64_t)hi * 65536, lo16 = (int64_t)lo * 65536;
+  pi->integ_q16 = (int32_t)(integ > hi16 ? hi16 : (integ < lo16 ? lo16 : integ));
+  return (q15_t)clamp_i32(p + ((pi->integ_q16 + (1 << 15)) >> 16), -lim, lim);
 }
 
 void pour_current_pi_reset(pour_current_pi_t *pi) { pi->integ_q16 = 0; }

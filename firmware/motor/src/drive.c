@@ -174,8 +174,9 @@ static uint16_t compare_of(int32_t duty_q15, uint16_t period) {
 
 void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive_output_t *out) {
   const pour_drive_config_t *c = &drv->config;
-  memset(out, 0, sizeof *out);
-  out->vbus = pour_sat_q15(pour_sat_i32(((int64_t)in->adc_vbus * drv->vbus_gain_q16 + (1 << 15)) >> 16));
+  out->id = out->iq = out->id_ref = out->iq_ref = 0;
+  out->limits = 0;
+  out->vbus = pour_sat_q15((int32_t)(((int64_t)in->adc_vbus * drv->vbus_gain_q16 + (1 << 15)) >> 16)); /* < 2^47 >> 16 */
   if (drv->state == POUR_DRIVE_CALIBRATING) {
     const int r = pour_current_sense_calibrate(&drv->sense, in->adc_phase);
     if (r < 0) {
@@ -224,11 +225,12 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   int32_t id_ref = 0;
   if (c->regen_enabled && out->vbus > drv->regen_on_q15) {
     const int32_t over = clamp_i32(out->vbus - drv->regen_on_q15, 0, drv->regen_span_q15);
-    id_ref = (int32_t)(((int64_t)drv->flux_brake_q15 * over) / drv->regen_span_q15);
+    id_ref = drv->flux_brake_q15 * over / drv->regen_span_q15; /* < 2^15 · 2^15: int32 */
     limits |= POUR_DRIVE_LIMIT_FLUX_BRAKE;
   }
-  const int32_t iq_max =
-      (int32_t)pour_foc_isqrt_u32((uint32_t)(drv->limit_q15 * drv->limit_q15 - id_ref * id_ref));
+  const int32_t iq_max = id_ref == 0 ? drv->limit_q15
+                                      : (int32_t)pour_foc_isqrt_u32((uint32_t)(drv->limit_q15 * drv->limit_q15 -
+                                                                               id_ref * id_ref));
   const int32_t iq_ref = clamp_i32(drv->iq_cmd_q15, -iq_max, iq_max);
   if (iq_ref != drv->iq_cmd_q15) limits |= POUR_DRIVE_LIMIT_CURRENT;
   /* the voltage vector within vmax, d first (flux braking keeps its current), q takes what is left */

@@ -1,29 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 #include "pour/foc.h"
 
-/* Taylor coefficients of sin(πz/2) = Σ c_k z^k on z ∈ [0, 1], Q30. The next term, (π/2)^11/11!, is
- * 3.6e-6: below half a Q15 LSB. */
-#define SIN_C1 1686629713LL
-#define SIN_C3 (-693598668LL)
-#define SIN_C5 85569306LL
-#define SIN_C7 (-5026995LL)
-#define SIN_C9 172272LL
-#define Q30_ONE (1LL << 30)
+#include "sin_table.h"
+
 #define INV_SQRT3_Q15 18919 /* 1/√3 in Q15 */
 
-static int64_t mul_q30(int64_t a, int64_t b) { return (a * b + (1LL << 29)) >> 30; }
-
-/* sin of the quarter-wave position r ∈ [0, 16384] (Q14 of π/2), Q15, saturated. */
+/* sin of the quarter-wave position r ∈ [0, 16384] (Q14 of π/2), Q15: the table's two neighbours
+ * interpolated linearly on the 6 bits between them, rounded (error below 1 LSB). */
 static q15_t sin_quarter(int32_t r) {
-  const int64_t z = (int64_t)r << 16; /* Q30 */
-  const int64_t z2 = mul_q30(z, z);
-  int64_t p = SIN_C9;
-  p = SIN_C7 + mul_q30(p, z2);
-  p = SIN_C5 + mul_q30(p, z2);
-  p = SIN_C3 + mul_q30(p, z2);
-  p = SIN_C1 + mul_q30(p, z2);
-  const int64_t s = mul_q30(p, z); /* Q30 */
-  return pour_sat_q15((int32_t)((s + (1LL << 14)) >> 15));
+  const int32_t k = r >> 6, frac = r & 63;
+  if (k >= POUR_SIN_TABLE_STEPS) return pour_sin_table[POUR_SIN_TABLE_STEPS];
+  const int32_t a = pour_sin_table[k], b = pour_sin_table[k + 1];
+  return (q15_t)(a + (((b - a) * frac + 32) >> 6));
 }
 
 static q15_t sin_angle(uint16_t angle) {
@@ -39,7 +27,8 @@ void pour_foc_sincos_q15(uint16_t angle, q15_t *s, q15_t *c) {
   *c = sin_angle((uint16_t)(angle + 16384u));
 }
 
-static q15_t round_q30_to_q15(int64_t x) { return pour_sat_q15(pour_sat_i32((x + (1LL << 14)) >> 15)); }
+/* A sum of two Q15 × Q15 products (|x| <= 2^31) rounded to Q15 and saturated: after the shift it fits int32. */
+static q15_t round_q30_to_q15(int64_t x) { return pour_sat_q15((int32_t)((x + (1LL << 14)) >> 15)); }
 
 void pour_foc_clarke_q15(q15_t a, q15_t b, q15_t c, q15_t *alpha, q15_t *beta) {
   /* (2a − b − c)/3, rounded to nearest (ties away from zero) */
@@ -74,29 +63,33 @@ void pour_foc_modulate_q15(q15_t alpha, q15_t beta, q15_t vbus, const q15_t i[3]
     if (v[k] < vmin) vmin = v[k];
   }
   const int32_t offset = -(vmax + vmin) / 2;
-  const int32_t bus = vbus > 0 ? vbus : 1;
+  /* 1/vbus once, Q30 (a 32-bit division), then a multiply per phase */
+  const int32_t inv_bus = (int32_t)((1 << 30) / (vbus > 0 ? vbus : 1));
+  const int32_t band = m->deadtime_band_q15 > 0 ? m->deadtime_band_q15 : 1;
   for (int k = 0; k < 3; ++k) {
-    /* (v + offset)/vbus in Q15: |v + offset| < 2^16, so the shifted numerator fits in int64 easily */
-    int32_t d = (int32_t)(((int64_t)(v[k] + offset) << 15) / bus);
+    /* (v + offset)/vbus in Q15: |v + offset| < 2^17 and inv_bus <= 2^30, so the product fits in int64 */
+    int32_t d = (int32_t)(((int64_t)(v[k] + offset) * inv_bus + (1 << 14)) >> 15);
     d = clamp_i32(d, -POUR_FOC_DUTY_ONE, POUR_FOC_DUTY_ONE) + POUR_FOC_DUTY_ONE / 2;
-    const int32_t band = m->deadtime_band_q15 > 0 ? m->deadtime_band_q15 : 1;
-    const int32_t ic = clamp_i32(i[k], -band, band);
-    d += (int32_t)(((int64_t)m->deadtime_duty_q15 * ic) / band);
+    /* deadtime_duty·clamp(i, ±band)/band: both below 2^15, so the product fits in int32 */
+    d += m->deadtime_duty_q15 * clamp_i32(i[k], -band, band) / band;
     duty[k] = clamp_i32(d, 0, m->duty_max_q15);
   }
 }
 
 uint32_t pour_foc_isqrt_u32(uint32_t x) {
-  uint32_t root = 0, bit = 1u << 30;
-  while (bit > x) bit >>= 2;
-  while (bit != 0u) {
-    if (x >= root + bit) {
-      x -= root + bit;
-      root = (root >> 1) + bit;
-    } else {
-      root >>= 1;
-    }
-    bit >>= 2;
+  if (x < 2u) return x;
+  /* Newton from above: r0 = 2^ceil(bits/2) >= √x, then r ← (r + x/r)/2 falls monotonically to floor(√x)
+   * (at most 6 steps for 32 bits; one hardware division each) */
+  unsigned bits = 0;
+#if defined(__GNUC__)
+  bits = 32u - (unsigned)__builtin_clz(x);
+#else
+  while (bits < 32u && (x >> bits) != 0u) ++bits;
+#endif
+  uint32_t r = 1u << ((bits + 1u) / 2u);
+  for (;;) {
+    const uint32_t next = (r + x / r) / 2u;
+    if (next >= r) return r;
+    r = next;
   }
-  return root;
 }

@@ -13,8 +13,8 @@
 /* Duty 1.0 in Q15 (duties are in [0, POUR_FOC_DUTY_ONE]). */
 #define POUR_FOC_DUTY_ONE 32768
 
-/* sin and cos of an electrical angle, Q15. A 9th-order odd polynomial on the quarter wave evaluated in
- * Q30 with int64 products, rounded to nearest: |error| <= 1 LSB; +1.0 saturates to 32767. */
+/* sin and cos of an electrical angle, Q15: a 257-entry quarter-wave table (src/sin_table.h, generated)
+ * interpolated linearly, rounded to nearest: |error| <= 1 LSB; +1.0 saturates to 32767. */
 void pour_foc_sincos_q15(uint16_t angle, q15_t *s, q15_t *c);
 
 /* Amplitude-invariant Clarke transform of three phase currents (all three shunts, Q15):
@@ -41,7 +41,7 @@ typedef struct {
 void pour_foc_modulate_q15(q15_t alpha, q15_t beta, q15_t vbus, const q15_t i[3],
                            const pour_foc_modulation_t *m, int32_t duty[3]);
 
-/* floor(√x) for a 32-bit x (bitwise, 16 iterations). */
+/* floor(√x) for a 32-bit x (Newton's iteration from above, at most 6 divisions). */
 uint32_t pour_foc_isqrt_u32(uint32_t x);
 
 #endif /* POUR_FOC_H */
