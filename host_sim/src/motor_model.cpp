@@ -106,7 +106,7 @@ double MotorModel::period(const double d_in[3], bool pwm_on, double omega_m) {
   }
   // the bridge's draw on the bus capacitor, averaged over the period
   const double vb_safe = std::max(vbus_, 1e-3);
-  double i_dc = 0.0;
+  double i_dc = p_.board_current;
   for (int k = 0; k < 3; ++k) i_dc += (v[k] / vb_safe) * i_abc_[k];
   if (fault_ == MotorFault::PhaseShort) {
     // terminals a and b shorted: the legs drive the short directly

@@ -16,9 +16,10 @@ namespace poursim {
 enum class MotorFault { None = 0, PhaseOpen = 1, PhaseShort = 2, EncoderReversed = 3, AmplifierOffset = 4 };
 
 struct MotorParams {
-  double r_phase = 0.304;         // [Ω]
-  double ld = 231.5e-6, lq = 231.5e-6; // [H]
-  double flux = 0.0369 / 12.0;    // permanent-magnet flux linkage ψ = Kt/(1.5·pp) [Wb]
+  // defaults: a placeholder; motor_params() fills every field from the firmware's configuration
+  double r_phase = 0.2865;        // [Ω]
+  double ld = 150.5e-6, lq = 150.5e-6; // [H]
+  double flux = 0.0404 / 12.0;    // permanent-magnet flux linkage ψ = Kt/(1.5·pp) [Wb]
   int pole_pairs = 8;
   double pwm_hz = 20000.0;
   double deadtime_s = 800e-9;
@@ -29,6 +30,7 @@ struct MotorParams {
   double vbus_divider = 19.17;    // bus / ADC pin [-]
   int encoder_cpr = 4096;
   double short_r = 0.02;          // resistance of a phase-to-phase short, with the legs' on-resistance [Ω]
+  double board_current = 0.05;    // the board's own draw on the bus (gate drivers, MCU, LDO) [A], assumed
 };
 
 // ADC readings at the PWM centre.

@@ -17,18 +17,19 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.pwm_hz = 20000;
   c.timer_clock_hz = 170000000;
   c.deadtime_ns = 800;
-  c.r_phase_uohm = 304000; /* half the 0.608 Ω terminal resistance (phase to phase) */
-  c.ld_nh = 231500;        /* half the 0.463 mH terminal inductance */
-  c.lq_nh = 231500;
-  c.kt_unm_per_a = 36900;
+  /* maxon EC 45 flat 70 W, 24 V (docs/motor.md): a star winding's phase is half the terminal values */
+  c.r_phase_uohm = 286500; /* half the 0.573 Ω terminal resistance (phase to phase) */
+  c.ld_nh = 150500;        /* half the 0.301 mH terminal inductance (iron-core, surface magnets: Ld = Lq) */
+  c.lq_nh = 150500;
+  c.kt_unm_per_a = 40400;
   c.pole_pairs = 8;
   c.gear_ratio = 20;
   c.gear_efficiency_q15 = 29491; /* 0.90 */
   c.bandwidth_rad_s = 3000;
   c.current_limit_ma = 36000;
   c.overcurrent_ma = 45000;
-  c.i_cont_ma = 4000;
-  c.i2t_budget_a2s = 4000;
+  c.i_cont_ma = 3290;       /* the motor's nominal (max. continuous) current */
+  c.i2t_budget_a2s = 466;   /* I_n²·τ_w: 3.29² A² × the winding's 43.1 s thermal time constant */
   c.vbus_ov_mv = 28000;
   c.vbus_uv_mv = 10000;
   c.regen_on_mv = 24500;

@@ -118,8 +118,8 @@ typedef struct {
   uint32_t phase_loss_count, phase_loss_limit; /* periods of lost current control, and the trip count */
 } pour_drive_t;
 
-/* The B-G431B-ESC1 (3 mΩ shunts, 20 kHz) with a maxon EC 45 flat 70 W 24 V on a 1:20 planetary gearhead
- * (docs/motor.md: every number and its source). */
+/* The B-G431B-ESC1 (3 mΩ shunts, 20 kHz) with a maxon EC 45 flat 70 W 24 V on the rig's 1:20 planetary
+ * gearhead (docs/motor.md: every number and its source). */
 pour_drive_config_t pour_drive_default_config(void);
 
 /* Checks every field (POUR_EINVAL names nothing: pour_drive_config_check says which); starts the offset
