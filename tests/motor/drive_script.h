@@ -19,7 +19,7 @@ typedef struct {
   uint16_t limits, faults;
 } pour_drive_golden_t;
 
-static uint32_t pour_drive_script_rng(uint32_t *state) {
+static inline uint32_t pour_drive_script_rng(uint32_t *state) {
   *state ^= *state << 13;
   *state ^= *state >> 17;
   *state ^= *state << 5;
@@ -27,7 +27,7 @@ static uint32_t pour_drive_script_rng(uint32_t *state) {
 }
 
 /* Runs the script; row k of out gets period k's output. Returns 0, or −1 if the drive does not start. */
-static int pour_drive_script_run(pour_drive_golden_t out[POUR_DRIVE_SCRIPT_PERIODS]) {
+static inline int pour_drive_script_run(pour_drive_golden_t out[POUR_DRIVE_SCRIPT_PERIODS]) {
   static pour_drive_t drv;
   pour_drive_config_t config = pour_drive_default_config();
   config.phase_loss_ms = 1000; /* the synthetic currents do not follow the loop */

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include <string.h>
 
+#include "drive_script.h"
 #include "pour/drive.h"
 #include "unity.h"
 
@@ -205,12 +206,7 @@ static void test_drive_I2tBudgetTripsAtItsIntegral(void) {
 }
 
 static uint32_t rng = 12345u;
-static uint32_t next(void) {
-  rng ^= rng << 13;
-  rng ^= rng >> 17;
-  rng ^= rng << 5;
-  return rng;
-}
+static uint32_t next(void) { return pour_drive_script_rng(&rng); }
 
 static void test_drive_AnyInputGivesDutiesInRange(void) {
   for (int trial = 0; trial < 200; ++trial) {

@@ -39,34 +39,36 @@ def read_trace(path: Path, columns: tuple[str, str]) -> tuple[np.ndarray, np.nda
     return x, y
 
 
-def current_step(path: Path, out: Path) -> None:
-    t, iq = read_trace(path, ("t_s", "iq_a"))
-    ref = 10.0
+def _plot(x: np.ndarray, y: np.ndarray, label: str, lines: Sequence[tuple[float, str, str, str]], xlabel: str,
+          ylabel: str, title: str, legend: str, out: Path) -> None:
+    """One trace with horizontal reference lines (value, colour, style, label or "")."""
     fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
-    ax.plot(t * 1e3, iq, label="q current (motor model, FOC in fixed point)")
-    ax.axhline(ref, color="k", lw=0.8, ls="--", label="reference")
-    for f in (0.1, 0.9):
-        ax.axhline(f * ref, color="0.6", lw=0.6, ls=":")
-    ax.set_xlabel("time after the step [ms]")
-    ax.set_ylabel("i_q [A]")
-    ax.set_title("Current step, locked rotor (bandwidth 3000 rad/s, 20 kHz)")
-    ax.legend(loc="lower right")
+    ax.plot(x, y, lw=1.0, label=label)
+    for value, colour, style, text in lines:
+        ax.axhline(value, color=colour, lw=0.8, ls=style, label=text or None)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(loc=legend)
     ax.grid(alpha=0.3)
     _save(fig, out)
+
+
+def current_step(path: Path, out: Path, ref: float = 10.0) -> None:
+    t, iq = read_trace(path, ("t_s", "iq_a"))
+    _plot(t * 1e3, iq, "q current (motor model, FOC in fixed point)",
+          [(ref, "k", "--", "reference"), (0.1 * ref, "0.6", ":", ""), (0.9 * ref, "0.6", ":", "")],
+          "time after the step [ms]", "i_q [A]", "Current step, locked rotor (bandwidth 3000 rad/s, 20 kHz)",
+          "lower right", out)
 
 
 def bus_pour(path: Path, out: Path) -> None:
     t, v = read_trace(path, ("t_s", "vbus_v"))
-    fig, ax = plt.subplots(figsize=(7, 4), dpi=120)
-    ax.plot(t, v, lw=0.8, label="bus voltage, flux braking on (highest of each 1 ms)")
-    ax.axhline(BOARD_RATING_V, color="r", lw=0.8, ls="--", label=f"board rating {BOARD_RATING_V} V")
-    ax.axhline(OVERVOLTAGE_TRIP_V, color="k", lw=0.8, ls=":", label=f"overvoltage trip {OVERVOLTAGE_TRIP_V} V")
-    ax.set_xlabel("time [s] (pour 0-10 s, return to upright 10-13 s)")
-    ax.set_ylabel("V_bus [V]")
-    ax.set_title("DC bus through the shipped policy's pour (24 V supply, 200 uF)")
-    ax.legend(loc="lower left")
-    ax.grid(alpha=0.3)
-    _save(fig, out)
+    _plot(t, v, "bus voltage, flux braking on (highest of each 1 ms)",
+          [(BOARD_RATING_V, "r", "--", f"board rating {BOARD_RATING_V} V"),
+           (OVERVOLTAGE_TRIP_V, "k", ":", f"overvoltage trip {OVERVOLTAGE_TRIP_V} V")],
+          "time [s] (pour 0-10 s, return to upright 10-13 s)", "V_bus [V]",
+          "DC bus through the shipped policy's pour (24 V supply, 200 uF)", "lower left", out)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -6,17 +6,10 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "icount.h"
 #include "pour/drive.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define N_CALLS 20000u
-#define CAL_ITERATIONS 200000u
-
-static uint32_t now(void) { return SYST_CVR; } /* counts down */
-static uint32_t elapsed(uint32_t start, uint32_t end) { return (start - end) & 0x00FFFFFFu; }
-static void spin(uint32_t n) { __asm volatile("1: subs %0, %0, #1\n nop\n bne 1b\n" : "+r"(n) : : "cc"); }
 
 static uint32_t rng = 0x2545F491u;
 static uint32_t next(void) {
@@ -40,14 +33,8 @@ static void make_sample(pour_drive_sample_t *s) {
 }
 
 int main(void) {
-  SYST_CSR = 0u;
-  SYST_RVR = 0x00FFFFFFu;
-  SYST_CVR = 0u;
-  SYST_CSR = 0x5u;
-  uint32_t t0 = now();
-  spin(CAL_ITERATIONS);
-  const uint32_t cal = elapsed(t0, now());
-  const uint64_t insn_per_kilotick = (3000ull * CAL_ITERATIONS) / cal;
+  const uint64_t insn_per_kilotick = icount_start();
+  uint32_t t0;
 
   pour_drive_config_t config = pour_drive_default_config();
   config.phase_loss_ms = 1000; /* the synthetic currents do not follow the loop: keep it running */
