@@ -10,7 +10,7 @@ namespace poursim {
 namespace {
 constexpr double kTwoPi = 6.283185307179586;
 constexpr double kSqrt3 = 1.7320508075688772;
-constexpr int kSubsteps = 4; // 12.5 µs: L/R is 760 µs, and ωe·Lq·h < 0.01 up to the base speed
+constexpr int kSubsteps = 4; // 12.5 µs: L/R is 525 µs, and ωe·Lq·h/L < 0.02 up to the base speed
 // dead-time error: the sign of the current, ramped over this band so that a current near 0 does not chatter
 constexpr double kDeadtimeBand = 0.05; // [A]
 } // namespace
