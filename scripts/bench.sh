@@ -84,6 +84,57 @@ bench_core() {
   printf '   with the deepest stack of a step: %d B\n' $((core_ram + ${state:-0} + ${stack:-0}))
 }
 
+# --- section: motor — the drive's current loop on the emulated Cortex-M4, and the full drive in the simulator
+# Instructions per current-loop interrupt (pour_drive_isr, each call timed on its own; SysTick resolution
+# 40 instructions) and per drive tick under -icount shift=0; the worst-case stack of the interrupt over the
+# 1 kHz step from -fstack-usage; then bench_motor's figures (docs/motor.md).
+# Bars: interrupt <= 850 instructions worst; interrupt + 1 kHz step <= 1024 B of stack.
+bench_motor() {
+  local build=build/cortex-m4 log out
+  log=$(mktemp)
+  echo "== motor: the current loop on a Cortex-M4 (QEMU mps2-an386, -icount shift=0) =="
+  if ! { cmake --preset cortex-m4 && cmake --build --preset cortex-m4 -j2 --target pour_bench_drive pour_core; } >"$log" 2>&1; then
+    cat "$log"; rm -f "$log"; echo "error: the cortex-m4 build failed" >&2; return 1
+  fi
+  rm -f "$log"
+  if ! out=$(timeout 120 qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none \
+               -semihosting-config enable=on,target=native -icount shift=0 \
+               -kernel "$build/firmware/ports/cortex-m4/pour_bench_drive.elf" 2>&1); then
+    echo "$out"; echo "error: pour_bench_drive did not run to completion under QEMU" >&2; return 1
+  fi
+  echo "$out" | sed 's/^/   /'
+  local worst
+  worst=$(sed -nE 's/.*pour_drive_isr\): worst ([0-9]+) instructions.*/\1/p' <<<"$out")
+  # Stack: the exception frame (8 words, no FPU) + pour_drive_isr + its deepest callee, preempting the
+  # 1 kHz step at its deepest (pour_control_step + pour_policy_eval + deepest kernel, or pour_drive_tick +
+  # pour_drive_trip) and the exception frame of the 1 kHz interrupt.
+  local stack
+  stack=$(cat "$build"/firmware/motor/CMakeFiles/pour_motor.dir/src/*.su "$build"/firmware/CMakeFiles/pour_core.dir/src/*.su |
+    awk -F'\t' '{ split($1, a, ":"); f[a[4]] = $2 }
+      END { callee = 0
+            n = split("pour_current_sense_calibrate pour_current_sense_convert pour_foc_sincos_q15 pour_foc_clarke_q15 pour_foc_park_q15 pour_current_pi_step pour_foc_isqrt_u32 pour_foc_inv_park_q15 pour_foc_modulate_q15 pour_drive_trip", c, " ")
+            for (i = 1; i <= n; ++i) if (f[c[i]] > callee) callee = f[c[i]]
+            isr = 32 + f["pour_drive_isr"] + callee
+            k = f["pour_policy_logits"]; if (f["pour_policy_softmax_q15"] > k) k = f["pour_policy_softmax_q15"]
+            if (f["pour_policy_sample"] > k) k = f["pour_policy_sample"]
+            step = f["pour_control_step"] + f["pour_policy_eval"] + k
+            tick = f["pour_drive_tick"] + f["pour_drive_trip"]; if (tick > step) step = tick
+            printf "%d %d %d\n", isr, step + 32, isr + step + 32 }')
+  read -r isr_stack step_stack total_stack <<<"$stack"
+  printf '   stack: interrupt %s B (frame + pour_drive_isr + deepest callee), 1 kHz step %s B, both %s B\n' \
+    "$isr_stack" "$step_stack" "$total_stack"
+  verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
+  printf '   bars: interrupt worst %s instructions (bar 850: %s); stack %s B (bar 1024: %s)\n' \
+    "$worst" "$(verdict "${worst:-99999}" 850)" "$total_stack" "$(verdict "${total_stack:-99999}" 1024)"
+  echo "-- the full drive in the simulator (bench_motor; traces in build/host/bench/):"
+  if ! cmake --build --preset host -j2 --target bench_motor >/dev/null; then
+    echo "error: the host build failed" >&2; return 1
+  fi
+  mkdir -p build/host/bench
+  ./build/host/bin/bench_motor --step-csv build/host/bench/current_step.csv --bus-csv build/host/bench/pour_bus.csv |
+    sed 's/^/   /'
+}
+
 # --- section: lcm — host_sim and pour_controller as two processes over LCM (udpm, loopback) ------------
 # Lockstep: loop rate and round trip POUR_SENSORS -> POUR_TORQUE (median, p99) over 20,000 exchanges with
 # synthetic samples (the transport and the controller alone), then a 10 s pour (10,000 steps, Box2D
@@ -310,7 +361,7 @@ print("%d/%d lines (%.1f %%)" % (t["covered"], t["count"], t["percent"]))' || ec
   echo "   findings in all: $findings (inputs in build/host-fuzz/bench/<target>/)"
 }
 
-SECTIONS=(core lcm sim can weights fuzz)
+SECTIONS=(core motor lcm sim can weights fuzz)
 wanted=()
 for a in "$@"; do
   # `fuzz 600`: the number is the seconds each fuzz target runs.
@@ -320,7 +371,7 @@ for a in "$@"; do
     wanted+=("$a")
   fi
 done
-[ ${#wanted[@]} -gt 0 ] || wanted=(core lcm sim can weights) # fuzz only when asked: it runs for minutes
+[ ${#wanted[@]} -gt 0 ] || wanted=(core motor lcm sim can weights) # fuzz only when asked: it runs for minutes
 status=0
 for s in "${wanted[@]}"; do
   if [[ " ${SECTIONS[*]} " != *" $s "* ]]; then

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -404,6 +405,7 @@ int main(int argc, char **argv) {
     poursim::write_csv_header(csv);
   }
   Recorder first;
+  poursim_drive_telemetry_t drive_peak{}; // the full drive's worst over the episodes (drive = 1)
   for (int k = 0; k < o.episodes; ++k) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
     Recorder rec;
@@ -423,11 +425,22 @@ int main(int argc, char **argv) {
       return status;
     }
     eps.push_back(e);
+    poursim_drive_telemetry_t tel;
+    poursim_drive_telemetry(world, &tel);
+    drive_peak.peak_current = std::max(drive_peak.peak_current, tel.peak_current);
+    drive_peak.peak_vbus = std::max(drive_peak.peak_vbus, tel.peak_vbus);
+    drive_peak.min_vbus = k == 0 ? tel.min_vbus : std::min(drive_peak.min_vbus, tel.min_vbus);
+    drive_peak.faults |= tel.faults;
     if (!o.quiet) poursim::print_episode(per, k + 1, e);
     if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
     if (k == 0 && !o.render.empty()) first = std::move(rec);
   }
   poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps);
+  if (cfg.drive == 1)
+    std::fprintf(per, "drive (field-oriented, docs/motor.md): peak phase current %.1f A, peak bus %.2f V (lowest %.2f V), "
+                 "faults 0x%04x\n",
+                 drive_peak.peak_current, drive_peak.peak_vbus, drive_peak.min_vbus,
+                 static_cast<unsigned>(drive_peak.faults));
   if (lcm_ctl != nullptr) {
     lcm_ctl->link().drain(50);
     std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());

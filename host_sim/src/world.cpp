@@ -410,7 +410,7 @@ int poursim_reset(poursim_world_t *w, uint32_t seed) {
   w->ep = poursim::draw_episode_config(w->cfg, seed);
   build_scene(w, seed);
   const poursim_config_t &c = w->ep;
-  w->drive.reset(c);
+  w->drive.reset(c, seed);
   w->sensor_noise = poursim::Gauss(0x5E4507ULL ^ (static_cast<uint64_t>(seed) << 28));
   size_t n = w->circles.size();
   w->region.assign(n, 0);
@@ -444,6 +444,7 @@ int poursim_step(poursim_world_t *w, double action, poursim_obs_t *out) {
   // ~1e-4). Coulomb friction and the brake are the joint's motor.
   const double omega = -static_cast<double>(b2Body_GetAngularVelocity(w->bucket));
   const double tau_motor = w->drive.step(tau_cmd, omega);
+  if (w->drive.brake_requested()) w->brake = true; // a drive fault: the bucket ends held, never coasting
   set_joint_friction(w);
   b2Body_ApplyTorque(w->bucket, static_cast<float>(-(tau_motor - w->ep.friction_viscous * omega)), true);
   advance(w);
@@ -565,3 +566,13 @@ uint64_t poursim_trajectory_hash(const poursim_world_t *w) { return w ? w->hash 
 const char *poursim_version(void) { return "poursim 0.1.0 (Box2D 3.1)"; }
 
 } // extern "C"
+
+int poursim_drive_telemetry(const poursim_world_t *w, poursim_drive_telemetry_t *out) {
+  if (w == nullptr || out == nullptr) return POURSIM_EINVAL;
+  *out = poursim_drive_telemetry_t{};
+  if (const poursim::FocDrive *f = w->drive.foc()) {
+    const poursim::FocTelemetry &t = f->telemetry();
+    *out = {t.peak_current, t.peak_vbus, t.min_vbus, t.faults, t.limits};
+  }
+  return POURSIM_OK;
+}

@@ -62,6 +62,15 @@ typedef struct {
 
 typedef struct poursim_world poursim_world_t;
 
+/* What the full drive (config drive = 1) saw since the last reset; zeros with the ideal drive. */
+typedef struct {
+  double peak_current;  /* largest |phase current| [A] */
+  double peak_vbus;     /* highest bus voltage [V] */
+  double min_vbus;      /* lowest bus voltage [V] */
+  uint32_t faults;      /* the drive's latched faults (firmware/motor/include/pour/drive_faults.h) */
+  uint32_t limits;      /* every POUR_DRIVE_LIMIT_* flag raised (pour/drive.h) */
+} poursim_drive_telemetry_t;
+
 /* Defaults of the paper's scene (docs/simulator.md). */
 poursim_config_t poursim_default_config(void);
 
@@ -121,6 +130,9 @@ int poursim_set_brake(poursim_world_t *world, int engaged);
 /* One dt step with the bucket driven toward theta_ref [rad] by a stiff servo (the joint's motor) instead
  * of a torque: for measurements that need a prescribed tilt (retention curve, sloshing). */
 int poursim_step_servo(poursim_world_t *world, double theta_ref, poursim_obs_t *out);
+
+/* The full drive's peaks and faults since the last reset (docs/motor.md). */
+int poursim_drive_telemetry(const poursim_world_t *world, poursim_drive_telemetry_t *out);
 
 /* The reason of the last failed step, "" if none. */
 const char *poursim_world_error(const poursim_world_t *world);

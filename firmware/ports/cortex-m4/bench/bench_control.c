@@ -5,23 +5,11 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "icount.h"
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
 
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
 #define N_STEPS 2000u
-#define CAL_ITERATIONS 200000u
-
-static uint32_t now(void) { return SYST_CVR; } /* counts down */
-
-static uint32_t elapsed(uint32_t start, uint32_t end) { return (start - end) & 0x00FFFFFFu; }
-
-/* 3 instructions per iteration (subs, nop, bne), in assembly so the count does not depend on flags. */
-static void spin(uint32_t n) {
-  __asm volatile("1: subs %0, %0, #1\n nop\n bne 1b\n" : "+r"(n) : : "cc");
-}
 
 static pour_control_t ctl;
 static pour_control_input_t inputs[64];
@@ -176,18 +164,10 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
 }
 
 int main(void) {
-  SYST_CSR = 0u;
-  SYST_RVR = 0x00FFFFFFu;
-  SYST_CVR = 0u;
-  SYST_CSR = 0x5u; /* enable, core clock, no interrupt */
+  const uint32_t insn_per_kilotick = icount_start();
   make_inputs();
-
-  const uint32_t t0 = now();
-  spin(CAL_ITERATIONS);
-  const uint32_t cal = elapsed(t0, now());
-  const uint32_t insn_per_kilotick = (uint32_t)((3000ull * CAL_ITERATIONS) / cal);
-  printf("calibration: %u SysTick ticks for %u instructions (%u.%03u instructions/tick)\n", (unsigned)cal,
-          (unsigned)(3u * CAL_ITERATIONS), (unsigned)(insn_per_kilotick / 1000u), (unsigned)(insn_per_kilotick % 1000u));
+  printf("calibration: %u.%03u instructions/tick\n", (unsigned)(insn_per_kilotick / 1000u),
+         (unsigned)(insn_per_kilotick % 1000u));
 
   /* The compiled policy as shipped, then the worst case: a decision on every tick. */
   pour_policy_weights_t every_tick = pour_weights_compiled;

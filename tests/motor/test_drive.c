@@ -1,0 +1,256 @@
+/* SPDX-License-Identifier: MIT */
+#include <string.h>
+
+#include "drive_script.h"
+#include "pour/drive.h"
+#include "unity.h"
+
+static pour_drive_t drv;
+static pour_drive_config_t cfg;
+static pour_drive_output_t out;
+
+/* ADC counts of a phase current [mA] and of a bus voltage [mV] on the default board */
+static uint16_t adc_of_ma(int32_t ma) {
+  return (uint16_t)(2048 + (int64_t)ma * 3000 * 9140 * 4096 / 3300000000000LL);
+}
+static uint16_t adc_of_mv(int32_t mv) { return (uint16_t)((int64_t)mv * 4096 * 1000 / (3300LL * 19170)); }
+
+static pour_drive_sample_t sample(int32_t ia, int32_t ib, int32_t ic, int32_t vbus_mv, uint16_t enc) {
+  pour_drive_sample_t s;
+  s.adc_phase[0] = adc_of_ma(ia);
+  s.adc_phase[1] = adc_of_ma(ib);
+  s.adc_phase[2] = adc_of_ma(ic);
+  s.adc_vbus = adc_of_mv(vbus_mv);
+  s.encoder = enc;
+  return s;
+}
+
+static void run_calibration(void) {
+  const pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  for (int n = 0; n < POUR_CURRENT_SENSE_CAL_SAMPLES; ++n) pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+void setUp(void) {
+  cfg = pour_drive_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_drive_init(&drv, &cfg));
+}
+void tearDown(void) {}
+
+static void assert_held(uint16_t fault) {
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv.state);
+  TEST_ASSERT_TRUE((out.faults & fault) != 0u);
+  TEST_ASSERT_EQUAL_UINT8(1, out.brake);
+  for (int k = 0; k < 3; ++k) TEST_ASSERT_EQUAL_UINT16(0, out.compare[k]);
+}
+
+static void test_drive_DefaultConfigIsValid(void) { TEST_ASSERT_NULL(pour_drive_config_check(&cfg)); }
+
+static void test_drive_ConfigCheckNamesTheBadField(void) {
+  struct { const char *name; pour_drive_config_t c; } cases[8];
+  for (int k = 0; k < 8; ++k) cases[k].c = cfg;
+  cases[0].name = "bandwidth_rad_s"; cases[0].c.bandwidth_rad_s = 6284; /* above 2π·20 kHz/20 = 6283 */
+  cases[1].name = "pwm_hz"; cases[1].c.pwm_hz = 10000;                 /* audible */
+  cases[2].name = "r_phase_uohm"; cases[2].c.r_phase_uohm = 0;
+  cases[3].name = "ld_nh"; cases[3].c.ld_nh = 20000000;
+  cases[4].name = "pole_pairs"; cases[4].c.pole_pairs = 0;
+  cases[5].name = "overcurrent_ma"; cases[5].c.overcurrent_ma = cfg.current_limit_ma;
+  cases[6].name = "encoder_cpr"; cases[6].c.encoder_cpr = 4000;
+  cases[7].name = "regen_on_mv"; cases[7].c.regen_on_mv = cfg.vbus_ov_mv;
+  for (int k = 0; k < 8; ++k) {
+    TEST_ASSERT_EQUAL_STRING(cases[k].name, pour_drive_config_check(&cases[k].c));
+    TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_drive_init(&drv, &cases[k].c));
+  }
+  cfg.bandwidth_rad_s = 6283;
+  TEST_ASSERT_NULL(pour_drive_config_check(&cfg));
+}
+
+static void test_drive_CalibratesWithThePwmOff(void) {
+  const pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_UINT8(0, out.pwm_enable);
+  TEST_ASSERT_EQUAL_UINT8(1, out.brake);
+  run_calibration();
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_UINT8(1, out.pwm_enable);
+  TEST_ASSERT_EQUAL_UINT16(0, out.faults);
+}
+
+static void test_drive_BrokenAmplifierLatchesTheOffsetFault(void) {
+  pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  s.adc_phase[1] = 2600;
+  for (int n = 0; n < POUR_CURRENT_SENSE_CAL_SAMPLES; ++n) pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, out.faults);
+  TEST_ASSERT_EQUAL_UINT8(0, out.pwm_enable); /* currents unknown: the bridge stays off, the brake holds */
+  TEST_ASSERT_EQUAL_UINT8(1, out.brake);
+  pour_drive_tick(&drv, 5000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_UINT8(0, out.pwm_enable);
+}
+
+static void test_drive_TorqueBecomesTheQCurrent(void) {
+  run_calibration();
+  pour_drive_tick(&drv, 20000, 0); /* 20 N·m / (20 · 0.9 · 0.0404 N·m/A) = 27.50 A */
+  TEST_ASSERT_INT_WITHIN(3, 27503 * 32768 / 64000, drv.iq_cmd_q15);
+  pour_drive_tick(&drv, 20000, -5); /* braking: the gearbox's loss helps, η² less current */
+  TEST_ASSERT_INT_WITHIN(3, 27503 * 81 / 100 * 32768 / 64000, drv.iq_cmd_q15);
+  pour_drive_tick(&drv, -40000, 0); /* beyond the 36 A limit */
+  TEST_ASSERT_EQUAL_INT32(-36000 * 32768 / 64000, drv.iq_cmd_q15);
+  const pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_INT16(-18432, out.iq_ref);
+}
+
+static void test_drive_OvercurrentTripsToShortedPhasesAndTheBrake(void) {
+  run_calibration();
+  const pour_drive_sample_t s = sample(46000, -23000, -23000, 24000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  assert_held(POUR_DRIVE_FAULT_OVERCURRENT);
+  TEST_ASSERT_EQUAL_UINT8(1, out.pwm_enable); /* low sides on: the windings shorted */
+}
+
+static void test_drive_BusOutOfRangeTrips(void) {
+  run_calibration();
+  pour_drive_sample_t s = sample(0, 0, 0, 30500, 0);
+  pour_drive_isr(&drv, &s, &out);
+  assert_held(POUR_DRIVE_FAULT_OVERVOLTAGE);
+  setUp();
+  run_calibration();
+  s = sample(0, 0, 0, 9000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  assert_held(POUR_DRIVE_FAULT_UNDERVOLTAGE);
+}
+
+static void test_drive_FluxBrakingStartsAboveRegenOn(void) {
+  run_calibration();
+  pour_drive_sample_t s = sample(0, 0, 0, 24400, 0);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_INT16(0, out.id_ref);
+  s = sample(0, 0, 0, 25100, 0);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_TRUE((out.limits & POUR_DRIVE_LIMIT_FLUX_BRAKE) != 0u);
+  TEST_ASSERT_INT_WITHIN(400, 20000 * 32768 / 64000, out.id_ref); /* the ADC's 15 mV steps */
+  cfg.regen_enabled = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_drive_init(&drv, &cfg));
+  run_calibration();
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_INT16(0, out.id_ref);
+}
+
+static void test_drive_CurrentsNotSummingToZeroTripThePhaseFault(void) {
+  run_calibration();
+  const pour_drive_sample_t s = sample(5000, 0, 0, 24000, 0); /* 5 A leaves through no other phase */
+  pour_drive_isr(&drv, &s, &out);
+  assert_held(POUR_DRIVE_FAULT_PHASE);
+}
+
+static void test_drive_OpenPhaseTripsWhenTheLoopCannotFollow(void) {
+  /* the references ask for 10 A while the phases carry nothing: the loop saturates, then trips after
+   * phase_loss_ms */
+  run_calibration();
+  pour_drive_tick(&drv, 7000, 0);
+  const pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  uint32_t n = 0;
+  while (drv.state == POUR_DRIVE_RUN && n < 20000u) {
+    pour_drive_isr(&drv, &s, &out);
+    ++n;
+  }
+  assert_held(POUR_DRIVE_FAULT_PHASE);
+  TEST_ASSERT_TRUE(n > 20u * 20u);    /* not before the loop had its 20 ms */
+  TEST_ASSERT_TRUE(n < 20u * 20u + 400u); /* saturating takes a few ms at this bandwidth */
+}
+
+static void test_drive_EncoderCountingTheWrongWayTrips(void) {
+  run_calibration();
+  /* the output turns +25 mrad; the motor should have turned +325 counts, its encoder went −325 */
+  uint16_t enc = 0;
+  for (int k = 0; k < 25; ++k) {
+    for (int p = 0; p < 20; ++p) {
+      enc = (uint16_t)((enc - (p % 3 == 0 ? 1u : 0u)) & 4095u);
+      const pour_drive_sample_t s = sample(0, 0, 0, 24000, enc);
+      pour_drive_isr(&drv, &s, &out);
+    }
+    pour_drive_tick(&drv, 0, 1000);
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv.state);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_ENCODER_DIRECTION, drv.faults);
+}
+
+static void test_drive_EncoderCountingTheRightWayPasses(void) {
+  run_calibration();
+  uint16_t enc = 0;
+  for (int k = 0; k < 50; ++k) {
+    for (int p = 0; p < 20; ++p) {
+      enc = (uint16_t)((enc + (p % 3 == 0 ? 1u : 0u)) & 4095u);
+      const pour_drive_sample_t s = sample(0, 0, 0, 24000, enc);
+      pour_drive_isr(&drv, &s, &out);
+    }
+    pour_drive_tick(&drv, 0, 1000);
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+static void test_drive_I2tBudgetTripsAtItsIntegral(void) {
+  /* 30 A measured on q (angle 0: q along β): (900 − 3.29²) A² over 466 A²·s trips after 0.524 s */
+  run_calibration();
+  const int32_t ib = 30000 * 866 / 1000;
+  const pour_drive_sample_t s = sample(0, ib, -ib, 24000, 0);
+  int ms = 0;
+  while (drv.state == POUR_DRIVE_RUN && ms < 6000) {
+    for (int p = 0; p < 20; ++p) pour_drive_isr(&drv, &s, &out);
+    pour_drive_tick(&drv, 20000, 0);
+    ++ms;
+  }
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_I2T, drv.faults);
+  TEST_ASSERT_INT_WITHIN(10, 524, ms);
+}
+
+static uint32_t rng = 12345u;
+static uint32_t next(void) { return pour_drive_script_rng(&rng); }
+
+static void test_drive_AnyInputGivesDutiesInRange(void) {
+  for (int trial = 0; trial < 200; ++trial) {
+    setUp();
+    run_calibration();
+    for (int k = 0; k < 200 && drv.state == POUR_DRIVE_RUN; ++k) {
+      pour_drive_sample_t s;
+      for (int p = 0; p < 3; ++p) s.adc_phase[p] = (uint16_t)(next() & 4095u);
+      s.adc_vbus = (uint16_t)(next() & 4095u);
+      s.encoder = (uint16_t)(next() & 4095u);
+      if (k % 20 == 0) pour_drive_tick(&drv, (int32_t)(next() % 80001u) - 40000, 0);
+      pour_drive_isr(&drv, &s, &out);
+      for (int p = 0; p < 3; ++p) {
+        TEST_ASSERT_TRUE(out.compare[p] <= drv.period);
+        TEST_ASSERT_TRUE(out.duty[p] >= 0 && out.duty[p] <= POUR_FOC_DUTY_ONE);
+      }
+    }
+  }
+}
+
+static void test_drive_TripFromOutsideLatches(void) {
+  run_calibration();
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_HW_OVERCURRENT);
+  const pour_drive_sample_t s = sample(0, 0, 0, 24000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  assert_held(POUR_DRIVE_FAULT_HW_OVERCURRENT);
+}
+
+int main(void) {
+  UNITY_BEGIN();
+  RUN_TEST(test_drive_DefaultConfigIsValid);
+  RUN_TEST(test_drive_ConfigCheckNamesTheBadField);
+  RUN_TEST(test_drive_CalibratesWithThePwmOff);
+  RUN_TEST(test_drive_BrokenAmplifierLatchesTheOffsetFault);
+  RUN_TEST(test_drive_TorqueBecomesTheQCurrent);
+  RUN_TEST(test_drive_OvercurrentTripsToShortedPhasesAndTheBrake);
+  RUN_TEST(test_drive_BusOutOfRangeTrips);
+  RUN_TEST(test_drive_FluxBrakingStartsAboveRegenOn);
+  RUN_TEST(test_drive_CurrentsNotSummingToZeroTripThePhaseFault);
+  RUN_TEST(test_drive_OpenPhaseTripsWhenTheLoopCannotFollow);
+  RUN_TEST(test_drive_EncoderCountingTheWrongWayTrips);
+  RUN_TEST(test_drive_EncoderCountingTheRightWayPasses);
+  RUN_TEST(test_drive_I2tBudgetTripsAtItsIntegral);
+  RUN_TEST(test_drive_AnyInputGivesDutiesInRange);
+  RUN_TEST(test_drive_TripFromOutsideLatches);
+  return UNITY_END();
+}
