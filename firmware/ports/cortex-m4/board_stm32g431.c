@@ -1,10 +1,16 @@
 /* SPDX-License-Identifier: MIT */
-/* The STM32G431 board: core clock (PLL, 170 MHz), the brake, power and e-stop lines, the independent
- * watchdog, and FDCAN1 behind hal_can. Registers and fields from stm32g431_regs.h's table (checked against
- * ST's description of the chip by tests/board/check_registers.py).
- *   PB0  e-stop input, active low, pull-up (an open circuit asserts it)
- *   PB1  brake release, high = released (reset state low: engaged)
- *   PB2  power stage enable, high = on (reset state low: off) */
+/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring, and which pin was checked against what): core
+ * clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent watchdog, the LED, and
+ * FDCAN1 behind hal_can. Registers and fields from stm32g431_regs.h's table (checked against ST's
+ * description of the chip by tests/board/check_registers.py).
+ *   PA15  e-stop input (the board's PWM-input pad): a normally-closed chain from 3.3 V holds it high;
+ *         pull-down, so an open contact or a broken wire reads low = asserted
+ *   PB12  brake release (the potentiometer pad), high = released; an external pull-down keeps the brake
+ *         engaged through reset and while the MCU is unpowered
+ *   PB8   power stage enable (J8's index pin, unused: the output encoder gives the absolute angle), high =
+ *         on; external pull-down (it also holds BOOT0 low: boot from flash)
+ *   PA11, PB9  FDCAN1 RX, TX (AF9); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
+ *   PC6   LED (red), high = on */
 #include <stddef.h>
 
 #include "clock.h"
@@ -20,19 +26,21 @@
 #include "stm32g431_regs.h"
 
 #define RCC_R POUR_PERIPH(RCC)
-#define PIN_ESTOP 0u
-#define PIN_BRAKE 1u
-#define PIN_POWER 2u
-#define PIN_CAN_RX 11u
-#define PIN_CAN_TX 12u
+#define GPIOA_R POUR_PERIPH(GPIOA)
+#define GPIOB_R POUR_PERIPH(GPIOB)
+#define GPIOC_R POUR_PERIPH(GPIOC)
 #define AF_FDCAN1 9u
-#define HSI16_HZ 16000000u
-#define PLL_HZ 170000000u
+#define CAN_TERMINATED true /* this node ends the bench's bus (the rig's sensor node is the other end) */
 #define WAIT_POLLS 100000u /* bound of every ready-flag wait: a flag that never comes is an error */
 
-static const pour_gpio_t estop = {POUR_PERIPH(GPIOB), PIN_ESTOP};
-static const pour_gpio_t brake = {POUR_PERIPH(GPIOB), PIN_BRAKE};
-static const pour_gpio_t power = {POUR_PERIPH(GPIOB), PIN_POWER};
+static const pour_gpio_t estop = {GPIOA_R, 15u};
+static const pour_gpio_t brake = {GPIOB_R, 12u};
+static const pour_gpio_t power = {GPIOB_R, 8u};
+static const pour_gpio_t led = {GPIOC_R, 6u};
+static const pour_gpio_t can_rx = {GPIOA_R, 11u};
+static const pour_gpio_t can_tx = {GPIOB_R, 9u};
+static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
+static const pour_gpio_t can_termination = {GPIOC_R, 14u};
 
 static int wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t want) {
   for (uint32_t i = 0; i < WAIT_POLLS; ++i) {
@@ -48,40 +56,15 @@ static void clock_on(uint32_t enr, uint32_t mask) {
   (void)RCC_R[enr]; /* the enable takes effect before the peripheral is touched */
 }
 
+static pour_clock_source_t clock_source = POUR_CLOCK_HSI16;
+
 pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
-  volatile uint32_t *const pwr = POUR_PERIPH(PWR);
-  volatile uint32_t *const flash = POUR_PERIPH(FLASH);
-  const uint32_t hpre = POUR_MSK(RCC, CFGR, HPRE);
-  *core_clock_hz = HSI16_HZ;
-  clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, PWREN));
-  RCC_R[POUR_RCC_CFGR] = (RCC_R[POUR_RCC_CFGR] & ~hpre) | POUR_VAL(RCC, CFGR, HPRE, 8u); /* /2 entering boost */
-  pwr[POUR_PWR_CR5] &= ~POUR_MSK(PWR, CR5, R1MODE); /* range 1 boost, up to 170 MHz */
-  flash[POUR_FLASH_ACR] = (flash[POUR_FLASH_ACR] & ~POUR_MSK(FLASH, ACR, LATENCY)) | POUR_VAL(FLASH, ACR, LATENCY, 4u) |
-                          POUR_MSK(FLASH, ACR, PRFTEN) | POUR_MSK(FLASH, ACR, ICEN) | POUR_MSK(FLASH, ACR, DCEN);
-  if (wait_set(&flash[POUR_FLASH_ACR], POUR_MSK(FLASH, ACR, LATENCY), POUR_VAL(FLASH, ACR, LATENCY, 4u)) != 0) {
-    return POUR_EINVAL;
-  }
-  /* HSI16 / M 4 * N 85 = 340 MHz VCO, / R 2 = 170 MHz. */
-  RCC_R[POUR_RCC_PLLCFGR] = POUR_VAL(RCC, PLLCFGR, PLLSRC, 2u) | POUR_VAL(RCC, PLLCFGR, PLLM, 4u - 1u) |
-                          POUR_VAL(RCC, PLLCFGR, PLLN, 85u) | POUR_MSK(RCC, PLLCFGR, PLLREN) |
-                          POUR_VAL(RCC, PLLCFGR, PLLR, 0u);
-  RCC_R[POUR_RCC_CR] |= POUR_MSK(RCC, CR, PLLON);
-  if (wait_set(&RCC_R[POUR_RCC_CR], POUR_MSK(RCC, CR, PLLRDY), POUR_MSK(RCC, CR, PLLRDY)) != 0) {
-    RCC_R[POUR_RCC_CFGR] &= ~hpre;
-    return POUR_EINVAL;
-  }
-  RCC_R[POUR_RCC_CFGR] = (RCC_R[POUR_RCC_CFGR] & ~POUR_MSK(RCC, CFGR, SW)) | POUR_VAL(RCC, CFGR, SW, 3u); /* PLL */
-  if (wait_set(&RCC_R[POUR_RCC_CFGR], POUR_MSK(RCC, CFGR, SWS), POUR_VAL(RCC, CFGR, SWS, 3u)) != 0) {
-    RCC_R[POUR_RCC_CFGR] &= ~hpre;
-    return POUR_EINVAL;
-  }
-  for (volatile uint32_t i = 0; i < 200u; ++i) { /* >= 1 µs at 85 MHz before HPRE /1 */
-  }
-  /* HPRE, PPRE1, PPRE2 /1: 170 MHz everywhere. */
-  RCC_R[POUR_RCC_CFGR] &= ~(hpre | POUR_MSK(RCC, CFGR, PPRE1) | POUR_MSK(RCC, CFGR, PPRE2));
-  *core_clock_hz = PLL_HZ;
-  return POUR_OK;
+  const pour_clock_hw_t hw = {POUR_PERIPH(RCC), POUR_PERIPH(PWR), POUR_PERIPH(FLASH)};
+  const pour_clock_config_t config = pour_clock_default_config();
+  return pour_clock_setup(&hw, &config, core_clock_hz, &clock_source);
 }
+
+pour_clock_source_t pour_clock_source(void) { return clock_source; }
 
 static void ports_on(void) {
   clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, GPIOAEN) | POUR_MSK(RCC, AHB2ENR, GPIOBEN) |
@@ -108,7 +91,8 @@ bool pour_hal_power_on(void) { return pour_gpio_driven(power); }
 
 void pour_hal_estop_init(void) {
   ports_on();
-  pour_gpio_input(estop, POUR_GPIO_PULL_UP);
+  pour_gpio_output(led, false);
+  pour_gpio_input(estop, POUR_GPIO_PULL_DOWN);
 }
 
 bool pour_hal_estop_asserted(void) { return !pour_gpio_read(estop); }
@@ -140,10 +124,10 @@ pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
   RCC_R[POUR_RCC_CCIPR] = (RCC_R[POUR_RCC_CCIPR] & ~POUR_MSK(RCC, CCIPR, FDCANSEL)) | POUR_VAL(RCC, CCIPR, FDCANSEL, 2u);
   clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, FDCANEN));
   ports_on();
-  const pour_gpio_t rx = {POUR_PERIPH(GPIOA), PIN_CAN_RX};
-  const pour_gpio_t tx = {POUR_PERIPH(GPIOA), PIN_CAN_TX};
-  pour_gpio_alternate(rx, AF_FDCAN1);
-  pour_gpio_alternate(tx, AF_FDCAN1);
+  pour_gpio_alternate(can_rx, AF_FDCAN1);
+  pour_gpio_alternate(can_tx, AF_FDCAN1);
+  pour_gpio_output(can_termination, CAN_TERMINATED);
+  pour_gpio_output(can_shutdown, false);
   pour_fdcan_config_t fc = pour_fdcan_default_config();
   fc.kernel_clock_hz = clock_hz;
   fc.node_id = node_id;
