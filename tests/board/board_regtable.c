@@ -3,7 +3,12 @@
  * tests/board/check_registers.py compares with ST's description of the chip. */
 #include <stdio.h>
 
+#include "adc_inj.h"
+#include "encoder_tim4.h"
 #include "fdcan.h"
+#include "ocp.h"
+#include "opamp.h"
+#include "pwm_tim1.h"
 #include "stm32g431_regs.h"
 
 #define PRINT_PERIPH(inst, block, base) printf("PERIPH %s %s 0x%08lx\n", #inst, #block, (unsigned long)(base));
@@ -15,5 +20,10 @@
 int main(void) {
   PRINT_TABLE(CHIP)
   PRINT_TABLE(FDCAN)
+  PRINT_TABLE(TIM1)
+  PRINT_TABLE(ADC)
+  PRINT_TABLE(OPAMP)
+  PRINT_TABLE(OCP)
+  PRINT_TABLE(TIM4)
   return 0;
 }
