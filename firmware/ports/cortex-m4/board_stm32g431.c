@@ -13,9 +13,15 @@
  *   PC6   LED (red), high = on */
 #include <stddef.h>
 
+#include "adc_inj.h"
 #include "clock.h"
+#include "encoder_tim4.h"
 #include "fdcan.h"
 #include "gpio.h"
+#include "hal_drive.h"
+#include "ocp.h"
+#include "opamp.h"
+#include "pwm_tim1.h"
 #include "hal_brake.h"
 #include "hal_can.h"
 #include "hal_estop.h"
@@ -41,6 +47,10 @@ static const pour_gpio_t can_rx = {GPIOA_R, 11u};
 static const pour_gpio_t can_tx = {GPIOB_R, 9u};
 static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
 static const pour_gpio_t can_termination = {GPIOC_R, 14u};
+
+static pour_pwm_t pwm;
+static pour_adc_t adc;
+static pour_ocp_t ocp;
 
 static int wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t want) {
   for (uint32_t i = 0; i < WAIT_POLLS; ++i) {
@@ -115,6 +125,7 @@ void pour_hal_watchdog_feed(void) { POUR_PERIPH(IWDG)[POUR_IWDG_KR] = 0xAAAAu; }
 void pour_safe_outputs(void) {
   pour_gpio_write(brake, false);
   pour_gpio_write(power, false);
+  pour_hal_drive_short_low_sides(); /* damping, never coasting, until the brake holds */
   pour_hal_motor_set_torque(0);
 }
 
@@ -139,3 +150,85 @@ void pour_hal_can_poll(void) { (void)pour_fdcan_poll(&fdcan); }
 int pour_hal_can_receive(pour_can_frame_t *frame) { return pour_fdcan_receive(&fdcan, frame); }
 
 int pour_hal_can_transmit(const pour_can_frame_t *frame) { return pour_fdcan_transmit(&fdcan, frame); }
+
+/* The motor's power stage (hal_drive). Alternate functions from the STM32G431's datasheet (DS12589, table
+ * "alternate functions"): TIM1 CH1..3 on PA8..PA10 AF6, CH1N on PC13 AF4, CH2N on PA12 AF6, CH3N on PB15
+ * AF4; TIM4 CH1, CH2 on PB6, PB7 AF2. */
+static const struct {
+  pour_gpio_t pin;
+  uint8_t af;
+} gates[6] = {{{GPIOA_R, 8u}, 6u},  {{GPIOA_R, 9u}, 6u},  {{GPIOA_R, 10u}, 6u},
+              {{GPIOC_R, 13u}, 4u}, {{GPIOA_R, 12u}, 6u}, {{GPIOB_R, 15u}, 4u}};
+/* OPAMP inputs and outputs, the bus divider, the NTC: PA0..PA3, PA5..PA7, PB0..PB2, PB14. */
+static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R, 2u}, {GPIOA_R, 3u},
+                                          {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
+                                          {GPIOB_R, 1u}, {GPIOB_R, 2u}, {GPIOB_R, 14u}};
+#define ENCODER_FILTER 6u   /* f_DTS / 4, N = 6: 141 ns at 170 MHz */
+#define OPAMP_GAIN 16u
+#define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
+
+
+pour_status_t pour_hal_drive_init(void) {
+  for (unsigned i = 0; i < 6u; ++i) {
+    pour_gpio_output(gates[i].pin, false); /* all six off while TIM1 is set up */
+  }
+  clock_on(POUR_RCC_APB2ENR, POUR_MSK(RCC, APB2ENR, TIM1EN) | POUR_MSK(RCC, APB2ENR, SYSCFGEN));
+  clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, TIM4EN));
+  clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, ADC12EN) | POUR_MSK(RCC, AHB2ENR, DAC3EN));
+  for (unsigned i = 0; i < sizeof analog_pins / sizeof analog_pins[0]; ++i) {
+    pour_gpio_analog(analog_pins[i]);
+  }
+  const pour_pwm_config_t pc = pour_pwm_default_config();
+  if (pour_pwm_init(&pwm, POUR_PERIPH(TIM1), &pc) != POUR_OK) {
+    return POUR_EINVAL;
+  }
+  for (unsigned i = 0; i < 6u; ++i) {
+    pour_gpio_alternate(gates[i].pin, gates[i].af); /* the timer, all six off, takes the pins */
+  }
+  const pour_gpio_t enc_a = {GPIOB_R, 6u};
+  const pour_gpio_t enc_b = {GPIOB_R, 7u};
+  pour_gpio_alternate(enc_a, 2u);
+  pour_gpio_alternate(enc_b, 2u);
+  if (pour_opamp_init(POUR_PERIPH(OPAMP), OPAMP_GAIN) != POUR_OK ||
+      pour_encoder_init(POUR_PERIPH(TIM4), ENCODER_FILTER, 0) != POUR_OK ||
+      pour_adc_init(&adc, POUR_PERIPH(ADC1), POUR_PERIPH(ADC2), POUR_PERIPH(ADC12_COMMON), WAIT_POLLS,
+                    ADC_REGULATOR_WAIT) != POUR_OK) {
+    return POUR_EINVAL;
+  }
+  return POUR_OK;
+}
+
+uint16_t pour_hal_drive_period(void) { return pwm.period; }
+
+bool pour_hal_drive_sample(pour_hal_drive_sample_t *sample) {
+  pour_adc_sample_t s;
+  if (adc.adc1 == NULL || !pour_adc_read(&adc, &s)) {
+    return false;
+  }
+  for (unsigned i = 0; i < 3u; ++i) {
+    sample->phase[i] = s.phase[i];
+  }
+  sample->vbus = s.vbus;
+  sample->ntc = s.ntc;
+  sample->encoder = pour_encoder_count(POUR_PERIPH(TIM4));
+  return true;
+}
+
+void pour_hal_drive_set_compares(const uint16_t compare[3]) { pour_pwm_set_compares(&pwm, compare); }
+
+void pour_hal_drive_enable(bool on) { pour_pwm_enable(&pwm, on); }
+
+void pour_hal_drive_short_low_sides(void) {
+  if (pwm.regs != NULL) {
+    pour_pwm_short_low_sides(&pwm);
+  }
+}
+
+pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
+  const pour_ocp_config_t oc = pour_ocp_default_config();
+  return pour_ocp_init(&ocp, POUR_PERIPH(COMP), POUR_PERIPH(DAC3), &oc, offset_counts);
+}
+
+bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
+
+void pour_hal_drive_clear_overcurrent(void) { pour_pwm_clear_break(&pwm); }

@@ -60,8 +60,13 @@
   F(RCC, AHB2ENR, GPIOAEN, 0, 1)                                                                               \
   F(RCC, AHB2ENR, GPIOBEN, 1, 1)                                                                               \
   F(RCC, AHB2ENR, GPIOCEN, 2, 1)                                                                               \
+  F(RCC, AHB2ENR, ADC12EN, 13, 1)                                                                              \
+  F(RCC, AHB2ENR, DAC3EN, 18, 1)                                                                               \
+  F(RCC, APB1ENR1, TIM4EN, 2, 1)                                                                               \
   F(RCC, APB1ENR1, FDCANEN, 25, 1)                                                                             \
   F(RCC, APB1ENR1, PWREN, 28, 1)                                                                               \
+  F(RCC, APB2ENR, SYSCFGEN, 0, 1)                                                                              \
+  F(RCC, APB2ENR, TIM1EN, 11, 1)                                                                               \
   F(RCC, CCIPR, FDCANSEL, 24, 2)                                                                               \
   F(PWR, CR5, R1MODE, 8, 1)                                                                                    \
   F(FLASH, ACR, LATENCY, 0, 4)                                                                                 \
