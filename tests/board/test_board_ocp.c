@@ -20,16 +20,16 @@ void tearDown(void) {}
 
 static void test_ocp_threshold_code_IsBiasPlusTripCurrentTimesShunt(void) {
   const pour_ocp_config_t c = pour_ocp_default_config();
-  /* bias 2048 / 16 = 128 counts; 30 A x 3 mΩ = 90 mV = 111.7 counts of 3.3 V */
-  TEST_ASSERT_EQUAL_UINT16(240u, pour_ocp_threshold_code(&c, 2048u));
-  TEST_ASSERT_EQUAL_UINT16(112u, pour_ocp_threshold_code(&c, 0u));
+  /* bias 2048 / 9.14 = 224.1 counts; 40 A x 3 mΩ = 120 mV = 148.9 counts of 3.3 V */
+  TEST_ASSERT_EQUAL_UINT16(373u, pour_ocp_threshold_code(&c, 2048u));
+  TEST_ASSERT_EQUAL_UINT16(149u, pour_ocp_threshold_code(&c, 0u));
 }
 
 static void test_ocp_init_ArmsTheComparatorsOnDac3(void) {
   const pour_ocp_config_t c = pour_ocp_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_ocp_init(&ocp, comp, dac, &c, offsets));
   TEST_ASSERT_EQUAL_HEX32(3u | (3u << 16), dac[POUR_DAC_MCR]); /* internal, no buffer */
-  TEST_ASSERT_EQUAL_HEX32(240u, dac[POUR_DAC_DHR12R1]);
+  TEST_ASSERT_EQUAL_HEX32(373u, dac[POUR_DAC_DHR12R1]);
   TEST_ASSERT_EQUAL_HEX32(pour_ocp_threshold_code(&c, 2080u), dac[POUR_DAC_DHR12R2]); /* V and W: the larger */
   TEST_ASSERT_EQUAL_HEX32(1u | (1u << 16), dac[POUR_DAC_CR]);
   const uint32_t csr = 1u | (4u << 4) | (1u << 16); /* EN, INM DAC3, INP pin 0, 10 mV hysteresis */
@@ -50,7 +50,7 @@ static void test_ocp_init_RefusesAnUnreadyDacOrAnUnreachableTrip(void) {
   c.trip_ma = 1200000u; /* 3.6 V across the shunt: beyond the DAC's 3.3 V */
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_ocp_init(&ocp, comp, dac, &c, offsets));
   c = pour_ocp_default_config();
-  c.amp_gain = 0u;
+  c.amp_gain_milli = 0u;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_ocp_init(&ocp, comp, dac, &c, offsets));
 }
 

@@ -23,10 +23,15 @@ static void test_opamp_init_SetsAllThreeAsPgasOfTheGain(void) {
   TEST_ASSERT_EQUAL_HEX32(5u << 14, regs[POUR_OPAMP_OPAMP3_CSR] & (0x1Fu << 14));
 }
 
+static void test_opamp_init_GainZeroUsesTheBoardsNetwork(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, 0u));
+  TEST_ASSERT_EQUAL_HEX32(1u | (1u << 7), regs[POUR_OPAMP_OPAMP2_CSR]); /* OPAEN, VM_SEL VINM0, OPAHSM */
+}
+
 static void test_opamp_init_RefusesAGainItCannotSet(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(regs, 10u));
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(regs, 128u));
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(regs, 0u));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(regs, 1u));
   TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_OPAMP_OPAMP1_CSR]); /* nothing enabled */
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(NULL, 16u));
 }
@@ -34,6 +39,7 @@ static void test_opamp_init_RefusesAGainItCannotSet(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_opamp_init_SetsAllThreeAsPgasOfTheGain);
+  RUN_TEST(test_opamp_init_GainZeroUsesTheBoardsNetwork);
   RUN_TEST(test_opamp_init_RefusesAGainItCannotSet);
   return UNITY_END();
 }

@@ -39,8 +39,8 @@ static void test_pwm_init_IsCentreAlignedComplementaryWithTheTriggerAtTheTop(voi
   TEST_ASSERT_EQUAL_HEX32((7u << 20) | (1u << 9) | (1u << 11) | (1u << 13), regs[POUR_TIM1_CR2]);
   TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_TIM1_CCER]); /* all six off */
   TEST_ASSERT_EQUAL_HEX32((1u << 1) | (1u << 2) | (1u << 4), regs[POUR_TIM1_AF1]); /* COMP1, 2, 4 */
-  /* DTG 85, OSSI, OSSR, BKE, BKP, no AOE, MOE, BKF 2 */
-  TEST_ASSERT_EQUAL_HEX32(85u | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 13) | (1u << 15) | (2u << 16),
+  /* DTG 800 ns = 136 clocks = (64 + 4) x 2, OSSI, OSSR, BKE, BKP, no AOE, MOE, BKF 2 */
+  TEST_ASSERT_EQUAL_HEX32((0x80u | 4u) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 13) | (1u << 15) | (2u << 16),
                           regs[POUR_TIM1_BDTR]);
   TEST_ASSERT_FALSE(pour_pwm_enabled(&pwm));
 }

@@ -164,7 +164,7 @@ static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R
                                           {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
                                           {GPIOB_R, 1u}, {GPIOB_R, 2u}, {GPIOB_R, 14u}};
 #define ENCODER_FILTER 6u   /* f_DTS / 4, N = 6: 141 ns at 170 MHz */
-#define OPAMP_GAIN 16u
+#define OPAMP_GAIN 0u /* the board's feedback network (opamp.h) */
 #define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
 
 

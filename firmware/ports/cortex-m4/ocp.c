@@ -11,8 +11,8 @@ pour_ocp_config_t pour_ocp_default_config(void) {
   pour_ocp_config_t c;
   c.vref_mv = 3300u;
   c.shunt_uohm = 3000u;
-  c.amp_gain = 16u;
-  c.trip_ma = 30000u;
+  c.amp_gain_milli = 9140u;
+  c.trip_ma = 40000u;
   c.ready_polls = 10000u;
   return c;
 }
@@ -20,7 +20,7 @@ pour_ocp_config_t pour_ocp_default_config(void) {
 uint16_t pour_ocp_threshold_code(const pour_ocp_config_t *config, uint16_t offset_counts) {
   /* The comparator sees the op-amp's input: the bias (the ADC's offset / gain) plus I x R. Both in
    * 1/4096 of vref: bias = offset / gain; trip = I[mA] x R[µΩ] / 1e9 V x 4096 / vref. */
-  const uint64_t bias = (uint64_t)offset_counts * 1000u / config->amp_gain; /* counts x 1000 */
+  const uint64_t bias = (uint64_t)offset_counts * 1000000u / config->amp_gain_milli; /* counts x 1000 */
   const uint64_t trip = (uint64_t)config->trip_ma * config->shunt_uohm * 4096u / config->vref_mv / 1000u; /* x 1000 */
   const uint64_t code = (bias + trip + 500u) / 1000u;
   return code > 4095u ? 4096u : (uint16_t)code;
@@ -29,7 +29,7 @@ uint16_t pour_ocp_threshold_code(const pour_ocp_config_t *config, uint16_t offse
 pour_status_t pour_ocp_init(pour_ocp_t *ocp, volatile uint32_t *comp, volatile uint32_t *dac,
                             const pour_ocp_config_t *config, const uint16_t offset_counts[3]) {
   if (ocp == NULL || comp == NULL || dac == NULL || config == NULL || offset_counts == NULL ||
-      config->vref_mv == 0u || config->amp_gain == 0u || config->trip_ma == 0u || config->shunt_uohm == 0u ||
+      config->vref_mv == 0u || config->amp_gain_milli == 0u || config->trip_ma == 0u || config->shunt_uohm == 0u ||
       config->ready_polls == 0u) {
     return POUR_EINVAL;
   }

@@ -48,7 +48,7 @@ POUR_REGS_DECLARE(OCP);
 typedef struct {
   uint32_t vref_mv;       /* ADC and DAC full scale [mV] */
   uint32_t shunt_uohm;    /* phase shunt [µΩ] */
-  uint32_t amp_gain;      /* op-amp gain (the ADC sees the bias and shunt voltage x gain) */
+  uint32_t amp_gain_milli; /* amplifier gain [1/1000] (the ADC sees the bias and shunt voltage x gain) */
   uint32_t trip_ma;       /* phase current that trips the break [mA] */
   uint32_t ready_polls;   /* bound of the wait for the DAC's ready flags */
 } pour_ocp_config_t;
@@ -58,7 +58,7 @@ typedef struct {
   uint16_t threshold[3]; /* DAC codes of phases U, V, W (U: DAC3 CH1; V, W share CH2: the larger bias) */
 } pour_ocp_t;
 
-/* B-G431B-ESC1: 3.3 V, 3 mΩ, gain 16, trip at 30 A (the board's 40 A peak less a margin). */
+/* B-G431B-ESC1: 3.3 V, 3 mΩ, gain 9.14, trip at 40 A (the board's peak; the software limit is lower). */
 pour_ocp_config_t pour_ocp_default_config(void);
 
 /* DAC code for a trip at config->trip_ma above a zero-current ADC reading of offset_counts. */

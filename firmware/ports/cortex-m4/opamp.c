@@ -3,7 +3,8 @@
 
 #include <stddef.h>
 
-#define VM_SEL_PGA 2u /* inverting input to the internal gain network */
+#define VM_SEL_VINM0 0u /* inverting input on its pin: the board's feedback network */
+#define VM_SEL_PGA 2u   /* inverting input to the internal gain network */
 #define VP_SEL_VINP0 0u
 
 pour_status_t pour_opamp_init(volatile uint32_t *regs, uint32_t gain) {
@@ -11,12 +12,13 @@ pour_status_t pour_opamp_init(volatile uint32_t *regs, uint32_t gain) {
   while (code < 6u && (2u << code) != gain) {
     ++code;
   }
-  if (regs == NULL || code == 6u) {
+  if (regs == NULL || (code == 6u && gain != 0u)) {
     return POUR_EINVAL;
   }
-  const uint32_t csr = POUR_MSK(OPAMP, OPAMP1_CSR, OPAEN) | POUR_VAL(OPAMP, OPAMP1_CSR, VP_SEL, VP_SEL_VINP0) |
-                       POUR_VAL(OPAMP, OPAMP1_CSR, VM_SEL, VM_SEL_PGA) | POUR_MSK(OPAMP, OPAMP1_CSR, OPAHSM) |
-                       POUR_VAL(OPAMP, OPAMP1_CSR, PGA_GAIN, code);
+  const uint32_t vm = gain == 0u ? POUR_VAL(OPAMP, OPAMP1_CSR, VM_SEL, VM_SEL_VINM0)
+                                 : POUR_VAL(OPAMP, OPAMP1_CSR, VM_SEL, VM_SEL_PGA) | POUR_VAL(OPAMP, OPAMP1_CSR, PGA_GAIN, code);
+  const uint32_t csr = POUR_MSK(OPAMP, OPAMP1_CSR, OPAEN) | POUR_VAL(OPAMP, OPAMP1_CSR, VP_SEL, VP_SEL_VINP0) | vm |
+                       POUR_MSK(OPAMP, OPAMP1_CSR, OPAHSM);
   regs[POUR_OPAMP_OPAMP1_CSR] = csr; /* OPAINTOEN clear: output on the pin, where the ADC reads it */
   regs[POUR_OPAMP_OPAMP2_CSR] = csr;
   regs[POUR_OPAMP_OPAMP3_CSR] = csr;

@@ -15,7 +15,7 @@ pour_pwm_config_t pour_pwm_default_config(void) {
   pour_pwm_config_t c;
   c.timer_clock_hz = 170000000u;
   c.pwm_hz = 20000u;
-  c.deadtime_ns = 500u;
+  c.deadtime_ns = 800u;
   c.break_filter = 2u;
   return c;
 }

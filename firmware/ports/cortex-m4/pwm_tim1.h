@@ -91,7 +91,7 @@ typedef struct {
   uint16_t period; /* ARR: counts from the bottom to the top of the centre-aligned count */
 } pour_pwm_t;
 
-/* B-G431B-ESC1: 170 MHz, 20 kHz, 500 ns dead time (the L6387 adds its own), break filter 2 samples. */
+/* B-G431B-ESC1: 170 MHz, 20 kHz, 800 ns dead time (the L6387 adds its own), break filter 2 samples. */
 pour_pwm_config_t pour_pwm_default_config(void);
 
 /* The dead-time generator's DTG code for deadtime_ns at timer_clock_hz (rounded up: never shorter); -1 if
