@@ -25,6 +25,9 @@
 #include "hal_brake.h"
 #include "hal_can.h"
 #include "hal_estop.h"
+#include "hal_led.h"
+#include "hal_timer.h"
+#include "led.h"
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
@@ -128,6 +131,8 @@ void pour_safe_outputs(void) {
   pour_hal_drive_short_low_sides(); /* damping, never coasting, until the brake holds */
   pour_hal_motor_set_torque(0);
 }
+
+void pour_hal_led_show(uint8_t mode, bool refused) { pour_gpio_write(led, pour_led_pattern(mode, refused, pour_hal_timer_ticks())); }
 
 static pour_fdcan_t fdcan;
 

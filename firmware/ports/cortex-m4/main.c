@@ -10,6 +10,7 @@
 #include "hal_brake.h"
 #include "hal_can.h"
 #include "hal_estop.h"
+#include "hal_led.h"
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_timer.h"
@@ -57,6 +58,7 @@ static void report_forever(void) {
       (void)pour_can_node_receive(&can_node, &f);
     }
     drive(&out);
+    pour_hal_led_show(out.mode, true);
     /* The torque frame says IDLE and 0; the heartbeat and identity frames carry the reason. */
     transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
     pour_hal_watchdog_feed();
@@ -109,6 +111,7 @@ int main(void) {
     pour_control_output_t out;
     pour_control_step(&controller, &in, &out);
     drive(&out);
+    pour_hal_led_show(out.mode, false);
     transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */
