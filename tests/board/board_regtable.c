@@ -6,6 +6,7 @@
 #include "adc_inj.h"
 #include "encoder_tim4.h"
 #include "fdcan.h"
+#include "flash_g4.h"
 #include "ocp.h"
 #include "opamp.h"
 #include "pwm_tim1.h"
@@ -25,5 +26,6 @@ int main(void) {
   PRINT_TABLE(OPAMP)
   PRINT_TABLE(OCP)
   PRINT_TABLE(TIM4)
+  PRINT_TABLE(FLASH)
   return 0;
 }
