@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "adc_inj.h"
+#include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
 #include "fdcan.h"
@@ -23,6 +24,7 @@
 #include "opamp.h"
 #include "pwm_tim1.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
 #include "hal_led.h"
@@ -237,3 +239,16 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
 bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
 
 void pour_hal_drive_clear_overcurrent(void) { pour_pwm_clear_break(&pwm); }
+
+/* The calibration: the block in the page the linker script leaves (hal_calibration). */
+static pour_calibration_t calibration;
+static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
+
+pour_status_t pour_hal_calibration_load(void) {
+  const pour_flash_t f = {POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE,
+                          WAIT_POLLS};
+  calibration_status = pour_calibration_load(&f, &calibration);
+  return calibration_status == POUR_CAL_OK ? POUR_OK : POUR_ECALIBRATION;
+}
+
+int pour_hal_calibration_reason(void) { return (int)calibration_status; }

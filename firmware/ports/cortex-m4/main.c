@@ -8,6 +8,7 @@
 
 #include "clock.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
 #include "hal_led.h"
@@ -80,6 +81,9 @@ int main(void) {
   pour_status_t status = pour_control_init(&controller, &config, &pour_weights_compiled);
   if (status == POUR_OK) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
+  }
+  if (status == POUR_OK) {
+    status = pour_hal_calibration_load(); /* an uncalibrated drive could turn the bucket the wrong way */
   }
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;

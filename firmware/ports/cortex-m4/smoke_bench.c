@@ -16,6 +16,7 @@
 
 #include "clock.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
 #include "hal_led.h"
@@ -52,6 +53,10 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
   *core_clock_hz = MPS2_AN386_CLOCK_HZ;
   return POUR_OK;
 }
+
+/* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
+pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
+int pour_hal_calibration_reason(void) { return 0; }
 
 void pour_hal_brake_init(void) { brake = true; }
 void pour_hal_brake_set(bool engage) { brake = engage; }
