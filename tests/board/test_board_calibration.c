@@ -5,20 +5,13 @@
 #include <string.h>
 
 #include "calibration_store.h"
+#include "flash_page_file.h"
 #include "unity.h"
 
-static uint32_t regs[POUR_FLASH_N_REGS];
-static uint32_t page[POUR_FLASH_PAGE_BYTES / 4];
-static pour_flash_t f;
 static pour_calibration_t good;
 
 void setUp(void) {
-  memset(regs, 0, sizeof regs);
-  memset(page, 0xFF, sizeof page);
-  f.regs = regs;
-  f.page = page;
-  f.page_number = POUR_FLASH_CAL_PAGE;
-  f.busy_polls = 10u;
+  flash_page_file_reset();
   good.r_phase_uohm = 304000u;
   good.l_phase_nh = 231500u;
   good.encoder_direction = -1;

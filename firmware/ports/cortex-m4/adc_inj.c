@@ -13,15 +13,6 @@
 #define CH_V 3u
 #define SMP_WIDTH 3u
 
-static int wait_for(volatile uint32_t *reg, uint32_t mask, uint32_t want, uint32_t polls) {
-  for (uint32_t i = 0; i < polls; ++i) {
-    if ((*reg & mask) == want) {
-      return 0;
-    }
-  }
-  return -1;
-}
-
 static void sample_time(volatile uint32_t *r, uint32_t channel, uint32_t smp) {
   volatile uint32_t *reg = channel < 10u ? &r[POUR_ADC_SMPR1] : &r[POUR_ADC_SMPR2];
   const uint32_t shift = SMP_WIDTH * (channel % 10u);
@@ -34,12 +25,12 @@ static pour_status_t bring_up(volatile uint32_t *r, uint32_t polls, uint32_t reg
   for (volatile uint32_t i = 0; i < regulator_wait; ++i) {
   }
   r[POUR_ADC_CR] = POUR_MSK(ADC, CR, ADVREGEN) | POUR_MSK(ADC, CR, ADCAL); /* single-ended calibration */
-  if (wait_for(&r[POUR_ADC_CR], POUR_MSK(ADC, CR, ADCAL), 0u, polls) != 0) {
+  if (pour_regs_wait(&r[POUR_ADC_CR], POUR_MSK(ADC, CR, ADCAL), 0u, polls) != 0) {
     return POUR_EINVAL;
   }
   r[POUR_ADC_ISR] = POUR_MSK(ADC, ISR, ADRDY); /* write 1 to clear */
   r[POUR_ADC_CR] = POUR_MSK(ADC, CR, ADVREGEN) | POUR_MSK(ADC, CR, ADEN);
-  if (wait_for(&r[POUR_ADC_ISR], POUR_MSK(ADC, ISR, ADRDY), POUR_MSK(ADC, ISR, ADRDY), polls) != 0) {
+  if (pour_regs_wait(&r[POUR_ADC_ISR], POUR_MSK(ADC, ISR, ADRDY), POUR_MSK(ADC, ISR, ADRDY), polls) != 0) {
     return POUR_EINVAL;
   }
   r[POUR_ADC_CFGR] = POUR_MSK(ADC, CFGR, JQDIS); /* JSQR is the sequence, no queue of contexts */

@@ -57,15 +57,6 @@ static pour_pwm_t pwm;
 static pour_adc_t adc;
 static pour_ocp_t ocp;
 
-static int wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t want) {
-  for (uint32_t i = 0; i < WAIT_POLLS; ++i) {
-    if ((*reg & mask) == want) {
-      return 0;
-    }
-  }
-  return -1;
-}
-
 static void clock_on(uint32_t enr, uint32_t mask) {
   RCC_R[enr] |= mask;
   (void)RCC_R[enr]; /* the enable takes effect before the peripheral is touched */
@@ -119,7 +110,8 @@ void pour_hal_watchdog_start(uint32_t timeout_ms) {
   iwdg[POUR_IWDG_PR] = POUR_VAL(IWDG, PR, PR, 0u); /* /4: 8 counts per ms */
   iwdg[POUR_IWDG_RLR] = POUR_VAL(IWDG, RLR, RL, timeout_ms * 8u - 1u);
   /* the new values reached the IWDG's clock domain */
-  (void)wait_set(&iwdg[POUR_IWDG_SR], POUR_MSK(IWDG, SR, PVU) | POUR_MSK(IWDG, SR, RVU) | POUR_MSK(IWDG, SR, WVU), 0u);
+  (void)pour_regs_wait(&iwdg[POUR_IWDG_SR], POUR_MSK(IWDG, SR, PVU) | POUR_MSK(IWDG, SR, RVU) | POUR_MSK(IWDG, SR, WVU), 0u,
+                       WAIT_POLLS);
   iwdg[POUR_IWDG_KR] = 0xAAAAu;
 }
 

@@ -22,15 +22,6 @@ pour_clock_config_t pour_clock_default_config(void) {
   return c;
 }
 
-static int wait_for(volatile uint32_t *reg, uint32_t mask, uint32_t want, uint32_t polls) {
-  for (uint32_t i = 0; i < polls; ++i) {
-    if ((*reg & mask) == want) {
-      return 0;
-    }
-  }
-  return -1;
-}
-
 static void pll_from(volatile uint32_t *rcc, uint32_t src, uint32_t in_hz) {
   rcc[POUR_RCC_PLLCFGR] = POUR_VAL(RCC, PLLCFGR, PLLSRC, src) | POUR_VAL(RCC, PLLCFGR, PLLM, in_hz / PLL_IN_HZ - 1u) |
                           POUR_VAL(RCC, PLLCFGR, PLLN, PLL_N) | POUR_MSK(RCC, PLLCFGR, PLLREN) |
@@ -58,14 +49,14 @@ pour_status_t pour_clock_setup(const pour_clock_hw_t *hw, const pour_clock_confi
   const uint32_t latency = POUR_VAL(FLASH, ACR, LATENCY, FLASH_WAIT_STATES);
   hw->flash[POUR_FLASH_ACR] = (hw->flash[POUR_FLASH_ACR] & ~POUR_MSK(FLASH, ACR, LATENCY)) | latency |
                               POUR_MSK(FLASH, ACR, PRFTEN) | POUR_MSK(FLASH, ACR, ICEN) | POUR_MSK(FLASH, ACR, DCEN);
-  if (wait_for(&hw->flash[POUR_FLASH_ACR], POUR_MSK(FLASH, ACR, LATENCY), latency, polls) != 0) {
+  if (pour_regs_wait(&hw->flash[POUR_FLASH_ACR], POUR_MSK(FLASH, ACR, LATENCY), latency, polls) != 0) {
     return POUR_EINVAL;
   }
   /* The crystal first; the clock security system then watches it (a crystal that stops later hands the
    * core to HSI16 in hardware and raises the NMI, which startup.c turns into the safe outputs). */
   rcc[POUR_RCC_CR] = (rcc[POUR_RCC_CR] & ~POUR_MSK(RCC, CR, HSEBYP)) | POUR_MSK(RCC, CR, HSEON);
   const uint32_t hserdy = POUR_MSK(RCC, CR, HSERDY);
-  if (wait_for(&rcc[POUR_RCC_CR], hserdy, hserdy, polls) == 0) {
+  if (pour_regs_wait(&rcc[POUR_RCC_CR], hserdy, hserdy, polls) == 0) {
     pll_from(rcc, PLLSRC_HSE, config->hse_hz);
     rcc[POUR_RCC_CR] |= POUR_MSK(RCC, CR, CSSON);
     *source = POUR_CLOCK_HSE;
@@ -76,13 +67,13 @@ pour_status_t pour_clock_setup(const pour_clock_hw_t *hw, const pour_clock_confi
   rcc[POUR_RCC_CR] |= POUR_MSK(RCC, CR, PLLON);
   const uint32_t pllrdy = POUR_MSK(RCC, CR, PLLRDY);
   const uint32_t sws_pll = POUR_VAL(RCC, CFGR, SWS, SW_PLL);
-  if (wait_for(&rcc[POUR_RCC_CR], pllrdy, pllrdy, polls) != 0) {
+  if (pour_regs_wait(&rcc[POUR_RCC_CR], pllrdy, pllrdy, polls) != 0) {
     rcc[POUR_RCC_CFGR] &= ~hpre;
     *source = POUR_CLOCK_HSI16;
     return POUR_EINVAL;
   }
   rcc[POUR_RCC_CFGR] = (rcc[POUR_RCC_CFGR] & ~POUR_MSK(RCC, CFGR, SW)) | POUR_VAL(RCC, CFGR, SW, SW_PLL);
-  if (wait_for(&rcc[POUR_RCC_CFGR], POUR_MSK(RCC, CFGR, SWS), sws_pll, polls) != 0) {
+  if (pour_regs_wait(&rcc[POUR_RCC_CFGR], POUR_MSK(RCC, CFGR, SWS), sws_pll, polls) != 0) {
     rcc[POUR_RCC_CFGR] &= ~hpre;
     *source = POUR_CLOCK_HSI16;
     return POUR_EINVAL;

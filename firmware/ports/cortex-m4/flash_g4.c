@@ -11,12 +11,7 @@
    POUR_MSK(FLASH, SR, MISERR) | POUR_MSK(FLASH, SR, FASTERR))
 
 static int idle(const pour_flash_t *f) {
-  for (uint32_t i = 0; i < f->busy_polls; ++i) {
-    if ((f->regs[POUR_FLASH_SR] & POUR_MSK(FLASH, SR, BSY)) == 0u) {
-      return 0;
-    }
-  }
-  return -1;
+  return pour_regs_wait(&f->regs[POUR_FLASH_SR], POUR_MSK(FLASH, SR, BSY), 0u, f->busy_polls);
 }
 
 static int begin(const pour_flash_t *f) {

@@ -47,11 +47,8 @@ pour_status_t pour_ocp_init(pour_ocp_t *ocp, volatile uint32_t *comp, volatile u
   dac[POUR_DAC_DHR12R2] = POUR_VAL(DAC, DHR12R2, DACCDHR, vw);
   dac[POUR_DAC_CR] = POUR_MSK(DAC, CR, EN1) | POUR_MSK(DAC, CR, EN2);
   const uint32_t ready = POUR_MSK(DAC, SR, DAC1RDY) | POUR_MSK(DAC, SR, DAC2RDY);
-  uint32_t n = 0u;
-  while ((dac[POUR_DAC_SR] & ready) != ready) {
-    if (++n >= config->ready_polls) {
-      return POUR_EINVAL;
-    }
+  if (pour_regs_wait(&dac[POUR_DAC_SR], ready, ready, config->ready_polls) != 0) {
+    return POUR_EINVAL;
   }
   /* INP: VINP0 pins (INPSEL 0: COMP1 PA1, COMP2 PA7, COMP4 PB0); output high above the threshold. */
   const uint32_t csr = POUR_MSK(COMP, C1CSR, EN) | POUR_VAL(COMP, C1CSR, INMSEL, INMSEL_DAC3) |

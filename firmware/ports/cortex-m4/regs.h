@@ -30,6 +30,17 @@
   ((((uint32_t)(v)) << POUR_##block##_##reg##_##field##_POS) & POUR_MSK(block, reg, field))
 #define POUR_GET(block, reg, field, word) (((uint32_t)(word) & POUR_MSK(block, reg, field)) >> POUR_##block##_##reg##_##field##_POS)
 
+/* Polls *reg until (*reg & mask) == want, at most polls times: 0, or -1 if the hardware never got there
+ * (every wait of the port is bounded: a flag that never comes is an error, not a hang). */
+static inline int pour_regs_wait(const volatile uint32_t *reg, uint32_t mask, uint32_t want, uint32_t polls) {
+  for (uint32_t i = 0; i < polls; ++i) {
+    if ((*reg & mask) == want) {
+      return 0;
+    }
+  }
+  return -1;
+}
+
 /* An instance's registers as a word array (only where the driver runs on the chip, never in host tests). */
 #define POUR_PERIPH(inst) ((volatile uint32_t *)(uintptr_t)POUR_##inst##_BASE)
 
