@@ -89,12 +89,15 @@ int main(void) {
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
   nc.identity.init_status = (int8_t)status;
+  pour_can_calibration_result_t calibration;
+  pour_hal_calibration_result(&calibration); /* what a CalibrationStart is answered with */
   if (pour_can_node_init(&can_node, &nc) != POUR_OK || pour_hal_can_init(clock_hz, nc.node_id) != POUR_OK) {
     /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
      * watchdog resets the MCU, which tries again. */
     for (;;) {
     }
   }
+  pour_can_node_set_calibration(&can_node, &calibration);
   if (status != POUR_OK) {
     report_forever();
   }

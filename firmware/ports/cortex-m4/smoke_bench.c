@@ -57,6 +57,10 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
 /* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
 pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
 int pour_hal_calibration_reason(void) { return 0; }
+void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
+  const pour_can_calibration_result_t none = {POUR_CAN_CAL_UNAVAILABLE, POUR_CAN_CAL_EMPTY, 0u, 0u, 0u, 0u, 0u};
+  *r = none;
+}
 
 void pour_hal_brake_init(void) { brake = true; }
 void pour_hal_brake_set(bool engage) { brake = engage; }
