@@ -14,7 +14,8 @@ pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 # Instructions per control step under qemu-system-arm -icount shift=0 (one instruction per virtual ns,
 # so the guest's SysTick turns into an instruction count: deterministic), for the hand-made 11-action
 # and 2-action policies; flash and RAM of the core and of the STM32G431 image (arm-none-eabi-size).
-# Bars: <= 1,500 instructions/step; core <= 4 KB flash and <= 512 B RAM.
+# Bars: <= 1,500 instructions/step; core <= 4 KB flash and <= 512 B RAM; the image <= 32 KB flash and
+# <= 8 KB static RAM with no soft-float helper.
 bench_core() {
   local build=build/cortex-m4 log
   log=$(mktemp)
@@ -71,6 +72,22 @@ bench_core() {
   read -r t d b < <(arm-none-eabi-size "$port/pour_firmware.elf" | awk 'NR == 2 {print $1, $2, $3}')
   printf '   image pour_firmware.elf: %d B flash (text+data), %d B RAM (data+bss) + 2048 B stack reserve\n' \
     $((t + d)) $((d + b))
+  local image_flash=$((t + d)) image_ram=$((d + b)) drive_flash=0 drive_ram=0 softfloat
+  # The B-G431B-ESC1's drivers, each object (before the linker drops what main.c does not call yet: the
+  # motor drivers and the board's protection wait for the current loop's interrupt, so image + their objects
+  # bounds the full image).
+  for o in "$port"/CMakeFiles/pour_firmware.dir/*.obj; do
+    case "$(basename "$o")" in
+      main.c.obj|startup.c.obj|hal_timer.c.obj|hal_motor.c.obj) continue ;;
+    esac
+    read -r t d b < <(arm-none-eabi-size "$o" | awk 'NR == 2 {print $1, $2, $3}')
+    printf '   %-22s %5d B flash, %4d B static RAM\n' "$(basename "$o" .obj)" $((t + d)) $((d + b))
+    case "$(basename "$o")" in
+      pwm_tim1.c.obj|adc_inj.c.obj|opamp.c.obj|ocp.c.obj|encoder_tim4.c.obj|protect.c.obj|board_guard.c.obj)
+        drive_flash=$((drive_flash + t + d)); drive_ram=$((drive_ram + d + b)) ;;
+    esac
+  done
+  softfloat=$(arm-none-eabi-nm "$port/pour_firmware.elf" | grep -cE ' __aeabi_(f|d|[ui]2[fd]|[fd]2)|__(add|sub|mul|div)[sd]f3' || true)
 
   echo "-- against the bars:"
   verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
@@ -82,6 +99,10 @@ bench_core() {
     "$core_text" "$(verdict "$core_text" 4096)" "$core_ram" "${state:-?}" \
     "$(verdict $((core_ram + ${state:-0})) 512)"
   printf '   with the deepest stack of a step: %d B\n' $((core_ram + ${state:-0} + ${stack:-0}))
+  printf '   STM32G431 image: %d B flash (bar 32768: %s), %d B static RAM (bar 8192: %s); with every motor driver and the protection linked at most %d B flash, %d B static RAM\n' \
+    "$image_flash" "$(verdict "$image_flash" 32768)" "$image_ram" "$(verdict "$image_ram" 8192)" \
+    $((image_flash + drive_flash)) $((image_ram + drive_ram))
+  printf '   soft-float helpers in the image (arm-none-eabi-nm): %d (bar 0)\n' "$softfloat"
 }
 
 # --- section: motor — the drive's current loop on the emulated Cortex-M4, and the full drive in the simulator

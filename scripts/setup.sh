@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs everything pour needs on Debian 12 (bookworm): apt packages, a pinned Python venv in .venv,
-# and the Unity test framework in .deps/unity. Idempotent: a second run checks and changes nothing.
+# the Unity test framework in .deps/unity, and ST's register description of the STM32G4 (the stm32g4 crate,
+# in cargo's home). Idempotent: a second run checks and changes nothing.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -21,7 +22,10 @@ APT_PACKAGES=(
   default-jdk-headless default-jre fonts-dejavu-core xvfb xauth x11-apps
   python3 python3-venv python3-dev python3-tk libglib2.0-0
   ca-certificates xz-utils
+  openocd
 )
+# cargo fetches the stm32g4 crate; a machine that has one (rustup's) keeps it, a bare one gets Debian's.
+command -v cargo >/dev/null || APT_PACKAGES+=(cargo)
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then
@@ -80,6 +84,38 @@ if [ ! -f "$UNITY_DIR/unity.c" ]; then
   mkdir -p "$UNITY_DIR"
   tar -xJf "$work/$UNITY_TARBALL" -C "$UNITY_DIR" --strip-components=3 \
     --wildcards '*/tests/unity/unity.c' '*/tests/unity/unity.h' '*/tests/unity/unity_internals.h'
+fi
+
+# ST's register description of the STM32G4 (the stm32g4 crate: stm32-rs's svd2rust output of ST's SVD
+# files), which tests/board/check_registers.py compares the port's register tables with. Fetched by cargo
+# into its home from the crate registry, pinned by version (scripts/stm32g4/Cargo.toml) and by the sha256
+# of the crate file, which cargo checks on download against the lock written here; never copied into
+# the repo. .deps/stm32g4/crate-dir names the unpacked sources.
+SVD_CRATE=stm32g4
+SVD_CRATE_VERSION=0.16.0
+SVD_CRATE_SHA256=97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d
+SVD_WORK=.deps/stm32g4
+svd_dir=$(cat "$SVD_WORK/crate-dir" 2>/dev/null || true)
+if [ -z "$svd_dir" ] || [ ! -f "$svd_dir/src/stm32g431/mod.rs" ] \
+   || ! cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"; then
+  log "stm32g4: fetching the $SVD_CRATE $SVD_CRATE_VERSION crate with cargo"
+  mkdir -p "$SVD_WORK/src"
+  cp scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"
+  cp scripts/stm32g4/src/lib.rs "$SVD_WORK/src/lib.rs"
+  (cd "$SVD_WORK" && cargo generate-lockfile -q && cargo fetch -q --locked)
+  got=$(awk -v name="$SVD_CRATE" -v ver="$SVD_CRATE_VERSION" '
+    /^\[\[package\]\]/ { n = ""; v = "" }
+    /^name = / { n = $3; gsub(/"/, "", n) }
+    /^version = / { v = $3; gsub(/"/, "", v) }
+    /^checksum = / { c = $3; gsub(/"/, "", c); if (n == name && v == ver) print c }' "$SVD_WORK/Cargo.lock")
+  [ "$got" = "$SVD_CRATE_SHA256" ] \
+    || { log "stm32g4: $SVD_CRATE $SVD_CRATE_VERSION has sha256 '$got', pinned $SVD_CRATE_SHA256"; exit 1; }
+  svd_dir=$(cd "$SVD_WORK" && cargo metadata -q --offline --locked --format-version 1 | "$PY" -c '
+import json, os, sys
+meta = json.load(sys.stdin)
+print(next(os.path.dirname(p["manifest_path"]) for p in meta["packages"] if p["name"] == sys.argv[1]))' "$SVD_CRATE")
+  [ -f "$svd_dir/src/stm32g431/mod.rs" ] || { log "stm32g4: no src/stm32g431 under '$svd_dir'"; exit 1; }
+  echo "$svd_dir" > "$SVD_WORK/crate-dir"
 fi
 
 log "ok"

@@ -13,6 +13,8 @@ const char *pour_status_name(pour_status_t status) {
       return "POUR_EFORMAT";
     case POUR_ECORRUPT:
       return "POUR_ECORRUPT";
+    case POUR_ECALIBRATION:
+      return "POUR_ECALIBRATION";
   }
   return "POUR_E?";
 }

@@ -53,6 +53,9 @@ static uint8_t command_of(const char *msg) {
   if (strcmp(msg, "stop") == 0) {
     return POUR_CAN_CMD_STOP;
   }
+  if (strcmp(msg, "calibration_start") == 0) {
+    return POUR_CAN_CMD_CALIBRATION_START;
+  }
   return strcmp(msg, "reset") == 0 ? POUR_CAN_CMD_RESET : 0u;
 }
 
@@ -79,6 +82,13 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "identity") == 0 && n == 5) {
     pour_can_identity_t m = {(uint32_t)v[1], (uint16_t)v[2], (uint8_t)v[3], (int8_t)v[4]};
     print_frame(pour_can_pack_identity(node, &m, &f), &f);
+  } else if (strcmp(msg, "calibration_result") == 0 && n == 8) {
+    pour_can_calibration_result_t m = {(uint8_t)v[1], (uint8_t)v[2], (uint8_t)v[3], (uint8_t)v[4],
+                                       (uint16_t)v[5], (uint16_t)v[6], (uint8_t)v[7]};
+    print_frame(pour_can_pack_calibration_result(node, &m, &f), &f);
+  } else if (strcmp(msg, "drive_telemetry") == 0 && n == 5) {
+    pour_can_drive_telemetry_t m = {(int16_t)v[1], (int16_t)v[2], (uint16_t)v[3], (uint16_t)v[4]};
+    print_frame(pour_can_pack_drive_telemetry(node, &m, &f), &f);
   } else if (command_of(msg) != 0u && n == 1) {
     print_frame(pour_can_pack_command(node, command_of(msg), &f), &f);
   } else {
@@ -148,6 +158,16 @@ static void do_unpack(const char *msg, char *rest) {
     rc = pour_can_unpack_identity(&f, &m);
     snprintf(out, sizeof out, "%lu %u %u %d", (unsigned long)m.weights_hash, (unsigned)m.tau_max_cnm,
              (unsigned)m.fw_version, (int)m.init_status);
+  } else if (strcmp(msg, "calibration_result") == 0) {
+    pour_can_calibration_result_t m = {0};
+    rc = pour_can_unpack_calibration_result(&f, &m);
+    snprintf(out, sizeof out, "%u %u %u %u %u %u %u", (unsigned)m.status, (unsigned)m.stored,
+             (unsigned)m.encoder_reversed, (unsigned)m.pole_pairs, (unsigned)m.resistance_mohm,
+             (unsigned)m.inductance_uh, (unsigned)m.electrical_offset);
+  } else if (strcmp(msg, "drive_telemetry") == 0) {
+    pour_can_drive_telemetry_t m = {0};
+    rc = pour_can_unpack_drive_telemetry(&f, &m);
+    snprintf(out, sizeof out, "%d %d %u %u", m.id_2ma, m.iq_2ma, (unsigned)m.vbus_mv, (unsigned)m.drive_faults);
   } else if (command_of(msg) != 0u) {
     rc = pour_can_unpack_command(&f, command_of(msg));
     out[0] = '\0';

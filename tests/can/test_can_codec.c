@@ -154,6 +154,47 @@ static void test_can_identity_RoundTripsHashScaleVersionAndNegativeStatus(void) 
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_identity(&f, &got));
 }
 
+static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
+  const pour_can_calibration_result_t r = {.status = POUR_CAN_CAL_REFUSED_RUNNING, .stored = POUR_CAN_CAL_OK,
+                                           .encoder_reversed = 1u, .pole_pairs = 8u, .resistance_mohm = 304u,
+                                           .inductance_uh = 231u, .electrical_offset = 200u};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
+  TEST_ASSERT_EQUAL_HEX16(pour_can_id(2, POUR_CAN_CMD_CALIBRATION_RESULT), f.id);
+  TEST_ASSERT_EQUAL_HEX8(0x06u, f.data[0]); /* status 6 in the low nibble, stored 0 in the high one */
+  pour_can_calibration_result_t got;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_UINT8(r.status, got.status);
+  TEST_ASSERT_EQUAL_UINT8(r.stored, got.stored);
+  TEST_ASSERT_EQUAL_UINT8(1u, got.encoder_reversed);
+  TEST_ASSERT_EQUAL_UINT8(8u, got.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(304u, got.resistance_mohm);
+  TEST_ASSERT_EQUAL_UINT16(231u, got.inductance_uh);
+  TEST_ASSERT_EQUAL_UINT8(200u, got.electrical_offset);
+  pour_can_calibration_result_t bad = r;
+  bad.status = POUR_CAN_CAL_STATUS_MAX + 1u;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_calibration_result(2, &bad, &f));
+  f.data[2] = 33u; /* pole pairs beyond 32 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(2, POUR_CAN_CMD_CALIBRATION_START, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_command(&f, POUR_CAN_CMD_CALIBRATION_START));
+}
+
+static void test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults(void) {
+  const pour_can_drive_telemetry_t t = {.id_2ma = -32767, .iq_2ma = 2500, .vbus_mv = 24100u, .drive_faults = 0xF902u};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_drive_telemetry(0, &t, &f));
+  pour_can_drive_telemetry_t got;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_drive_telemetry(&f, &got));
+  TEST_ASSERT_EQUAL_INT16(-32767, got.id_2ma);
+  TEST_ASSERT_EQUAL_INT16(2500, got.iq_2ma);
+  TEST_ASSERT_EQUAL_UINT16(24100u, got.vbus_mv);
+  TEST_ASSERT_EQUAL_HEX16(0x0102u, got.drive_faults); /* bits beyond the 11 named ones are not carried */
+  pour_can_drive_telemetry_t bad = t;
+  bad.iq_2ma = INT16_MIN;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_drive_telemetry(0, &bad, &f));
+}
+
 static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {
   const uint32_t accept = 1u << POUR_CAN_CMD_SENSORS;
   pour_can_frame_t f = {.id = pour_can_id(4, POUR_CAN_CMD_SENSORS), .dlc = 8, .data = {0}};
@@ -184,6 +225,8 @@ int main(void) {
   RUN_TEST(test_can_heartbeat_CarriesOnlyNamedFaultBits);
   RUN_TEST(test_can_unpack_RejectsWrongDlcAndWrongCmd);
   RUN_TEST(test_can_identity_RoundTripsHashScaleVersionAndNegativeStatus);
+  RUN_TEST(test_can_calibration_result_RoundTripsAndNamesTheReason);
+  RUN_TEST(test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults);
   RUN_TEST(test_can_classify_SeparatesNodesCmdsAndDlcs);
   return UNITY_END();
 }

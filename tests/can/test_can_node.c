@@ -47,6 +47,47 @@ static uint8_t tick(q15_t torque, pour_control_input_t *in, pour_can_frame_t tx[
   return pour_can_node_end_tick(&node, &out, 9, tx);
 }
 
+/* One tick in the given mode after a CalibrationStart: the CalibrationResult it produced, decoded. */
+static pour_can_calibration_result_t calibration_answer(uint8_t mode) {
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(cfg.node_id, POUR_CAN_CMD_CALIBRATION_START, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+  pour_control_input_t in;
+  pour_can_node_begin_tick(&node, &in);
+  pour_control_output_t out;
+  memset(&out, 0, sizeof out);
+  out.mode = mode;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  const uint8_t n = pour_can_node_end_tick(&node, &out, 0, tx);
+  pour_can_calibration_result_t r;
+  memset(&r, 0xFF, sizeof r);
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&tx[n - 1u], &r));
+  /* one answer per request */
+  pour_can_node_begin_tick(&node, &in);
+  const uint8_t next = pour_can_node_end_tick(&node, &out, 0, tx);
+  for (uint8_t i = 0; i < next; ++i) {
+    TEST_ASSERT_NOT_EQUAL((int)pour_can_id(cfg.node_id, POUR_CAN_CMD_CALIBRATION_RESULT), (int)tx[i].id);
+  }
+  return r;
+}
+
+static void test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason(void) {
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_ESTOP, calibration_answer((uint8_t)POUR_MODE_ESTOP).status);
+  const pour_can_calibration_result_t idle = calibration_answer((uint8_t)POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_UNAVAILABLE, idle.status); /* no port answer set: it cannot measure */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_EMPTY, idle.stored);
+  const pour_can_calibration_result_t stored = {.status = POUR_CAN_CAL_UNAVAILABLE, .stored = POUR_CAN_CAL_OK,
+                                                .encoder_reversed = 0u, .pole_pairs = 8u, .resistance_mohm = 304u,
+                                                .inductance_uh = 231u, .electrical_offset = 17u};
+  pour_can_node_set_calibration(&node, &stored);
+  const pour_can_calibration_result_t fault = calibration_answer((uint8_t)POUR_MODE_FAULT);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, fault.stored); /* the stored calibration, read back */
+  TEST_ASSERT_EQUAL_UINT8(8u, fault.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(304u, fault.resistance_mohm);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
+}
+
 static void test_can_node_init_RejectsBadConfig(void) {
   pour_can_node_config_t bad = cfg;
   bad.node_id = 64;
@@ -459,6 +500,7 @@ static void test_can_node_RefusedResetInRunChangesNothing(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_node_init_RejectsBadConfig);
+  RUN_TEST(test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason);
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);

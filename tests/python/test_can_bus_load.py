@@ -42,13 +42,13 @@ def test_real_frames_never_exceed_the_worst_case_bound():
 def test_protocol_load_at_1khz_is_under_half_the_bus():
     rows = {r.name: r for r in bl.cyclic_messages()}
     # One 8-byte Sensors frame per tick carries the whole sample (no longer two state frames).
-    assert set(rows) == {"Sensors", "Torque", "Heartbeat", "Identity"}
+    assert set(rows) == {"Sensors", "Torque", "Heartbeat", "Identity", "DriveTelemetry"}
     assert rows["Sensors"].rate_hz == rows["Torque"].rate_hz == 1000.0
-    assert rows["Heartbeat"].rate_hz == rows["Identity"].rate_hz == 10.0
+    assert rows["Heartbeat"].rate_hz == rows["Identity"].rate_hz == rows["DriveTelemetry"].rate_hz == 10.0
     total = sum(r.load for r in rows.values())
-    assert total == pytest.approx(((135 + 125) * 1000 + 135 * 10 * 2) / 1e6)
+    assert total == pytest.approx(((135 + 125) * 1000 + 135 * 10 * 3) / 1e6)
     assert total < 0.5
-    assert "26.3 % worst case" in bl.report(list(rows.values()))
+    assert "26.4 % worst case" in bl.report(list(rows.values()))
 
 
 def test_cli_reports_and_rejects_bad_input(tmp_path):

@@ -29,12 +29,23 @@ MESSAGES = {
     "clear_errors": ("ClearErrors", []),
     "stop": ("Stop", []),
     "reset": ("Reset", []),
+    "calibration_start": ("CalibrationStart", []),
+    "calibration_result": ("CalibrationResult", ["Status", "Stored", "EncoderReversed", "PolePairs", "Resistance",
+                                                 "Inductance", "ElectricalOffset"]),
+    "drive_telemetry": ("DriveTelemetry", ["Id", "Iq", "Vbus", "DriveFaults"]),
 }
-SIGNAL_FREE = ("clear_errors", "stop", "reset")
+SIGNAL_FREE = ("clear_errors", "stop", "reset", "calibration_start")
 FAULT_BITS = {"Fault_StaleInput": 0x0001, "Fault_EStop": 0x0002, "Fault_BadInput": 0x0004,
               "Fault_Position": 0x0008, "Fault_Overspeed": 0x0010, "Fault_TorqueSign": 0x0020,
               "Fault_Encoder": 0x0040, "Fault_Volume": 0x0080, "Fault_CanWatchdog": 0x0100,
               "Fault_Seq": 0x0200, "Fault_Scale": 0x0400}
+# The drive's fault word (pour/drive_faults.h) in DriveTelemetry, the same way.
+DRIVE_FAULT_BITS = {"DriveFault_Overcurrent": 0x0001, "DriveFault_HwOvercurrent": 0x0002,
+                    "DriveFault_Overvoltage": 0x0004, "DriveFault_Undervoltage": 0x0008,
+                    "DriveFault_Overtemp": 0x0010, "DriveFault_CurrentOffset": 0x0020, "DriveFault_Phase": 0x0040,
+                    "DriveFault_EncoderDirection": 0x0080, "DriveFault_EncoderMismatch": 0x0100,
+                    "DriveFault_Calibration": 0x0200, "DriveFault_I2t": 0x0400}
+BIT_FIELDS = {"Faults": FAULT_BITS, "DriveFaults": DRIVE_FAULT_BITS}
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +90,7 @@ def field_ranges(db, cname: str) -> list[tuple[int, int]]:
     msg = db.get_message_by_name(dbc_name)
     out = []
     for f in fields:
-        if f == "Faults":
+        if f in BIT_FIELDS:
             out.append((0, 0xFFFF))
         else:
             out.append(raw_range(msg.get_signal_by_name(f)))
@@ -90,8 +101,8 @@ def to_signals(cname: str, values: list[int]) -> dict[str, int]:
     _, fields = MESSAGES[cname]
     sigs: dict[str, int] = {}
     for f, v in zip(fields, values):
-        if f == "Faults":
-            for name, bit in FAULT_BITS.items():
+        if f in BIT_FIELDS:
+            for name, bit in BIT_FIELDS[f].items():
                 sigs[name] = 1 if v & bit else 0
         else:
             sigs[f] = v
@@ -102,8 +113,8 @@ def from_signals(cname: str, sigs: dict) -> list[int]:
     _, fields = MESSAGES[cname]
     out = []
     for f in fields:
-        if f == "Faults":
-            out.append(sum(bit for name, bit in FAULT_BITS.items() if sigs[name]))
+        if f in BIT_FIELDS:
+            out.append(sum(bit for name, bit in BIT_FIELDS[f].items() if sigs[name]))
         else:
             out.append(int(sigs[f]))
     return out
@@ -155,8 +166,9 @@ def test_pack_matches_dbc_for_random_and_edge_values(db, harness, cname):
         want = msg.encode(to_signals(cname, values), scaling=False, strict=True)
         # The C codec only carries the fault bits the DBC names.
         assert data == want, (cname, values, data.hex(), want.hex())
-        if cname == "heartbeat":
-            values[1] &= sum(FAULT_BITS.values())
+        for i, f in enumerate(MESSAGES[cname][1]):
+            if f in BIT_FIELDS:
+                values[i] &= sum(BIT_FIELDS[f].values())
         assert from_signals(cname, msg.decode(data, scaling=False, decode_choices=False)) == values
 
 
@@ -167,7 +179,7 @@ def test_pack_refuses_what_the_dbc_calls_out_of_range(db, harness, cname):
     msg = db.get_message_by_name(dbc_name)
     refused = 0
     for i, (lo, hi) in enumerate(ranges):
-        sig = None if fields[i] == "Faults" else msg.get_signal_by_name(fields[i])
+        sig = None if fields[i] in BIT_FIELDS else msg.get_signal_by_name(fields[i])
         if sig is None:
             continue
         field_min = -(1 << (sig.length - 1)) if sig.is_signed else 0
@@ -181,7 +193,7 @@ def test_pack_refuses_what_the_dbc_calls_out_of_range(db, harness, cname):
             with pytest.raises(cantools.database.errors.EncodeError):
                 msg.encode(to_signals(cname, case), scaling=False, strict=True)
             refused += 1
-    if cname in ("sensors", "torque", "heartbeat", "estop", "identity"):
+    if cname in ("sensors", "torque", "heartbeat", "estop", "identity", "calibration_result", "drive_telemetry"):
         assert refused > 0
 
 
@@ -237,7 +249,8 @@ def test_cmd_ids_and_lengths_match_the_c_header(db, source_dir):
     header = (source_dir / "firmware" / "can" / "include" / "pour" / "can_codec.h").read_text()
     names = {"Heartbeat": "HEARTBEAT", "Estop": "ESTOP", "Sensors": "SENSORS",
              "Torque": "TORQUE", "ClearErrors": "CLEAR_ERRORS", "Stop": "STOP", "Reset": "RESET",
-             "Identity": "IDENTITY"}
+             "Identity": "IDENTITY", "CalibrationStart": "CALIBRATION_START",
+             "CalibrationResult": "CALIBRATION_RESULT", "DriveTelemetry": "DRIVE_TELEMETRY"}
     assert sorted(m.name for m in db.messages) == sorted(names)
     for m in db.messages:
         c = names[m.name]
@@ -253,7 +266,7 @@ def test_every_signal_has_a_unit_or_choices_and_a_comment(db):
             assert s.comment, (m.name, s.name)
             assert s.unit or s.choices or s.length == 1 or s.name in ("Seq", "Counter", "Action",
                                                                         "Limits", "WeightsHash", "FwVersion",
-                                                                        "InitStatus"), (m.name, s.name)
+                                                                        "InitStatus", "PolePairs"), (m.name, s.name)
 
 
 def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
@@ -261,7 +274,9 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     lines = []
     frames = [("sensors", [7, 131071, -5, 12345]),
               ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5]), ("estop", [1]),
-              ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", [])]
+              ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", []),
+              ("calibration_start", []), ("calibration_result", [7, 2, 0, 0, 0, 0, 0]),
+              ("drive_telemetry", [-1500, 2500, 24100, 0x0102])]
     for cname, values in frames:
         frame_id, _, data = c_pack(harness, cname, 0, values)
         lines.append(f"(1700000000.{len(lines):06d}) vcan0 {frame_id:03X}#{data.hex().upper()}")
@@ -276,6 +291,9 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "Fault_TorqueSign: 1" in text
     assert "TauMax: 20.0 N.m" in text
     assert "Assert: ASSERT" in text
+    assert "Status: REFUSED_ESTOP" in text and "Stored: CORRUPT" in text  # a refusal's reason, by name
+    assert "Iq: 5.0 A" in text and "Vbus: 24.1 V" in text
+    assert "DriveFault_HwOvercurrent: 1" in text and "DriveFault_EncoderMismatch: 1" in text
     assert "ClearErrors(" in text
     assert "Stop(" in text and "Reset(" in text
 

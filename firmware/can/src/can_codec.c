@@ -109,8 +109,45 @@ pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t 
   return POUR_OK;
 }
 
+static int calibration_ok(const pour_can_calibration_result_t *m) {
+  return m->status <= POUR_CAN_CAL_STATUS_MAX && m->stored <= POUR_CAN_CAL_STORED_MAX && m->encoder_reversed <= 1u &&
+         m->pole_pairs <= POUR_CAN_POLE_PAIRS_MAX;
+}
+
+pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_calibration_result_t *msg,
+                                               pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !calibration_ok(msg)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_CALIBRATION_RESULT, POUR_CAN_DLC_CALIBRATION_RESULT);
+  frame->data[0] = (uint8_t)(msg->status | (uint8_t)(msg->stored << 4));
+  frame->data[1] = msg->encoder_reversed;
+  frame->data[2] = msg->pole_pairs;
+  put_u16(&frame->data[3], msg->resistance_mohm);
+  put_u16(&frame->data[5], msg->inductance_uh);
+  frame->data[7] = msg->electrical_offset;
+  return POUR_OK;
+}
+
+static int current_ok(int16_t i) { return i >= -POUR_CAN_CURRENT_MAX; }
+
+pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_drive_telemetry_t *msg,
+                                            pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !current_ok(msg->id_2ma) ||
+      !current_ok(msg->iq_2ma)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_DRIVE_TELEMETRY, POUR_CAN_DLC_DRIVE_TELEMETRY);
+  put_u16(&frame->data[0], i16_bits(msg->id_2ma));
+  put_u16(&frame->data[2], i16_bits(msg->iq_2ma));
+  put_u16(&frame->data[4], msg->vbus_mv);
+  put_u16(&frame->data[6], (uint16_t)(msg->drive_faults & POUR_CAN_DRIVE_FAULT_MASK));
+  return POUR_OK;
+}
+
 static int is_signal_free_command(uint8_t cmd) {
-  return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET;
+  return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET ||
+         cmd == POUR_CAN_CMD_CALIBRATION_START;
 }
 
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame) {
@@ -127,6 +164,9 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_ESTOP: return (int)POUR_CAN_DLC_ESTOP;
     case POUR_CAN_CMD_STOP: return (int)POUR_CAN_DLC_STOP;
     case POUR_CAN_CMD_IDENTITY: return (int)POUR_CAN_DLC_IDENTITY;
+    case POUR_CAN_CMD_CALIBRATION_START: return (int)POUR_CAN_DLC_CALIBRATION_START;
+    case POUR_CAN_CMD_CALIBRATION_RESULT: return (int)POUR_CAN_DLC_CALIBRATION_RESULT;
+    case POUR_CAN_CMD_DRIVE_TELEMETRY: return (int)POUR_CAN_DLC_DRIVE_TELEMETRY;
     case POUR_CAN_CMD_RESET: return (int)POUR_CAN_DLC_RESET;
     case POUR_CAN_CMD_SENSORS: return (int)POUR_CAN_DLC_SENSORS;
     case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
@@ -244,4 +284,41 @@ pour_can_rx_t pour_can_classify(const pour_can_frame_t *frame, uint8_t node_id, 
     return POUR_CAN_RX_BAD_ID;
   }
   return frame->dlc == (uint8_t)dlc ? POUR_CAN_RX_OK : POUR_CAN_RX_BAD_DLC;
+}
+
+pour_can_rx_t pour_can_unpack_calibration_result(const pour_can_frame_t *frame, pour_can_calibration_result_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_CALIBRATION_RESULT);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  pour_can_calibration_result_t m;
+  m.status = (uint8_t)(frame->data[0] & 0x0Fu);
+  m.stored = (uint8_t)(frame->data[0] >> 4);
+  m.encoder_reversed = (uint8_t)(frame->data[1] & 1u); /* bits 9..15 are not signals */
+  m.pole_pairs = frame->data[2];
+  m.resistance_mohm = get_u16(&frame->data[3]);
+  m.inductance_uh = get_u16(&frame->data[5]);
+  m.electrical_offset = frame->data[7];
+  if (!calibration_ok(&m)) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  *msg = m;
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_drive_telemetry(const pour_can_frame_t *frame, pour_can_drive_telemetry_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_DRIVE_TELEMETRY);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  const int16_t id = as_i16(get_u16(&frame->data[0]));
+  const int16_t iq = as_i16(get_u16(&frame->data[2]));
+  if (!current_ok(id) || !current_ok(iq)) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->id_2ma = id;
+  msg->iq_2ma = iq;
+  msg->vbus_mv = get_u16(&frame->data[4]);
+  msg->drive_faults = (uint16_t)(get_u16(&frame->data[6]) & POUR_CAN_DRIVE_FAULT_MASK);
+  return POUR_CAN_RX_OK;
 }

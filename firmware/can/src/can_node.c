@@ -5,7 +5,8 @@
 
 /* Commands a controller accepts; HEARTBEAT, IDENTITY and TORQUE are its own transmissions. */
 #define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_SENSORS) | \
-                     (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET))
+                     (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET) |                             \
+                     (1u << POUR_CAN_CMD_CALIBRATION_START))
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
@@ -29,6 +30,8 @@ pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_conf
   node->config = *config;
   node->ms_to_heartbeat = 0;
   pour_commands_init(&node->commands);
+  node->calibration.status = POUR_CAN_CAL_UNAVAILABLE;
+  node->calibration.stored = POUR_CAN_CAL_EMPTY;
   return POUR_OK;
 }
 
@@ -105,6 +108,10 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       pour_commands_reset(&node->commands);
       kick(node);
       break;
+    case POUR_CAN_CMD_CALIBRATION_START: /* answered, or refused with its reason, at the end of the tick */
+      node->calibration_requested = true;
+      kick(node);
+      break;
     default: /* POUR_CAN_CMD_CLEAR_ERRORS */
       pour_commands_clear(&node->commands);
       kick(node);
@@ -179,5 +186,21 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
     node->ms_to_heartbeat = node->config.heartbeat_period_ms;
   }
   --node->ms_to_heartbeat;
+  if (node->calibration_requested) {
+    pour_can_calibration_result_t r = node->calibration;
+    if (out->mode == (uint8_t)POUR_MODE_RUN) {
+      r.status = POUR_CAN_CAL_REFUSED_RUNNING;
+    } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
+      r.status = POUR_CAN_CAL_REFUSED_ESTOP;
+    }
+    if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
+      ++n;
+    }
+    node->calibration_requested = false;
+  }
   return n;
+}
+
+void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
+  node->calibration = *result;
 }

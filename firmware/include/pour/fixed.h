@@ -18,7 +18,8 @@ typedef enum {
   POUR_EINVAL = -1,  /* a null pointer or an argument outside its documented range */
   POUR_ESHAPE = -2,  /* weights with an unsupported shape (features, actions) */
   POUR_EFORMAT = -3, /* weights with an unsupported Q format or format version */
-  POUR_ECORRUPT = -4 /* weights whose content hash does not match */
+  POUR_ECORRUPT = -4,    /* weights whose content hash does not match */
+  POUR_ECALIBRATION = -5 /* no valid drive calibration (none stored, corrupt, an older format, out of range) */
 } pour_status_t;
 
 /* Name of a status value, for logs and error messages. */

@@ -1,134 +1,143 @@
 /* SPDX-License-Identifier: MIT */
-/* The STM32G431 board: core clock (PLL, 170 MHz), the brake, power and e-stop lines, the independent
- * watchdog, and FDCAN1 behind hal_can. Register addresses and fields from RM0440.
- *   PB0  e-stop input, active low, pull-up (an open circuit asserts it)
- *   PB1  brake release, high = released (reset state low: engaged)
- *   PB2  power stage enable, high = on (reset state low: off) */
+/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring, and which pin was checked against what): core
+ * clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent watchdog, the LED, and
+ * FDCAN1 behind hal_can. Registers and fields from stm32g431_regs.h's table (checked against ST's
+ * description of the chip by tests/board/check_registers.py).
+ *   PA15  e-stop input (the board's PWM-input pad): a normally-closed chain from 3.3 V holds it high;
+ *         pull-down, so an open contact or a broken wire reads low = asserted
+ *   PB12  brake release (the potentiometer pad), high = released; an external pull-down keeps the brake
+ *         engaged through reset and while the MCU is unpowered
+ *   PB8   power stage enable (J8's index pin, unused: the output encoder gives the absolute angle), high =
+ *         on; external pull-down (it also holds BOOT0 low: boot from flash)
+ *   PA11, PB9  FDCAN1 RX, TX (AF9); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
+ *   PC6   LED (red), high = on */
 #include <stddef.h>
 
+#include "adc_inj.h"
+#include "calibration_store.h"
 #include "clock.h"
+#include "encoder_tim4.h"
 #include "fdcan.h"
+#include "gpio.h"
+#include "hal_drive.h"
+#include "ocp.h"
+#include "opamp.h"
+#include "pwm_tim1.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
+#include "hal_led.h"
+#include "hal_timer.h"
+#include "led.h"
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
 #include "safe_outputs.h"
+#include "stm32g431_regs.h"
 
-#define REG(addr) (*(volatile uint32_t *)(uintptr_t)(addr))
-#define RCC_CR REG(0x40021000u)
-#define RCC_CFGR REG(0x40021008u)
-#define RCC_PLLCFGR REG(0x4002100Cu)
-#define RCC_AHB2ENR REG(0x4002104Cu)
-#define RCC_APB1ENR1 REG(0x40021058u)
-#define PWR_CR5 REG(0x40007080u)
-#define FLASH_ACR REG(0x40022000u)
-#define IWDG_KR REG(0x40003000u)
-#define IWDG_PR REG(0x40003004u)
-#define IWDG_RLR REG(0x40003008u)
-#define IWDG_SR REG(0x4000300Cu)
-#define GPIOB_MODER REG(0x48000400u)
-#define GPIOB_PUPDR REG(0x4800040Cu)
-#define GPIOB_IDR REG(0x48000410u)
-#define GPIOB_ODR REG(0x48000414u)
-#define GPIOB_BSRR REG(0x48000418u)
-
-#define PIN_ESTOP 0u
-#define PIN_BRAKE 1u
-#define PIN_POWER 2u
-#define HSI16_HZ 16000000u
-#define PLL_HZ 170000000u
+#define RCC_R POUR_PERIPH(RCC)
+#define GPIOA_R POUR_PERIPH(GPIOA)
+#define GPIOB_R POUR_PERIPH(GPIOB)
+#define GPIOC_R POUR_PERIPH(GPIOC)
+#define AF_FDCAN1 9u
+#define CAN_TERMINATED true /* this node ends the bench's bus (the rig's sensor node is the other end) */
 #define WAIT_POLLS 100000u /* bound of every ready-flag wait: a flag that never comes is an error */
 
-static int wait_set(volatile uint32_t *reg, uint32_t mask, uint32_t want) {
-  for (uint32_t i = 0; i < WAIT_POLLS; ++i) {
-    if ((*reg & mask) == want) {
-      return 0;
-    }
-  }
-  return -1;
+static const pour_gpio_t estop = {GPIOA_R, 15u};
+static const pour_gpio_t brake = {GPIOB_R, 12u};
+static const pour_gpio_t power = {GPIOB_R, 8u};
+static const pour_gpio_t led = {GPIOC_R, 6u};
+static const pour_gpio_t can_rx = {GPIOA_R, 11u};
+static const pour_gpio_t can_tx = {GPIOB_R, 9u};
+static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
+static const pour_gpio_t can_termination = {GPIOC_R, 14u};
+
+static pour_pwm_t pwm;
+static pour_adc_t adc;
+static pour_ocp_t ocp;
+
+static void clock_on(uint32_t enr, uint32_t mask) {
+  RCC_R[enr] |= mask;
+  (void)RCC_R[enr]; /* the enable takes effect before the peripheral is touched */
 }
+
+static pour_clock_source_t clock_source = POUR_CLOCK_HSI16;
 
 pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
-  *core_clock_hz = HSI16_HZ;
-  RCC_APB1ENR1 |= 1u << 28;                               /* PWREN */
-  (void)RCC_APB1ENR1;
-  RCC_CFGR = (RCC_CFGR & ~(0xFu << 4)) | (0x8u << 4);     /* HPRE /2 while entering boost mode */
-  PWR_CR5 &= ~(1u << 8);                                  /* R1MODE = 0: range 1 boost, up to 170 MHz */
-  FLASH_ACR = (FLASH_ACR & ~0xFu) | 4u | (7u << 8);       /* 4 wait states; prefetch, I- and D-cache on */
-  if (wait_set(&FLASH_ACR, 0xFu, 4u) != 0) {
-    return POUR_EINVAL;
-  }
-  /* HSI16 / M 4 * N 85 = 340 MHz VCO, / R 2 = 170 MHz. */
-  RCC_PLLCFGR = 2u | (3u << 4) | (85u << 8) | (1u << 24); /* PLLSRC HSI16, PLLM-1, PLLN, PLLREN; PLLR /2 */
-  RCC_CR |= 1u << 24;                                     /* PLLON */
-  if (wait_set(&RCC_CR, 1u << 25, 1u << 25) != 0) {       /* PLLRDY */
-    RCC_CFGR &= ~(0xFu << 4);
-    return POUR_EINVAL;
-  }
-  RCC_CFGR = (RCC_CFGR & ~3u) | 3u;                       /* SW = PLL */
-  if (wait_set(&RCC_CFGR, 3u << 2, 3u << 2) != 0) {       /* SWS = PLL */
-    RCC_CFGR &= ~(0xFu << 4);
-    return POUR_EINVAL;
-  }
-  for (volatile uint32_t i = 0; i < 200u; ++i) {          /* >= 1 µs at 85 MHz before HPRE /1 */
-  }
-  RCC_CFGR &= ~((0xFu << 4) | (7u << 8) | (7u << 11));   /* HPRE, PPRE1, PPRE2 /1: 170 MHz everywhere */
-  *core_clock_hz = PLL_HZ;
-  return POUR_OK;
+  const pour_clock_hw_t hw = {POUR_PERIPH(RCC), POUR_PERIPH(PWR), POUR_PERIPH(FLASH)};
+  const pour_clock_config_t config = pour_clock_default_config();
+  return pour_clock_setup(&hw, &config, core_clock_hz, &clock_source);
 }
 
-static void gpiob_output(uint32_t pin) {
-  RCC_AHB2ENR |= 1u << 1; /* GPIOBEN */
-  (void)RCC_AHB2ENR;
-  GPIOB_BSRR = 1u << (pin + 16u); /* low first: the safe level */
-  GPIOB_MODER = (GPIOB_MODER & ~(3u << (2u * pin))) | (1u << (2u * pin));
+pour_clock_source_t pour_clock_source(void) { return clock_source; }
+
+static void ports_on(void) {
+  clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, GPIOAEN) | POUR_MSK(RCC, AHB2ENR, GPIOBEN) |
+                                 POUR_MSK(RCC, AHB2ENR, GPIOCEN));
 }
 
-void pour_hal_brake_init(void) { gpiob_output(PIN_BRAKE); }
+void pour_hal_brake_init(void) {
+  ports_on();
+  pour_gpio_output(brake, false);
+}
 
-void pour_hal_brake_set(bool engage) { GPIOB_BSRR = engage ? 1u << (PIN_BRAKE + 16u) : 1u << PIN_BRAKE; }
+void pour_hal_brake_set(bool engage) { pour_gpio_write(brake, !engage); }
 
-bool pour_hal_brake_engaged(void) { return (GPIOB_ODR & (1u << PIN_BRAKE)) == 0u; }
+bool pour_hal_brake_engaged(void) { return !pour_gpio_driven(brake); }
 
-void pour_hal_power_init(void) { gpiob_output(PIN_POWER); }
+void pour_hal_power_init(void) {
+  ports_on();
+  pour_gpio_output(power, false);
+}
 
-void pour_hal_power_set(bool on) { GPIOB_BSRR = on ? 1u << PIN_POWER : 1u << (PIN_POWER + 16u); }
+void pour_hal_power_set(bool on) { pour_gpio_write(power, on); }
 
-bool pour_hal_power_on(void) { return (GPIOB_ODR & (1u << PIN_POWER)) != 0u; }
+bool pour_hal_power_on(void) { return pour_gpio_driven(power); }
 
 void pour_hal_estop_init(void) {
-  RCC_AHB2ENR |= 1u << 1;
-  (void)RCC_AHB2ENR;
-  GPIOB_MODER &= ~(3u << (2u * PIN_ESTOP));                                         /* input */
-  GPIOB_PUPDR = (GPIOB_PUPDR & ~(3u << (2u * PIN_ESTOP))) | (1u << (2u * PIN_ESTOP)); /* pull-up */
+  ports_on();
+  pour_gpio_output(led, false);
+  pour_gpio_input(estop, POUR_GPIO_PULL_DOWN);
 }
 
-bool pour_hal_estop_asserted(void) { return (GPIOB_IDR & (1u << PIN_ESTOP)) == 0u; }
+bool pour_hal_estop_asserted(void) { return !pour_gpio_read(estop); }
 
 void pour_hal_watchdog_start(uint32_t timeout_ms) {
-  IWDG_KR = 0xCCCCu; /* start (LSI 32 kHz) */
-  IWDG_KR = 0x5555u; /* unlock PR and RLR */
-  IWDG_PR = 0u;      /* /4: 8 counts per ms */
-  IWDG_RLR = timeout_ms * 8u - 1u;
-  (void)wait_set(&IWDG_SR, 0x7u, 0u); /* the new values reached the IWDG's clock domain */
-  IWDG_KR = 0xAAAAu;
+  volatile uint32_t *const iwdg = POUR_PERIPH(IWDG);
+  iwdg[POUR_IWDG_KR] = 0xCCCCu; /* start (LSI 32 kHz) */
+  iwdg[POUR_IWDG_KR] = 0x5555u; /* unlock PR and RLR */
+  iwdg[POUR_IWDG_PR] = POUR_VAL(IWDG, PR, PR, 0u); /* /4: 8 counts per ms */
+  iwdg[POUR_IWDG_RLR] = POUR_VAL(IWDG, RLR, RL, timeout_ms * 8u - 1u);
+  /* the new values reached the IWDG's clock domain */
+  (void)pour_regs_wait(&iwdg[POUR_IWDG_SR], POUR_MSK(IWDG, SR, PVU) | POUR_MSK(IWDG, SR, RVU) | POUR_MSK(IWDG, SR, WVU), 0u,
+                       WAIT_POLLS);
+  iwdg[POUR_IWDG_KR] = 0xAAAAu;
 }
 
-void pour_hal_watchdog_feed(void) { IWDG_KR = 0xAAAAu; }
+void pour_hal_watchdog_feed(void) { POUR_PERIPH(IWDG)[POUR_IWDG_KR] = 0xAAAAu; }
 
 /* Called from every fault exception (startup.c): the outputs to their safe levels, whatever state the
  * program is in; the watchdog then resets the MCU, which starts again with the brake engaged. */
 void pour_safe_outputs(void) {
-  GPIOB_BSRR = (1u << (PIN_BRAKE + 16u)) | (1u << (PIN_POWER + 16u));
+  pour_gpio_write(brake, false);
+  pour_gpio_write(power, false);
+  pour_hal_drive_short_low_sides(); /* damping, never coasting, until the brake holds */
   pour_hal_motor_set_torque(0);
 }
+
+void pour_hal_led_show(uint8_t mode, bool refused) { pour_gpio_write(led, pour_led_pattern(mode, refused, pour_hal_timer_ticks())); }
 
 static pour_fdcan_t fdcan;
 
 pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
-  pour_fdcan_stm32g4_board_init();
+  RCC_R[POUR_RCC_CCIPR] = (RCC_R[POUR_RCC_CCIPR] & ~POUR_MSK(RCC, CCIPR, FDCANSEL)) | POUR_VAL(RCC, CCIPR, FDCANSEL, 2u);
+  clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, FDCANEN));
+  ports_on();
+  pour_gpio_alternate(can_rx, AF_FDCAN1);
+  pour_gpio_alternate(can_tx, AF_FDCAN1);
+  pour_gpio_output(can_termination, CAN_TERMINATED);
+  pour_gpio_output(can_shutdown, false);
   pour_fdcan_config_t fc = pour_fdcan_default_config();
   fc.kernel_clock_hz = clock_hz;
   fc.node_id = node_id;
@@ -140,3 +149,109 @@ void pour_hal_can_poll(void) { (void)pour_fdcan_poll(&fdcan); }
 int pour_hal_can_receive(pour_can_frame_t *frame) { return pour_fdcan_receive(&fdcan, frame); }
 
 int pour_hal_can_transmit(const pour_can_frame_t *frame) { return pour_fdcan_transmit(&fdcan, frame); }
+
+/* The motor's power stage (hal_drive). Alternate functions from the STM32G431's datasheet (DS12589, table
+ * "alternate functions"): TIM1 CH1..3 on PA8..PA10 AF6, CH1N on PC13 AF4, CH2N on PA12 AF6, CH3N on PB15
+ * AF4; TIM4 CH1, CH2 on PB6, PB7 AF2. */
+static const struct {
+  pour_gpio_t pin;
+  uint8_t af;
+} gates[6] = {{{GPIOA_R, 8u}, 6u},  {{GPIOA_R, 9u}, 6u},  {{GPIOA_R, 10u}, 6u},
+              {{GPIOC_R, 13u}, 4u}, {{GPIOA_R, 12u}, 6u}, {{GPIOB_R, 15u}, 4u}};
+/* OPAMP inputs and outputs, the bus divider, the NTC: PA0..PA3, PA5..PA7, PB0..PB2, PB14. */
+static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R, 2u}, {GPIOA_R, 3u},
+                                          {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
+                                          {GPIOB_R, 1u}, {GPIOB_R, 2u}, {GPIOB_R, 14u}};
+#define ENCODER_FILTER 6u   /* f_DTS / 4, N = 6: 141 ns at 170 MHz */
+#define OPAMP_GAIN 0u /* the board's feedback network (opamp.h) */
+#define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
+
+
+pour_status_t pour_hal_drive_init(void) {
+  for (unsigned i = 0; i < 6u; ++i) {
+    pour_gpio_output(gates[i].pin, false); /* all six off while TIM1 is set up */
+  }
+  clock_on(POUR_RCC_APB2ENR, POUR_MSK(RCC, APB2ENR, TIM1EN) | POUR_MSK(RCC, APB2ENR, SYSCFGEN));
+  clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, TIM4EN));
+  clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, ADC12EN) | POUR_MSK(RCC, AHB2ENR, DAC3EN));
+  for (unsigned i = 0; i < sizeof analog_pins / sizeof analog_pins[0]; ++i) {
+    pour_gpio_analog(analog_pins[i]);
+  }
+  const pour_pwm_config_t pc = pour_pwm_default_config();
+  if (pour_pwm_init(&pwm, POUR_PERIPH(TIM1), &pc) != POUR_OK) {
+    return POUR_EINVAL;
+  }
+  for (unsigned i = 0; i < 6u; ++i) {
+    pour_gpio_alternate(gates[i].pin, gates[i].af); /* the timer, all six off, takes the pins */
+  }
+  const pour_gpio_t enc_a = {GPIOB_R, 6u};
+  const pour_gpio_t enc_b = {GPIOB_R, 7u};
+  pour_gpio_alternate(enc_a, 2u);
+  pour_gpio_alternate(enc_b, 2u);
+  if (pour_opamp_init(POUR_PERIPH(OPAMP), OPAMP_GAIN) != POUR_OK ||
+      pour_encoder_init(POUR_PERIPH(TIM4), ENCODER_FILTER, 0) != POUR_OK ||
+      pour_adc_init(&adc, POUR_PERIPH(ADC1), POUR_PERIPH(ADC2), POUR_PERIPH(ADC12_COMMON), WAIT_POLLS,
+                    ADC_REGULATOR_WAIT) != POUR_OK) {
+    return POUR_EINVAL;
+  }
+  return POUR_OK;
+}
+
+uint16_t pour_hal_drive_period(void) { return pwm.period; }
+
+bool pour_hal_drive_sample(pour_hal_drive_sample_t *sample) {
+  pour_adc_sample_t s;
+  if (adc.adc1 == NULL || !pour_adc_read(&adc, &s)) {
+    return false;
+  }
+  for (unsigned i = 0; i < 3u; ++i) {
+    sample->phase[i] = s.phase[i];
+  }
+  sample->vbus = s.vbus;
+  sample->ntc = s.ntc;
+  sample->encoder = pour_encoder_count(POUR_PERIPH(TIM4));
+  return true;
+}
+
+void pour_hal_drive_set_compares(const uint16_t compare[3]) { pour_pwm_set_compares(&pwm, compare); }
+
+void pour_hal_drive_enable(bool on) { pour_pwm_enable(&pwm, on); }
+
+void pour_hal_drive_short_low_sides(void) {
+  if (pwm.regs != NULL) {
+    pour_pwm_short_low_sides(&pwm);
+  }
+}
+
+pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
+  const pour_ocp_config_t oc = pour_ocp_default_config();
+  return pour_ocp_init(&ocp, POUR_PERIPH(COMP), POUR_PERIPH(DAC3), &oc, offset_counts);
+}
+
+bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
+
+void pour_hal_drive_clear_overcurrent(void) { pour_pwm_clear_break(&pwm); }
+
+/* The calibration: the block in the page the linker script leaves (hal_calibration). */
+static pour_calibration_t calibration;
+static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
+
+pour_status_t pour_hal_calibration_load(void) {
+  const pour_flash_t f = {POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE,
+                          WAIT_POLLS};
+  calibration_status = pour_calibration_load(&f, &calibration);
+  return calibration_status == POUR_CAL_OK ? POUR_OK : POUR_ECALIBRATION;
+}
+
+int pour_hal_calibration_reason(void) { return (int)calibration_status; }
+
+void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
+  const bool ok = calibration_status == POUR_CAL_OK;
+  r->status = POUR_CAN_CAL_UNAVAILABLE;
+  r->stored = (uint8_t)calibration_status; /* POUR_CAN_CAL_OK .. _WRITE_FAILED are pour_cal_status_t's values */
+  r->encoder_reversed = ok && calibration.encoder_direction < 0 ? 1u : 0u;
+  r->pole_pairs = ok ? (uint8_t)calibration.pole_pairs : 0u;
+  r->resistance_mohm = ok ? (uint16_t)(calibration.r_phase_uohm / 1000u) : 0u;
+  r->inductance_uh = ok ? (uint16_t)(calibration.l_phase_nh / 1000u) : 0u;
+  r->electrical_offset = ok ? (uint8_t)(calibration.electrical_offset >> 8) : 0u;
+}

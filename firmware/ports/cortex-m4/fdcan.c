@@ -3,33 +3,11 @@
 
 #include <stddef.h>
 
-/* CCCR */
-#define CCCR_INIT (1u << 0)
-#define CCCR_CCE (1u << 1)
-#define CCCR_ASM (1u << 2)
-#define CCCR_MON (1u << 5)
-#define CCCR_DAR (1u << 6)
-#define CCCR_TEST (1u << 7)
-#define CCCR_FDOE (1u << 8)
-#define CCCR_BRSE (1u << 9)
-/* PSR */
-#define PSR_BO (1u << 7)
-/* IR */
-#define IR_RF0L (1u << 2)
-/* RXGFC */
-#define RXGFC_RRFE (1u << 0)
-#define RXGFC_RRFS (1u << 1)
-#define RXGFC_ANFE_REJECT (2u << 2)
-#define RXGFC_ANFS_REJECT (2u << 4)
-#define RXGFC_F0OM_OVERWRITE (1u << 9)
-#define RXGFC_LSS_POS 16u
-/* RXF0S */
-#define RXF0S_F0FL_MASK 0xFu
-#define RXF0S_F0GI_POS 8u
-#define RXF0S_RF0L (1u << 25)
-/* TXFQS */
-#define TXFQS_TFQPI_POS 16u
-#define TXFQS_TFQF (1u << 21)
+#define CCCR_INIT POUR_MSK(FDCAN, CCCR, INIT)
+#define CCCR_CCE POUR_MSK(FDCAN, CCCR, CCE)
+#define IR_RF0L POUR_MSK(FDCAN, IR, RF0L)
+#define RXF0S_RF0L POUR_MSK(FDCAN, RXF0S, RF0L)
+#define RXGFC_REJECT 2u /* ANFS, ANFE: reject frames no filter accepts */
 /* Element header words */
 #define E0_XTD (1u << 30)
 #define E0_RTR (1u << 29)
@@ -84,18 +62,6 @@ pour_fdcan_hw_t pour_fdcan_stm32g4_fdcan1(void) {
   return hw;
 }
 
-void pour_fdcan_stm32g4_board_init(void) {
-  volatile uint32_t *const rcc = (volatile uint32_t *)(uintptr_t)0x40021000u;
-  volatile uint32_t *const gpioa = (volatile uint32_t *)(uintptr_t)0x48000000u;
-  rcc[0x88u / 4u] = (rcc[0x88u / 4u] & ~(3u << 24)) | (2u << 24); /* CCIPR.FDCANSEL = PCLK1 */
-  rcc[0x4Cu / 4u] |= 1u << 0;                                      /* AHB2ENR.GPIOAEN */
-  rcc[0x58u / 4u] |= 1u << 25;                                     /* APB1ENR1.FDCANEN */
-  (void)rcc[0x58u / 4u];                                           /* the enable takes effect */
-  /* PA11 = FDCAN1_RX, PA12 = FDCAN1_TX: alternate function 9. */
-  gpioa[0x00u / 4u] = (gpioa[0x00u / 4u] & ~((3u << 22) | (3u << 24))) | (2u << 22) | (2u << 24);
-  gpioa[0x24u / 4u] = (gpioa[0x24u / 4u] & ~((0xFu << 12) | (0xFu << 16))) | (9u << 12) | (9u << 16);
-}
-
 static int wait_init(const pour_fdcan_t *can, uint32_t want) {
   for (uint32_t i = 0; i < can->config.init_timeout; ++i) {
     if ((can->hw.regs[POUR_FDCAN_CCCR] & CCCR_INIT) == want) {
@@ -124,9 +90,10 @@ pour_status_t pour_fdcan_init(pour_fdcan_t *can, pour_fdcan_hw_t hw, const pour_
   }
   r[POUR_FDCAN_CCCR] |= CCCR_CCE;
   /* Classic CAN, automatic retransmission, normal (not monitoring, restricted or test) operation. */
-  r[POUR_FDCAN_CCCR] &= ~(CCCR_FDOE | CCCR_BRSE | CCCR_DAR | CCCR_ASM | CCCR_MON | CCCR_TEST);
-  r[POUR_FDCAN_NBTP] = ((uint32_t)(t.sjw - 1u) << 25) | ((uint32_t)(t.prescaler - 1u) << 16) |
-                       ((uint32_t)(t.tseg1 - 1u) << 8) | (uint32_t)(t.tseg2 - 1u);
+  r[POUR_FDCAN_CCCR] &= ~(POUR_MSK(FDCAN, CCCR, FDOE) | POUR_MSK(FDCAN, CCCR, BRSE) | POUR_MSK(FDCAN, CCCR, DAR) |
+                          POUR_MSK(FDCAN, CCCR, ASM) | POUR_MSK(FDCAN, CCCR, MON) | POUR_MSK(FDCAN, CCCR, TEST));
+  r[POUR_FDCAN_NBTP] = POUR_VAL(FDCAN, NBTP, NSJW, t.sjw - 1u) | POUR_VAL(FDCAN, NBTP, NBRP, t.prescaler - 1u) |
+                       POUR_VAL(FDCAN, NBTP, NTSEG1, t.tseg1 - 1u) | POUR_VAL(FDCAN, NBTP, NTSEG2, t.tseg2 - 1u);
 
   for (uint32_t i = 0; i < POUR_FDCAN_RAM_WORDS; ++i) {
     hw.ram[i] = 0u; /* the message RAM is not reset with the peripheral */
@@ -135,8 +102,9 @@ pour_status_t pour_fdcan_init(pour_fdcan_t *can, pour_fdcan_hw_t hw, const pour_
                                ((uint32_t)pour_can_id(config->node_id, 0) << SF_ID1_POS) | POUR_CAN_NODE_MASK;
   /* One standard filter; everything else (other nodes, extended and remote frames) is rejected in
    * hardware. FIFO 0 overwrites: with three elements, the newest state must win. */
-  r[POUR_FDCAN_RXGFC] = (1u << RXGFC_LSS_POS) | RXGFC_F0OM_OVERWRITE | RXGFC_ANFS_REJECT | RXGFC_ANFE_REJECT |
-                        RXGFC_RRFS | RXGFC_RRFE;
+  r[POUR_FDCAN_RXGFC] = POUR_VAL(FDCAN, RXGFC, LSS, 1u) | POUR_MSK(FDCAN, RXGFC, F0OM) |
+                        POUR_VAL(FDCAN, RXGFC, ANFS, RXGFC_REJECT) | POUR_VAL(FDCAN, RXGFC, ANFE, RXGFC_REJECT) |
+                        POUR_MSK(FDCAN, RXGFC, RRFS) | POUR_MSK(FDCAN, RXGFC, RRFE);
   r[POUR_FDCAN_TXBC] = 0u;  /* TX FIFO mode (not queue) */
   r[POUR_FDCAN_IE] = 0u;    /* polled from the 1 kHz loop */
   r[POUR_FDCAN_IR] = 0xFFFFFFFFu;
@@ -150,10 +118,10 @@ int pour_fdcan_receive(pour_fdcan_t *can, pour_can_frame_t *frame) {
   /* Bounded: at most the FIFO's depth of rejected elements is skipped per call. */
   for (unsigned n = 0; n < POUR_FDCAN_FIFO_ELEMENTS; ++n) {
     const uint32_t status = r[POUR_FDCAN_RXF0S];
-    if ((status & RXF0S_F0FL_MASK) == 0u) {
+    if (POUR_GET(FDCAN, RXF0S, F0FL, status) == 0u) {
       return 0;
     }
-    const uint32_t gi = (status >> RXF0S_F0GI_POS) & 3u;
+    const uint32_t gi = POUR_GET(FDCAN, RXF0S, F0GI, status);
     const volatile uint32_t *e = &can->hw.ram[POUR_FDCAN_RAM_RF0 + gi * POUR_FDCAN_ELEMENT_WORDS];
     const uint32_t e0 = e[0];
     const uint32_t e1 = e[1];
@@ -180,11 +148,11 @@ int pour_fdcan_receive(pour_fdcan_t *can, pour_can_frame_t *frame) {
 int pour_fdcan_transmit(pour_fdcan_t *can, const pour_can_frame_t *frame) {
   volatile uint32_t *r = can->hw.regs;
   const uint32_t status = r[POUR_FDCAN_TXFQS];
-  if ((status & TXFQS_TFQF) != 0u || frame->dlc > 8u) {
+  if ((status & POUR_MSK(FDCAN, TXFQS, TFQF)) != 0u || frame->dlc > 8u) {
     can->tx_full++;
     return -1;
   }
-  const uint32_t pi = (status >> TXFQS_TFQPI_POS) & 3u;
+  const uint32_t pi = POUR_GET(FDCAN, TXFQS, TFQPI, status);
   volatile uint32_t *e = &can->hw.ram[POUR_FDCAN_RAM_TXQ + pi * POUR_FDCAN_ELEMENT_WORDS];
   uint32_t d0 = 0u;
   uint32_t d1 = 0u;
@@ -207,7 +175,7 @@ int pour_fdcan_poll(pour_fdcan_t *can) {
     can->rx_lost++;
     r[POUR_FDCAN_IR] = IR_RF0L; /* write 1 to clear */
   }
-  if ((r[POUR_FDCAN_PSR] & PSR_BO) == 0u) {
+  if ((r[POUR_FDCAN_PSR] & POUR_MSK(FDCAN, PSR, BO)) == 0u) {
     return 0;
   }
   /* Bus-off sets INIT; clearing it starts the recovery (128 x 11 recessive bits), then the bus again. */

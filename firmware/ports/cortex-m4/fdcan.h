@@ -18,23 +18,51 @@
 
 #include "pour/can_codec.h"
 #include "pour/fixed.h"
+#include "regs.h"
 
-/* Register offsets [32-bit words] from the instance base (RM0440). */
-enum {
-  POUR_FDCAN_CCCR = 0x018 / 4,
-  POUR_FDCAN_NBTP = 0x01C / 4,
-  POUR_FDCAN_ECR = 0x040 / 4,
-  POUR_FDCAN_PSR = 0x044 / 4,
-  POUR_FDCAN_IR = 0x050 / 4,
-  POUR_FDCAN_IE = 0x054 / 4,
-  POUR_FDCAN_RXGFC = 0x080 / 4,
-  POUR_FDCAN_RXF0S = 0x090 / 4,
-  POUR_FDCAN_RXF0A = 0x094 / 4,
-  POUR_FDCAN_TXBC = 0x0C0 / 4,
-  POUR_FDCAN_TXFQS = 0x0C4 / 4,
-  POUR_FDCAN_TXBAR = 0x0CC / 4,
-  POUR_FDCAN_N_REGS = 0x100 / 4
-};
+/* The registers and fields the driver uses (regs.h's table form; RM0440 names). */
+#define POUR_FDCAN_PERIPHS(P) P(FDCAN1, FDCAN, 0x40006400) P(SRAMCAN, SRAMCAN, 0x4000A400)
+#define POUR_FDCAN_REGS(R)                                                                                     \
+  R(FDCAN, CCCR, 0x018)                                                                                        \
+  R(FDCAN, NBTP, 0x01C)                                                                                        \
+  R(FDCAN, ECR, 0x040)                                                                                         \
+  R(FDCAN, PSR, 0x044)                                                                                         \
+  R(FDCAN, IR, 0x050)                                                                                          \
+  R(FDCAN, IE, 0x054)                                                                                          \
+  R(FDCAN, RXGFC, 0x080)                                                                                       \
+  R(FDCAN, RXF0S, 0x090)                                                                                       \
+  R(FDCAN, RXF0A, 0x094)                                                                                       \
+  R(FDCAN, TXBC, 0x0C0)                                                                                        \
+  R(FDCAN, TXFQS, 0x0C4)                                                                                       \
+  R(FDCAN, TXBAR, 0x0CC)
+#define POUR_FDCAN_FIELDS(F)                                                                                   \
+  F(FDCAN, CCCR, INIT, 0, 1)                                                                                   \
+  F(FDCAN, CCCR, CCE, 1, 1)                                                                                    \
+  F(FDCAN, CCCR, ASM, 2, 1)                                                                                    \
+  F(FDCAN, CCCR, MON, 5, 1)                                                                                    \
+  F(FDCAN, CCCR, DAR, 6, 1)                                                                                    \
+  F(FDCAN, CCCR, TEST, 7, 1)                                                                                   \
+  F(FDCAN, CCCR, FDOE, 8, 1)                                                                                   \
+  F(FDCAN, CCCR, BRSE, 9, 1)                                                                                   \
+  F(FDCAN, NBTP, NTSEG2, 0, 7)                                                                                 \
+  F(FDCAN, NBTP, NTSEG1, 8, 8)                                                                                 \
+  F(FDCAN, NBTP, NBRP, 16, 9)                                                                                  \
+  F(FDCAN, NBTP, NSJW, 25, 7)                                                                                  \
+  F(FDCAN, PSR, BO, 7, 1)                                                                                      \
+  F(FDCAN, IR, RF0L, 2, 1)                                                                                     \
+  F(FDCAN, RXGFC, RRFE, 0, 1)                                                                                  \
+  F(FDCAN, RXGFC, RRFS, 1, 1)                                                                                  \
+  F(FDCAN, RXGFC, ANFE, 2, 2)                                                                                  \
+  F(FDCAN, RXGFC, ANFS, 4, 2)                                                                                  \
+  F(FDCAN, RXGFC, F0OM, 9, 1)                                                                                  \
+  F(FDCAN, RXGFC, LSS, 16, 5)                                                                                  \
+  F(FDCAN, RXF0S, F0FL, 0, 4)                                                                                  \
+  F(FDCAN, RXF0S, F0GI, 8, 2)                                                                                  \
+  F(FDCAN, RXF0S, RF0L, 25, 1)                                                                                 \
+  F(FDCAN, TXFQS, TFQPI, 16, 2)                                                                                \
+  F(FDCAN, TXFQS, TFQF, 21, 1)
+POUR_REGS_DECLARE(FDCAN);
+#define POUR_FDCAN_N_REGS (0x100 / 4) /* the register file a host test provides [words] */
 
 /* Message RAM layout [32-bit words] (see above). */
 #define POUR_FDCAN_RAM_WORDS (0x350u / 4u)
@@ -43,10 +71,6 @@ enum {
 #define POUR_FDCAN_RAM_TXQ (0x278u / 4u)     /* TX FIFO */
 #define POUR_FDCAN_ELEMENT_WORDS 18u         /* RX/TX element: 2 header words + 64 data bytes */
 #define POUR_FDCAN_FIFO_ELEMENTS 3u
-
-/* STM32G431 addresses: FDCAN1 registers and its message RAM (SRAMCAN). */
-#define POUR_FDCAN1_BASE 0x40006400u
-#define POUR_SRAMCAN_BASE 0x4000A400u
 
 typedef struct {
   volatile uint32_t *regs; /* instance registers (POUR_FDCAN_N_REGS words) */
@@ -88,9 +112,6 @@ pour_fdcan_config_t pour_fdcan_default_config(void);
 
 /* FDCAN1 and its message RAM on the STM32G431. */
 pour_fdcan_hw_t pour_fdcan_stm32g4_fdcan1(void);
-
-/* STM32G431 board set-up: FDCAN kernel clock = PCLK1, FDCAN1 and GPIOA clocks on, PA11/PA12 as AF9. */
-void pour_fdcan_stm32g4_board_init(void);
 
 /* Configures the peripheral (classic CAN, filters, FIFOs, bit timing) and starts it on the bus.
  * POUR_EINVAL for a bad config, no exact bit timing, or a CCCR.INIT that never acknowledges. */

@@ -6,7 +6,7 @@
 
 #include <stdbool.h>
 
-/* Configures the input (pull-up: an open circuit asserts the e-stop). */
+/* Configures the input (pull-down: an open circuit or a broken wire asserts the e-stop). */
 void pour_hal_estop_init(void);
 
 /* true while the e-stop is asserted (the line is low). */

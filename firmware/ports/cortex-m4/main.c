@@ -8,8 +8,10 @@
 
 #include "clock.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
+#include "hal_led.h"
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_timer.h"
@@ -45,6 +47,7 @@ static void report_forever(void) {
       (void)pour_can_node_receive(&can_node, &f);
     }
     pour_port_outputs(&out);
+    pour_hal_led_show(out.mode, true);
     /* The torque frame says IDLE and 0; the heartbeat and identity frames carry the reason. */
     transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
     pour_hal_watchdog_feed();
@@ -67,16 +70,22 @@ int main(void) {
   if (status == POUR_OK) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
   }
+  if (status == POUR_OK) {
+    status = pour_hal_calibration_load(); /* an uncalibrated drive could turn the bucket the wrong way */
+  }
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
   nc.identity.init_status = (int8_t)status;
+  pour_can_calibration_result_t calibration;
+  pour_hal_calibration_result(&calibration); /* what a CalibrationStart is answered with */
   if (pour_can_node_init(&can_node, &nc) != POUR_OK || pour_hal_can_init(clock_hz, nc.node_id) != POUR_OK) {
     /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
      * watchdog resets the MCU, which tries again. */
     for (;;) {
     }
   }
+  pour_can_node_set_calibration(&can_node, &calibration);
   if (status != POUR_OK) {
     report_forever();
   }
@@ -96,6 +105,7 @@ int main(void) {
     in.estop = in.estop || pour_hal_estop_asserted(); /* the hardwired line, every tick, beside the frame */
     pour_control_output_t out;
     pour_port_tick(&controller, &in, &out);
+    pour_hal_led_show(out.mode, false);
     transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */

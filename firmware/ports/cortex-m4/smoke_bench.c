@@ -10,14 +10,16 @@
  * Checked: RUN and torque before the e-stop; zero torque, brake engaged and power off in the e-stop's own
  * tick; ESTOP latched until the clear, then RUN again through the slew limit; the stale-input fault and the
  * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
- * healthy tick. */
+ * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "clock.h"
 #include "hal_brake.h"
+#include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
+#include "hal_led.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
 #include "pour/control.h"
@@ -40,7 +42,7 @@ static pour_can_frame_t rx[3];
 static unsigned rx_n, rx_i;
 
 static struct {
-  uint32_t feeds, heartbeats, identities, bad_identity, slew_steps;
+  uint32_t feeds, heartbeats, identities, bad_identity, slew_steps, led_shows, led_wrong;
   bool ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
   q15_t peak, last_torque;
   uint8_t last_mode;
@@ -52,10 +54,23 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
   return POUR_OK;
 }
 
+/* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
+pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
+int pour_hal_calibration_reason(void) { return 0; }
+void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
+  const pour_can_calibration_result_t none = {POUR_CAN_CAL_UNAVAILABLE, POUR_CAN_CAL_EMPTY, 0u, 0u, 0u, 0u, 0u};
+  *r = none;
+}
+
 void pour_hal_brake_init(void) { brake = true; }
 void pour_hal_brake_set(bool engage) { brake = engage; }
 bool pour_hal_brake_engaged(void) { return brake; }
 void pour_hal_power_init(void) { power = false; }
+static uint8_t led_mode = 0xFFu;
+void pour_hal_led_show(uint8_t mode, bool refused) {
+  led_mode = refused ? 0xFEu : mode;
+  seen.led_shows++;
+}
 void pour_hal_power_set(bool on) { power = on; }
 bool pour_hal_power_on(void) { return power; }
 void pour_hal_estop_init(void) {}
@@ -104,6 +119,7 @@ static void on_torque(const pour_can_torque_t *t) {
   }
   seen.last_torque = t->torque;
   seen.last_mode = t->mode;
+  seen.led_wrong += led_mode == t->mode ? 0u : 1u; /* the LED shows the mode of the tick's torque frame */
   if (tick < ESTOP_FROM && t->mode == POUR_MODE_RUN) {
     seen.ran = true;
     seen.peak = t->torque > seen.peak ? t->torque : seen.peak;
@@ -148,13 +164,13 @@ void pour_hal_watchdog_feed(void) {
   const bool ok = seen.ran && seen.peak > 0 && seen.estop_same_tick && seen.estop_latched && seen.ran_again &&
                   seen.stale_at_end && (seen.last_faults & POUR_FAULT_STALE_INPUT) != 0u && seen.heartbeats >= 2u &&
                   seen.identities == seen.heartbeats && seen.bad_identity == 0u && seen.slew_steps == 0u &&
-                  seen.feeds + 5u >= tick;
+                  seen.feeds + 5u >= tick && seen.led_shows + 5u >= tick && seen.led_wrong == 0u;
   printf("smoke: %u ticks, watchdog fed %u; ran %d (peak torque %d); e-stop: zero torque, brake, power off in its "
          "tick %d, latched %d; after the clear ran %d; stale at the end %d (faults 0x%x); heartbeats %u, identities "
-         "%u (%u wrong); slew-limit breaches %u: %s\n",
+         "%u (%u wrong); slew-limit breaches %u; LED shown %u ticks, %u not the tick's mode: %s\n",
          (unsigned)tick, (unsigned)seen.feeds, (int)seen.ran, (int)seen.peak, (int)seen.estop_same_tick,
          (int)seen.estop_latched, (int)seen.ran_again, (int)seen.stale_at_end, (unsigned)seen.last_faults,
          (unsigned)seen.heartbeats, (unsigned)seen.identities, (unsigned)seen.bad_identity,
-         (unsigned)seen.slew_steps, ok ? "ok" : "FAILED");
+         (unsigned)seen.slew_steps, (unsigned)seen.led_shows, (unsigned)seen.led_wrong, ok ? "ok" : "FAILED");
   exit(ok ? 0 : 1);
 }

@@ -106,9 +106,9 @@ def cyclic_messages(dbc: Path | None = None, heartbeat_ms: float | None = None) 
 
 
 def report(rows: list[Row]) -> str:
-    lines = [f"{'message':<10} {'DLC':>3} {'rate':>8} {'bits':>5} {'bits*':>5} {'load':>7}"]
+    lines = [f"{'message':<14} {'DLC':>3} {'rate':>8} {'bits':>5} {'bits*':>5} {'load':>7}"]
     for r in rows:
-        lines.append(f"{r.name:<10} {r.dlc:>3} {r.rate_hz:>6.0f}Hz {r.bits_nominal:>5} {r.bits:>5} {100 * r.load:>6.2f}%")
+        lines.append(f"{r.name:<14} {r.dlc:>3} {r.rate_hz:>6.0f}Hz {r.bits_nominal:>5} {r.bits:>5} {100 * r.load:>6.2f}%")
     total = sum(r.load for r in rows)
     nominal = sum(r.rate_hz * r.bits_nominal for r in rows) / BITRATE
     lines.append(f"bus load at 1 Mbit/s: {100 * total:.1f} % worst case (bits* = with worst-case stuffing), "

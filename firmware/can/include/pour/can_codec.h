@@ -20,6 +20,9 @@
 #define POUR_CAN_CMD_ESTOP 0x02u        /* host -> controller */
 #define POUR_CAN_CMD_STOP 0x03u         /* host -> controller: end the run */
 #define POUR_CAN_CMD_IDENTITY 0x04u     /* controller -> host, with every heartbeat: policy, scale, version */
+#define POUR_CAN_CMD_CALIBRATION_START 0x05u  /* host -> controller: calibrate the drive */
+#define POUR_CAN_CMD_CALIBRATION_RESULT 0x06u /* controller -> host: the answer, and what is stored */
+#define POUR_CAN_CMD_DRIVE_TELEMETRY 0x07u    /* controller -> host, with every heartbeat: id, iq, vbus, faults */
 #define POUR_CAN_CMD_SENSORS 0x10u      /* host -> controller: one raw sensor sample (encoder, scales) */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
@@ -30,6 +33,9 @@
 #define POUR_CAN_DLC_ESTOP 1u
 #define POUR_CAN_DLC_STOP 0u
 #define POUR_CAN_DLC_IDENTITY 8u
+#define POUR_CAN_DLC_CALIBRATION_START 0u
+#define POUR_CAN_DLC_CALIBRATION_RESULT 8u
+#define POUR_CAN_DLC_DRIVE_TELEMETRY 8u
 #define POUR_CAN_DLC_SENSORS 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
@@ -44,6 +50,23 @@
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
+#define POUR_CAN_POLE_PAIRS_MAX 32u
+#define POUR_CAN_CURRENT_MAX 32767 /* |Id|, |Iq| [2 mA]; -32768 is out of range */
+#define POUR_CAN_DRIVE_FAULT_MASK 0x07FFu /* the 11 bits of pour/drive_faults.h, in their order */
+
+/* CalibrationResult.Status: 0 .. 5 the stored block's state (as calibration_store.h's pour_cal_status_t),
+ * then the refusals of a CalibrationStart, each with its reason. */
+#define POUR_CAN_CAL_OK 0u
+#define POUR_CAN_CAL_EMPTY 1u
+#define POUR_CAN_CAL_CORRUPT 2u
+#define POUR_CAN_CAL_OLD_VERSION 3u
+#define POUR_CAN_CAL_OUT_OF_RANGE 4u
+#define POUR_CAN_CAL_WRITE_FAILED 5u
+#define POUR_CAN_CAL_REFUSED_RUNNING 6u /* asked for in RUN: Stop first */
+#define POUR_CAN_CAL_REFUSED_ESTOP 7u   /* asked for while the e-stop is asserted */
+#define POUR_CAN_CAL_UNAVAILABLE 8u     /* this firmware cannot measure (the drive's calibration routine is not in it) */
+#define POUR_CAN_CAL_STATUS_MAX 8u
+#define POUR_CAN_CAL_STORED_MAX 5u
 
 /* The CAN node's command watchdog latches in the core as its link fault. */
 #define POUR_CAN_FAULT_WATCHDOG POUR_FAULT_LINK
@@ -92,6 +115,25 @@ typedef struct {
   int8_t init_status;      /* pour_status_t of the controller's start-up (0 = OK, else it never runs) */
 } pour_can_identity_t;
 
+/* The answer to a CalibrationStart, and the calibration stored in flash, read back. */
+typedef struct {
+  uint8_t status;            /* POUR_CAN_CAL_*, 0 .. POUR_CAN_CAL_STATUS_MAX */
+  uint8_t stored;            /* the stored block's state, 0 .. POUR_CAN_CAL_STORED_MAX */
+  uint8_t encoder_reversed;  /* 0, 1 */
+  uint8_t pole_pairs;        /* 0 (none) .. POUR_CAN_POLE_PAIRS_MAX */
+  uint16_t resistance_mohm;  /* phase resistance [mΩ] */
+  uint16_t inductance_uh;    /* phase inductance [µH] */
+  uint8_t electrical_offset; /* electrical angle at encoder count 0, 256 = 2π */
+} pour_can_calibration_result_t;
+
+/* The drive's state with every heartbeat. */
+typedef struct {
+  int16_t id_2ma;        /* d current [2 mA], |.| <= POUR_CAN_CURRENT_MAX */
+  int16_t iq_2ma;        /* q current [2 mA], |.| <= POUR_CAN_CURRENT_MAX */
+  uint16_t vbus_mv;      /* bus voltage [mV] */
+  uint16_t drive_faults; /* POUR_DRIVE_FAULT_* (pour/drive_faults.h); only POUR_CAN_DRIVE_FAULT_MASK is carried */
+} pour_can_drive_telemetry_t;
+
 /* The fault bits the heartbeat carries: every POUR_FAULT_* of the core, the link (watchdog) fault included. */
 #define POUR_CAN_HEARTBEAT_FAULT_MASK POUR_FAULT_ALL
 
@@ -118,7 +160,12 @@ pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_
                                       pour_can_frame_t *frame);
 pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t *msg, pour_can_frame_t *frame);
-/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP and _RESET (POUR_EINVAL for another cmd). */
+pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_calibration_result_t *msg,
+                                               pour_can_frame_t *frame);
+pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_drive_telemetry_t *msg,
+                                            pour_can_frame_t *frame);
+/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET and _CALIBRATION_START (POUR_EINVAL
+ * for another cmd). */
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame);
 
 /* Unpack functions check the id's cmd, the DLC and every range; msg is written only on POUR_CAN_RX_OK.
@@ -128,6 +175,8 @@ pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_tor
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg);
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg);
 pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg);
+pour_can_rx_t pour_can_unpack_calibration_result(const pour_can_frame_t *frame, pour_can_calibration_result_t *msg);
+pour_can_rx_t pour_can_unpack_drive_telemetry(const pour_can_frame_t *frame, pour_can_drive_telemetry_t *msg);
 /* The commands without signals: checks the id's cmd (as given) and the DLC. */
 pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd);
 

@@ -15,7 +15,7 @@
 #include "pour/fixed.h"
 #include "pour/sensors.h"
 
-#define POUR_CAN_NODE_MAX_TX 3u /* frames one tick can produce: torque, heartbeat and identity */
+#define POUR_CAN_NODE_MAX_TX 4u /* frames one tick can produce: torque, heartbeat, identity, calibration result */
 
 typedef struct {
   uint8_t node_id;              /* 0 .. 63 */
@@ -44,6 +44,8 @@ typedef struct {
   uint16_t ms_to_heartbeat;
   uint8_t heartbeat_counter;
   pour_can_node_counters_t counters;
+  bool calibration_requested;                /* a CalibrationStart arrived since the last tick */
+  pour_can_calibration_result_t calibration; /* what the port says a start does and what is stored */
 } pour_can_node_t;
 
 /* Node 0, watchdog 50 ms (above the core's input timeout, so the core trips first), heartbeat 100 ms,
@@ -52,6 +54,10 @@ pour_can_node_config_t pour_can_node_default_config(void);
 
 /* Validates config (POUR_EINVAL otherwise); no sample yet, heartbeat due on the first tick. */
 pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_config_t *config);
+
+/* What the port answers a CalibrationStart with when it is not refused: status (POUR_CAN_CAL_*) and the
+ * stored calibration. Until set: UNAVAILABLE and nothing stored (EMPTY). */
+void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result);
 
 /* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
@@ -63,8 +69,9 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
  * Reset, takes the new run's first sample whatever its seq, and a refused Reset changes nothing here. */
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 
-/* End of a tick: advances the watchdog by 1 ms, then writes the torque frame and, when due, the
- * heartbeat and the identity frame into tx. overruns: the port's missed deadlines. Returns the count. */
+/* End of a tick: advances the watchdog by 1 ms, then writes the torque frame, when due the heartbeat and
+ * the identity frame, and after a CalibrationStart its CalibrationResult into tx: refused in RUN
+ * (REFUSED_RUNNING) and in ESTOP (REFUSED_ESTOP), else the port's answer (pour_can_node_set_calibration). overruns: the port's missed deadlines. Returns the count. */
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
 
