@@ -66,7 +66,7 @@ def test_lockstep_loop_over_can_is_bit_identical_to_in_process(tmp_path):
     assert over_can == inproc  # every step: state, action, torque, reward
     summary = [x for x in run.stdout.splitlines() if x.startswith("summary")]
     assert summary == [x for x in ref.stdout.splitlines() if x.startswith("summary")]
-    assert f"states {steps} answers {steps} on_time {steps}" in run.stdout
+    assert f"samples {steps} answers {steps} on_time {steps}" in run.stdout
     # host_sim resends a sample whose answer is slow (the guest is slow): every copy crosses and is answered.
     m = re.search(r"states (\d+) refused (\d+) torques (\d+) unmatched (\d+)", bridge_out)
     assert m, bridge_out
