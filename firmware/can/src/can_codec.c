@@ -109,8 +109,53 @@ pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t 
   return POUR_OK;
 }
 
+pour_status_t pour_can_pack_param_read(uint8_t node_id, const pour_can_param_read_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_PARAM_READ, POUR_CAN_DLC_PARAM_READ);
+  frame->data[0] = msg->param_id;
+  return POUR_OK;
+}
+
+static int is_param_cmd(uint8_t cmd) { return cmd == POUR_CAN_CMD_PARAM_VALUE || cmd == POUR_CAN_CMD_PARAM_WRITE; }
+
+pour_status_t pour_can_pack_param(uint8_t node_id, uint8_t cmd, const pour_can_param_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !is_param_cmd(cmd)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, cmd, POUR_CAN_DLC_PARAM_VALUE);
+  frame->data[0] = msg->param_id;
+  put_u32(&frame->data[1], (uint32_t)msg->value);
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->request > POUR_CAN_CMD_MASK ||
+      msg->result > POUR_CAN_PARAM_RESULT_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_PARAM_ACK, POUR_CAN_DLC_PARAM_ACK);
+  frame->data[0] = msg->request;
+  frame->data[1] = msg->param_id;
+  frame->data[2] = msg->result;
+  return POUR_OK;
+}
+
+static int tare_ok(uint8_t scales) { return scales >= 1u && scales <= (POUR_CAN_TARE_ROTATING | POUR_CAN_TARE_TARGET); }
+
+pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !tare_ok(msg->scales)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_TARE, POUR_CAN_DLC_TARE);
+  frame->data[0] = msg->scales;
+  return POUR_OK;
+}
+
 static int is_signal_free_command(uint8_t cmd) {
-  return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET;
+  return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET ||
+         cmd == POUR_CAN_CMD_PARAM_SAVE || cmd == POUR_CAN_CMD_ZERO;
 }
 
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame) {
@@ -131,6 +176,13 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_SENSORS: return (int)POUR_CAN_DLC_SENSORS;
     case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
     case POUR_CAN_CMD_CLEAR_ERRORS: return (int)POUR_CAN_DLC_CLEAR_ERRORS;
+    case POUR_CAN_CMD_PARAM_READ: return (int)POUR_CAN_DLC_PARAM_READ;
+    case POUR_CAN_CMD_PARAM_VALUE: return (int)POUR_CAN_DLC_PARAM_VALUE;
+    case POUR_CAN_CMD_PARAM_WRITE: return (int)POUR_CAN_DLC_PARAM_WRITE;
+    case POUR_CAN_CMD_PARAM_SAVE: return (int)POUR_CAN_DLC_PARAM_SAVE;
+    case POUR_CAN_CMD_PARAM_ACK: return (int)POUR_CAN_DLC_PARAM_ACK;
+    case POUR_CAN_CMD_TARE: return (int)POUR_CAN_DLC_TARE;
+    case POUR_CAN_CMD_ZERO: return (int)POUR_CAN_DLC_ZERO;
     default: return -1;
   }
 }
@@ -220,6 +272,53 @@ pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_i
   msg->tau_max_cnm = get_u16(&frame->data[4]);
   msg->fw_version = frame->data[6];
   msg->init_status = (int8_t)((int32_t)frame->data[7] - ((frame->data[7] & 0x80u) ? 256 : 0));
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can_param_read_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_PARAM_READ);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  msg->param_id = frame->data[0];
+  return POUR_CAN_RX_OK;
+}
+
+static int32_t as_i32(uint32_t v) { return (v & 0x80000000u) ? -(int32_t)(~v) - 1 : (int32_t)v; }
+
+pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg) {
+  pour_can_rx_t rc = is_param_cmd(cmd) ? check_header(frame, cmd) : POUR_CAN_RX_BAD_ID;
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  msg->param_id = frame->data[0];
+  msg->value = as_i32(get_u32(&frame->data[1]));
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_PARAM_ACK);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if (frame->data[0] > POUR_CAN_CMD_MASK || frame->data[2] > POUR_CAN_PARAM_RESULT_MAX) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->request = frame->data[0];
+  msg->param_id = frame->data[1];
+  msg->result = frame->data[2];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg) {
+  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_TARE);
+  if (rc != POUR_CAN_RX_OK || msg == NULL) {
+    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  }
+  if (!tare_ok(frame->data[0])) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->scales = frame->data[0];
   return POUR_CAN_RX_OK;
 }
 

@@ -20,6 +20,13 @@
 #define POUR_CAN_CMD_ESTOP 0x02u        /* host -> controller */
 #define POUR_CAN_CMD_STOP 0x03u         /* host -> controller: end the run */
 #define POUR_CAN_CMD_IDENTITY 0x04u     /* controller -> host, with every heartbeat: policy, scale, version */
+#define POUR_CAN_CMD_PARAM_READ 0x08u   /* host -> controller: read one parameter (pour/params.h) */
+#define POUR_CAN_CMD_PARAM_VALUE 0x09u  /* controller -> host: a parameter's value (answers read and write) */
+#define POUR_CAN_CMD_PARAM_WRITE 0x0Au  /* host -> controller: set one parameter (IDLE or FAULT only) */
+#define POUR_CAN_CMD_PARAM_SAVE 0x0Bu   /* host -> controller: store all parameters */
+#define POUR_CAN_CMD_PARAM_ACK 0x0Cu    /* controller -> host: the result of a parameter request */
+#define POUR_CAN_CMD_TARE 0x0Du         /* host -> controller: tare the scales at their latest reading */
+#define POUR_CAN_CMD_ZERO 0x0Eu         /* host -> controller: the encoder's latest count becomes upright */
 #define POUR_CAN_CMD_SENSORS 0x10u      /* host -> controller: one raw sensor sample (encoder, scales) */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
@@ -30,6 +37,13 @@
 #define POUR_CAN_DLC_ESTOP 1u
 #define POUR_CAN_DLC_STOP 0u
 #define POUR_CAN_DLC_IDENTITY 8u
+#define POUR_CAN_DLC_PARAM_READ 1u
+#define POUR_CAN_DLC_PARAM_VALUE 5u
+#define POUR_CAN_DLC_PARAM_WRITE 5u
+#define POUR_CAN_DLC_PARAM_SAVE 0u
+#define POUR_CAN_DLC_PARAM_ACK 3u
+#define POUR_CAN_DLC_TARE 1u
+#define POUR_CAN_DLC_ZERO 0u
 #define POUR_CAN_DLC_SENSORS 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
@@ -44,6 +58,9 @@
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
+#define POUR_CAN_PARAM_RESULT_MAX 6u    /* ParamAck.Result: a pour_param_result_t */
+#define POUR_CAN_TARE_ROTATING 1u       /* Tare.Scales bits */
+#define POUR_CAN_TARE_TARGET 2u
 
 /* The CAN node's command watchdog latches in the core as its link fault. */
 #define POUR_CAN_FAULT_WATCHDOG POUR_FAULT_LINK
@@ -92,6 +109,28 @@ typedef struct {
   int8_t init_status;      /* pour_status_t of the controller's start-up (0 = OK, else it never runs) */
 } pour_can_identity_t;
 
+/* ParamRead: which parameter. */
+typedef struct {
+  uint8_t param_id; /* pour_param_id_t (an unknown id is the controller's to refuse, not malformed) */
+} pour_can_param_read_t;
+
+/* ParamValue and ParamWrite: a parameter and its value in the parameter's unit (pour/params.h). */
+typedef struct {
+  uint8_t param_id;
+  int32_t value;
+} pour_can_param_t;
+
+/* ParamAck: what became of a request. */
+typedef struct {
+  uint8_t request;  /* cmd id of the request answered, 0 .. 31 */
+  uint8_t param_id; /* its parameter (0 for save, tare and zero) */
+  uint8_t result;   /* pour_param_result_t, 0 (ok) .. POUR_CAN_PARAM_RESULT_MAX */
+} pour_can_param_ack_t;
+
+typedef struct {
+  uint8_t scales; /* POUR_CAN_TARE_* bits, 1 .. 3 */
+} pour_can_tare_t;
+
 /* The fault bits the heartbeat carries: every POUR_FAULT_* of the core, the link (watchdog) fault included. */
 #define POUR_CAN_HEARTBEAT_FAULT_MASK POUR_FAULT_ALL
 
@@ -101,7 +140,8 @@ typedef enum {
   POUR_CAN_RX_OTHER_NODE = 1,  /* another node's id: not ours, silently ignored */
   POUR_CAN_RX_BAD_ID = -1,     /* our node, but no such cmd (or a cmd we only send) */
   POUR_CAN_RX_BAD_DLC = -2,    /* known cmd with the wrong data length */
-  POUR_CAN_RX_OUT_OF_RANGE = -3 /* a signal outside its DBC range */
+  POUR_CAN_RX_OUT_OF_RANGE = -3, /* a signal outside its DBC range */
+  POUR_CAN_RX_BUSY = -4          /* a parameter request while the previous one still waits (pour_can_node) */
 } pour_can_rx_t;
 
 /* id of cmd for node_id (both masked to their field widths). */
@@ -118,7 +158,13 @@ pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_
                                       pour_can_frame_t *frame);
 pour_status_t pour_can_pack_estop(uint8_t node_id, const pour_can_estop_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_identity(uint8_t node_id, const pour_can_identity_t *msg, pour_can_frame_t *frame);
-/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP and _RESET (POUR_EINVAL for another cmd). */
+pour_status_t pour_can_pack_param_read(uint8_t node_id, const pour_can_param_read_t *msg, pour_can_frame_t *frame);
+/* cmd: POUR_CAN_CMD_PARAM_VALUE or _PARAM_WRITE (one layout). */
+pour_status_t pour_can_pack_param(uint8_t node_id, uint8_t cmd, const pour_can_param_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame);
+/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET, _PARAM_SAVE and _ZERO (POUR_EINVAL
+ * for another cmd). */
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame);
 
 /* Unpack functions check the id's cmd, the DLC and every range; msg is written only on POUR_CAN_RX_OK.
@@ -128,6 +174,10 @@ pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_tor
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg);
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg);
 pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg);
+pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can_param_read_t *msg);
+pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg);
+pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg);
+pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg);
 /* The commands without signals: checks the id's cmd (as given) and the DLC. */
 pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd);
 
