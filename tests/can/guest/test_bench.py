@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """Bench bring-up end to end over vcan0, as a user runs it: pour-bench (scan, info, config set/save, faults,
-e-stop, clear) against pour_controller --io can:vcan0,params=FILE, with host_sim pouring as the plant through
+e-stop, clear, plot, log) against pour_controller --io can:vcan0,params=FILE, with host_sim pouring as the plant through
 can_bridge; the controller restarted, its saved parameters still in force. Then the bad cases
 on a real bus: no node, two nodes on one id, a refused write, a node that stops answering mid-command."""
 from __future__ import annotations
@@ -82,6 +82,10 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
         assert params.stat().st_size > 0
         out = ok("faults")
         assert "mode FAULT" in out and "EStop" in out, out
+        # The live plot of the running bus, drawn off-screen here (no display in the guest).
+        png = tmp_path / "plot.png"
+        out = ok("plot", "--seconds", "2", "--no-window", "--png", str(png))
+        assert "frames of node 0" in out and png.read_bytes()[:4] == b"\x89PNG", out
         # Motion commands check the policy and want a confirmation.
         r = bench("clear")
         assert r.returncode == 2 and "--expect-hash" in r.stderr, r.stderr

@@ -10,6 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from pour import atomic
 from pour.bench import node as bn
 from pour.policy import weights_h
 
@@ -95,6 +96,14 @@ def parser() -> argparse.ArgumentParser:
     p = sub.add_parser("log", help="record the bus as a candump -L log")
     p.add_argument("output", type=Path)
     p.add_argument("--seconds", type=_seconds, default=10.0)
+    p = sub.add_parser("plot", help="live plot: θ, θ̇, torque, scales, mode and faults (--png to save)")
+    p.add_argument("--seconds", type=_seconds, default=3600.0, help="stop after this long (default: an hour)")
+    p.add_argument("--window", type=_seconds, default=10.0, help="seconds shown (default %(default)s)")
+    p.add_argument("--encoder-bits", type=_int, default=17, help="the controller's encoder_bits (default 17)")
+    p.add_argument("--png", type=Path, help="save the figure as a PNG at the end")
+    p.add_argument("--replay", type=Path, help="plot a candump -L log (pour-bench log) instead of the bus")
+    p.add_argument("--fast", action="store_true", help="--replay as fast as it draws, not at the log's pace")
+    p.add_argument("--no-window", action="store_true", help="draw off-screen (with --png)")
     sub.add_parser("calibrate", help="drive calibration (needs the board's calibration messages)")
     return ap
 
@@ -131,6 +140,31 @@ def _print_state(st: bn.NodeState) -> None:
           f"rx_dropped {st.rx_dropped}, overruns {st.overruns}")
 
 
+def _plot(a: argparse.Namespace) -> int:
+    from pour.bench import plot
+    if not 8 <= a.encoder_bits <= 24:
+        raise UsageError(f"--encoder-bits {a.encoder_bits} outside 8..24")
+    if a.png is not None:
+        try:
+            atomic.check_output_path(a.png, "--png")
+        except ValueError as e:
+            raise UsageError(str(e)) from e
+    if a.no_window and a.png is None:
+        raise UsageError("--no-window draws nothing to see: give --png FILE")
+    if a.replay is not None and not a.replay.is_file():
+        raise UsageError(f"--replay {a.replay}: no such file")
+    db = bn.load_dbc()
+    if a.replay is not None:
+        used = plot.run(plot.replay(a.replay, paced=not a.fast), db, a.node, a.seconds, a.encoder_bits, a.window,
+                        a.png, not a.no_window, hold=True)
+    else:
+        with bn.Bench(channel=a.iface, interface=a.interface) as bench:
+            used = plot.run(bench.frames(a.seconds), db, a.node, a.seconds, a.encoder_bits, a.window, a.png,
+                            not a.no_window)
+    print(f"pour-bench plot: {used} frames of node {a.node}" + (f", figure in {a.png}" if a.png else ""))
+    return 0
+
+
 def run(a: argparse.Namespace) -> int:
     if a.cmd == "calibrate":
         raise bn.BenchError("calibrate is not available over this firmware: its CAN protocol has no calibration "
@@ -140,6 +174,8 @@ def run(a: argparse.Namespace) -> int:
             print(f"{pid:3d} {name}")
         return 0
     want = _expected_hash(a) if a.cmd in MOTION else None
+    if a.cmd == "plot":
+        return _plot(a)
     with bn.Bench(channel=a.iface, interface=a.interface) as bench:
         if a.cmd == "scan":
             for st in bench.scan(max(a.timeout, bn.HEARTBEAT_WAIT_S)).values():

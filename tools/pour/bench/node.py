@@ -101,6 +101,25 @@ def param_names(db: cantools.database.can.Database) -> dict[int, str]:
     return {int(k): str(v) for k, v in sorted(pid.choices.items())}
 
 
+class Decoder:
+    """Frames -> (node id, message name, raw signals) by the DBC; None for a frame it does not know."""
+
+    def __init__(self, db: cantools.database.can.Database) -> None:
+        self._by_cmd = {m.frame_id: m for m in db.messages}
+
+    def decode(self, msg: can.Message) -> tuple[int, str, dict] | None:
+        if msg.is_extended_id or msg.is_error_frame or msg.is_remote_frame:
+            return None
+        node_id, cmd = msg.arbitration_id >> dbc.NODE_SHIFT, msg.arbitration_id & dbc.CMD_MASK
+        m = self._by_cmd.get(cmd)
+        if m is None or len(msg.data) != m.length:
+            return None
+        try:
+            return node_id, m.name, m.decode(bytes(msg.data), scaling=False, decode_choices=False)
+        except cantools.database.errors.DecodeError:
+            return None
+
+
 class Bench:
     """One CAN bus. channel/interface are python-can's; bus: an open python-can bus instead."""
 
@@ -114,6 +133,7 @@ class Bench:
             raise BenchError(f"cannot open CAN bus {interface}:{channel}: {e}") from e
         self.states: dict[int, NodeState] = {}
         self._by_cmd = {m.frame_id: m for m in self.db.messages}
+        self.decoder = Decoder(self.db)
         self._faults = fault_signals(self.db)
         self._listeners: list[Callable[[can.Message], None]] = []
         self.param_names = param_names(self.db)
@@ -142,17 +162,7 @@ class Bench:
             raise BenchError(f"cannot send {name} to node {node_id} on {self.channel}: {e}") from e
 
     def decode(self, msg: can.Message) -> tuple[int, str, dict] | None:
-        """(node id, message name, raw signals) of one of ours, None for a frame the DBC does not know."""
-        if msg.is_extended_id or msg.is_error_frame or msg.is_remote_frame:
-            return None
-        node_id, cmd = msg.arbitration_id >> dbc.NODE_SHIFT, msg.arbitration_id & dbc.CMD_MASK
-        m = self._by_cmd.get(cmd)
-        if m is None or len(msg.data) != m.length:
-            return None
-        try:
-            return node_id, m.name, m.decode(bytes(msg.data), scaling=False, decode_choices=False)
-        except cantools.database.errors.DecodeError:
-            return None
+        return self.decoder.decode(msg)
 
     def _note(self, msg: can.Message) -> tuple[int, str, dict] | None:
         d = self.decode(msg)
