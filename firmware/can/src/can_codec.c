@@ -198,10 +198,16 @@ static pour_can_rx_t check_header(const pour_can_frame_t *frame, uint8_t cmd) {
   return POUR_CAN_RX_OK;
 }
 
+/* check_header, and a place to unpack into. */
+static pour_can_rx_t check_unpack(const pour_can_frame_t *frame, uint8_t cmd, const void *msg) {
+  const pour_can_rx_t rc = check_header(frame, cmd);
+  return rc != POUR_CAN_RX_OK ? rc : (msg == NULL ? POUR_CAN_RX_BAD_ID : POUR_CAN_RX_OK);
+}
+
 pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_sensors_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_SENSORS);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_SENSORS, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   const int16_t rot = as_i16(get_u16(&frame->data[4]));
   const int16_t tgt = as_i16(get_u16(&frame->data[6]));
@@ -216,9 +222,9 @@ pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_se
 }
 
 pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_TORQUE);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_TORQUE, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[4] > POUR_CAN_ACTION_MAX || frame->data[5] > POUR_CAN_MODE_MAX ||
       frame->data[6] > POUR_CAN_LIMITS_MAX) {
@@ -233,9 +239,9 @@ pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_tor
 }
 
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_HEARTBEAT);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_HEARTBEAT, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[0] > POUR_CAN_MODE_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
@@ -249,9 +255,9 @@ pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_
 }
 
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_ESTOP);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_ESTOP, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[0] > 1u) {
     return POUR_CAN_RX_OUT_OF_RANGE;
@@ -261,9 +267,9 @@ pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_esto
 }
 
 pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_IDENTITY);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_IDENTITY, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if ((frame->data[7] & 0x80u) == 0u && frame->data[7] != 0u) {
     return POUR_CAN_RX_OUT_OF_RANGE; /* a positive status does not exist */
@@ -276,9 +282,9 @@ pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_i
 }
 
 pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can_param_read_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_PARAM_READ);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_PARAM_READ, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   msg->param_id = frame->data[0];
   return POUR_CAN_RX_OK;
@@ -287,9 +293,9 @@ pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can
 static int32_t as_i32(uint32_t v) { return (v & 0x80000000u) ? -(int32_t)(~v) - 1 : (int32_t)v; }
 
 pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg) {
-  pour_can_rx_t rc = is_param_cmd(cmd) ? check_header(frame, cmd) : POUR_CAN_RX_BAD_ID;
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = is_param_cmd(cmd) ? check_unpack(frame, cmd, msg) : POUR_CAN_RX_BAD_ID;
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   msg->param_id = frame->data[0];
   msg->value = as_i32(get_u32(&frame->data[1]));
@@ -297,9 +303,9 @@ pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, 
 }
 
 pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_PARAM_ACK);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_PARAM_ACK, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[0] > POUR_CAN_CMD_MASK || frame->data[2] > POUR_CAN_PARAM_RESULT_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
@@ -311,9 +317,9 @@ pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_
 }
 
 pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_TARE);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_TARE, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (!tare_ok(frame->data[0])) {
     return POUR_CAN_RX_OUT_OF_RANGE;
