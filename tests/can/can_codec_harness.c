@@ -5,13 +5,16 @@
  *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
  * msg: sensors (seq_low encoder scale_rotating scale_target), torque (seq torque action mode limits),
  * heartbeat (mode faults rx_dropped overruns counter), estop (assert), identity (hash tau_max fw init),
- * clear_errors, stop and reset (no fields).
+ * param_read (id), param_value and param_write (id value), param_ack (request id result), tare (scales),
+ * clear_errors, stop, reset, param_save and zero (no fields).
+ *   param <id>                          -> "ok <name> <unit or -> <min> <max>" | "none" (pour/params.h's table)
  * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "pour/can_codec.h"
+#include "pour/params.h"
 
 #define MAX_FIELDS 8
 
@@ -56,7 +59,21 @@ static uint8_t command_of(const char *msg) {
   if (strcmp(msg, "calibration_start") == 0) {
     return POUR_CAN_CMD_CALIBRATION_START;
   }
+  if (strcmp(msg, "param_save") == 0) {
+    return POUR_CAN_CMD_PARAM_SAVE;
+  }
+  if (strcmp(msg, "zero") == 0) {
+    return POUR_CAN_CMD_ZERO;
+  }
   return strcmp(msg, "reset") == 0 ? POUR_CAN_CMD_RESET : 0u;
+}
+
+/* ParamValue and ParamWrite share one layout. */
+static uint8_t param_cmd_of(const char *msg) {
+  if (strcmp(msg, "param_value") == 0) {
+    return POUR_CAN_CMD_PARAM_VALUE;
+  }
+  return strcmp(msg, "param_write") == 0 ? POUR_CAN_CMD_PARAM_WRITE : 0u;
 }
 
 static void do_pack(const char *msg, long *v, int n) {
@@ -89,6 +106,18 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "drive_telemetry") == 0 && n == 5) {
     pour_can_drive_telemetry_t m = {(int16_t)v[1], (int16_t)v[2], (uint16_t)v[3], (uint16_t)v[4]};
     print_frame(pour_can_pack_drive_telemetry(node, &m, &f), &f);
+  } else if (strcmp(msg, "param_read") == 0 && n == 2) {
+    pour_can_param_read_t m = {(uint8_t)v[1]};
+    print_frame(pour_can_pack_param_read(node, &m, &f), &f);
+  } else if (param_cmd_of(msg) != 0u && n == 3) {
+    pour_can_param_t m = {(uint8_t)v[1], (int32_t)v[2]};
+    print_frame(pour_can_pack_param(node, param_cmd_of(msg), &m, &f), &f);
+  } else if (strcmp(msg, "param_ack") == 0 && n == 4) {
+    pour_can_param_ack_t m = {(uint8_t)v[1], (uint8_t)v[2], (uint8_t)v[3]};
+    print_frame(pour_can_pack_param_ack(node, &m, &f), &f);
+  } else if (strcmp(msg, "tare") == 0 && n == 2) {
+    pour_can_tare_t m = {(uint8_t)v[1]};
+    print_frame(pour_can_pack_tare(node, &m, &f), &f);
   } else if (command_of(msg) != 0u && n == 1) {
     print_frame(pour_can_pack_command(node, command_of(msg), &f), &f);
   } else {
@@ -168,6 +197,22 @@ static void do_unpack(const char *msg, char *rest) {
     pour_can_drive_telemetry_t m = {0};
     rc = pour_can_unpack_drive_telemetry(&f, &m);
     snprintf(out, sizeof out, "%d %d %u %u", m.id_2ma, m.iq_2ma, (unsigned)m.vbus_mv, (unsigned)m.drive_faults);
+  } else if (strcmp(msg, "param_read") == 0) {
+    pour_can_param_read_t m = {0};
+    rc = pour_can_unpack_param_read(&f, &m);
+    snprintf(out, sizeof out, "%u", (unsigned)m.param_id);
+  } else if (param_cmd_of(msg) != 0u) {
+    pour_can_param_t m = {0, 0};
+    rc = pour_can_unpack_param(&f, param_cmd_of(msg), &m);
+    snprintf(out, sizeof out, "%u %ld", (unsigned)m.param_id, (long)m.value);
+  } else if (strcmp(msg, "param_ack") == 0) {
+    pour_can_param_ack_t m = {0, 0, 0};
+    rc = pour_can_unpack_param_ack(&f, &m);
+    snprintf(out, sizeof out, "%u %u %u", (unsigned)m.request, (unsigned)m.param_id, (unsigned)m.result);
+  } else if (strcmp(msg, "tare") == 0) {
+    pour_can_tare_t m = {0};
+    rc = pour_can_unpack_tare(&f, &m);
+    snprintf(out, sizeof out, "%u", (unsigned)m.scales);
   } else if (command_of(msg) != 0u) {
     rc = pour_can_unpack_command(&f, command_of(msg));
     out[0] = '\0';
@@ -197,6 +242,15 @@ int main(void) {
         puts("error fields");
       } else {
         do_pack(msg, v, n);
+      }
+    } else if (strcmp(verb, "param") == 0) {
+      const long id = strtol(msg, NULL, 0);
+      const pour_param_info_t *info = id >= 0 && id <= 255 ? pour_param_info((uint8_t)id) : NULL;
+      if (info == NULL) {
+        puts("none");
+      } else {
+        printf("ok %s %s %ld %ld\n", info->name, info->unit[0] != '\0' ? info->unit : "-", (long)info->min,
+               (long)info->max);
       }
     } else if (strcmp(verb, "unpack") == 0 && rest != NULL) {
       do_unpack(msg, rest);

@@ -3,7 +3,9 @@
 without CAN: pour_controller --io can:..., can_bridge."""
 from __future__ import annotations
 
+import struct
 import subprocess
+import zlib
 from pathlib import Path
 
 import pytest
@@ -43,6 +45,41 @@ def test_controller_without_the_interface_says_so():
     r = run(exe("pour_controller"), "--io", "can:nosuchcan0")
     assert r.returncode == 1
     assert "no CAN support" in r.stderr or "no such CAN interface" in r.stderr
+
+
+def params_blob(values: dict[int, int], version: int = 1) -> bytes:
+    """A parameter file as firmware/include/pour/params.h lays it out (magic, version, count, records,
+    CRC-32), to hand the controller files it must refuse."""
+    body = b"PPRM" + struct.pack("<HH", version, len(values))
+    body += b"".join(struct.pack("<Bi", k, v) for k, v in sorted(values.items()))
+    return body + struct.pack("<I", zlib.crc32(body))
+
+
+@pytest.mark.parametrize("content, needle", [
+    (b"", "truncated"),
+    (params_blob({4: 1500000})[:-1], "truncated"),
+    (b"XXXX" + params_blob({4: 1500000})[4:], "bad magic"),
+    (params_blob({4: 1500000}, version=2), "unsupported layout version"),
+    (params_blob({4: 1500000})[:-1] + b"\0", "CRC mismatch"),
+    (params_blob({16: 30}), "parameter 16 (encoder_bits)"),
+    (params_blob({99: 1}), "parameter 99 (no such parameter)"),
+    (params_blob({17: 200000}), "parameter 17 (encoder_zero)"),
+])
+def test_controller_refuses_a_bad_parameter_file_at_start(tmp_path, content, needle):
+    f = tmp_path / "params.bin"
+    f.write_bytes(content)
+    r = run(exe("pour_controller"), "--io", f"can:vcan0,params={f}")
+    assert r.returncode == 1, r.stderr
+    assert f"parameter file {f}" in r.stderr and needle in r.stderr, r.stderr
+    assert f.read_bytes() == content  # never rewritten
+
+
+def test_controller_refuses_a_parameter_set_the_core_refuses(tmp_path):
+    f = tmp_path / "params.bin"
+    f.write_bytes(params_blob({2: 100000, 3: 50000}))  # theta_min above theta_max: each in range
+    r = run(exe("pour_controller"), "--io", f"can:vcan0,params={f}")
+    assert r.returncode == 1
+    assert f"parameter file {f}: the core refuses its configuration" in r.stderr, r.stderr
 
 
 @pytest.mark.parametrize("argv, needle", [

@@ -19,7 +19,7 @@ def bin_dir(build_dir):
 
 
 @pytest.mark.parametrize("program", ["host_sim", "pour_controller", "can_bridge", "pour.policy.export",
-                                     "pour.eval.render"])
+                                     "pour.eval.render", "pour.bench.cli"])
 def test_help_documents_the_exit_statuses(bin_dir, program):
     argv = [sys.executable, "-m", program] if program.startswith("pour.") else [bin_dir / program]
     r = _run(*argv, "--help")

@@ -130,6 +130,7 @@ ALLOWED: dict[str, set[str]] = {
     "eval": {"train", "sim", "policy"},
     "lcm": {"eval", "sim"},
     "can": set(),
+    "bench": {"can", "policy"},
 }
 
 

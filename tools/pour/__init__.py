@@ -14,6 +14,7 @@
                   plots, render
     pour.lcm      the LCM link's tools: channels, messages, sensors, cmd, run, spy, logfile, live_view
     pour.can      the CAN protocol's DBC (dbc) and bus load (bus_load)
+    pour.bench    the bench over CAN: scan, state, commands, parameters, logs (node); pour-bench (cli)
 
 A subpackage imports only those on its row (and the shared modules, which import no subpackage);
 tests/python/test_imports.py checks it:
@@ -24,6 +25,7 @@ tests/python/test_imports.py checks it:
     pour.eval     train, sim, policy
     pour.lcm      eval, sim
     pour.can      -
+    pour.bench    can, policy
 
 So the simulator never reaches the trainer, and nothing but the evaluation (a sweep trains its trials;
 results and robust_scale read training runs and use the trainer's Ray executors) imports pour.train.

@@ -145,9 +145,53 @@ pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_driv
   return POUR_OK;
 }
 
+pour_status_t pour_can_pack_param_read(uint8_t node_id, const pour_can_param_read_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_PARAM_READ, POUR_CAN_DLC_PARAM_READ);
+  frame->data[0] = msg->param_id;
+  return POUR_OK;
+}
+
+static int is_param_cmd(uint8_t cmd) { return cmd == POUR_CAN_CMD_PARAM_VALUE || cmd == POUR_CAN_CMD_PARAM_WRITE; }
+
+pour_status_t pour_can_pack_param(uint8_t node_id, uint8_t cmd, const pour_can_param_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !is_param_cmd(cmd)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, cmd, POUR_CAN_DLC_PARAM_VALUE);
+  frame->data[0] = msg->param_id;
+  put_u32(&frame->data[1], (uint32_t)msg->value);
+  return POUR_OK;
+}
+
+pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->request > POUR_CAN_CMD_MASK ||
+      msg->result > POUR_CAN_PARAM_RESULT_MAX) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_PARAM_ACK, POUR_CAN_DLC_PARAM_ACK);
+  frame->data[0] = msg->request;
+  frame->data[1] = msg->param_id;
+  frame->data[2] = msg->result;
+  return POUR_OK;
+}
+
+static int tare_ok(uint8_t scales) { return scales >= 1u && scales <= (POUR_CAN_TARE_ROTATING | POUR_CAN_TARE_TARGET); }
+
+pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !tare_ok(msg->scales)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_TARE, POUR_CAN_DLC_TARE);
+  frame->data[0] = msg->scales;
+  return POUR_OK;
+}
+
 static int is_signal_free_command(uint8_t cmd) {
   return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET ||
-         cmd == POUR_CAN_CMD_CALIBRATION_START;
+         cmd == POUR_CAN_CMD_CALIBRATION_START || cmd == POUR_CAN_CMD_PARAM_SAVE || cmd == POUR_CAN_CMD_ZERO;
 }
 
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame) {
@@ -171,6 +215,13 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_SENSORS: return (int)POUR_CAN_DLC_SENSORS;
     case POUR_CAN_CMD_TORQUE: return (int)POUR_CAN_DLC_TORQUE;
     case POUR_CAN_CMD_CLEAR_ERRORS: return (int)POUR_CAN_DLC_CLEAR_ERRORS;
+    case POUR_CAN_CMD_PARAM_READ: return (int)POUR_CAN_DLC_PARAM_READ;
+    case POUR_CAN_CMD_PARAM_VALUE: return (int)POUR_CAN_DLC_PARAM_VALUE;
+    case POUR_CAN_CMD_PARAM_WRITE: return (int)POUR_CAN_DLC_PARAM_WRITE;
+    case POUR_CAN_CMD_PARAM_SAVE: return (int)POUR_CAN_DLC_PARAM_SAVE;
+    case POUR_CAN_CMD_PARAM_ACK: return (int)POUR_CAN_DLC_PARAM_ACK;
+    case POUR_CAN_CMD_TARE: return (int)POUR_CAN_DLC_TARE;
+    case POUR_CAN_CMD_ZERO: return (int)POUR_CAN_DLC_ZERO;
     default: return -1;
   }
 }
@@ -186,10 +237,16 @@ static pour_can_rx_t check_header(const pour_can_frame_t *frame, uint8_t cmd) {
   return POUR_CAN_RX_OK;
 }
 
+/* check_header, and a place to unpack into. */
+static pour_can_rx_t check_unpack(const pour_can_frame_t *frame, uint8_t cmd, const void *msg) {
+  const pour_can_rx_t rc = check_header(frame, cmd);
+  return rc != POUR_CAN_RX_OK ? rc : (msg == NULL ? POUR_CAN_RX_BAD_ID : POUR_CAN_RX_OK);
+}
+
 pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_sensors_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_SENSORS);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_SENSORS, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   const int16_t rot = as_i16(get_u16(&frame->data[4]));
   const int16_t tgt = as_i16(get_u16(&frame->data[6]));
@@ -204,9 +261,9 @@ pour_can_rx_t pour_can_unpack_sensors(const pour_can_frame_t *frame, pour_can_se
 }
 
 pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_torque_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_TORQUE);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_TORQUE, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[4] > POUR_CAN_ACTION_MAX || frame->data[5] > POUR_CAN_MODE_MAX ||
       frame->data[6] > POUR_CAN_LIMITS_MAX) {
@@ -221,9 +278,9 @@ pour_can_rx_t pour_can_unpack_torque(const pour_can_frame_t *frame, pour_can_tor
 }
 
 pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_heartbeat_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_HEARTBEAT);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_HEARTBEAT, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[0] > POUR_CAN_MODE_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
@@ -237,9 +294,9 @@ pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_
 }
 
 pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_estop_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_ESTOP);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_ESTOP, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if (frame->data[0] > 1u) {
     return POUR_CAN_RX_OUT_OF_RANGE;
@@ -249,9 +306,9 @@ pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_esto
 }
 
 pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg) {
-  pour_can_rx_t rc = check_header(frame, POUR_CAN_CMD_IDENTITY);
-  if (rc != POUR_CAN_RX_OK || msg == NULL) {
-    return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_IDENTITY, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
   }
   if ((frame->data[7] & 0x80u) == 0u && frame->data[7] != 0u) {
     return POUR_CAN_RX_OUT_OF_RANGE; /* a positive status does not exist */
@@ -260,6 +317,53 @@ pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_i
   msg->tau_max_cnm = get_u16(&frame->data[4]);
   msg->fw_version = frame->data[6];
   msg->init_status = (int8_t)((int32_t)frame->data[7] - ((frame->data[7] & 0x80u) ? 256 : 0));
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can_param_read_t *msg) {
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_PARAM_READ, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
+  }
+  msg->param_id = frame->data[0];
+  return POUR_CAN_RX_OK;
+}
+
+static int32_t as_i32(uint32_t v) { return (v & 0x80000000u) ? -(int32_t)(~v) - 1 : (int32_t)v; }
+
+pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg) {
+  const pour_can_rx_t rc = is_param_cmd(cmd) ? check_unpack(frame, cmd, msg) : POUR_CAN_RX_BAD_ID;
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
+  }
+  msg->param_id = frame->data[0];
+  msg->value = as_i32(get_u32(&frame->data[1]));
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg) {
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_PARAM_ACK, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
+  }
+  if (frame->data[0] > POUR_CAN_CMD_MASK || frame->data[2] > POUR_CAN_PARAM_RESULT_MAX) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->request = frame->data[0];
+  msg->param_id = frame->data[1];
+  msg->result = frame->data[2];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg) {
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_TARE, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
+  }
+  if (!tare_ok(frame->data[0])) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->scales = frame->data[0];
   return POUR_CAN_RX_OK;
 }
 

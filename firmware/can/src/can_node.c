@@ -4,9 +4,11 @@
 #include <stddef.h>
 
 /* Commands a controller accepts; HEARTBEAT, IDENTITY and TORQUE are its own transmissions. */
+#define PARAM_MASK ((1u << POUR_CAN_CMD_PARAM_READ) | (1u << POUR_CAN_CMD_PARAM_WRITE) | \
+                    (1u << POUR_CAN_CMD_PARAM_SAVE) | (1u << POUR_CAN_CMD_TARE) | (1u << POUR_CAN_CMD_ZERO))
 #define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_SENSORS) | \
                      (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET) |                             \
-                     (1u << POUR_CAN_CMD_CALIBRATION_START))
+                     (1u << POUR_CAN_CMD_CALIBRATION_START) | PARAM_MASK)
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
@@ -70,6 +72,47 @@ static void take_sample(pour_can_node_t *node, const pour_can_sensors_t *m) {
   node->sensors_fresh = true;
 }
 
+/* A parameter request, unpacked; the port answers it outside the tick. Not a command of the control loop:
+ * it does not feed the watchdog. */
+static pour_can_rx_t take_param_request(pour_can_node_t *node, const pour_can_frame_t *frame, uint8_t cmd) {
+  pour_can_param_request_t r = {.cmd = cmd, .param_id = 0u, .value = 0, .scales = 0u};
+  pour_can_rx_t rc = POUR_CAN_RX_OK;
+  if (cmd == POUR_CAN_CMD_PARAM_READ) {
+    pour_can_param_read_t m;
+    rc = pour_can_unpack_param_read(frame, &m);
+    r.param_id = m.param_id;
+  } else if (cmd == POUR_CAN_CMD_PARAM_WRITE) {
+    pour_can_param_t m;
+    rc = pour_can_unpack_param(frame, cmd, &m);
+    r.param_id = m.param_id;
+    r.value = m.value;
+  } else if (cmd == POUR_CAN_CMD_TARE) {
+    pour_can_tare_t m;
+    rc = pour_can_unpack_tare(frame, &m);
+    r.scales = m.scales;
+  }
+  if (rc != POUR_CAN_RX_OK) {
+    return drop(node, rc);
+  }
+  if (node->param_pending) {
+    count(&node->counters.param_busy);
+    return POUR_CAN_RX_BUSY;
+  }
+  node->param_request = r;
+  node->param_pending = true;
+  count(&node->counters.accepted);
+  return POUR_CAN_RX_OK;
+}
+
+bool pour_can_node_take_param_request(pour_can_node_t *node, pour_can_param_request_t *request) {
+  if (!node->param_pending) {
+    return false;
+  }
+  *request = node->param_request;
+  node->param_pending = false;
+  return true;
+}
+
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame) {
   if (node == NULL) {
     return POUR_CAN_RX_BAD_ID;
@@ -78,6 +121,9 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
   pour_can_rx_t rc = pour_can_classify(frame, node->config.node_id, ACCEPT_MASK, &cmd);
   if (rc != POUR_CAN_RX_OK) {
     return drop(node, rc);
+  }
+  if ((PARAM_MASK & (1u << cmd)) != 0u) {
+    return take_param_request(node, frame, cmd);
   }
   switch (cmd) {
     case POUR_CAN_CMD_SENSORS: {
@@ -143,7 +189,7 @@ bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {
 
 uint32_t pour_can_node_dropped(const pour_can_node_t *node) {
   const pour_can_node_counters_t *c = &node->counters;
-  uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range;
+  uint64_t sum = (uint64_t)c->bad_id + c->bad_dlc + c->out_of_range + c->param_busy;
   return sum > UINT32_MAX ? UINT32_MAX : (uint32_t)sum;
 }
 

@@ -17,8 +17,9 @@
 
 /* Version of the firmware as the bus reports it (Identity.FwVersion): +1 with any change in behaviour a
  * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity.
- * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp). */
-#define POUR_FIRMWARE_VERSION 3u
+ * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp).
+ * 4: parameters and calibration over CAN, the transitions of docs/safety.md (torque continuity, refusals). */
+#define POUR_FIRMWARE_VERSION 4u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {

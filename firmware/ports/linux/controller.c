@@ -142,6 +142,9 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   l->clear_pending = false;
   l->stop_pending = false;
   l->reset_pending = false;
+  if (l->io->service != NULL) {
+    l->io->service(l->io, &l->ctl);
+  }
   if (l->io->begin_tick != NULL) {
     l->io->begin_tick(l->io, &ci);
   }

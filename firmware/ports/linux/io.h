@@ -66,6 +66,9 @@ struct pour_io {
   /* Optional (NULL: the loop's own input stands): once per tick, the transport's part of the control
    * input. The CAN node supplies all of it there, its watchdog as the link fault included. */
   void (*begin_tick)(pour_io_t *io, pour_control_input_t *in);
+  /* Optional (NULL: none): once per tick before the step, the transport's work on the core itself. The CAN
+   * transport answers parameter requests there and puts an accepted write in force (pour/params.h). */
+  void (*service)(pour_io_t *io, pour_control_t *ctl);
   /* Sends the answer to a sample; returns 0 or negative on a transport error. */
   int (*send_torque)(pour_io_t *io, const pour_io_answer_t *answer);
   /* Sends the health status; returns 0 or negative on a transport error. */

@@ -13,6 +13,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "params_file.h"
+#include "pour/can_params.h"
+
 typedef struct {
   int fd;
   pour_io_socketcan_config_t config;
@@ -22,6 +25,8 @@ typedef struct {
   uint32_t dropped_reported;
   pour_control_output_t out; /* the latest output the loop told us of (what the heartbeat reports) */
   uint32_t overruns;
+  pour_params_t params;      /* in force; saved on ParamSave */
+  pour_control_t *ctl;       /* the core, while can_service runs (what an accepted write reconfigures) */
 } socketcan_t;
 
 static socketcan_t g_can; /* one transport per process */
@@ -131,6 +136,43 @@ static void can_begin_tick(pour_io_t *io, pour_control_input_t *in) {
   socketcan_t *s = io->ctx;
   housekeeping(s);
   pour_can_node_begin_tick(&s->node, in);
+  pour_params_correct(&s->params, &in->sensors);
+}
+
+static pour_status_t apply_params(void *user, const pour_params_t *candidate) {
+  socketcan_t *s = user;
+  return pour_params_apply(s->ctl, candidate, s->ctl->policy.weights);
+}
+
+static pour_status_t save_params(void *user, const pour_params_t *params) {
+  socketcan_t *s = user;
+  return pour_params_file_save(s->config.params_path, params) == 0 ? POUR_OK : POUR_EINVAL;
+}
+
+/* One parameter request per tick, answered before the step; the node id in force stays the one bound at
+ * start (a new node_id takes effect at the next start). */
+static void can_service(pour_io_t *io, pour_control_t *ctl) {
+  socketcan_t *s = io->ctx;
+  pour_can_param_request_t r;
+  if (!pour_can_node_take_param_request(&s->node, &r)) {
+    return;
+  }
+  s->ctl = ctl;
+  const pour_can_params_env_t env = {
+      .writable = pour_params_writable(ctl),
+      .have_sample = s->node.have_seq,
+      .sample = s->node.sensors,
+      .apply = apply_params,
+      .save = s->config.params_path[0] != '\0' ? save_params : NULL,
+      .user = s,
+  };
+  pour_can_frame_t reply;
+  const pour_param_result_t res = pour_can_params_handle(s->config.node.node_id, &r, &s->params, &env, &reply);
+  if (res != POUR_PARAM_OK) {
+    fprintf(stderr, "pour_controller: parameter request 0x%02x (parameter %u) refused: %s\n", (unsigned)r.cmd,
+            (unsigned)r.param_id, pour_param_result_name(res));
+  }
+  (void)send_frame(s, &reply);
 }
 
 static int can_send_torque(pour_io_t *io, const pour_io_answer_t *a) {
@@ -178,7 +220,7 @@ static int parse_field(const char *what, const char *v, unsigned long max, unsig
 int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config) {
   char buf[128];
   if (spec == NULL || strlen(spec) >= sizeof buf) {
-    fprintf(stderr, "pour_controller: --io can: needs IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n");
+    fprintf(stderr, "pour_controller: --io can: needs IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N][,params=FILE]\n");
     return -1;
   }
   strcpy(buf, spec);
@@ -213,11 +255,42 @@ int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config
         return -1;
       }
       config->node.watchdog_ms = (uint16_t)n;
+    } else if (strcmp(kv, "params") == 0) {
+      if (v[0] == '\0' || strlen(v) >= sizeof config->params_path) {
+        fprintf(stderr, "pour_controller: --io can: params needs a file name of 1..%zu characters\n",
+                sizeof config->params_path - 1u);
+        return -1;
+      }
+      strcpy(config->params_path, v);
     } else {
-      fprintf(stderr, "pour_controller: --io can: unknown key '%s' (node, heartbeat-ms, watchdog-ms)\n", kv);
+      fprintf(stderr, "pour_controller: --io can: unknown key '%s' (node, heartbeat-ms, watchdog-ms, params)\n", kv);
       return -1;
     }
   }
+  return 0;
+}
+
+int pour_io_socketcan_load_params(pour_io_socketcan_config_t *config, pour_control_config_t *control,
+                                  const pour_policy_weights_t *weights) {
+  pour_params_default(&config->params, control, config->node.node_id);
+  if (config->params_path[0] != '\0') {
+    const int rc = pour_params_file_load(config->params_path, &config->params);
+    if (rc < 0) {
+      return -1;
+    }
+    static pour_control_t trial; /* the core's own rules between parameters, before anything runs */
+    const pour_status_t st = pour_control_init(&trial, &config->params.control, weights);
+    if (st != POUR_OK) {
+      fprintf(stderr, "pour_controller: parameter file %s: the core refuses its configuration (%s: e.g. theta_min "
+              ">= theta_max, a stop torque above tau_limit); fix it with pour-bench config or delete it\n",
+              config->params_path, pour_status_name(st));
+      return -1;
+    }
+    fprintf(stderr, "pour_controller: parameters %s %s\n", rc == 0 ? "from" : "at their defaults; none yet in",
+            config->params_path);
+  }
+  *control = config->params.control;
+  config->node.node_id = config->params.node_id;
   return 0;
 }
 
@@ -226,6 +299,7 @@ int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *conf
   memset(s, 0, sizeof *s);
   s->fd = -1;
   s->config = *config;
+  s->params = config->params;
   pour_can_node_config_t nc = config->node;
   const uint32_t wd = (uint32_t)nc.watchdog_ms + config->watchdog_grace_ms;
   nc.watchdog_ms = (uint16_t)(wd > UINT16_MAX ? UINT16_MAX : wd);
@@ -267,6 +341,7 @@ int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *conf
   io->ctx = s;
   io->wait = can_wait;
   io->begin_tick = can_begin_tick;
+  io->service = can_service;
   io->send_torque = can_send_torque;
   io->send_status = can_send_status;
   io->close = can_close;

@@ -26,6 +26,8 @@ static void usage(FILE *f) {
           "  --io lcm[:URL]         transport (default lcm with its default URL)\n"
           "  --io can:IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N]\n"
           "                         SocketCAN, the protocol of can/pour.dbc (defaults 0, 100, 50)\n"
+          "                         [,params=FILE]: parameters loaded from FILE at start, saved there on\n"
+          "                         ParamSave (pour-bench config save); it overrides node= and the options\n"
           "  --lcm URL              the same as --io lcm:URL (the LCM URL's flag in every pour program)\n"
           "  --iface IFACE [--node N]  the same as --io can:IFACE[,node=N] (as can_bridge spells them)\n"
           "  --lockstep             one tick per sensor sample (deterministic: what host_sim --lcm runs\n"
@@ -81,7 +83,7 @@ static int parse_seconds(const char *opt, const char *s, long long *out_ms) {
 
 /* Opens the transport named by spec: "lcm", "lcm:URL" or "can:IFACE[,...]". Other backends add a branch here.
  * Returns 0, -2 for a spec that does not parse (a command-line error), -1 if the transport cannot open. */
-static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *cfg) {
+static int open_io(const char *spec, pour_io_t *io, pour_linux_config_t *cfg) {
   if (strcmp(spec, "lcm") == 0) {
     return pour_io_lcm_open(io, NULL);
   }
@@ -94,7 +96,10 @@ static int open_io(const char *spec, pour_io_t *io, const pour_linux_config_t *c
     can.node.identity.tau_max_cnm = (uint16_t)(cfg->weights->tau_max_mnm / 10);
     /* In lockstep the loop itself waits stall_ms before it treats silence as stale input. */
     can.watchdog_grace_ms = cfg->lockstep ? (uint32_t)cfg->stall_ms : 0u;
-    return pour_io_socketcan_parse(spec + 4, &can) == 0 ? pour_io_socketcan_open(io, &can) : -2;
+    if (pour_io_socketcan_parse(spec + 4, &can) != 0) {
+      return -2;
+    }
+    return pour_io_socketcan_load_params(&can, &cfg->control, cfg->weights) == 0 ? pour_io_socketcan_open(io, &can) : -1;
   }
   fprintf(stderr, "pour_controller: unknown transport '%s' (known: lcm[:URL], can:IFACE)\n", spec);
   return -2;

@@ -23,6 +23,13 @@
 #define POUR_CAN_CMD_CALIBRATION_START 0x05u  /* host -> controller: calibrate the drive */
 #define POUR_CAN_CMD_CALIBRATION_RESULT 0x06u /* controller -> host: the answer, and what is stored */
 #define POUR_CAN_CMD_DRIVE_TELEMETRY 0x07u    /* controller -> host, with every heartbeat: id, iq, vbus, faults */
+#define POUR_CAN_CMD_PARAM_READ 0x08u   /* host -> controller: read one parameter (pour/params.h) */
+#define POUR_CAN_CMD_PARAM_VALUE 0x09u  /* controller -> host: a parameter's value (answers read and write) */
+#define POUR_CAN_CMD_PARAM_WRITE 0x0Au  /* host -> controller: set one parameter (IDLE or FAULT only) */
+#define POUR_CAN_CMD_PARAM_SAVE 0x0Bu   /* host -> controller: store all parameters */
+#define POUR_CAN_CMD_PARAM_ACK 0x0Cu    /* controller -> host: the result of a parameter request */
+#define POUR_CAN_CMD_TARE 0x0Du         /* host -> controller: tare the scales at their latest reading */
+#define POUR_CAN_CMD_ZERO 0x0Eu         /* host -> controller: the encoder's latest count becomes upright */
 #define POUR_CAN_CMD_SENSORS 0x10u      /* host -> controller: one raw sensor sample (encoder, scales) */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
@@ -36,6 +43,13 @@
 #define POUR_CAN_DLC_CALIBRATION_START 0u
 #define POUR_CAN_DLC_CALIBRATION_RESULT 8u
 #define POUR_CAN_DLC_DRIVE_TELEMETRY 8u
+#define POUR_CAN_DLC_PARAM_READ 1u
+#define POUR_CAN_DLC_PARAM_VALUE 5u
+#define POUR_CAN_DLC_PARAM_WRITE 5u
+#define POUR_CAN_DLC_PARAM_SAVE 0u
+#define POUR_CAN_DLC_PARAM_ACK 3u
+#define POUR_CAN_DLC_TARE 1u
+#define POUR_CAN_DLC_ZERO 0u
 #define POUR_CAN_DLC_SENSORS 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
@@ -67,6 +81,9 @@
 #define POUR_CAN_CAL_UNAVAILABLE 8u     /* this firmware cannot measure (the drive's calibration routine is not in it) */
 #define POUR_CAN_CAL_STATUS_MAX 8u
 #define POUR_CAN_CAL_STORED_MAX 5u
+#define POUR_CAN_PARAM_RESULT_MAX 6u    /* ParamAck.Result: a pour_param_result_t */
+#define POUR_CAN_TARE_ROTATING 1u       /* Tare.Scales bits */
+#define POUR_CAN_TARE_TARGET 2u
 
 /* The CAN node's command watchdog latches in the core as its link fault. */
 #define POUR_CAN_FAULT_WATCHDOG POUR_FAULT_LINK
@@ -133,6 +150,27 @@ typedef struct {
   uint16_t vbus_mv;      /* bus voltage [mV] */
   uint16_t drive_faults; /* POUR_DRIVE_FAULT_* (pour/drive_faults.h); only POUR_CAN_DRIVE_FAULT_MASK is carried */
 } pour_can_drive_telemetry_t;
+/* ParamRead: which parameter. */
+typedef struct {
+  uint8_t param_id; /* pour_param_id_t (an unknown id is the controller's to refuse, not malformed) */
+} pour_can_param_read_t;
+
+/* ParamValue and ParamWrite: a parameter and its value in the parameter's unit (pour/params.h). */
+typedef struct {
+  uint8_t param_id;
+  int32_t value;
+} pour_can_param_t;
+
+/* ParamAck: what became of a request. */
+typedef struct {
+  uint8_t request;  /* cmd id of the request answered, 0 .. 31 */
+  uint8_t param_id; /* its parameter (0 for save, tare and zero) */
+  uint8_t result;   /* pour_param_result_t, 0 (ok) .. POUR_CAN_PARAM_RESULT_MAX */
+} pour_can_param_ack_t;
+
+typedef struct {
+  uint8_t scales; /* POUR_CAN_TARE_* bits, 1 .. 3 */
+} pour_can_tare_t;
 
 /* The fault bits the heartbeat carries: every POUR_FAULT_* of the core, the link (watchdog) fault included. */
 #define POUR_CAN_HEARTBEAT_FAULT_MASK POUR_FAULT_ALL
@@ -143,7 +181,8 @@ typedef enum {
   POUR_CAN_RX_OTHER_NODE = 1,  /* another node's id: not ours, silently ignored */
   POUR_CAN_RX_BAD_ID = -1,     /* our node, but no such cmd (or a cmd we only send) */
   POUR_CAN_RX_BAD_DLC = -2,    /* known cmd with the wrong data length */
-  POUR_CAN_RX_OUT_OF_RANGE = -3 /* a signal outside its DBC range */
+  POUR_CAN_RX_OUT_OF_RANGE = -3, /* a signal outside its DBC range */
+  POUR_CAN_RX_BUSY = -4          /* a parameter request while the previous one still waits (pour_can_node) */
 } pour_can_rx_t;
 
 /* id of cmd for node_id (both masked to their field widths). */
@@ -164,7 +203,13 @@ pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_c
                                                pour_can_frame_t *frame);
 pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_drive_telemetry_t *msg,
                                             pour_can_frame_t *frame);
-/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET and _CALIBRATION_START (POUR_EINVAL
+pour_status_t pour_can_pack_param_read(uint8_t node_id, const pour_can_param_read_t *msg, pour_can_frame_t *frame);
+/* cmd: POUR_CAN_CMD_PARAM_VALUE or _PARAM_WRITE (one layout). */
+pour_status_t pour_can_pack_param(uint8_t node_id, uint8_t cmd, const pour_can_param_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame);
+/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET, _CALIBRATION_START, _PARAM_SAVE and
+ * _ZERO (POUR_EINVAL
  * for another cmd). */
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame);
 
@@ -177,6 +222,10 @@ pour_can_rx_t pour_can_unpack_estop(const pour_can_frame_t *frame, pour_can_esto
 pour_can_rx_t pour_can_unpack_identity(const pour_can_frame_t *frame, pour_can_identity_t *msg);
 pour_can_rx_t pour_can_unpack_calibration_result(const pour_can_frame_t *frame, pour_can_calibration_result_t *msg);
 pour_can_rx_t pour_can_unpack_drive_telemetry(const pour_can_frame_t *frame, pour_can_drive_telemetry_t *msg);
+pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can_param_read_t *msg);
+pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg);
+pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg);
+pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg);
 /* The commands without signals: checks the id's cmd (as given) and the DLC. */
 pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd);
 

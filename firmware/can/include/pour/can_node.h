@@ -31,7 +31,17 @@ typedef struct {
   uint32_t bad_dlc;      /* wrong data length */
   uint32_t out_of_range; /* a signal outside its DBC range */
   uint32_t other_node;   /* other nodes' frames (ignored, not an error) */
+  uint32_t param_busy;   /* a parameter request that came while the previous one waited for the port */
 } pour_can_node_counters_t;
+
+/* A parameter request (ParamRead, ParamWrite, ParamSave, Tare, Zero) waiting for the port, which answers it
+ * with pour_can_params_handle (can_params.h). */
+typedef struct {
+  uint8_t cmd;      /* POUR_CAN_CMD_PARAM_READ, _PARAM_WRITE, _PARAM_SAVE, _TARE or _ZERO */
+  uint8_t param_id; /* read, write */
+  int32_t value;    /* write */
+  uint8_t scales;   /* tare: POUR_CAN_TARE_* bits */
+} pour_can_param_request_t;
 
 typedef struct {
   pour_can_node_config_t config;
@@ -39,6 +49,8 @@ typedef struct {
   pour_sensors_t sensors;       /* latest sensor sample, seq extended to 32 bits */
   bool sensors_fresh;           /* arrived since the last tick */
   pour_commands_t commands;     /* Estop, ClearErrors, Stop and Reset since the last tick, in their order */
+  bool param_pending;           /* param_request waits for the port */
+  pour_can_param_request_t param_request;
   bool armed;                   /* watchdog runs once the first valid sample or command arrived */
   uint32_t ms_since_valid;
   uint16_t ms_to_heartbeat;
@@ -85,6 +97,10 @@ pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour
 /* Heartbeat (counter advanced) then identity: 2 frames, or 0 if the output cannot be packed. */
 uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                     pour_can_frame_t tx[2]);
+
+/* Takes the waiting parameter request, if any (one at a time: another that comes before is dropped and
+ * counted as param_busy). */
+bool pour_can_node_take_param_request(pour_can_node_t *node, pour_can_param_request_t *request);
 
 /* Total of the dropped-frame counters (what the heartbeat's RxDropped carries, mod 2^16). */
 uint32_t pour_can_node_dropped(const pour_can_node_t *node);

@@ -1,0 +1,152 @@
+/* SPDX-License-Identifier: MIT */
+/* The controller's tunable parameters: one table (POUR_PARAMS) gives each its id, name, unit, range and the
+ * field it lives in; defaults come from the modules' own default configs. Values are int32 in the field's
+ * unit. Get/set by id with range checks, the sample correction (encoder zero, scale tare and factor), a
+ * storage blob with a version and a CRC-32, and putting a new set in force in the core. Pure: no I/O.
+ * The motor's parameters and the current-loop bandwidth join the table with the motor library. */
+#ifndef POUR_PARAMS_H
+#define POUR_PARAMS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "pour/control.h"
+#include "pour/fixed.h"
+#include "pour/safety.h"
+#include "pour/sensors.h"
+
+#define POUR_PARAM_FACTOR_ONE 1000000 /* a scale factor of 1.0 [ppm] */
+
+/* X(id, name, unit, min, max, C type, field of pour_params_t). Ids are the bus's (ParamId in can/pour.dbc,
+ * whose value table names them alike; tests/python/test_can_dbc.py keeps the two equal). */
+#define POUR_PARAMS(X)                                                                                         \
+  /* the motion envelope (pour_safety_config_t) */                                                            \
+  X(0, tau_limit, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.tau_limit)                                    \
+  X(1, slew_per_tick, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.slew_per_tick)                            \
+  X(2, theta_min, "urad", -3141593, 3141593, int32_t, control.safety.theta_min_urad)                         \
+  X(3, theta_max, "urad", -3141593, 3141593, int32_t, control.safety.theta_max_urad)                         \
+  X(4, omega_max, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.omega_max_urad_s)        \
+  X(5, alpha_max, "urad/s2", 1000, 1000000000, int32_t, control.safety.alpha_max_urad_s2)                     \
+  X(6, omega_slack, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.omega_slack_urad_s)    \
+  X(7, governor_gain, "Q15/(rad/s)", 1, POUR_Q15_MAX, q15_t, control.safety.torque_per_rad_s)                 \
+  /* the controlled stop (pour_stop_config_t) */                                                              \
+  X(8, stop_torque_max, "Q15", 1, POUR_Q15_MAX, q15_t, control.stop.torque_max)                               \
+  X(9, stop_return_speed, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.stop.return_speed_urad_s) \
+  X(10, stop_return_gain, "1/s", 1, UINT16_MAX, uint16_t, control.stop.return_gain_per_s)                     \
+  X(11, stop_gain, "Q15/(rad/s)", 1, POUR_Q15_MAX, q15_t, control.stop.torque_per_rad_s)                      \
+  X(12, stop_rest_theta, "urad", 1, 3141593, int32_t, control.stop.rest_theta_urad)                          \
+  X(13, stop_rest_omega, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.stop.rest_omega_urad_s)  \
+  X(14, stop_timeout, "ms", 1, UINT16_MAX, uint16_t, control.stop.timeout_ms)                                 \
+  /* the node and the encoder */                                                                              \
+  X(15, node_id, "", 0, 63, uint8_t, node_id)                                                                 \
+  X(16, encoder_bits, "bits", POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, uint8_t, control.sensors.encoder_bits) \
+  X(17, encoder_zero, "counts", 0, 16777215, int32_t, encoder_zero)                                           \
+  /* the gearbox between the motor and the output shaft (the drive's: motor torque = output torque / ratio) */ \
+  X(18, gear_ratio, "1/1000", 1000, 1000000, int32_t, gear_ratio_milli)                                       \
+  /* the load cells: grams = (reading - tare) * factor */                                                     \
+  X(19, scale_rotating_factor, "ppm", 500000, 2000000, int32_t, scale_rotating_factor_ppm)                    \
+  X(20, scale_rotating_tare, "g", -32767, 32767, int32_t, scale_rotating_tare_g)                             \
+  X(21, scale_target_factor, "ppm", 500000, 2000000, int32_t, scale_target_factor_ppm)                        \
+  X(22, scale_target_tare, "g", -32767, 32767, int32_t, scale_target_tare_g)
+
+#define POUR_PARAM_COUNT 23u
+
+/* POUR_PARAM_ID_<name>: each parameter's id, from the table. */
+typedef enum {
+#define POUR_PARAM_ENUM(id, name, unit, lo, hi, type, field) POUR_PARAM_ID_##name = id,
+  POUR_PARAMS(POUR_PARAM_ENUM)
+#undef POUR_PARAM_ENUM
+} pour_param_id_t;
+
+/* Where the parameters live: the core's configuration and the port's own. */
+typedef struct {
+  pour_control_config_t control;
+  uint8_t node_id;                   /* CAN node id; the port binds it at start-up */
+  int32_t encoder_zero;              /* raw count read upright [counts], < 2^encoder_bits */
+  int32_t gear_ratio_milli;          /* motor turns per output turn [1/1000] */
+  int32_t scale_rotating_factor_ppm; /* grams per reading unit [ppm] */
+  int32_t scale_rotating_tare_g;     /* reading with the rotating bucket empty [g] */
+  int32_t scale_target_factor_ppm;
+  int32_t scale_target_tare_g;
+} pour_params_t;
+
+typedef struct {
+  uint8_t id;
+  const char *name;
+  const char *unit;
+  int32_t min; /* valid values: min .. max, inclusive */
+  int32_t max;
+} pour_param_info_t;
+
+/* How a parameter request or a stored set is judged. */
+typedef enum {
+  POUR_PARAM_OK = 0,
+  POUR_PARAM_UNKNOWN_ID = 1,   /* no parameter has this id */
+  POUR_PARAM_OUT_OF_RANGE = 2, /* the value lies outside the parameter's [min, max] */
+  POUR_PARAM_BUSY = 3,         /* the core runs (RUN, ESTOP, or a controlled stop under way) */
+  POUR_PARAM_INCONSISTENT = 4, /* in range, but the set as a whole is refused (e.g. theta_min >= theta_max) */
+  POUR_PARAM_NO_STORAGE = 5,   /* save: the controller has no storage, or writing it failed */
+  POUR_PARAM_NO_SAMPLE = 6     /* tare, zero: no sensor sample has arrived yet */
+} pour_param_result_t;
+
+/* The name of a result ("ok", "unknown id", ...). */
+const char *pour_param_result_name(pour_param_result_t result);
+
+/* Table row of id, or NULL. */
+const pour_param_info_t *pour_param_info(uint8_t id);
+
+/* The defaults: control as given (the port's command line on top of pour_control_default_config), node_id,
+ * no encoder zero offset, gear ratio 1, factors 1.0, tares 0. */
+void pour_params_default(pour_params_t *params, const pour_control_config_t *control, uint8_t node_id);
+
+/* The value of id; POUR_PARAM_UNKNOWN_ID otherwise (*value untouched). */
+pour_param_result_t pour_params_get(const pour_params_t *params, uint8_t id, int32_t *value);
+
+/* Sets id to value after the range check (the set's consistency is pour_params_check's). */
+pour_param_result_t pour_params_set(pour_params_t *params, uint8_t id, int32_t value);
+
+/* The rules between parameters that the table's ranges cannot say and the core does not check
+ * (encoder_zero < 2^encoder_bits). The core's own rules are checked when the set is put in force. */
+pour_param_result_t pour_params_check(const pour_params_t *params);
+
+/* A raw sample as the core must see it: encoder (count - zero) mod 2^bits (a count >= 2^bits passes as it
+ * is, so that the core still refuses it), scales (reading - tare) * factor, rounded half away from zero. */
+void pour_params_correct(const pour_params_t *params, pour_sensors_t *sample);
+
+/* True if the core takes a new configuration now: IDLE, or FAULT once the controlled stop is over. */
+bool pour_params_writable(const pour_control_t *ctl);
+
+/* Puts params->control in force in ctl (pour_control_init), which must be writable: IDLE stays IDLE; FAULT
+ * keeps its latched faults, the brake and the tick count. POUR_EINVAL (ctl unchanged in effect: the old
+ * configuration is put back) if the core refuses the configuration or ctl is not writable. */
+pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params,
+                                const pour_policy_weights_t *weights);
+
+/* Storage blob, little-endian: magic "PPRM", version u16, count u16, count x (id u8, value i32), CRC-32 (IEEE
+ * 802.3) of all bytes before it. */
+#define POUR_PARAMS_BLOB_VERSION 1u
+#define POUR_PARAMS_BLOB_MAX (8u + 5u * POUR_PARAM_COUNT + 4u)
+
+typedef enum {
+  POUR_PARAMS_BLOB_OK = 0,
+  POUR_PARAMS_BLOB_TRUNCATED = -1,   /* shorter than its header says, or than a header */
+  POUR_PARAMS_BLOB_BAD_MAGIC = -2,   /* not a parameter blob */
+  POUR_PARAMS_BLOB_BAD_VERSION = -3, /* another layout version */
+  POUR_PARAMS_BLOB_BAD_CRC = -4,     /* corrupt */
+  POUR_PARAMS_BLOB_BAD_VALUE = -5    /* an unknown id, a value out of its range, or an inconsistent set */
+} pour_params_blob_t;
+
+const char *pour_params_blob_name(pour_params_blob_t status);
+
+/* Writes the whole set into buf (cap >= POUR_PARAMS_BLOB_MAX); returns the length, 0 if it does not fit. */
+uint32_t pour_params_serialize(const pour_params_t *params, uint8_t *buf, uint32_t cap);
+
+/* Reads a blob onto *params (ids it lacks keep their values). On POUR_PARAMS_BLOB_BAD_VALUE *bad_id names the
+ * parameter; *params is written only on POUR_PARAMS_BLOB_OK. */
+pour_params_blob_t pour_params_deserialize(const uint8_t *buf, uint32_t len, pour_params_t *params,
+                                           uint8_t *bad_id);
+
+/* CRC-32 (IEEE 802.3, reflected, init and final xor 0xFFFFFFFF) of len bytes. */
+uint32_t pour_crc32(const uint8_t *data, uint32_t len);
+
+#endif /* POUR_PARAMS_H */

@@ -1,0 +1,137 @@
+# SPDX-License-Identifier: MIT
+"""pour-bench's bad input on any kernel (the bus itself is tested in the user-mode Linux guest,
+tests/can/guest/test_bench.py): a bad command line is 2, a bus that cannot open or a command this firmware
+lacks is 1, each with a message that names the problem."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+
+def bench(*argv: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "pour.bench.cli", *argv], capture_output=True, text=True,
+                          timeout=60)
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--node", "64", "info"], "node id 64 outside 0..63"),
+    (["--node", "x", "info"], "'x' is not a decimal integer"),
+    (["--timeout", "0", "info"], "not a number of seconds"),
+    (["--expect-hash", "0xnothex", "clear"], "not a 32-bit policy hash"),
+    (["config", "set", "omega_max", "1.5"], "'1.5' is not a decimal integer"),
+    (["config", "set", "omega_max"], "the following arguments are required: value"),
+    (["frobnicate"], "invalid choice: 'frobnicate'"),
+    ([], "the following arguments are required: COMMAND"),
+])
+def test_bad_command_lines_are_status_2(argv, needle):
+    r = bench(*argv)
+    assert r.returncode == 2 and needle in r.stderr, r.stderr
+
+
+def test_a_bad_weights_file_is_status_2(tmp_path):
+    bad = tmp_path / "weights.h"
+    bad.write_text("not a header\n")
+    r = bench("--iface", "nosuchcan0", "--weights", str(bad), "clear")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith(f"pour-bench: error: --weights {bad}: "), r.stderr
+    r = bench("--iface", "nosuchcan0", "reset")
+    assert r.returncode == 2 and "'reset' can move the axis: give the policy you expect" in r.stderr, r.stderr
+
+
+def test_calibrate_is_not_available_over_this_firmware():
+    r = bench("calibrate")
+    assert r.returncode == 1
+    assert "calibrate is not available over this firmware" in r.stderr
+
+
+def test_a_bus_that_cannot_open_says_which():
+    r = bench("--iface", "nosuchcan0", "scan")
+    assert r.returncode == 1
+    assert "pour-bench: error: cannot open CAN bus socketcan:nosuchcan0" in r.stderr, r.stderr
+
+
+def test_config_list_names_the_dbc_parameters_without_a_bus():
+    r = bench("--iface", "nosuchcan0", "config", "list")
+    assert r.returncode == 0, r.stderr
+    assert "  4 omega_max" in r.stdout and " 22 scale_target_tare" in r.stdout, r.stdout
+
+
+def candump_log(path, node: int = 0, samples: int = 300) -> None:
+    """A candump -L log of one pour's frames for node, packed by the DBC: the encoder turning 1 count per
+    sample, torque at 25 % of a 20 N·m tau_max, a heartbeat and identity every 100 samples (RUN, then
+    FAULT with StaleInput)."""
+    import cantools
+
+    from pour.can import dbc
+    db = cantools.database.load_file(str(dbc.DBC_PATH))
+    lines = []
+
+    def frame(t: float, name: str, **sig) -> None:
+        m = db.get_message_by_name(name)
+        data = m.encode(sig, scaling=False)
+        lines.append(f"({1700000000 + t:.6f}) vcan0 {dbc.can_id(node, m.frame_id):03X}#{data.hex().upper()}")
+
+    faults = {f"Fault_{n}": 0 for n in ("StaleInput", "EStop", "BadInput", "Position", "Overspeed", "TorqueSign",
+                                         "Encoder", "Volume", "CanWatchdog", "Seq", "Scale")}
+    for k in range(samples):
+        t = k * 0.001
+        frame(t, "Sensors", Seq=k % 256, Encoder=k, ScaleRotating=10000 - k, ScaleTarget=k)
+        frame(t, "Torque", Seq=k, Torque=8192, Action=3, Mode=1, Limits=0)
+        if k % 100 == 0:
+            late = k >= 200
+            frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
+                  Overruns=0, Counter=k // 100)
+            frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_plot_of_a_log_draws_the_node_and_saves_a_png(tmp_path):
+    log = tmp_path / "run.log"
+    candump_log(log)
+    png = tmp_path / "plot.png"
+    r = bench("plot", "--replay", str(log), "--fast", "--no-window", "--png", str(png))
+    assert r.returncode == 0, r.stderr
+    assert "pour-bench plot: 606 frames of node 0" in r.stdout, r.stdout  # 300 samples, 300 torques, 3 + 3
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_series_theta_rate_torque_and_faults():
+    from pour.bench import plot
+    s = plot.Series(window_s=100.0, encoder_bits=17)
+    names = ["Fault_StaleInput", "Fault_EStop"]
+    s.add("Identity", {"TauMax": 2000}, names)
+    for k in range(300):  # 300 samples: Seq wraps at 256, the encoder below upright (counts wrap under 2^17)
+        s.add("Sensors", {"Seq": k % 256, "Encoder": (131072 - 10 * k) % 131072, "ScaleRotating": 500,
+                          "ScaleTarget": -20}, names)
+        s.add("Torque", {"Torque": -16384}, names)
+    s.add("Heartbeat", {"Mode": 2, "Fault_StaleInput": 1, "Fault_EStop": 0}, names)
+    assert s.theta[-1][0] == 0.299  # the samples' clock across the wrap
+    assert abs(s.theta[-1][1] - (-2990 * 360 / 131072)) < 1e-9
+    assert abs(s.omega[-1][1] - (-10 * 360 / 131072 * 1000)) < 1e-6  # deg/s at 10 counts per ms
+    assert s.torque[-1][1] == -10.0  # half of tau_max, backwards
+    assert s.scales[-1][1:] == (0.5, -0.02)
+    assert s.faults[-1] == (0.299, ["StaleInput"]) and s.modes[-1] == (0.299, 2)
+
+
+@pytest.mark.parametrize("make, argv, status, needle", [
+    (None, ["--replay", "nosuch.log", "--no-window", "--png", "x.png"], 2, "nosuch.log: no such file"),
+    ("garbage", ["--no-window", "--png", "x.png"], 1, "not a candump -L log"),
+    ("node5", ["--no-window", "--png", "x.png"], 1, "no frame of node 0 to plot"),
+    ("log", ["--no-window"], 2, "--no-window draws nothing to see: give --png FILE"),
+    ("log", ["--no-window", "--png", "nosuchdir/x.png"], 2, "does not exist"),
+    ("log", ["--encoder-bits", "30", "--no-window", "--png", "x.png"], 2, "--encoder-bits 30 outside 8..24"),
+])
+def test_plot_bad_input(tmp_path, make, argv, status, needle):
+    log = tmp_path / "run.log"
+    if make == "garbage":
+        log.write_text("this is not a log\n")
+    elif make == "node5":
+        candump_log(log, node=5)
+    elif make == "log":
+        candump_log(log)
+    argv = [str(tmp_path / a) if a.endswith((".log", ".png")) else a for a in argv]
+    r = bench("plot", *(["--replay", str(log)] if make else []), "--fast", *argv)
+    assert r.returncode == status, (r.stdout, r.stderr)
+    assert needle in r.stderr, r.stderr

@@ -1,0 +1,245 @@
+# SPDX-License-Identifier: MIT
+"""pour-bench: bring a pour controller up on a CAN bus (scan, info, faults, e-stop, parameters, logs).
+
+Commands that can make the axis move (clear, which resumes a run, and reset) say so, check the node's
+policy hash against --expect-hash or --weights first, and ask for confirmation unless --yes.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from pour import atomic
+from pour.bench import node as bn
+from pour.policy import weights_h
+
+PROG = "pour-bench"
+EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a failure while running (no node, two "
+          "nodes on one id, a node that does not answer, a request the controller refuses, a policy that is not "
+          "the expected one); 2 bad input (the command line, or the weights.h it names). Numbers are decimal; a "
+          "hash may be 0x hex.")
+
+
+MOTION = ("clear", "reset")  # commands after which the policy drives the axis again
+
+
+class UsageError(Exception):
+    """Bad input: exit status 2."""
+
+
+def _int(text: str) -> int:
+    try:
+        return int(text, 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a decimal integer") from None
+
+
+def _hash(text: str) -> int:
+    try:
+        v = int(text[2:], 16) if text.lower().startswith("0x") else int(text, 10)
+    except ValueError:
+        v = -1
+    if not 0 <= v <= 0xFFFFFFFF:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a 32-bit policy hash (0x hex or decimal)")
+    return v
+
+
+def _node_id(text: str) -> int:
+    v = _int(text)
+    if not 0 <= v <= 63:
+        raise argparse.ArgumentTypeError(f"node id {v} outside 0..63")
+    return v
+
+
+def _seconds(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        v = -1.0
+    if not 0.0 < v <= 86400.0:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of seconds in (0, 86400]")
+    return v
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
+    ap.add_argument("--iface", default="vcan0", help="CAN interface (python-can channel; default %(default)s)")
+    ap.add_argument("--interface", default="socketcan", help="python-can interface (default %(default)s)")
+    ap.add_argument("--node", type=_node_id, default=0, help="controller node id, 0..63 (default 0)")
+    ap.add_argument("--timeout", type=_seconds, default=bn.DEFAULT_TIMEOUT_S,
+                    help="seconds to wait for an answer (default %(default)s)")
+    ap.add_argument("--expect-hash", type=_hash, help="the policy hash the node must run before a motion command")
+    ap.add_argument("--weights", type=Path, help="weights.h whose content hash the node must run (instead)")
+    ap.add_argument("--yes", action="store_true", help="do not ask before a command that can move the axis")
+    sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
+    sub.add_parser("scan", help="list the nodes on the bus")
+    sub.add_parser("info", help="identity and state of the node")
+    sub.add_parser("faults", help="mode and latched faults by name")
+    sub.add_parser("clear", help="clear latched faults (MOVES: a run resumes)")
+    p = sub.add_parser("estop", help="assert the e-stop (or --release it)")
+    p.add_argument("--release", action="store_true")
+    sub.add_parser("stop", help="end the run (RUN -> IDLE)")
+    sub.add_parser("reset", help="start a new run from the power-on state (MOVES once samples flow)")
+    p = sub.add_parser("config", help="parameters: get [NAME...], set NAME VALUE, save, list")
+    csub = p.add_subparsers(dest="config_cmd", required=True, metavar="ACTION")
+    g = csub.add_parser("get")
+    g.add_argument("names", nargs="*", help="parameter names or ids (default: all)")
+    s = csub.add_parser("set")
+    s.add_argument("name")
+    s.add_argument("value", type=_int)
+    csub.add_parser("save")
+    csub.add_parser("list", help="the parameter names this DBC knows")
+    p = sub.add_parser("tare", help="tare the scales at their present reading")
+    p.add_argument("--scale", choices=["rotating", "target", "both"], default="both")
+    sub.add_parser("zero", help="the encoder's present count becomes upright")
+    p = sub.add_parser("log", help="record the bus as a candump -L log")
+    p.add_argument("output", type=Path)
+    p.add_argument("--seconds", type=_seconds, default=10.0)
+    p = sub.add_parser("plot", help="live plot: θ, θ̇, torque, scales, mode and faults (--png to save)")
+    p.add_argument("--seconds", type=_seconds, default=3600.0, help="stop after this long (default: an hour)")
+    p.add_argument("--window", type=_seconds, default=10.0, help="seconds shown (default %(default)s)")
+    p.add_argument("--encoder-bits", type=_int, default=17, help="the controller's encoder_bits (default 17)")
+    p.add_argument("--png", type=Path, help="save the figure as a PNG at the end")
+    p.add_argument("--replay", type=Path, help="plot a candump -L log (pour-bench log) instead of the bus")
+    p.add_argument("--fast", action="store_true", help="--replay as fast as it draws, not at the log's pace")
+    p.add_argument("--no-window", action="store_true", help="draw off-screen (with --png)")
+    sub.add_parser("calibrate", help="drive calibration (needs the board's calibration messages)")
+    return ap
+
+
+def _expected_hash(a: argparse.Namespace) -> int:
+    if a.weights is not None:
+        try:
+            return weights_h.parse_weights_h(a.weights).content_hash
+        except (OSError, ValueError) as e:
+            raise UsageError(f"--weights {a.weights}: {e}") from e
+    if a.expect_hash is None:
+        raise UsageError(f"'{a.cmd}' can move the axis: give the policy you expect with --expect-hash HASH or "
+                            f"--weights weights.h")
+    return a.expect_hash
+
+
+def _confirm_motion(a: argparse.Namespace, n: bn.Node, want: int) -> None:
+    st = n.info(a.timeout)
+    assert st.identity is not None
+    if st.identity.weights_hash != want:
+        raise bn.BenchError(f"node {n.id} runs policy 0x{st.identity.weights_hash:08x}, not the expected "
+                            f"0x{want:08x}: '{a.cmd}' refused")
+    if a.yes:
+        return
+    if not sys.stdin.isatty():
+        raise bn.BenchError(f"'{a.cmd}' can move the axis: confirm with --yes (no terminal to ask on)")
+    answer = input(f"'{a.cmd}' can move the axis of node {n.id} (policy 0x{want:08x}). Type yes to go on: ")
+    if answer.strip() != "yes":
+        raise bn.BenchError(f"'{a.cmd}' not confirmed")
+
+
+def _print_state(st: bn.NodeState) -> None:
+    print(f"node {st.node_id}: mode {st.mode}, faults {', '.join(st.faults) or 'none'}, "
+          f"rx_dropped {st.rx_dropped}, overruns {st.overruns}")
+
+
+def _plot(a: argparse.Namespace) -> int:
+    from pour.bench import plot
+    if not 8 <= a.encoder_bits <= 24:
+        raise UsageError(f"--encoder-bits {a.encoder_bits} outside 8..24")
+    if a.png is not None:
+        try:
+            atomic.check_output_path(a.png, "--png")
+        except ValueError as e:
+            raise UsageError(str(e)) from e
+    if a.no_window and a.png is None:
+        raise UsageError("--no-window draws nothing to see: give --png FILE")
+    if a.replay is not None and not a.replay.is_file():
+        raise UsageError(f"--replay {a.replay}: no such file")
+    db = bn.load_dbc()
+    if a.replay is not None:
+        used = plot.run(plot.replay(a.replay, paced=not a.fast), db, a.node, a.seconds, a.encoder_bits, a.window,
+                        a.png, not a.no_window, hold=True)
+    else:
+        with bn.Bench(channel=a.iface, interface=a.interface) as bench:
+            used = plot.run(bench.frames(a.seconds), db, a.node, a.seconds, a.encoder_bits, a.window, a.png,
+                            not a.no_window)
+    print(f"pour-bench plot: {used} frames of node {a.node}" + (f", figure in {a.png}" if a.png else ""))
+    return 0
+
+
+def run(a: argparse.Namespace) -> int:
+    if a.cmd == "calibrate":
+        raise bn.BenchError("calibrate is not available over this firmware: its CAN protocol has no calibration "
+                            "messages (can/pour.dbc)")
+    if a.cmd == "config" and a.config_cmd == "list":
+        for pid, name in bn.param_names(bn.load_dbc()).items():
+            print(f"{pid:3d} {name}")
+        return 0
+    want = _expected_hash(a) if a.cmd in MOTION else None
+    if a.cmd == "plot":
+        return _plot(a)
+    with bn.Bench(channel=a.iface, interface=a.interface) as bench:
+        if a.cmd == "scan":
+            for st in bench.scan(max(a.timeout, bn.HEARTBEAT_WAIT_S)).values():
+                ident = st.identity
+                extra = (f", policy 0x{ident.weights_hash:08x}, tau_max {ident.tau_max_nm:.2f} N.m, "
+                         f"firmware {ident.fw_version}") if ident else ""
+                print(f"node {st.node_id}: mode {st.mode}{extra}")
+            return 0
+        n = bench.node(a.node)
+        if a.cmd == "info":
+            st = n.info(a.timeout)
+            assert st.identity is not None
+            i = st.identity
+            print(f"node {st.node_id}: policy 0x{i.weights_hash:08x}, tau_max {i.tau_max_nm:.2f} N.m, firmware "
+                  f"{i.fw_version}, init status {i.init_status}")
+            _print_state(st)
+        elif a.cmd == "faults":
+            _print_state(n.info(a.timeout))
+        elif a.cmd == "estop":
+            n.estop(not a.release)
+            _print_state(n.wait_mode({"FAULT"} if a.release else {"ESTOP"}, a.timeout))
+        elif a.cmd == "stop":
+            n.stop()
+            _print_state(n.info(a.timeout))
+        elif a.cmd in MOTION:
+            assert want is not None
+            _confirm_motion(a, n, want)
+            n.clear() if a.cmd == "clear" else n.reset()
+            st = n.wait_mode({"IDLE", "RUN"} if a.cmd == "clear" else {"IDLE", "RUN", "FAULT"}, a.timeout)
+            _print_state(st)
+        elif a.cmd == "config":
+            if a.config_cmd == "get":
+                names = a.names or [name for _, name in sorted(bench.param_names.items())]
+                for name in names:
+                    print(f"{name} {n.get(name, a.timeout)}")
+            elif a.config_cmd == "set":
+                print(f"{a.name} {n.set(a.name, a.value, a.timeout)}")
+            else:
+                n.save(a.timeout)
+                print(f"node {n.id}: parameters saved")
+        elif a.cmd == "tare":
+            scales = {"rotating": bn.TARE_ROTATING, "target": bn.TARE_TARGET}.get(a.scale, 3)
+            n.tare(scales, a.timeout)
+            print(f"node {n.id}: {a.scale} tared")
+        elif a.cmd == "zero":
+            n.zero(a.timeout)
+            print(f"node {n.id}: encoder zeroed")
+        elif a.cmd == "log":
+            count = n.record(a.output, a.seconds)
+            print(f"{a.output}: {count} frames in {a.seconds:g} s")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    a = parser().parse_args(argv)
+    try:
+        return run(a)
+    except UsageError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 2
+    except (bn.BenchError, ValueError) as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,362 @@
+# SPDX-License-Identifier: MIT
+"""A bench's view of pour controllers on a CAN bus: python-can moves the frames, cantools decodes them with
+can/pour.dbc (the one source of truth: message layouts, fault names, modes, parameter names and results).
+
+    bus = Bench(channel="vcan0")            # python-can, interface socketcan by default
+    nodes = bus.scan()                      # {node_id: NodeState}; two nodes on one id: DuplicateNodeError
+    n = bus.node(0)
+    n.info()                                # NodeState: mode, faults by name, identity (policy hash, tau_max)
+    n.set("omega_max", 1500000); n.save()   # ParamValue or ParamAck; a refusal: ParamRefused (its reason)
+    n.estop(); n.clear(); n.record("run.log", seconds=5)
+
+Every wait has a timeout; a node that does not answer raises NodeTimeout, which carries its last state.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterator
+
+import can
+import cantools
+
+from pour import atomic
+from pour.can import dbc
+
+DEFAULT_TIMEOUT_S = 1.0
+HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
+TARE_ROTATING = 1
+TARE_TARGET = 2
+
+
+class BenchError(Exception):
+    """Anything the bench cannot do; the message says what and why."""
+
+
+class NoNodeError(BenchError):
+    pass
+
+
+class DuplicateNodeError(BenchError):
+    pass
+
+
+class NodeTimeout(BenchError):
+    def __init__(self, message: str, last: "NodeState | None") -> None:
+        super().__init__(message)
+        self.last = last
+
+
+class ParamRefused(BenchError):
+    def __init__(self, message: str, param: str, result: str) -> None:
+        super().__init__(message)
+        self.param = param
+        self.result = result
+
+
+@dataclass
+class Identity:
+    weights_hash: int
+    tau_max_nm: float
+    fw_version: int
+    init_status: int
+
+
+@dataclass
+class NodeState:
+    """What a node last said of itself (monotonic times [s])."""
+    node_id: int
+    mode: str = "?"
+    faults: list[str] = field(default_factory=list)
+    rx_dropped: int = 0
+    overruns: int = 0
+    counter: int | None = None
+    identity: Identity | None = None
+    t_heartbeat: float | None = None
+    heartbeats: int = 0
+    counter_breaks: int = 0  # heartbeats whose counter repeated or went back: another node on this id
+    identities: set[int] = field(default_factory=set)  # distinct policy hashes seen on this id
+
+    def describe(self, now: float | None = None) -> str:
+        now = time.monotonic() if now is None else now
+        age = f"{now - self.t_heartbeat:.2f} s ago" if self.t_heartbeat is not None else "never"
+        faults = ", ".join(self.faults) or "none"
+        return f"node {self.node_id}: mode {self.mode}, faults {faults}, last heartbeat {age}"
+
+
+def fault_signals(db: cantools.database.can.Database) -> list[str]:
+    """The heartbeat's fault signals, in bit order (names as the DBC gives them, without "Fault_")."""
+    hb = db.get_message_by_name("Heartbeat")
+    return [s.name for s in sorted(hb.signals, key=lambda s: s.start) if s.name.startswith("Fault_")]
+
+
+def load_dbc(path: Path = dbc.DBC_PATH) -> cantools.database.can.Database:
+    return cantools.database.load_file(str(path))
+
+
+def param_names(db: cantools.database.can.Database) -> dict[int, str]:
+    """Parameter id -> name, from ParamId's value table (the firmware's table, firmware/include/pour/params.h)."""
+    pid = db.get_message_by_name("ParamRead").get_signal_by_name("ParamId")
+    return {int(k): str(v) for k, v in sorted(pid.choices.items())}
+
+
+class Decoder:
+    """Frames -> (node id, message name, raw signals) by the DBC; None for a frame it does not know."""
+
+    def __init__(self, db: cantools.database.can.Database) -> None:
+        self._by_cmd = {m.frame_id: m for m in db.messages}
+
+    def decode(self, msg: can.Message) -> tuple[int, str, dict] | None:
+        if msg.is_extended_id or msg.is_error_frame or msg.is_remote_frame:
+            return None
+        node_id, cmd = msg.arbitration_id >> dbc.NODE_SHIFT, msg.arbitration_id & dbc.CMD_MASK
+        m = self._by_cmd.get(cmd)
+        if m is None or len(msg.data) != m.length:
+            return None
+        try:
+            return node_id, m.name, m.decode(bytes(msg.data), scaling=False, decode_choices=False)
+        except cantools.database.errors.DecodeError:
+            return None
+
+
+class Bench:
+    """One CAN bus. channel/interface are python-can's; bus: an open python-can bus instead."""
+
+    def __init__(self, channel: str = "vcan0", interface: str = "socketcan", bus: can.BusABC | None = None,
+                 dbc_path: Path = dbc.DBC_PATH) -> None:
+        self.db = load_dbc(dbc_path)
+        self.channel = channel
+        try:
+            self.bus = bus if bus is not None else can.Bus(interface=interface, channel=channel)
+        except (OSError, can.CanError, ValueError) as e:
+            raise BenchError(f"cannot open CAN bus {interface}:{channel}: {e}") from e
+        self.states: dict[int, NodeState] = {}
+        self._by_cmd = {m.frame_id: m for m in self.db.messages}
+        self.decoder = Decoder(self.db)
+        self._faults = fault_signals(self.db)
+        self._listeners: list[Callable[[can.Message], None]] = []
+        self.param_names = param_names(self.db)
+        self.param_ids = {v: k for k, v in self.param_names.items()}
+
+    def close(self) -> None:
+        self.bus.shutdown()
+
+    def __enter__(self) -> "Bench":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -- frames ------------------------------------------------------------------------------------------
+    def message(self, cmd_or_name: int | str):
+        return self.db.get_message_by_name(cmd_or_name) if isinstance(cmd_or_name, str) else self._by_cmd[cmd_or_name]
+
+    def send(self, node_id: int, name: str, **signals: int) -> None:
+        m = self.db.get_message_by_name(name)
+        data = m.encode(signals, scaling=False, strict=True) if m.signals else b""
+        try:
+            self.bus.send(can.Message(arbitration_id=dbc.can_id(node_id, m.frame_id), data=data,
+                                      is_extended_id=False))
+        except can.CanError as e:
+            raise BenchError(f"cannot send {name} to node {node_id} on {self.channel}: {e}") from e
+
+    def decode(self, msg: can.Message) -> tuple[int, str, dict] | None:
+        return self.decoder.decode(msg)
+
+    def _note(self, msg: can.Message) -> tuple[int, str, dict] | None:
+        d = self.decode(msg)
+        if d is None:
+            return None
+        node_id, name, sig = d
+        now = time.monotonic()
+        if name == "Heartbeat":
+            st = self.states.setdefault(node_id, NodeState(node_id))
+            # One node's counter only moves forward (1, or a little more past lost frames); two nodes on one id
+            # interleave two counters, so that at least every other step repeats one or goes back.
+            if st.counter is not None and ((sig["Counter"] - st.counter) % 256 == 0 or
+                                           (sig["Counter"] - st.counter) % 256 >= 128):
+                st.counter_breaks += 1
+            st.counter = sig["Counter"]
+            st.mode = self.message("Heartbeat").get_signal_by_name("Mode").choices.get(sig["Mode"], str(sig["Mode"]))
+            st.mode = str(st.mode)
+            st.faults = [f.removeprefix("Fault_") for f in self._faults if sig[f]]
+            st.rx_dropped, st.overruns = sig["RxDropped"], sig["Overruns"]
+            st.t_heartbeat = now
+            st.heartbeats += 1
+        elif name == "Identity":
+            st = self.states.setdefault(node_id, NodeState(node_id))
+            st.identity = Identity(sig["WeightsHash"], sig["TauMax"] * 0.01, sig["FwVersion"], sig["InitStatus"])
+            st.identities.add(sig["WeightsHash"])
+        return d
+
+    def frames(self, seconds: float) -> Iterator[can.Message]:
+        """Every frame on the bus for the given time (states updated on the way)."""
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            msg = self.bus.recv(timeout=left)
+            if msg is None:
+                continue
+            self._note(msg)
+            for cb in self._listeners:
+                cb(msg)
+            yield msg
+
+    def wait_for(self, node_id: int, pred: Callable[[str, dict], bool], timeout: float, what: str) -> tuple[str, dict]:
+        """The first message of node_id satisfying pred(name, signals), else NodeTimeout naming what."""
+        for msg in self.frames(timeout):
+            d = self.decode(msg)
+            if d is not None and d[0] == node_id and pred(d[1], d[2]):
+                return d[1], d[2]
+        last = self.states.get(node_id)
+        state = last.describe() if last else f"node {node_id}: never heard on {self.channel}"
+        raise NodeTimeout(f"node {node_id} did not answer {what} within {timeout:g} s ({state})", last)
+
+    # -- nodes -------------------------------------------------------------------------------------------
+    def scan(self, seconds: float = HEARTBEAT_WAIT_S) -> dict[int, NodeState]:
+        """The nodes whose heartbeats arrive within seconds. NoNodeError if none; DuplicateNodeError if an id
+        carries two controllers (two policy hashes, or two heartbeat counters interleaved)."""
+        self.states = {}
+        for _ in self.frames(seconds):
+            pass
+        found = {k: v for k, v in sorted(self.states.items()) if v.heartbeats > 0}
+        if not found:
+            raise NoNodeError(f"no node on {self.channel}: no heartbeat within {seconds:g} s (is the controller "
+                              f"running, on this interface, at the bus's bit rate?)")
+        for st in found.values():
+            if len(st.identities) > 1 or st.counter_breaks >= 2:
+                raise DuplicateNodeError(
+                    f"two nodes answer on id {st.node_id} of {self.channel} ({len(st.identities)} policy hashes, "
+                    f"{st.counter_breaks} of {st.heartbeats} heartbeat counters repeated or went back): give each "
+                    f"controller its own node id")
+        return found
+
+    def node(self, node_id: int) -> "Node":
+        dbc.check_node_id(node_id)
+        return Node(self, node_id)
+
+
+class Node:
+    """One controller on the bus."""
+
+    def __init__(self, bench: Bench, node_id: int) -> None:
+        self.bench = bench
+        self.id = node_id
+
+    @property
+    def state(self) -> NodeState | None:
+        return self.bench.states.get(self.id)
+
+    def info(self, timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        """Waits for a heartbeat and an identity frame of this node."""
+        self.bench.wait_for(self.id, lambda n, s: n == "Heartbeat", timeout, "with a heartbeat")
+        if self.state is None or self.state.identity is None:
+            self.bench.wait_for(self.id, lambda n, s: n == "Identity", timeout, "with its identity")
+        assert self.state is not None
+        return self.state
+
+    # -- commands (no answer of their own: the next heartbeat shows their effect) ---------------------------
+    def estop(self, asserted: bool = True) -> None:
+        self.bench.send(self.id, "Estop", Assert=1 if asserted else 0)
+
+    def clear(self) -> None:
+        self.bench.send(self.id, "ClearErrors")
+
+    def stop(self) -> None:
+        self.bench.send(self.id, "Stop")
+
+    def reset(self) -> None:
+        self.bench.send(self.id, "Reset")
+
+    def wait_mode(self, modes: set[str], timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        """Waits for a heartbeat whose mode is one of modes."""
+        names = self.bench.message("Heartbeat").get_signal_by_name("Mode").choices
+        want = {int(k) for k, v in names.items() if str(v) in modes}
+        self.bench.wait_for(self.id, lambda n, s: n == "Heartbeat" and s["Mode"] in want, timeout,
+                            f"with a heartbeat in {'/'.join(sorted(modes))}")
+        assert self.state is not None
+        return self.state
+
+    # -- parameters ----------------------------------------------------------------------------------------
+    def param_id(self, name_or_id: str | int) -> int:
+        if isinstance(name_or_id, int) or str(name_or_id).isdigit():
+            return int(name_or_id)
+        try:
+            return self.bench.param_ids[str(name_or_id)]
+        except KeyError:
+            raise BenchError(f"no parameter '{name_or_id}' (known: {', '.join(self.bench.param_ids)})") from None
+
+    def _param_name(self, pid: int) -> str:
+        return self.bench.param_names.get(pid, f"#{pid}")
+
+    def _request(self, request: str, pid: int, timeout: float, **signals: int) -> dict:
+        """Sends a parameter request; returns the ParamValue's signals (read, write) or the ParamAck's (save,
+        tare, zero). ParamRefused with the controller's reason; NodeTimeout if it does not answer."""
+        cmd = self.bench.message(request).frame_id
+        self.bench.send(self.id, request, **signals)
+
+        def answer(name: str, s: dict) -> bool:
+            return (name == "ParamValue" and s["ParamId"] == pid) or (
+                name == "ParamAck" and s["Request"] == cmd and s["ParamId"] == pid)
+
+        name, s = self.bench.wait_for(self.id, answer, timeout, f"{request}({self._param_name(pid)})"
+                                      if request in ("ParamRead", "ParamWrite") else request)
+        if name == "ParamAck" and s["Result"] != 0:
+            result = str(self.bench.message("ParamAck").get_signal_by_name("Result").choices[s["Result"]])
+            what = f"{request} {self._param_name(pid)}" if request in ("ParamRead", "ParamWrite") else request
+            reason = {"BUSY": "the controller runs: stop it or let it reach IDLE/FAULT first",
+                      "OUT_OF_RANGE": "the value lies outside the parameter's range (firmware/include/pour/params.h)",
+                      "UNKNOWN_ID": "this controller has no such parameter",
+                      "INCONSISTENT": "the controller refuses the set as a whole (e.g. theta_min >= theta_max)",
+                      "NO_STORAGE": "the controller has no storage (pour_controller --io can:IFACE,params=FILE)",
+                      "NO_SAMPLE": "no sensor sample has reached the controller yet"}.get(result, "")
+            raise ParamRefused(f"node {self.id} refused {what}: {result} ({reason})", self._param_name(pid), result)
+        return s
+
+    def get(self, name_or_id: str | int, timeout: float = DEFAULT_TIMEOUT_S) -> int:
+        pid = self.param_id(name_or_id)
+        return int(self._request("ParamRead", pid, timeout, ParamId=pid)["Value"])
+
+    def set(self, name_or_id: str | int, value: int, timeout: float = DEFAULT_TIMEOUT_S) -> int:
+        """Sets a parameter (raw, in its unit); returns the value now in force."""
+        pid = self.param_id(name_or_id)
+        return int(self._request("ParamWrite", pid, timeout, ParamId=pid, Value=int(value))["Value"])
+
+    def params(self, timeout: float = DEFAULT_TIMEOUT_S) -> dict[str, int]:
+        return {name: self.get(pid, timeout) for pid, name in sorted(self.bench.param_names.items())}
+
+    def save(self, timeout: float = DEFAULT_TIMEOUT_S) -> None:
+        self._request("ParamSave", 0, timeout)
+
+    def tare(self, scales: int = TARE_ROTATING | TARE_TARGET, timeout: float = DEFAULT_TIMEOUT_S) -> None:
+        self._request("Tare", 0, timeout, Scales=scales)
+
+    def zero(self, timeout: float = DEFAULT_TIMEOUT_S) -> None:
+        self._request("Zero", 0, timeout)
+
+    # -- telemetry -----------------------------------------------------------------------------------------
+    def stream(self, seconds: float) -> Iterator[tuple[float, str, dict]]:
+        """(time [s], message name, raw signals) of this node's frames for the given time."""
+        for msg in self.bench.frames(seconds):
+            d = self.bench.decode(msg)
+            if d is not None and d[0] == self.id:
+                yield msg.timestamp, d[1], d[2]
+
+    def record(self, path: str | Path, seconds: float) -> int:
+        """Writes every frame of the bus for the given time as a candump -L log (atomically); returns the count.
+        NodeTimeout if this node sent nothing in that time (the log is then not written)."""
+        atomic.check_output_path(path, "log")
+        n = mine = 0
+        with atomic.atomic_path(path) as tmp:
+            writer = can.CanutilsLogWriter(str(tmp), channel=self.bench.channel)
+            try:
+                for msg in self.bench.frames(seconds):
+                    writer.on_message_received(msg)
+                    n += 1
+                    mine += int(msg.arbitration_id >> dbc.NODE_SHIFT == self.id and not msg.is_extended_id)
+            finally:
+                writer.stop()
+            if mine == 0:
+                raise NodeTimeout(f"node {self.id} sent nothing on {self.bench.channel} in {seconds:g} s: no log "
+                                  f"written", self.state)
+        return n
