@@ -29,6 +29,7 @@ from pour.train import executors, reinforce
 from pour.train.executors import Runner  # the local pool, the default executor (also as trainer.Runner)
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
+STREAM_INIT = 4  # policy.init = "random" (ars.py's directions are stream 3)
 
 LOG_FIELDS = ["iteration", "episodes", "wall_s", "return_mean", "return_std", "return_min", "return_max",
               "reward_sum_mean", "v_target_mean", "v_spill_mean", "finish_s_mean", "entropy_mean",
@@ -126,6 +127,17 @@ def episode_return(ep: envs.Episode, gamma_decision: float) -> float:
     return reinforce.discounted_return(ep.rewards, gamma_decision)
 
 
+def initial_params(cfg: cfgmod.TrainConfig) -> np.ndarray:
+    """The run's starting parameters: zeros, policy.init_beta, or seeded normal(0, init_scale^2)."""
+    shape = reinforce.params_shape(cfg.policy.param, cfg.policy.n_actions)
+    if cfg.policy.init == "beta":
+        return np.array(cfg.policy.init_beta, dtype=np.float64)
+    if cfg.policy.init == "random":
+        rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, STREAM_INIT]))
+        return cfg.policy.init_scale * rng.standard_normal(shape)
+    return np.zeros(shape)
+
+
 def score(episodes: Sequence[envs.Episode], steps: int) -> float:
     """Validation score: the per-tick reward averaged over the episode and over the episodes."""
     return float(np.mean([np.sum(e.rewards) for e in episodes])) / steps
@@ -207,19 +219,20 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call.
     make_runner: cfg -> the episode runner (Runner, the local pool, or executors.RayRunner): same results."""
     run_dir = Path(run_dir)
+    if cfg.algo.kind == "ars":
+        from pour.train import ars  # ars builds on this module's run directory
+        return ars.train(cfg, run_dir, resume, quiet, stop_after, make_runner)
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
     digest = cfg.digest()
-    n_feat, n_act = envs.N_FEATURES, cfg.policy.n_actions
     steps = int(round(cfg.env.episode_s * 1000))
 
-    params = np.zeros(reinforce.params_shape(cfg.policy.param, n_act))
-    if cfg.policy.init == "beta":
-        params = np.array(cfg.policy.init_beta, dtype=np.float64)
+    params = initial_params(cfg)
     w = weights(cfg, params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
     opt = reinforce.Adam(params.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
     best_ep: dict[str, np.ndarray] = {}
+    history: list[np.ndarray] = []  # W after every iteration (pour-results' episodes to reach the bars)
     rows: list[dict[str, Any]] = []
     # Rollback (algo.rollback > 0): the parameters of the best batch so far, its mean return and its
     # standard error, and how many steps were undone (each one shrinks the trust region).
@@ -236,6 +249,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
         if opt is not None:
             opt.load_state_dict(st)
         best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
+        history = list(np.array(st["history_w"])) if "history_w" in st else []
         if "anchor_params" in st:
             anchor_params, anchor_ret = np.array(st["anchor_params"]), float(st["anchor_ret"])
             anchor_se, n_rollbacks = float(st["anchor_se"]), int(st["n_rollbacks"])
@@ -287,6 +301,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             else:
                 params, stats = update(cfg, params, eps, opt, it, bound)
             w = weights(cfg, params)
+            history.append(w.copy())
             ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
             last = it == cfg.iterations - 1
             if cfg.eval.episodes and ((it + 1) % cfg.eval.every == 0 or last):
@@ -311,7 +326,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
                      "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep,
                      "anchor_params": anchor_params, "anchor_ret": anchor_ret, "anchor_se": anchor_se,
-                     "n_rollbacks": n_rollbacks}
+                     "n_rollbacks": n_rollbacks, "history_w": np.array(history)}
             # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
             write_log(log_path, rows)
             write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
