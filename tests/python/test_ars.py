@@ -86,6 +86,7 @@ BAD = [
     ({"ars": {"top": 5}}, "ars.top = 5: expected 1..ars.directions (4)"),
     ({"ars": {"directions": 0}}, "ars.directions = 0: expected 1..256"),
     ({"ars": {"noise": 0.0}}, "ars.noise = 0.0: expected 0 < nu <= 10"),
+    ({"ars": {"noise": 0.5, "noise_final": 0.6}}, "ars.noise_final = 0.6: expected 0 < nu_final <= ars.noise"),
     ({"ars": {"step_size": float("nan")}}, "ars.step_size = nan: expected a finite number"),
     ({"ars": {"step_size": 0.1, "step_size_final": 0.2}}, "ars.step_size_final = 0.2: expected <= ars.step_size"),
     ({"ars": {"episodes_per_direction": 0}}, "ars.episodes_per_direction = 0: expected 1..64"),
@@ -161,3 +162,41 @@ def test_a_collapsing_return_stops_the_run_and_keeps_the_best(tmp_path, monkeypa
     best = export.weights_of(export.load_policy(tmp_path / "r"), "best")
     np.testing.assert_array_equal(best, ck["best_w"])
     assert _v_target(best) > 0.1 and _v_target(ck["w"]) == 0.0
+
+
+def test_pour_results_reach_finds_the_first_confirmed_iteration(tmp_path, monkeypatch):
+    from pour.eval import results
+    trainer.train(_cfg(iterations=20), tmp_path / "r", quiet=True)
+    monkeypatch.setattr(results, "BAR_POURED_PCT", 15.0)   # bars the toy reaches
+    monkeypatch.setattr(results, "BAR_SPILLED_PCT", 5.0)
+    monkeypatch.setattr(results, "PREFILTER", (0.05, 1.0))
+    got = results.reach(tmp_path / "r", 4)
+    log = trainer.read_log(tmp_path / "r" / "log.csv")
+    hist = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")["history_w"]
+    env = envs.ToyEnv(11, 10, 10.0)
+
+    def passes(i):
+        ms = [env.rollout(hist[i], s, True).metrics for s in range(results.FIRST_SEED, results.FIRST_SEED + 4)]
+        return 100 * np.mean([m["v_target"] for m in ms]) >= 15 and 100 * np.mean([m["v_spill"] for m in ms]) <= 5
+
+    candidates = [i for i, r in enumerate(log) if float(r["eval_v_target"]) >= 0.05]
+    first = next(i for i in candidates if passes(i))
+    assert got["iteration"] == first and got["episodes"] == int(log[first]["episodes"]) == (first + 1) * 8
+    row = results.reach_row("toy", [tmp_path / "r", tmp_path / "r"], 4)
+    assert row["reached"] == 2 and row["episodes_median"] == got["episodes"] and row["budget_episodes"] == 160
+    monkeypatch.setattr(results, "BAR_POURED_PCT", 101.0)  # never reached: no number, said so
+    never = results.reach_row("toy", [tmp_path / "r"], 4)
+    assert never["reached"] == 0 and never["episodes_median"] is None
+    assert "not reached" in results.reach_markdown([never], {"toy": {"poured_pct": 1.0, "spilled_pct": 0.0,
+                                                             "spilled_pct_max": 0.0, "reversals": 0.0,
+                                                             "reversals_max": 0.0, "finish_s": 1.0}}, 4)
+
+
+def test_pour_results_reach_refuses_a_run_without_history(tmp_path):
+    from pour.eval import results
+    trainer.train(_cfg(iterations=2), tmp_path / "r", quiet=True)
+    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    del ck["history_w"]
+    trainer.save_checkpoint(tmp_path / "r" / "checkpoint.npz", ck)
+    with pytest.raises(ValueError, match="no W history"):
+        results.reach(tmp_path / "r", 2)

@@ -48,6 +48,13 @@ def step_size(cfg: cfgmod.TrainConfig, it: int) -> float:
     return r.step_size + (r.step_size_final - r.step_size) * it / max(1, cfg.iterations - 1)
 
 
+def noise(cfg: cfgmod.TrainConfig, it: int) -> float:
+    r = cfg.ars
+    if r.noise_final < 0:
+        return r.noise
+    return r.noise * (r.noise_final / r.noise) ** (it / max(1, cfg.iterations - 1))
+
+
 def ars_step(deltas: np.ndarray, r_plus: np.ndarray, r_minus: np.ndarray, top: int, alpha: float
              ) -> tuple[np.ndarray, float]:
     """The increment of one iteration and sigma_R. r_plus, r_minus: each direction's mean return on its
@@ -109,7 +116,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                 break
             deltas = directions(cfg, it, params.shape)
             seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, r.episodes_per_direction)
-            ws = [trainer.weights(cfg, params + sign * r.noise * d) for d in deltas for sign in (1.0, -1.0)]
+            nu = noise(cfg, it)
+            ws = [trainer.weights(cfg, params + sign * nu * d) for d in deltas for sign in (1.0, -1.0)]
             jobs_w = [wk for wk in ws for _ in seeds]
             eps = runner.run_each(jobs_w, seeds * len(ws), greedy=True)
             rets = np.array([trainer.episode_return(e, gamma_d) for e in eps]) * cfg.algo.reward_scale

@@ -66,6 +66,7 @@ class ArsConfig:
     step_size: float = 0.02        # alpha at the first iteration (the step is alpha / (top * sigma_R) sum ...)
     step_size_final: float = -1.0  # linearly decayed to this at the last iteration (< 0: constant)
     noise: float = 0.03            # nu: the perturbation's standard deviation per parameter
+    noise_final: float = -1.0      # decayed geometrically to this at the last iteration (< 0: constant)
     episodes_per_direction: int = 1  # rigs per perturbed policy; the same rigs for +, - and every direction
     collapse: float = 0.0          # stop when the centre's validation score falls this fraction of |best| below
                                    # the best (plus eval.episodes' standard error) ...
@@ -245,6 +246,9 @@ def _validate_ars(cfg: TrainConfig) -> None:
            f"ars.step_size_final = {r.step_size_final}: expected <= ars.step_size ({r.step_size}), or negative "
            "for a constant step")
     _check(0.0 < r.noise <= 10.0, f"ars.noise = {r.noise}: expected 0 < nu <= 10")
+    _check(r.noise_final < 0 or 0 < r.noise_final <= r.noise,
+           f"ars.noise_final = {r.noise_final}: expected 0 < nu_final <= ars.noise ({r.noise}), or negative for a "
+           "constant noise")
     _check(1 <= r.episodes_per_direction <= 64,
            f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
     _check(0.0 <= r.collapse <= 10.0, f"ars.collapse = {r.collapse}: expected 0 <= fraction <= 10 (0 = off)")
