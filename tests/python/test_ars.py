@@ -90,8 +90,14 @@ BAD = [
     ({"ars": {"step_size": float("nan")}}, "ars.step_size = nan: expected a finite number"),
     ({"ars": {"step_size": 0.1, "step_size_final": 0.2}}, "ars.step_size_final = 0.2: expected <= ars.step_size"),
     ({"ars": {"episodes_per_direction": 0}}, "ars.episodes_per_direction = 0: expected 1..64"),
-    ({"ars": {"collapse": -1.0}}, "ars.collapse = -1.0"),
-    ({"ars": {"collapse_patience": -1}}, "ars.collapse_patience = -1"),
+    ({"eval": {"collapse": -1.0}}, "eval.collapse = -1.0"),
+    ({"eval": {"collapse": 0.5, "collapse_patience": 0}}, "eval.collapse_patience = 0: expected >= 1"),
+    ({"algo": {"kind": "pg"}, "eval": {"collapse": 0.5}}, "eval.collapse = 0.5: only for algo.kind 'ars' or 'cem'"),
+    ({"algo": {"kind": "cem"}, "cem": {"elites": 16}}, r"cem.elites = 16: expected 1..cem.population - 1 \(15\)"),
+    ({"algo": {"kind": "cem"}, "cem": {"population": 1}}, "cem.population = 1: expected 2..1024"),
+    ({"algo": {"kind": "cem"}, "cem": {"init_std": 0.0}}, "cem.init_std = 0.0: expected 0 < std <= 100"),
+    ({"algo": {"kind": "cem"}, "cem": {"init_std": 1.0, "min_std": 2.0}}, "cem.min_std = 2.0: expected 0 < min_std"),
+    ({"algo": {"kind": "cem", "rollback": 0.1}}, "algo.kind = 'cem' has no algo.rollback"),
     ({"ars": {"sigma": 1.0}}, r"\[ars\] unknown key\(s\) sigma"),
     ({"algo": {"max_kl": 0.1}}, "algo.kind = 'ars' has no algo.max_kl"),
     ({"policy": {"init": "random"}}, "policy.init_scale = 0.0: expected > 0 exactly when policy.init = 'random'"),
@@ -152,7 +158,7 @@ def test_a_collapsing_return_stops_the_run_and_keeps_the_best(tmp_path, monkeypa
             step[5, 0] = 1e3
         return step, sigma
 
-    cfg = _cfg(iterations=20, ars={"collapse": 0.5, "collapse_patience": 2})
+    cfg = _cfg(iterations=20, eval={"collapse": 0.5, "collapse_patience": 2})
     assert trainer.train(cfg, tmp_path / "ok", quiet=True, stop_after=7).best_score > 0.05  # a best to fall from
     monkeypatch.setattr(ars, "ars_step", collapsing)
     with pytest.raises(trainer.TrainError, match=r"iteration 7: the return collapsed .* 2 evaluations in a row"):
@@ -162,6 +168,27 @@ def test_a_collapsing_return_stops_the_run_and_keeps_the_best(tmp_path, monkeypa
     best = export.weights_of(export.load_policy(tmp_path / "r"), "best")
     np.testing.assert_array_equal(best, ck["best_w"])
     assert _v_target(best) > 0.1 and _v_target(ck["w"]) == 0.0
+
+
+CEM = {"algo": {"kind": "cem", "entropy_coef": 0.0}, "cem": {"population": 16, "elites": 4, "init_std": 1.0}}
+
+
+def test_cem_from_zero_learns_to_pour_the_toy_reproducibly_and_resumes(tmp_path):
+    res = trainer.train(_cfg(iterations=12, **CEM), tmp_path / "r", quiet=True)
+    assert _v_target(res.best_w) > 0.15 and res.best_score > 0.05
+    trainer.train(_cfg(iterations=12, **CEM), tmp_path / "s", quiet=True, stop_after=5)
+    again = trainer.train(_cfg(iterations=12, workers=2, **CEM), tmp_path / "s", quiet=True)
+    np.testing.assert_array_equal(res.w, again.w)
+    assert (tmp_path / "r" / "policy.json").read_bytes() == (tmp_path / "s" / "policy.json").read_bytes()
+    with pytest.raises(trainer.TrainError, match="different config"):   # CEM's state under ARS's config
+        trainer.train(_cfg(iterations=12), tmp_path / "s", quiet=True)
+
+
+def test_cem_refits_to_the_elites_with_a_floor():
+    cands = np.array([[0.0, 1.0], [2.0, 3.0], [4.0, 3.0], [9.0, 9.0]])
+    mean, std = ars.cem_update(cands, np.array([1.0, 5.0, 5.0, -3.0]), elites=2, min_std=0.5)
+    np.testing.assert_array_equal(mean, [3.0, 3.0])
+    np.testing.assert_array_equal(std, [1.0, 0.5])
 
 
 def test_pour_results_reach_finds_the_first_confirmed_iteration(tmp_path, monkeypatch):

@@ -1,22 +1,28 @@
 # SPDX-License-Identifier: MIT
-"""Augmented random search (Mania, Guy & Recht 2018, "basic random search" with the top-b directions and
-the reward's standard deviation, V1-t) on greedy rollouts of the softmax-linear policy.
+"""Derivative-free search on greedy rollouts of the softmax-linear policy: augmented random search
+(algo.kind = 'ars') and the cross-entropy method ('cem'), over the policy's parameters (W itself for
+policy.param 'full', the six feedback gains beta for 'feedback').
 
-Each iteration draws `directions` Gaussian directions d_k in the parameter space (W itself for
-policy.param 'full', the six feedback gains beta for 'feedback'), rolls out the greedy policies of
-theta + nu d_k and theta - nu d_k on the same rigs (common random numbers: the two sides of a direction,
-and every direction, see the same `episodes_per_direction` episode seeds, so a difference in return is
-the policy's and not the rig's), keeps the `top` directions with the largest max(R+, R-) and steps
+ARS (Mania, Guy & Recht 2018, V1-t): each iteration draws `directions` Gaussian directions d_k, rolls out
+theta + nu d_k and theta - nu d_k, keeps the `top` directions with the largest max(R+, R-) and steps
 
     theta <- theta + alpha / (top * sigma_R) * sum_k (R+_k - R-_k) d_k
 
-where sigma_R is the standard deviation of the 2 * top returns kept. The directions come from
-(seed, STREAM_ARS, iteration) through numpy's SeedSequence, so a run needs no RNG state to resume and is
-bit-identical whatever the number of workers. The run directory is pour-train's (trainer.py): the same
-log, checkpoint and policy.json, plus `history_w` (the centre's W after every iteration) in the checkpoint.
+where sigma_R is the standard deviation of the 2 * top returns kept.
+
+CEM (Rubinstein; in control, e.g. Szita & Lorincz 2006): each iteration draws `population` candidates
+from normal(mean, diag(std^2)), rolls them out, and refits mean and std to the `elites` best ones (std
+floored at min_std). It compares candidates across the whole spread of the distribution instead of
+differencing around one point, so it jumps between basins that a local estimate climbs out of slowly.
+
+Both use common random numbers: every candidate of an iteration runs on the same episode seeds (rigs), so a
+difference in return is the policy's and not the rig's. The draws come from (seed, STREAM_SEARCH,
+iteration) through numpy's SeedSequence, so a run needs no RNG state to resume and is bit-identical
+whatever the number of workers. The run directory is pour-train's (trainer.py): the same log, checkpoint
+and policy.json, plus `history_w` (the centre's W after every iteration) in the checkpoint.
 
 Divergence: parameters that are not finite, or a centre whose greedy validation score stays far below the
-best one (ars.collapse, ars.collapse_patience), stop the run with TrainError; the checkpoint and
+best one (eval.collapse, eval.collapse_patience), stop the run with TrainError; the checkpoint and
 policy.json on disk still hold the best validated weights, which pour-export exports.
 """
 from __future__ import annotations
@@ -32,13 +38,13 @@ import numpy as np
 from pour.train import config as cfgmod
 from pour.train import reinforce, trainer
 
-STREAM_ARS = 3  # the directions' stream (trainer.STREAM_TRAIN, _VALID and _TEST are 0, 1, 2)
+STREAM_SEARCH = 3  # the draws' stream (trainer.STREAM_TRAIN, _VALID, _TEST and _INIT are 0, 1, 2, 4)
 
 
-def directions(cfg: cfgmod.TrainConfig, it: int, shape: tuple) -> np.ndarray:
-    """The iteration's directions, [directions][*shape], standard normal."""
-    rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, STREAM_ARS, it]))
-    return rng.standard_normal((cfg.ars.directions, *shape))
+def draws(cfg: cfgmod.TrainConfig, it: int, n: int, shape: tuple) -> np.ndarray:
+    """The iteration's standard normal draws, [n][*shape] (ARS's directions, CEM's candidates' noise)."""
+    rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, STREAM_SEARCH, it]))
+    return rng.standard_normal((n, *shape))
 
 
 def step_size(cfg: cfgmod.TrainConfig, it: int) -> float:
@@ -68,9 +74,16 @@ def ars_step(deltas: np.ndarray, r_plus: np.ndarray, r_minus: np.ndarray, top: i
     return alpha / (top * sigma) * np.sum(diff * deltas[order], axis=0), sigma
 
 
+def cem_update(cands: np.ndarray, returns: np.ndarray, elites: int, min_std: float
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The next (mean, std): those of the `elites` candidates with the highest returns (ties: lowest index)."""
+    best = cands[np.argsort(-returns, kind="stable")[:elites]]
+    return best.mean(axis=0), np.maximum(best.std(axis=0), min_std)
+
+
 def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, stop_after: int | None,
           make_runner: Any) -> trainer.RunResult:
-    """trainer.train for algo.kind = 'ars' (same arguments, same run directory)."""
+    """trainer.train for algo.kind 'ars' and 'cem' (same arguments, same run directory)."""
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
     digest = cfg.digest()
@@ -78,23 +91,25 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     steps = int(round(cfg.env.episode_s * 1000))
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
     params = trainer.initial_params(cfg)
+    std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)
     w = trainer.weights(cfg, params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
     best_ep: dict[str, np.ndarray] = {}
     history: list[np.ndarray] = []
-    n_low = 0  # evaluations in a row far below the best (ars.collapse)
+    n_low = 0  # evaluations in a row far below the best (eval.collapse)
     rows: list[dict[str, Any]] = []
     if ckpt_path.exists() and resume:
         st = trainer.load_checkpoint(ckpt_path)
         if str(st["config_digest"]) != digest or "history_w" not in st:
             raise trainer.TrainError(
                 f"{run_dir}: checkpoint was made with a different config (digest "
-                f"{str(st['config_digest'])[:12]} vs {digest[:12]}, algo.kind = 'ars' needs its own state); "
+                f"{str(st['config_digest'])[:12]} vs {digest[:12]}, algo.kind = {cfg.algo.kind!r} needs its own state); "
                 "use a new run directory or --fresh")
         params, best_w, best_score = np.array(st["params"]), np.array(st["best_w"]), float(st["best_score"])
         w = trainer.weights(cfg, params)
         start, wall_prev, n_low = int(st["iteration"]), float(st["wall_s"]), int(st["n_low"])
         history = list(np.array(st["history_w"]))
+        std = np.array(st["cem_std"])
         best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
         rows = [row for row in trainer.read_log(log_path) if int(row["iteration"]) < start]
         if not quiet:
@@ -107,29 +122,39 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     trainer.write_log(log_path, rows)
 
     valid_seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_VALID, 0, cfg.eval.episodes)
-    per_iteration = 2 * r.directions * r.episodes_per_direction
+    is_ars, c, v = cfg.algo.kind == "ars", cfg.cem, cfg.eval
+    per_iteration = 2 * r.directions * r.episodes_per_direction if is_ars else c.population * c.episodes_per_candidate
     t0 = time.monotonic()
     done = 0
     with make_runner(cfg) as runner:
         for it in range(start, cfg.iterations):
             if stop_after is not None and done >= stop_after:
                 break
-            deltas = directions(cfg, it, params.shape)
-            seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, r.episodes_per_direction)
-            nu = noise(cfg, it)
-            ws = [trainer.weights(cfg, params + sign * nu * d) for d in deltas for sign in (1.0, -1.0)]
-            jobs_w = [wk for wk in ws for _ in seeds]
-            eps = runner.run_each(jobs_w, seeds * len(ws), greedy=True)
+            m = r.episodes_per_direction if is_ars else c.episodes_per_candidate
+            seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, m)
+            if is_ars:
+                deltas = draws(cfg, it, r.directions, params.shape)
+                nu = noise(cfg, it)
+                cands = np.stack([params + sign * nu * d for d in deltas for sign in (1.0, -1.0)])
+            else:
+                cands = params + std * draws(cfg, it, c.population, params.shape)
+            ws = [trainer.weights(cfg, p) for p in cands]
+            eps = runner.run_each([wk for wk in ws for _ in seeds], seeds * len(ws), greedy=True)
             rets = np.array([trainer.episode_return(e, gamma_d) for e in eps]) * cfg.algo.reward_scale
-            by_side = rets.reshape(r.directions, 2, r.episodes_per_direction).mean(axis=2)
-            alpha = step_size(cfg, it)
+            per_cand = rets.reshape(len(ws), m).mean(axis=1)
+            alpha, sigma = step_size(cfg, it), float(np.std(per_cand))
             with np.errstate(over="ignore", invalid="ignore"):
-                step, sigma = ars_step(deltas, by_side[:, 0], by_side[:, 1], r.top, alpha)
-                new_params = params + step
-            if not np.all(np.isfinite(new_params)):
+                if is_ars:
+                    by_side = per_cand.reshape(r.directions, 2)
+                    step, sigma = ars_step(deltas, by_side[:, 0], by_side[:, 1], r.top, alpha)
+                    new_params = params + step
+                else:
+                    new_params, std = cem_update(cands, per_cand, c.elites, c.min_std)
+                    step = new_params - params
+            if not (np.all(np.isfinite(new_params)) and np.all(np.isfinite(std))):
                 raise trainer.TrainError(
-                    f"{run_dir}: iteration {it}: the parameters diverged (non-finite after a step of alpha "
-                    f"{alpha:g}, sigma_R {sigma:g}); stopped. The best validated weights (score {best_score:.6g}) "
+                    f"{run_dir}: iteration {it}: the parameters diverged (non-finite after a step, sigma_R "
+                    f"{sigma:g}); stopped. The best validated weights (score {best_score:.6g}) "
                     "are kept in checkpoint.npz and policy.json: pour-export exports them; lower ars.step_size")
             params = new_params
             w = trainer.weights(cfg, params)
@@ -150,13 +175,12 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                       "eval_v_spill": np.mean([e.metrics["v_spill"] for e in veps]),
                       "eval_finish_s": np.mean([e.metrics["finish_s"] for e in veps])}
                 se = float(np.std([np.sum(e.rewards) for e in veps])) / steps / np.sqrt(len(veps))
-                if r.collapse > 0 and r.collapse_patience > 0 and np.isfinite(best_score) \
-                        and sc < best_score - r.collapse * abs(best_score) - se:
+                if v.collapse > 0 and np.isfinite(best_score) and sc < best_score - v.collapse * abs(best_score) - se:
                     n_low += 1
-                    if n_low >= r.collapse_patience:
+                    if n_low >= v.collapse_patience:
                         collapsed = (f"{run_dir}: iteration {it}: the return collapsed (validation score {sc:.6g}, "
                                      f"best {best_score:.6g}, {n_low} evaluations in a row more than "
-                                     f"{r.collapse:g} x |best| below it); stopped. The best validated weights "
+                                     f"{v.collapse:g} x |best| below it); stopped. The best validated weights "
                                      "are kept in checkpoint.npz and policy.json: pour-export exports them")
                 else:
                     n_low = 0
@@ -175,6 +199,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
             rows.append({k: trainer._fmt(v) for k, v in row.items()})
             state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1,
                      "wall_s": wall, "config_digest": digest, "history_w": np.array(history), "n_low": n_low,
+                     "cem_std": std,
                      **best_ep}
             trainer.write_log(log_path, rows)
             trainer.write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)

@@ -68,9 +68,16 @@ class ArsConfig:
     noise: float = 0.03            # nu: the perturbation's standard deviation per parameter
     noise_final: float = -1.0      # decayed geometrically to this at the last iteration (< 0: constant)
     episodes_per_direction: int = 1  # rigs per perturbed policy; the same rigs for +, - and every direction
-    collapse: float = 0.0          # stop when the centre's validation score falls this fraction of |best| below
-                                   # the best (plus eval.episodes' standard error) ...
-    collapse_patience: int = 3     # ... at this many evaluations in a row; the best checkpoint is kept (0 = off)
+
+
+@dataclass(frozen=True)
+class CemConfig:
+    """The cross-entropy method over the policy's parameters (tools/pour/train/ars.py)."""
+    population: int = 16           # candidates per iteration, drawn from normal(mean, diag(std^2))
+    elites: int = 4                # the best candidates, whose mean and spread become the next distribution
+    init_std: float = 2.0          # the distribution's standard deviation per parameter at the start
+    min_std: float = 0.05          # floor of the standard deviation (keeps exploring; > 0)
+    episodes_per_candidate: int = 1  # rigs per candidate; the same rigs for every candidate of an iteration
 
 
 @dataclass(frozen=True)
@@ -78,6 +85,9 @@ class EvalConfig:
     every: int = 5                 # greedy evaluation every this many iterations (and the last)
     episodes: int = 8              # validation episodes per evaluation (seeds disjoint from training)
     select_best: bool = True       # keep the weights with the best greedy validation score
+    collapse: float = 0.0          # algo.kind 'ars' or 'cem': stop when the validation score falls this fraction
+                                   # of |best| below the best (plus its standard error) ...
+    collapse_patience: int = 3     # ... at this many evaluations in a row; the best checkpoint is kept
 
 
 @dataclass(frozen=True)
@@ -95,16 +105,20 @@ class TrainConfig:
     policy: PolicyConfig = PolicyConfig()
     algo: AlgoConfig = AlgoConfig()
     ars: ArsConfig = ArsConfig()
+    cem: CemConfig = CemConfig()
     eval: EvalConfig = EvalConfig()
     env: EnvConfig = EnvConfig()
 
     def to_dict(self) -> dict[str, Any]:
-        """Every value, except those of a method the run does not use ([ars] unless algo.kind = 'ars',
-        policy.init_scale unless init = 'random'): a config that does not use them keeps its digest, and
+        """Every value, except those of a method the run does not use ([ars] and [cem] unless algo.kind
+        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that does not use them keeps its digest, and
         the header it exports keeps its bytes."""
         d = dataclasses.asdict(self)
-        if self.algo.kind != "ars":
-            del d["ars"]
+        for method in ("ars", "cem"):
+            if self.algo.kind != method:
+                del d[method]
+        if self.eval.collapse == 0.0:
+            del d["eval"]["collapse"], d["eval"]["collapse_patience"]
         if self.policy.init != "random":
             del d["policy"]["init_scale"]
         return d
@@ -117,7 +131,7 @@ class TrainConfig:
         return hashlib.sha256(blob).hexdigest()
 
 
-_SECTIONS = {"policy": PolicyConfig, "algo": AlgoConfig, "ars": ArsConfig, "eval": EvalConfig, "env": EnvConfig}
+_SECTIONS = {"policy": PolicyConfig, "algo": AlgoConfig, "ars": ArsConfig, "cem": CemConfig, "eval": EvalConfig, "env": EnvConfig}
 
 
 def _typed(section: str, key: str, value: Any, want: Any) -> Any:
@@ -189,9 +203,14 @@ def validate(cfg: TrainConfig) -> TrainConfig:
                "V_spill, bias)")
     _check(p.param in ("full", "feedback"), f"policy.param = {p.param!r}: expected 'full' or 'feedback'")
     _check(0.0 < p.sharpness <= 1000.0, f"policy.sharpness = {p.sharpness}: expected 0 < c <= 1000")
-    _check(a.kind in ("vanilla", "pg", "ars"), f"algo.kind = {a.kind!r}: expected 'vanilla', 'pg' or 'ars'")
-    if a.kind == "ars":
-        _validate_ars(cfg)
+    _check(a.kind in ("vanilla", "pg", "ars", "cem"),
+           f"algo.kind = {a.kind!r}: expected 'vanilla', 'pg', 'ars' or 'cem'")
+    if a.kind in ("ars", "cem"):
+        _validate_search(cfg)
+    _check(0.0 <= e.collapse <= 10.0, f"eval.collapse = {e.collapse}: expected 0 <= fraction <= 10 (0 = off)")
+    _check(e.collapse == 0 or a.kind in ("ars", "cem"),
+           f"eval.collapse = {e.collapse}: only for algo.kind 'ars' or 'cem' (kind 'pg' has algo.rollback)")
+    _check(e.collapse_patience >= 1, f"eval.collapse_patience = {e.collapse_patience}: expected >= 1")
     if a.kind == "vanilla":
         paper = {"lr_final": -1.0, "reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
                  "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0, "max_kl": 0.0,
@@ -237,8 +256,8 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     return cfg
 
 
-def _validate_ars(cfg: TrainConfig) -> None:
-    r, a = cfg.ars, cfg.algo
+def _validate_search(cfg: TrainConfig) -> None:
+    r, c, a = cfg.ars, cfg.cem, cfg.algo
     _check(1 <= r.directions <= 256, f"ars.directions = {r.directions}: expected 1..256")
     _check(1 <= r.top <= r.directions, f"ars.top = {r.top}: expected 1..ars.directions ({r.directions})")
     _check(0.0 < r.step_size <= 10.0, f"ars.step_size = {r.step_size}: expected 0 < alpha <= 10")
@@ -251,12 +270,17 @@ def _validate_ars(cfg: TrainConfig) -> None:
            "constant noise")
     _check(1 <= r.episodes_per_direction <= 64,
            f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
-    _check(0.0 <= r.collapse <= 10.0, f"ars.collapse = {r.collapse}: expected 0 <= fraction <= 10 (0 = off)")
-    _check(r.collapse_patience >= 0, f"ars.collapse_patience = {r.collapse_patience}: expected >= 0 (0 = off)")
+    _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
+    _check(1 <= c.elites < c.population, f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
+    _check(0.0 < c.init_std <= 100.0, f"cem.init_std = {c.init_std}: expected 0 < std <= 100")
+    _check(0.0 < c.min_std <= c.init_std, f"cem.min_std = {c.min_std}: expected 0 < min_std <= cem.init_std "
+                                          f"({c.init_std})")
+    _check(1 <= c.episodes_per_candidate <= 64,
+           f"cem.episodes_per_candidate = {c.episodes_per_candidate}: expected 1..64")
     # The policy-gradient options have no meaning for random search: refuse them rather than ignore them.
     for k in ("max_kl", "rollback", "grad_clip"):
-        _check(getattr(a, k) == 0.0, f"algo.kind = 'ars' has no algo.{k} (got {getattr(a, k)!r}); its options are "
-                                     "in [ars]")
+        _check(getattr(a, k) == 0.0, f"algo.kind = {a.kind!r} has no algo.{k} (got {getattr(a, k)!r}); its "
+                                     f"options are in [{a.kind}]")
 
 
 def from_dict(data: dict) -> TrainConfig:

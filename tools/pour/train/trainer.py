@@ -29,7 +29,7 @@ from pour.train import executors, reinforce
 from pour.train.executors import Runner  # the local pool, the default executor (also as trainer.Runner)
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
-STREAM_INIT = 4  # policy.init = "random" (ars.py's directions are stream 3)
+STREAM_INIT = 4  # policy.init = "random" (ars.py's draws are stream 3)
 
 LOG_FIELDS = ["iteration", "episodes", "wall_s", "return_mean", "return_std", "return_min", "return_max",
               "reward_sum_mean", "v_target_mean", "v_spill_mean", "finish_s_mean", "entropy_mean",
@@ -219,8 +219,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call.
     make_runner: cfg -> the episode runner (Runner, the local pool, or executors.RayRunner): same results."""
     run_dir = Path(run_dir)
-    if cfg.algo.kind == "ars":
-        from pour.train import ars  # ars builds on this module's run directory
+    if cfg.algo.kind in ("ars", "cem"):
+        from pour.train import ars  # the search methods build on this module's run directory
         return ars.train(cfg, run_dir, resume, quiet, stop_after, make_runner)
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
