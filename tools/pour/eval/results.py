@@ -154,8 +154,9 @@ def reach_markdown(reach_rows: list[dict[str, Any]], rows: dict[str, dict[str, A
              "|---|---|---|---|---|---|---|---|---|"]
     for r in reach_rows:
         f = rows[r["name"]]
-        lines.append(f"| {r['name']} | {r['reached']}/{r['runs']} | {num(r['episodes_median'], '.0f')}; "
-                     f"{num(r['episodes_min'], '.0f')}–{num(r['episodes_max'], '.0f')} | "
+        spread = "" if r["episodes_min"] is None else \
+            f"; {num(r['episodes_min'], '.0f')}–{num(r['episodes_max'], '.0f')}"
+        lines.append(f"| {r['name']} | {r['reached']}/{r['runs']} | {num(r['episodes_median'], '.0f')}{spread} | "
                      f"{num(r['wall_s_median'], '.0f')} | {r['budget_episodes']} | {f['poured_pct']:.1f} | "
                      f"{f['spilled_pct']:.2f} ({f['spilled_pct_max']:.1f}) | {f['reversals']:.1f} "
                      f"({f['reversals_max']:.0f}) | {f['finish_s']:.2f} |")

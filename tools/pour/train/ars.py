@@ -48,17 +48,11 @@ def draws(cfg: cfgmod.TrainConfig, it: int, n: int, shape: tuple) -> np.ndarray:
 
 
 def step_size(cfg: cfgmod.TrainConfig, it: int) -> float:
-    r = cfg.ars
-    if r.step_size_final < 0:
-        return r.step_size
-    return r.step_size + (r.step_size_final - r.step_size) * it / max(1, cfg.iterations - 1)
+    return trainer.linear_schedule(cfg.ars.step_size, cfg.ars.step_size_final, it, cfg.iterations)
 
 
 def noise(cfg: cfgmod.TrainConfig, it: int) -> float:
-    r = cfg.ars
-    if r.noise_final < 0:
-        return r.noise
-    return r.noise * (r.noise_final / r.noise) ** (it / max(1, cfg.iterations - 1))
+    return trainer.geometric_schedule(cfg.ars.noise, cfg.ars.noise_final, it, cfg.iterations)
 
 
 def ars_step(deltas: np.ndarray, r_plus: np.ndarray, r_minus: np.ndarray, top: int, alpha: float
@@ -88,7 +82,6 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
     digest = cfg.digest()
     r, n_act = cfg.ars, cfg.policy.n_actions
-    steps = int(round(cfg.env.episode_s * 1000))
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
     params = trainer.initial_params(cfg)
     std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)
@@ -125,11 +118,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     is_ars, c, v = cfg.algo.kind == "ars", cfg.cem, cfg.eval
     per_iteration = 2 * r.directions * r.episodes_per_direction if is_ars else c.population * c.episodes_per_candidate
     t0 = time.monotonic()
-    done = 0
     with make_runner(cfg) as runner:
-        for it in range(start, cfg.iterations):
-            if stop_after is not None and done >= stop_after:
-                break
+        for it in trainer.iterations(cfg, start, stop_after):
             m = r.episodes_per_direction if is_ars else c.episodes_per_candidate
             seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, m)
             if is_ars:
@@ -164,17 +154,10 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                 e = eps[ib]
                 best_ep = {"best_ep_x": e.x, "best_ep_actions": e.actions, "best_ep_rewards": e.rewards,
                            "best_ep_return": np.array(rets[ib]), "best_ep_iteration": np.array(it)}
-            ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
-            last = it == cfg.iterations - 1
+            ev, se = trainer.validate(cfg, runner, w, valid_seeds, it)
             collapsed = ""
-            if cfg.eval.episodes and ((it + 1) % cfg.eval.every == 0 or last):
-                veps = runner.run(w, valid_seeds, greedy=True)
-                sc = trainer.score(veps, steps)
-                ev = {"eval_score": sc,
-                      "eval_v_target": np.mean([e.metrics["v_target"] for e in veps]),
-                      "eval_v_spill": np.mean([e.metrics["v_spill"] for e in veps]),
-                      "eval_finish_s": np.mean([e.metrics["finish_s"] for e in veps])}
-                se = float(np.std([np.sum(e.rewards) for e in veps])) / steps / np.sqrt(len(veps))
+            if np.isfinite(ev["eval_score"]):
+                sc = ev["eval_score"]
                 if v.collapse > 0 and np.isfinite(best_score) and sc < best_score - v.collapse * abs(best_score) - se:
                     n_low += 1
                     if n_low >= v.collapse_patience:
@@ -204,7 +187,6 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
             trainer.write_log(log_path, rows)
             trainer.write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
             trainer.save_checkpoint(ckpt_path, state)
-            done += 1
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} |step| {row['grad_norm']:.4f} "
