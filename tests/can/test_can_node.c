@@ -222,12 +222,14 @@ static void test_can_node_SeqWrapIsTheNextSampleNotANewRun(void) {
     TEST_ASSERT_FALSE(in.reset);
   }
   (void)tx;
-  /* Only a Reset frame starts the count again (and asks the core for a new run). */
+  /* A Reset asks the core for a new run but leaves the count alone: the new run's first frame (seq 0) is the
+   * next sample by its forward distance, which a core that accepted the Reset takes whatever its value. */
+  const uint32_t last = in.sensors.seq;
   receive_command(POUR_CAN_CMD_RESET);
   send_sample(0, 0);
   pour_can_node_begin_tick(&node, &in);
   TEST_ASSERT_TRUE(in.reset);
-  TEST_ASSERT_EQUAL_UINT32(0, in.sensors.seq);
+  TEST_ASSERT_EQUAL_UINT32(last + ((0u - last) & 0xFFu), in.sensors.seq);
 }
 
 /* A Sensors frame may carry what no sensor of the rig can read (a count past the encoder's 2^17, a scale past
@@ -350,6 +352,110 @@ static void test_can_node_MalformedFramesAreDroppedAndCounted(void) {
   TEST_ASSERT_EQUAL_INT32(10000, in.sensors.scale_rotating_g);
 }
 
+static void receive_estop(bool asserted) {
+  pour_can_frame_t f;
+  const pour_can_estop_t e = {.assert_estop = asserted ? 1u : 0u};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_estop(cfg.node_id, &e, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+}
+
+/* Runs the core on samples for n ticks; returns the last output. */
+static void run_ticks(unsigned n, uint32_t *seq, pour_control_output_t *out) {
+  for (unsigned t = 0; t < n; ++t) {
+    send_sample((*seq)++, 0);
+    core_tick(out);
+  }
+}
+
+/* docs/safety.md, transitions: a ClearErrors that arrives while the e-stop is held is dropped where it arrives,
+ * even when the release follows it before the next tick; the e-stop fault stays latched and no torque comes. */
+static void test_can_node_ClearBeforeTheReleaseInOneTickIsDropped(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(30u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  receive_estop(true);
+  run_ticks(5u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  receive_estop(false);
+  run_ticks(50u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
+  TEST_ASSERT_TRUE(out.brake);
+  TEST_ASSERT_EQUAL_UINT32(1u, node.commands.clears_dropped);
+  /* The deliberate second step: a clear after the release counts. */
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  send_sample(seq++, 0);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT32(0u, out.faults);
+}
+
+/* The other order within one tick, release then clear, is the documented clear: it counts. An assert after a
+ * clear in the same tick, or a pulse (assert, release, clear), drops the clear. */
+static void test_can_node_ClearCountsOnlyAfterTheReleaseAndWhileReleased(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(10u, &seq, &out);
+  receive_estop(true);
+  run_ticks(3u, &seq, &out);
+  receive_estop(false);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  receive_estop(true);
+  run_ticks(3u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  receive_estop(false);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  receive_estop(true);
+  receive_estop(false); /* a pulse after the clear: the assert is not lost, and it drops the clear */
+  send_sample(seq++, 0);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  run_ticks(3u, &seq, &out);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
+  TEST_ASSERT_EQUAL_UINT32(2u, node.commands.clears_dropped);
+  receive_estop(false);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  send_sample(seq++, 0);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT32(0u, out.faults);
+}
+
+/* A ClearErrors every tick for a second while the e-stop is held clears nothing. */
+static void test_can_node_ClearStormWhileEstopHeldClearsNothing(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(10u, &seq, &out);
+  receive_estop(true);
+  for (unsigned t = 0; t < 1000u; ++t) {
+    receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+    send_sample(seq++, 0);
+    core_tick(&out);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+    TEST_ASSERT_EQUAL_INT16(0, out.torque);
+  }
+  receive_estop(false);
+  run_ticks(20u, &seq, &out);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
+  TEST_ASSERT_EQUAL_UINT32(1000u, node.commands.clears_dropped);
+}
+
+/* A Reset the core refuses in RUN changes nothing in the node either: the samples after it stay fresh and the
+ * run goes on (the node used to restart its count, so the core took no sample as fresh and braked). */
+static void test_can_node_RefusedResetInRunChangesNothing(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(300u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  const uint32_t seq_before = node.sensors.seq;
+  receive_command(POUR_CAN_CMD_RESET);
+  run_ticks(300u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.resets_refused);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_UINT32(0u, out.faults);
+  TEST_ASSERT_EQUAL_UINT32(seq_before + 300u, node.sensors.seq);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_node_init_RejectsBadConfig);
@@ -364,5 +470,9 @@ int main(void) {
   RUN_TEST(test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop);
   RUN_TEST(test_can_node_EstopLevelReachesTheNextTick);
   RUN_TEST(test_can_node_MalformedFramesAreDroppedAndCounted);
+  RUN_TEST(test_can_node_ClearBeforeTheReleaseInOneTickIsDropped);
+  RUN_TEST(test_can_node_ClearCountsOnlyAfterTheReleaseAndWhileReleased);
+  RUN_TEST(test_can_node_ClearStormWhileEstopHeldClearsNothing);
+  RUN_TEST(test_can_node_RefusedResetInRunChangesNothing);
   return UNITY_END();
 }

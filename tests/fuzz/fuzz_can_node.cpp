@@ -4,7 +4,10 @@
 // docs/safety.md on the control step, slew limit included (control_model.h); the sample the core got is the
 // last Sensors frame the node accepted, reading for reading; on the bus, the torque frame decodes, carries
 // exactly the core's command and mode, stays within tau_limit, and is zero while the e-stop is asserted;
-// the heartbeat and identity frames decode.
+// the heartbeat and identity frames decode. The order of the host's commands within a tick (docs/safety.md,
+// transitions): the core sees the e-stop if it was asserted at any frame since the last tick, and a clear
+// only if one arrived with the e-stop released and no assert came in the same tick; the 32-bit sample count
+// runs on by the frames' forward distance whatever commands came (a refused Reset changes nothing).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstring>
@@ -65,8 +68,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   FUZZ_CHECK(pour_can_node_init(&node, &ncfg) == POUR_OK, "a valid node config was refused");
   ControlModel model(cfg, pour_weights_compiled.n_actions);
   static const bool trace = std::getenv("POUR_FUZZ_TRACE") != nullptr; // replaying a crash: one line per tick
+  bool estop_level = false, have_count = false;
+  uint32_t count = 0;
   for (uint32_t tick = 0; tick < 4000 && fdp.remaining_bytes() > 0; ++tick) {
     bool sampled = false;
+    bool asserted = false, clear_released = false;
+    const auto counted = [&](const pour_can_sensors_t &m) { // the node's count after one more sample frame
+      count = have_count ? count + static_cast<uint8_t>(m.seq_low - (count & 0xFFu)) : m.seq_low;
+      have_count = true;
+    };
     pour_can_sensors_t last{}; // the last Sensors frame the node accepted this tick
     if (fdp.ConsumeBool()) { // this tick's sample: mostly what the rig reads (a 17-bit encoder between a
                              // little below upright and the stop, scales within their limits), now and then not
@@ -81,15 +91,25 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       if (pour_can_pack_sensors(ncfg.node_id, &m, &f) == POUR_OK && pour_can_node_receive(&node, &f) == POUR_CAN_RX_OK) {
         sampled = true;
         last = m;
+        counted(m);
       }
     }
     const int n_rx = fdp.ConsumeIntegralInRange<int>(0, 3);
     for (int k = 0; k < n_rx; ++k) {
       const pour_can_frame_t f = fuzz_frame(fdp, ncfg.node_id);
       pour_can_sensors_t m{};
-      if (pour_can_node_receive(&node, &f) == POUR_CAN_RX_OK && pour_can_unpack_sensors(&f, &m) == POUR_CAN_RX_OK) {
+      if (pour_can_node_receive(&node, &f) != POUR_CAN_RX_OK) continue;
+      const uint8_t cmd = static_cast<uint8_t>(f.id & POUR_CAN_CMD_MASK);
+      pour_can_estop_t e{};
+      if (pour_can_unpack_sensors(&f, &m) == POUR_CAN_RX_OK) {
         sampled = true;
         last = m;
+        counted(m);
+      } else if (cmd == POUR_CAN_CMD_ESTOP && pour_can_unpack_estop(&f, &e) == POUR_CAN_RX_OK) {
+        estop_level = e.assert_estop != 0u;
+        asserted = asserted || estop_level;
+      } else if (cmd == POUR_CAN_CMD_CLEAR_ERRORS && !estop_level) {
+        clear_released = true;
       }
     }
     pour_control_input_t in{};
@@ -102,6 +122,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                  "the core got seq %u encoder %u scales %d/%d, the frame said %u %u %d/%d", in.sensors.seq,
                  in.sensors.encoder, in.sensors.scale_rotating_g, in.sensors.scale_target_g, last.seq_low, last.encoder,
                  last.scale_rotating_g, last.scale_target_g);
+    FUZZ_CHECK(in.estop == (estop_level || asserted), "e-stop %d, the frames said level %d, asserted %d", in.estop,
+               estop_level, asserted);
+    FUZZ_CHECK(in.clear_faults == (clear_released && !asserted), "clear %d, the frames said released %d, asserted %d",
+               in.clear_faults, clear_released, asserted);
+    if (sampled) {
+      FUZZ_CHECK(in.sensors.seq == count, "sample count %u, expected %u", in.sensors.seq, count);
+    }
     pour_control_output_t out{};
     pour_control_step(&ctl, &in, &out);
     model.check(in, out, ctl.state.theta_urad);

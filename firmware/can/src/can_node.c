@@ -28,6 +28,7 @@ pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_conf
   *node = zero;
   node->config = *config;
   node->ms_to_heartbeat = 0;
+  pour_commands_init(&node->commands);
   return POUR_OK;
 }
 
@@ -92,21 +93,20 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       if (rc != POUR_CAN_RX_OK) {
         return drop(node, rc);
       }
-      node->estop = e.assert_estop != 0u;
+      pour_commands_estop(&node->commands, e.assert_estop != 0u);
       kick(node);
       break;
     }
     case POUR_CAN_CMD_STOP: /* classify checked the DLC of these three: they have no signals */
-      node->stop_request = true;
+      pour_commands_stop(&node->commands);
       kick(node);
       break;
     case POUR_CAN_CMD_RESET:
-      node->reset_request = true;
-      node->have_seq = false; /* the new run's first sample starts the count again */
+      pour_commands_reset(&node->commands);
       kick(node);
       break;
     default: /* POUR_CAN_CMD_CLEAR_ERRORS */
-      node->clear_request = true;
+      pour_commands_clear(&node->commands);
       kick(node);
       break;
   }
@@ -121,15 +121,9 @@ static bool tripped(const pour_can_node_t *node) {
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
   in->sensors_fresh = node->sensors_fresh;
   in->sensors = node->sensors;
-  in->estop = node->estop;
-  in->clear_faults = node->clear_request;
-  in->stop = node->stop_request;
-  in->reset = node->reset_request;
+  pour_commands_take(&node->commands, in);
   in->link_fault = tripped(node);
   node->sensors_fresh = false;
-  node->clear_request = false;
-  node->stop_request = false;
-  node->reset_request = false;
 }
 
 bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms) {

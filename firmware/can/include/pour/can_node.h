@@ -10,6 +10,7 @@
 #include <stdint.h>
 
 #include "pour/can_codec.h"
+#include "pour/commands.h"
 #include "pour/control.h"
 #include "pour/fixed.h"
 #include "pour/sensors.h"
@@ -34,13 +35,10 @@ typedef struct {
 
 typedef struct {
   pour_can_node_config_t config;
-  bool have_seq;                /* a sample arrived since init or the last Reset */
+  bool have_seq;                /* a sample arrived since init */
   pour_sensors_t sensors;       /* latest sensor sample, seq extended to 32 bits */
   bool sensors_fresh;           /* arrived since the last tick */
-  bool estop;                   /* level, from the latest Estop frame */
-  bool clear_request;           /* one-shot, from ClearErrors */
-  bool stop_request;            /* one-shot, from Stop */
-  bool reset_request;           /* one-shot, from Reset */
+  pour_commands_t commands;     /* Estop, ClearErrors, Stop and Reset since the last tick, in their order */
   bool armed;                   /* watchdog runs once the first valid sample or command arrived */
   uint32_t ms_since_valid;
   uint16_t ms_to_heartbeat;
@@ -61,7 +59,8 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
 /* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick (the
  * latest Sensors sample, as the sensors read it), the watchdog's state as in->link_fault. The frame's
  * 8-bit seq reaches the core extended to 32 bits by its forward distance (it wraps every 256 ms at 1 kHz;
- * a wrap is just the next sample, only a Reset frame restarts the count). */
+ * a wrap is just the next sample). A Reset does not restart the count: the core, when it accepts the
+ * Reset, takes the new run's first sample whatever its seq, and a refused Reset changes nothing here. */
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 
 /* End of a tick: advances the watchdog by 1 ms, then writes the torque frame and, when due, the
