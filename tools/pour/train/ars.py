@@ -96,7 +96,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
         if str(st["config_digest"]) != digest or "history_w" not in st:
             raise trainer.TrainError(
                 f"{run_dir}: checkpoint was made with a different config (digest "
-                f"{str(st['config_digest'])[:12]} vs {digest[:12]}, algo.kind = {cfg.algo.kind!r} needs its own state); "
+                f"{str(st['config_digest'])[:12]} vs {digest[:12]}, algo.kind = {cfg.algo.kind!r} needs its own "
+                "state); "
                 "use a new run directory or --fresh")
         params, best_w, best_score = np.array(st["params"]), np.array(st["best_w"]), float(st["best_score"])
         w = trainer.weights(cfg, params)

@@ -60,7 +60,7 @@ class AlgoConfig:
 
 @dataclass(frozen=True)
 class ArsConfig:
-    """Augmented random search (Mania, Guy & Recht 2018, V1-t) over the policy's parameters (tools/pour/train/ars.py)."""
+    """Augmented random search (Mania, Guy & Recht 2018, V1-t) over the policy's parameters (ars.py)."""
     directions: int = 8            # random directions per iteration, each rolled out at +noise and -noise
     top: int = 4                   # the directions with the best max(R+, R-) that make the step
     step_size: float = 0.02        # alpha at the first iteration (the step is alpha / (top * sigma_R) sum ...)
@@ -111,8 +111,8 @@ class TrainConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Every value, except those of a method the run does not use ([ars] and [cem] unless algo.kind
-        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that does not use them keeps its digest, and
-        the header it exports keeps its bytes."""
+        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that
+        does not use them keeps its digest, and the header it exports keeps its bytes."""
         d = dataclasses.asdict(self)
         for method in ("ars", "cem"):
             if self.algo.kind != method:
@@ -271,7 +271,8 @@ def _validate_search(cfg: TrainConfig) -> None:
     _check(1 <= r.episodes_per_direction <= 64,
            f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
     _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
-    _check(1 <= c.elites < c.population, f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
+    _check(1 <= c.elites < c.population,
+           f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
     _check(0.0 < c.init_std <= 100.0, f"cem.init_std = {c.init_std}: expected 0 < std <= 100")
     _check(0.0 < c.min_std <= c.init_std, f"cem.min_std = {c.min_std}: expected 0 < min_std <= cem.init_std "
                                           f"({c.init_std})")
