@@ -88,6 +88,20 @@ def test_toy_run_on_ray_is_bit_identical_to_the_local_pool(local_ray, tmp_path):
     assert (tmp_path / "other" / "policy.json").read_bytes() != (tmp_path / "local" / "policy.json").read_bytes()
 
 
+@pytest.mark.parametrize("search", [
+    {"algo": {"kind": "ars", "entropy_coef": 0.0}, "ars": {"directions": 3, "top": 2, "noise": 0.5}},
+    {"algo": {"kind": "cem", "entropy_coef": 0.0}, "cem": {"population": 5, "elites": 2}}])
+def test_search_runs_on_ray_are_bit_identical_to_the_local_pool(local_ray, tmp_path, search):
+    # One policy per episode (run_each): each distinct W is its own group of tasks.
+    d = json.loads(json.dumps(TOY))
+    d.update(search)
+    d["policy"]["param"] = "feedback"
+    cfg = cfgmod.from_dict(d)
+    trainer.train(cfg, tmp_path / "local", quiet=True)
+    trainer.train(cfg, tmp_path / "ray", quiet=True, make_runner=executors.RayRunner)
+    assert_same_run(tmp_path / "local", tmp_path / "ray")
+
+
 def test_simulator_run_on_ray_is_bit_identical_and_workers_find_libpoursim(local_ray, tmp_path):
     """Two iterations on libpoursim; the workers load the library the driver's environment names."""
     beta = [0.0, 0.0, 0.0, 0.0, 0.0, 0.9]

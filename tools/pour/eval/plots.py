@@ -180,6 +180,30 @@ def _liquid(out_dir: Path, prefix: str, poursim: Any, progress: Any) -> list[Pat
     return paths
 
 
+def validation_curves(groups: dict[str, Sequence[Path]], out: Path) -> None:
+    """The greedy validation score (mean per-tick reward, log.csv's eval_score) of each group against
+    training episodes and against wall time: mean over the group's runs, shaded min to max."""
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), dpi=120, sharey=True)
+    for label, dirs in groups.items():
+        logs = [_log(Path(d)) for d in dirs]
+        n = min(len(lg["eval_score"]) for lg in logs)
+        keep = np.all(np.stack([np.isfinite(lg["eval_score"][:n]) for lg in logs]), axis=0)
+        y = np.stack([lg["eval_score"][:n][keep] for lg in logs])
+        for ax, x in ((axes[0], logs[0]["episodes"][:n][keep]),
+                      (axes[1], np.mean([lg["wall_s"][:n][keep] for lg in logs], axis=0))):
+            line, = ax.plot(x, y.mean(axis=0), label=f"{label} ({len(dirs)} runs)")
+            ax.fill_between(x, y.min(axis=0), y.max(axis=0), color=line.get_color(), alpha=0.2)
+    axes[0].set_xlabel("training episodes")
+    axes[1].set_xlabel("wall time [s] (mean over runs)")
+    axes[0].set_ylabel("greedy validation score (mean reward per tick)")
+    axes[0].legend(fontsize=7)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.suptitle("Learning curves: mean over training seeds, shaded min to max")
+    fig.tight_layout()
+    _save(fig, out)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-plots", description="Plots of training runs.")
     ap.add_argument("--group", action="append", nargs="+", metavar=("LABEL", "RUN_DIR"),

@@ -22,12 +22,13 @@ from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
 from pour.sim import envs
+from pour.train import trainer
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
 
 
 def _row(name: str, how: str, poured: Sequence[float], spilled: Sequence[float], finish: Sequence[float],
-         ret: Sequence[float]) -> dict[str, Any]:
+         ret: Sequence[float], reversals: Sequence[float]) -> dict[str, Any]:
     poured, spilled, finish = np.asarray(poured), np.asarray(spilled), np.asarray(finish)
     ok = (poured >= 95) & (spilled <= 3) & (finish >= 0) & (finish <= 8)
     return {"name": name, "how": how, "episodes": int(poured.size), "poured_pct": float(poured.mean()),
@@ -37,24 +38,25 @@ def _row(name: str, how: str, poured: Sequence[float], spilled: Sequence[float],
             "finish_s": float(np.mean(np.where(finish < 0, 10.0, finish))),
             "finish_s_max": float(np.max(np.where(finish < 0, 10.0, finish))) if np.any(finish >= 0) else -1.0,
             "unfinished": int(np.sum(finish < 0)),
-            "return": float(np.mean(ret)), "episodes_meeting_all_targets": int(ok.sum())}
+            "return": float(np.mean(ret)), "reversals": float(np.mean(reversals)),
+            "reversals_max": float(np.max(reversals)), "episodes_meeting_all_targets": int(ok.sum())}
 
 
 def host_sim_row(name: str, args: Sequence[str], n: int, build_dir: str | None) -> dict[str, Any]:
     out = evaluate.run_host_sim([*args, "--episodes", str(n), "--seed", str(FIRST_SEED), "--quiet"], build_dir)
     per = out["per_episode"]
     return _row(name, "host_sim " + " ".join(args), [e["poured_pct"] for e in per], [e["spilled_pct"] for e in per],
-                [e["finish_s"] for e in per], [e["return"] for e in per])
+                [e["finish_s"] for e in per], [e["return"] for e in per], [e["reversals"] for e in per])
 
 
 _SIMS: dict[tuple[int, int], Any] = {}
 
 
 def _greedy_metrics(job: tuple) -> dict[str, float]:
-    n_actions, period_ms, w, seed = job
-    if (n_actions, period_ms) not in _SIMS:
-        _SIMS[(n_actions, period_ms)] = envs.make_env("sim", n_actions, period_ms, 10.0)
-    return dict(_SIMS[(n_actions, period_ms)].rollout(w, seed, True).metrics)
+    kind, n_actions, period_ms, w, seed = job
+    if (kind, n_actions, period_ms) not in _SIMS:
+        _SIMS[(kind, n_actions, period_ms)] = envs.make_env(kind, n_actions, period_ms, 10.0)
+    return dict(_SIMS[(kind, n_actions, period_ms)].rollout(w, seed, True).metrics)
 
 
 def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> dict[str, Any]:
@@ -65,48 +67,134 @@ def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> 
     for run in runs:
         doc = export.load_policy(run)
         w = export.weights_of(doc, which)
-        jobs += [(int(doc["n_actions"]), int(doc["decision_period_ms"]), w, seed)
+        jobs += [(doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]), w, seed)
                  for seed in range(FIRST_SEED, FIRST_SEED + n)]
     # Episodes are independent and seeded: run them on every core, results in job order.
-    with mp.get_context("fork").Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
-        ms = pool.map(_greedy_metrics, jobs, chunksize=1)
+    ms = _held_out(jobs)
     p = [100 * m["v_target"] for m in ms]
     s = [100 * m["v_spill"] for m in ms]
     f = [m["finish_s"] for m in ms]
     r = [m["return"] for m in ms]
     what = "output" if which == "best" else "final"
-    return _row(name, f"{what} float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r)
+    return _row(name, f"{what} float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r,
+                [m["reversals"] for m in ms])
+
+
+# Episodes to reach the bars: the first iteration whose training validation (greedy, seeds disjoint from
+# training) is within PREFILTER of the bars is confirmed on the held-out seeds; the first confirmed one counts.
+BAR_POURED_PCT, BAR_SPILLED_PCT = 98.0, 1.0
+PREFILTER = (0.95, 0.02)   # validation V_target >= , V_spill <=
+MAX_CHECKS = 12            # held-out confirmations per run at most (each costs n episodes of 10 s)
+
+
+def _held_out(jobs: list[tuple]) -> list[dict[str, float]]:
+    with mp.get_context("fork").Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
+        return pool.map(_greedy_metrics, jobs, chunksize=1)
+
+
+def reach(run: Path, n: int) -> dict[str, Any]:
+    """When a run's greedy policy first pours >= 98 % and spills <= 1 % on average over n held-out episodes
+    of 10 s: its training episodes and wall time then (None when it never did), from the W history in its
+    checkpoint and the validation columns of its log."""
+    cfg_doc = export.load_policy(run)
+    log = trainer.read_log(run / "log.csv")
+    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    if "history_w" not in ck:
+        raise ValueError(f"{run}: its checkpoint has no W history (history_w): train it again with this pour-train")
+    kind = cfg_doc["config"]["env"]["kind"]
+    na, period = int(cfg_doc["n_actions"]), int(cfg_doc["decision_period_ms"])
+    checks = 0
+    for i, row in enumerate(log):
+        vt, vs = float(row["eval_v_target"]), float(row["eval_v_spill"])
+        if not (vt >= PREFILTER[0] and vs <= PREFILTER[1]) or i >= len(ck["history_w"]):
+            continue
+        if checks == MAX_CHECKS:
+            break
+        checks += 1
+        ms = _held_out([(kind, na, period, ck["history_w"][i], seed) for seed in range(FIRST_SEED, FIRST_SEED + n)])
+        poured = 100 * float(np.mean([m["v_target"] for m in ms]))
+        spilled = 100 * float(np.mean([m["v_spill"] for m in ms]))
+        if poured >= BAR_POURED_PCT and spilled <= BAR_SPILLED_PCT:
+            return {"run": str(run), "episodes": int(row["episodes"]), "wall_s": float(row["wall_s"]),
+                    "iteration": i, "poured_pct": poured, "spilled_pct": spilled, "checks": checks}
+    return {"run": str(run), "episodes": None, "wall_s": None, "iteration": None, "checks": checks}
+
+
+def reach_row(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
+    per = [reach(r, n) for r in runs]
+    got = [p for p in per if p["episodes"] is not None]
+    budget = [int(_last_log_row(r)["episodes"]) for r in runs]
+    # A run that never reached the bars counts as its whole budget and more: the median is then a lower bound.
+    eps = sorted(p["episodes"] if p["episodes"] is not None else np.inf for p in per)
+    wall = sorted(p["wall_s"] if p["wall_s"] is not None else np.inf for p in per)
+    def finite(v: float) -> float | None:
+        return float(v) if np.isfinite(v) else None
+    return {"name": name, "runs": len(runs), "reached": len(got), "budget_episodes": max(budget),
+            "episodes_median": finite(np.median(eps)), "episodes_min": finite(eps[0]),
+            "episodes_max": finite(eps[-1]), "wall_s_median": finite(np.median(wall)), "per_run": per}
+
+
+def _last_log_row(run: Path) -> dict[str, str]:
+    rows = trainer.read_log(run / "log.csv")
+    if not rows:
+        raise ValueError(f"{run}/log.csv has no rows")
+    return rows[-1]
+
+
+def reach_markdown(reach_rows: list[dict[str, Any]], rows: dict[str, dict[str, Any]], n: int) -> str:
+    def num(v: float | None, fmt: str) -> str:
+        return "not reached" if v is None else format(v, fmt)
+    lines = ["", f"Learning from zero: training episodes and wall time until the greedy policy first pours >= "
+             f"{BAR_POURED_PCT:g} % and spills <= {BAR_SPILLED_PCT:g} % on average over {n} held-out episodes "
+             "(median over the runs; a run that never did counts as not reached), and the output policies' "
+             "figures on the held-out seeds.", "",
+             "| method | runs reaching 98 % / 1 % | episodes to reach (median; min–max) | wall s to reach (median) | "
+             "budget (episodes) | poured % | spilled % (max) | reversals per 10 s (max) | finish s |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in reach_rows:
+        f = rows[r["name"]]
+        spread = "" if r["episodes_min"] is None else \
+            f"; {num(r['episodes_min'], '.0f')}–{num(r['episodes_max'], '.0f')}"
+        lines.append(f"| {r['name']} | {r['reached']}/{r['runs']} | {num(r['episodes_median'], '.0f')}{spread} | "
+                     f"{num(r['wall_s_median'], '.0f')} | {r['budget_episodes']} | {f['poured_pct']:.1f} | "
+                     f"{f['spilled_pct']:.2f} ({f['spilled_pct_max']:.1f}) | {f['reversals']:.1f} "
+                     f"({f['reversals_max']:.0f}) | {f['finish_s']:.2f} |")
+    return "\n".join(lines) + "\n"
 
 
 def init_row(config_path: str, n: int) -> dict[str, Any]:
     """The policy a training config starts from, greedy, on the held-out seeds."""
-    from pour.train import config, reinforce
+    from pour.train import config
     cfg = config.load(config_path)
-    p = np.zeros(reinforce.params_shape(cfg.policy.param, cfg.policy.n_actions))
-    if cfg.policy.init == "beta":
-        p = np.array(cfg.policy.init_beta, dtype=np.float64)
-    w = reinforce.w_from_params(cfg.policy.param, p, cfg.policy.n_actions, cfg.policy.sharpness)
+    w = trainer.weights(cfg, trainer.initial_params(cfg))
     sim = envs.make_env("sim", cfg.policy.n_actions, cfg.policy.decision_period_ms, 10.0)
     ms = [sim.rollout(w, seed, True).metrics for seed in range(FIRST_SEED, FIRST_SEED + n)]
     return _row(f"initial policy of {Path(config_path).name}", "greedy float, C rollout",
                 [100 * m["v_target"] for m in ms], [100 * m["v_spill"] for m in ms],
-                [m["finish_s"] for m in ms], [m["return"] for m in ms])
+                [m["finish_s"] for m in ms], [m["return"] for m in ms], [m["reversals"] for m in ms])
 
 
 def markdown(rows: list[dict[str, Any]], n: int) -> str:
     lines = [f"Held-out seeds {FIRST_SEED}..{FIRST_SEED + n - 1} ({n} episodes of 10 s each per policy, "
              "greedy). Targets: poured >= 95 %, spilled <= 3 %, finished within 8 s.", "",
-             "| policy | poured % (mean / min) | spilled % (mean / max) | finish s (mean / max) | return | "
-             "episodes meeting all targets |",
-             "|---|---|---|---|---|---|",
-             "| paper (REINFORCE, pure-Python sim) | not reported | not reported | not reported | "
+             "| policy | poured % (mean / min) | spilled % (mean / max) | finish s (mean / max) | "
+             "reversals per 10 s (mean / max) | return | episodes meeting all targets |",
+             "|---|---|---|---|---|---|---|",
+             "| paper (REINFORCE, pure-Python sim) | not reported | not reported | not reported | not reported | "
              "slight upward trend in 100 episodes (binary); no convergence in 500 (11 actions) | — |"]
     for r in rows:
         fin = "never (nothing poured)" if r["finish_s_max"] < 0 else f"{r['finish_s']:.2f} / {r['finish_s_max']:.2f}"
         lines.append(f"| {r['name']} | {r['poured_pct']:.1f} / {r['poured_pct_min']:.1f} | "
-                     f"{r['spilled_pct']:.1f} / {r['spilled_pct_max']:.1f} | {fin} | {r['return']:.0f} | "
+                     f"{r['spilled_pct']:.1f} / {r['spilled_pct_max']:.1f} | {fin} | "
+                     f"{r['reversals']:.1f} / {r['reversals_max']:.0f} | {r['return']:.0f} | "
                      f"{r['episodes_meeting_all_targets']}/{r['episodes']} |")
     return "\n".join(lines) + "\n"
+
+
+def _json_number(v: Any) -> Any:
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    raise TypeError(f"not JSON: {v!r}")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -118,6 +206,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                     help="as --group, but the runs' final weights (not the best validated ones); repeatable")
     ap.add_argument("--init", metavar="CONFIG", help="also evaluate the initial policy of this training config")
     ap.add_argument("--episodes", type=int, default=20)
+    ap.add_argument("--reach", action="store_true",
+                    help="also the episodes and wall time each --group's runs took to reach 98 %% / 1 %% on the "
+                         "held-out seeds, and their validation curves (reach_curves.png)")
     ap.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
     ap.add_argument("-o", "--out", default="results", type=Path)
     ap.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
@@ -141,6 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         todo.append(lambda: host_sim_row(f"ours, shipped {Path(args.header).name} (firmware core, fixed point)",
                                          ["--policy", args.header], n, args.build_dir))
         rows = [make() for make in cli.progress(todo, len(todo), "results", args.quiet, unit="row")]
+        reach_rows = [reach_row(g[0], [Path(d) for d in g[1:]], n) for g in args.group] if args.reach else []
     except (OSError, RuntimeError, ValueError, envs.EnvError, weights_h.WeightsHError, export.ExportError) as exc:
         print(f"pour-results: error: {exc}", file=sys.stderr)
         return 2
@@ -152,10 +244,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     title = f"Shipped policy, held-out seed {FIRST_SEED}"
     plots.angle({"shipped policy": ep.x}, hdr.decision_period_ms, args.out / "shipped_angle.png", title)
     plots.volumes(ep.x, hdr.decision_period_ms, args.out / "shipped_volumes.png", title)
+    text = markdown(rows, n)
+    if reach_rows:
+        text += reach_markdown(reach_rows, {r["name"]: r for r in rows}, n)
+        plots.validation_curves({g[0]: [Path(d) for d in g[1:]] for g in args.group}, args.out / "reach_curves.png")
     atomic.write_atomic(args.out / "results.json",
-                        json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows}, indent=1) + "\n")
-    atomic.write_atomic(args.out / "results.md", markdown(rows, n))
-    print(markdown(rows, n))
+                        json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows, "reach": reach_rows},
+                                   indent=1, default=_json_number) + "\n")
+    atomic.write_atomic(args.out / "results.md", text)
+    print(text)
     return 0
 
 

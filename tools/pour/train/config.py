@@ -24,15 +24,18 @@ class ConfigError(ValueError):
 class PolicyConfig:
     n_actions: int = 11            # torque levels evenly spaced in [-1, 1] x tau_max, 2..16
     decision_period_ms: int = 10   # a new action every this many 1 ms ticks
-    init: str = "zeros"            # "zeros": every parameter 0 (param "full": uniform random actions, as the paper)
+    init: str = "zeros"            # "zeros": every parameter 0 (param "full": uniform random actions, as the paper);
+                                   # "random": i.i.d. normal(0, init_scale^2), seeded by the run's seed
     init_beta: list = field(default_factory=list)  # param "feedback", init "beta": the 6 initial beta values
     param: str = "full"            # "full": W itself; "feedback": W from a linear feedback u(x) (reinforce.py)
     sharpness: float = 4.0         # "feedback": c in logit_a = -c (L_a - u(x))^2
+    init_scale: float = 0.0        # init "random": standard deviation of each initial parameter
 
 
 @dataclass(frozen=True)
 class AlgoConfig:
-    kind: str = "pg"               # "vanilla" (paper eq. 19) or "pg" (the improved update)
+    kind: str = "pg"               # "vanilla" (paper eq. 19), "pg" (the improved update) or "ars" (random
+                                   # search on greedy rollouts, options in [ars]; uses gamma and reward_scale)
     batch_episodes: int = 16       # episodes per update (vanilla: the paper uses 1)
     gamma: float = 0.9995          # discount per 1 ms tick (per decision: gamma ** period)
     lr: float = 0.05               # learning rate at the first iteration
@@ -56,10 +59,35 @@ class AlgoConfig:
 
 
 @dataclass(frozen=True)
+class ArsConfig:
+    """Augmented random search (Mania, Guy & Recht 2018, V1-t) over the policy's parameters (ars.py)."""
+    directions: int = 8            # random directions per iteration, each rolled out at +noise and -noise
+    top: int = 4                   # the directions with the best max(R+, R-) that make the step
+    step_size: float = 0.02        # alpha at the first iteration (the step is alpha / (top * sigma_R) sum ...)
+    step_size_final: float = -1.0  # linearly decayed to this at the last iteration (< 0: constant)
+    noise: float = 0.03            # nu: the perturbation's standard deviation per parameter
+    noise_final: float = -1.0      # decayed geometrically to this at the last iteration (< 0: constant)
+    episodes_per_direction: int = 1  # rigs per perturbed policy; the same rigs for +, - and every direction
+
+
+@dataclass(frozen=True)
+class CemConfig:
+    """The cross-entropy method over the policy's parameters (tools/pour/train/ars.py)."""
+    population: int = 16           # candidates per iteration, drawn from normal(mean, diag(std^2))
+    elites: int = 4                # the best candidates, whose mean and spread become the next distribution
+    init_std: float = 2.0          # the distribution's standard deviation per parameter at the start
+    min_std: float = 0.05          # floor of the standard deviation (keeps exploring; > 0)
+    episodes_per_candidate: int = 1  # rigs per candidate; the same rigs for every candidate of an iteration
+
+
+@dataclass(frozen=True)
 class EvalConfig:
     every: int = 5                 # greedy evaluation every this many iterations (and the last)
     episodes: int = 8              # validation episodes per evaluation (seeds disjoint from training)
     select_best: bool = True       # keep the weights with the best greedy validation score
+    collapse: float = 0.0          # algo.kind 'ars' or 'cem': stop when the validation score falls this fraction
+                                   # of |best| below the best (plus its standard error) ...
+    collapse_patience: int = 3     # ... at this many evaluations in a row; the best checkpoint is kept
 
 
 @dataclass(frozen=True)
@@ -76,11 +104,24 @@ class TrainConfig:
     workers: int = 2
     policy: PolicyConfig = PolicyConfig()
     algo: AlgoConfig = AlgoConfig()
+    ars: ArsConfig = ArsConfig()
+    cem: CemConfig = CemConfig()
     eval: EvalConfig = EvalConfig()
     env: EnvConfig = EnvConfig()
 
     def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        """Every value, except those of a method the run does not use ([ars] and [cem] unless algo.kind
+        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that
+        does not use them keeps its digest, and the header it exports keeps its bytes."""
+        d = dataclasses.asdict(self)
+        for method in ("ars", "cem"):
+            if self.algo.kind != method:
+                del d[method]
+        if self.eval.collapse == 0.0:
+            del d["eval"]["collapse"], d["eval"]["collapse_patience"]
+        if self.policy.init != "random":
+            del d["policy"]["init_scale"]
+        return d
 
     def digest(self) -> str:
         """sha256 of the canonical JSON of every value but `workers` (which never changes results)."""
@@ -90,7 +131,7 @@ class TrainConfig:
         return hashlib.sha256(blob).hexdigest()
 
 
-_SECTIONS = {"policy": PolicyConfig, "algo": AlgoConfig, "eval": EvalConfig, "env": EnvConfig}
+_SECTIONS = {"policy": PolicyConfig, "algo": AlgoConfig, "ars": ArsConfig, "cem": CemConfig, "eval": EvalConfig, "env": EnvConfig}
 
 
 def _typed(section: str, key: str, value: Any, want: Any) -> Any:
@@ -148,7 +189,12 @@ def validate(cfg: TrainConfig) -> TrainConfig:
     _check(2 <= p.n_actions <= 16, f"policy.n_actions = {p.n_actions}: expected 2..16")
     _check(1 <= p.decision_period_ms <= 1000,
            f"policy.decision_period_ms = {p.decision_period_ms}: expected 1..1000")
-    _check(p.init in ("zeros", "beta"), f"policy.init = {p.init!r}: expected 'zeros' or 'beta'")
+    _check(p.init in ("zeros", "beta", "random"),
+           f"policy.init = {p.init!r}: expected 'zeros', 'beta' or 'random'")
+    _check(0.0 <= p.init_scale <= 100.0, f"policy.init_scale = {p.init_scale}: expected 0 <= scale <= 100")
+    _check((p.init == "random") == (p.init_scale > 0),
+           f"policy.init_scale = {p.init_scale}: expected > 0 exactly when policy.init = 'random' "
+           f"(init = {p.init!r})")
     if p.init == "beta":
         _check(p.param == "feedback", "policy.init = 'beta' needs policy.param = 'feedback'")
         _check(len(p.init_beta) == 6 and all(isinstance(b, (int, float)) and not isinstance(b, bool)
@@ -157,7 +203,14 @@ def validate(cfg: TrainConfig) -> TrainConfig:
                "V_spill, bias)")
     _check(p.param in ("full", "feedback"), f"policy.param = {p.param!r}: expected 'full' or 'feedback'")
     _check(0.0 < p.sharpness <= 1000.0, f"policy.sharpness = {p.sharpness}: expected 0 < c <= 1000")
-    _check(a.kind in ("vanilla", "pg"), f"algo.kind = {a.kind!r}: expected 'vanilla' or 'pg'")
+    _check(a.kind in ("vanilla", "pg", "ars", "cem"),
+           f"algo.kind = {a.kind!r}: expected 'vanilla', 'pg', 'ars' or 'cem'")
+    if a.kind in ("ars", "cem"):
+        _validate_search(cfg)
+    _check(0.0 <= e.collapse <= 10.0, f"eval.collapse = {e.collapse}: expected 0 <= fraction <= 10 (0 = off)")
+    _check(e.collapse == 0 or a.kind in ("ars", "cem"),
+           f"eval.collapse = {e.collapse}: only for algo.kind 'ars' or 'cem' (kind 'pg' has algo.rollback)")
+    _check(e.collapse_patience >= 1, f"eval.collapse_patience = {e.collapse_patience}: expected >= 1")
     if a.kind == "vanilla":
         paper = {"lr_final": -1.0, "reward_to_go": False, "baseline": "none", "normalize_advantages": False, "entropy_coef": 0.0,
                  "entropy_coef_final": 0.0, "optimizer": "sgd", "grad_clip": 0.0, "max_kl": 0.0,
@@ -201,6 +254,34 @@ def validate(cfg: TrainConfig) -> TrainConfig:
            f"env.episode_s = {v.episode_s} is not a whole number of decision periods "
            f"({p.decision_period_ms} ms)")
     return cfg
+
+
+def _validate_search(cfg: TrainConfig) -> None:
+    r, c, a = cfg.ars, cfg.cem, cfg.algo
+    _check(1 <= r.directions <= 256, f"ars.directions = {r.directions}: expected 1..256")
+    _check(1 <= r.top <= r.directions, f"ars.top = {r.top}: expected 1..ars.directions ({r.directions})")
+    _check(0.0 < r.step_size <= 10.0, f"ars.step_size = {r.step_size}: expected 0 < alpha <= 10")
+    _check(r.step_size_final < 0 or r.step_size_final <= r.step_size,
+           f"ars.step_size_final = {r.step_size_final}: expected <= ars.step_size ({r.step_size}), or negative "
+           "for a constant step")
+    _check(0.0 < r.noise <= 10.0, f"ars.noise = {r.noise}: expected 0 < nu <= 10")
+    _check(r.noise_final < 0 or 0 < r.noise_final <= r.noise,
+           f"ars.noise_final = {r.noise_final}: expected 0 < nu_final <= ars.noise ({r.noise}), or negative for a "
+           "constant noise")
+    _check(1 <= r.episodes_per_direction <= 64,
+           f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
+    _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
+    _check(1 <= c.elites < c.population,
+           f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
+    _check(0.0 < c.init_std <= 100.0, f"cem.init_std = {c.init_std}: expected 0 < std <= 100")
+    _check(0.0 < c.min_std <= c.init_std, f"cem.min_std = {c.min_std}: expected 0 < min_std <= cem.init_std "
+                                          f"({c.init_std})")
+    _check(1 <= c.episodes_per_candidate <= 64,
+           f"cem.episodes_per_candidate = {c.episodes_per_candidate}: expected 1..64")
+    # The policy-gradient options have no meaning for random search: refuse them rather than ignore them.
+    for k in ("max_kl", "rollback", "grad_clip"):
+        _check(getattr(a, k) == 0.0, f"algo.kind = {a.kind!r} has no algo.{k} (got {getattr(a, k)!r}); its "
+                                     f"options are in [{a.kind}]")
 
 
 def from_dict(data: dict) -> TrainConfig:

@@ -192,7 +192,11 @@ class Runner:
             self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
 
     def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
-        jobs = [(w, s, greedy) for s in seeds]
+        return self.run_each([w] * len(seeds), seeds, greedy)
+
+    def run_each(self, ws: Sequence[np.ndarray], seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
+        """Episode i runs policy ws[i] on seeds[i] (random search's perturbed policies), in order."""
+        jobs = [(w, s, greedy) for w, s in zip(ws, seeds, strict=True)]
         if self.pool is None:
             return [_run(j) for j in jobs]
         return self.pool.map(_run, jobs, chunksize=1)
@@ -293,16 +297,35 @@ class RayRunner:
         return out or [""]
 
     def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
+        return self.run_each([w] * len(seeds), seeds, greedy)
+
+    def run_each(self, ws: Sequence[np.ndarray], seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
+        """Runner.run_each on Ray. Consecutive episodes of one policy (the same array) form a group whose
+        weights are sent once; a lone group is cut into one batch per CPU, several groups share the CPUs."""
         if not len(seeds):
             return []
+        if len(ws) != len(seeds):
+            raise ValueError(f"run_each: {len(ws)} policies for {len(seeds)} seeds")
+        groups, i = [], 0
+        while i < len(seeds):
+            j = i + 1
+            while j < len(seeds) and ws[j] is ws[i]:
+                j += 1
+            groups.append((ws[i], list(seeds[i:j])))
+            i = j
         slots = self.slots()
-        n_tasks = math.ceil(len(seeds) / self.episodes_per_task) if self.episodes_per_task else len(slots)
-        w_ref = self.ray.put(np.asarray(w))
         affinity = self.ray.util.scheduling_strategies.NodeAffinitySchedulingStrategy
-        self.pending = [
-            self.task.options(scheduling_strategy=affinity(slots[i % len(slots)], soft=True) if slots[0] else None)
-            .remote(self.env_args, w_ref, b, bool(greedy), self.kill_marker)
-            for i, b in enumerate(batches(seeds, n_tasks))]
+        self.pending, k = [], 0
+        for w, group in groups:
+            n_tasks = math.ceil(len(group) / self.episodes_per_task) if self.episodes_per_task \
+                else max(1, len(slots) // len(groups))
+            w_ref = self.ray.put(np.asarray(w))
+            for b in batches(group, n_tasks):
+                slot = slots[k % len(slots)]
+                k += 1
+                self.pending.append(
+                    self.task.options(scheduling_strategy=affinity(slot, soft=True) if slot else None)
+                    .remote(self.env_args, w_ref, b, bool(greedy), self.kill_marker))
         # On KeyboardInterrupt the tasks stay in self.pending, and close() (the trainer's `with`) cancels them.
         try:
             results = self.ray.get(self.pending)

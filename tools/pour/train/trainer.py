@@ -29,6 +29,7 @@ from pour.train import executors, reinforce
 from pour.train.executors import Runner  # the local pool, the default executor (also as trainer.Runner)
 
 STREAM_TRAIN, STREAM_VALID, STREAM_TEST = 0, 1, 2
+STREAM_INIT = 4  # policy.init = "random" (ars.py's draws are stream 3)
 
 LOG_FIELDS = ["iteration", "episodes", "wall_s", "return_mean", "return_std", "return_min", "return_max",
               "reward_sum_mean", "v_target_mean", "v_spill_mean", "finish_s_mean", "entropy_mean",
@@ -126,6 +127,17 @@ def episode_return(ep: envs.Episode, gamma_decision: float) -> float:
     return reinforce.discounted_return(ep.rewards, gamma_decision)
 
 
+def initial_params(cfg: cfgmod.TrainConfig) -> np.ndarray:
+    """The run's starting parameters: zeros, policy.init_beta, or seeded normal(0, init_scale^2)."""
+    shape = reinforce.params_shape(cfg.policy.param, cfg.policy.n_actions)
+    if cfg.policy.init == "beta":
+        return np.array(cfg.policy.init_beta, dtype=np.float64)
+    if cfg.policy.init == "random":
+        rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, STREAM_INIT]))
+        return cfg.policy.init_scale * rng.standard_normal(shape)
+    return np.zeros(shape)
+
+
 def score(episodes: Sequence[envs.Episode], steps: int) -> float:
     """Validation score: the per-tick reward averaged over the episode and over the episodes."""
     return float(np.mean([np.sum(e.rewards) for e in episodes])) / steps
@@ -142,19 +154,27 @@ def weights(cfg: cfgmod.TrainConfig, params: np.ndarray) -> np.ndarray:
     return reinforce.w_from_params(cfg.policy.param, params, cfg.policy.n_actions, cfg.policy.sharpness)
 
 
+def linear_schedule(start: float, final: float, it: int, iterations: int) -> float:
+    """start at iteration 0, linearly to final at the last iteration; final < 0: constant start."""
+    if final < 0:
+        return start
+    return start + (final - start) * it / max(1, iterations - 1)
+
+
+def geometric_schedule(start: float, final: float, it: int, iterations: int) -> float:
+    """start at iteration 0, geometrically to final at the last iteration; final < 0 or start 0: constant."""
+    if final < 0 or start == 0:
+        return start
+    return start * (final / start) ** (it / max(1, iterations - 1))
+
+
 def learning_rate(cfg: cfgmod.TrainConfig, it: int) -> float:
-    a = cfg.algo
-    if a.lr_final < 0:
-        return a.lr
-    return a.lr + (a.lr_final - a.lr) * it / max(1, cfg.iterations - 1)
+    return linear_schedule(cfg.algo.lr, cfg.algo.lr_final, it, cfg.iterations)
 
 
 def max_kl(cfg: cfgmod.TrainConfig, it: int) -> float:
     """The trust region's bound at iteration it [nats]: max_kl, decayed geometrically to max_kl_final."""
-    a = cfg.algo
-    if a.max_kl_final < 0 or a.max_kl == 0:
-        return a.max_kl
-    return a.max_kl * (a.max_kl_final / a.max_kl) ** (it / max(1, cfg.iterations - 1))
+    return geometric_schedule(cfg.algo.max_kl, cfg.algo.max_kl_final, it, cfg.iterations)
 
 
 def update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode], opt: reinforce.Adam | None,
@@ -202,24 +222,46 @@ def _update(cfg: cfgmod.TrainConfig, w: np.ndarray, eps: Sequence[envs.Episode],
     return w_new, {"grad_norm": norm, "lr": lr, "kl_bound": delta, "kl": kl, "step_scale": scale}
 
 
+def iterations(cfg: cfgmod.TrainConfig, start: int, stop_after: int | None) -> range:
+    """The iterations one call runs: from start to the config's end, at most stop_after of them."""
+    end = cfg.iterations if stop_after is None else min(cfg.iterations, start + stop_after)
+    return range(start, end)
+
+
+def validate(cfg: cfgmod.TrainConfig, runner: Any, w: np.ndarray, seeds: Sequence[int], it: int
+             ) -> tuple[dict[str, float], float]:
+    """The greedy validation of W when iteration it is due one (every eval.every and the last): the log's
+    eval_* columns (NaN when not due) and the score's standard error."""
+    ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
+    if not cfg.eval.episodes or ((it + 1) % cfg.eval.every != 0 and it != cfg.iterations - 1):
+        return ev, np.nan
+    steps = int(round(cfg.env.episode_s * 1000))
+    veps = runner.run(w, seeds, greedy=True)
+    ev = {"eval_score": score(veps, steps),
+          "eval_v_target": np.mean([e.metrics["v_target"] for e in veps]),
+          "eval_v_spill": np.mean([e.metrics["v_spill"] for e in veps]),
+          "eval_finish_s": np.mean([e.metrics["finish_s"] for e in veps])}
+    return ev, float(np.std([np.sum(e.rewards) for e in veps])) / steps / np.sqrt(len(veps))
+
+
 def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, quiet: bool = False,
           stop_after: int | None = None, make_runner: Any = Runner) -> RunResult:
     """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call.
     make_runner: cfg -> the episode runner (Runner, the local pool, or executors.RayRunner): same results."""
     run_dir = Path(run_dir)
+    if cfg.algo.kind in ("ars", "cem"):
+        from pour.train import ars  # the search methods build on this module's run directory
+        return ars.train(cfg, run_dir, resume, quiet, stop_after, make_runner)
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
     digest = cfg.digest()
-    n_feat, n_act = envs.N_FEATURES, cfg.policy.n_actions
-    steps = int(round(cfg.env.episode_s * 1000))
 
-    params = np.zeros(reinforce.params_shape(cfg.policy.param, n_act))
-    if cfg.policy.init == "beta":
-        params = np.array(cfg.policy.init_beta, dtype=np.float64)
+    params = initial_params(cfg)
     w = weights(cfg, params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
     opt = reinforce.Adam(params.shape, cfg.algo.lr) if cfg.algo.optimizer == "adam" else None
     best_ep: dict[str, np.ndarray] = {}
+    history: list[np.ndarray] = []  # W after every iteration (pour-results' episodes to reach the bars)
     rows: list[dict[str, Any]] = []
     # Rollback (algo.rollback > 0): the parameters of the best batch so far, its mean return and its
     # standard error, and how many steps were undone (each one shrinks the trust region).
@@ -236,6 +278,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
         if opt is not None:
             opt.load_state_dict(st)
         best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
+        history = list(np.array(st["history_w"])) if "history_w" in st else []
         if "anchor_params" in st:
             anchor_params, anchor_ret = np.array(st["anchor_params"]), float(st["anchor_ret"])
             anchor_se, n_rollbacks = float(st["anchor_se"]), int(st["n_rollbacks"])
@@ -252,11 +295,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
     valid_seeds = episode_seeds(cfg.seed, STREAM_VALID, 0, cfg.eval.episodes)
     t0 = time.monotonic()
-    done = 0
     with make_runner(cfg) as runner:
-        for it in range(start, cfg.iterations):
-            if stop_after is not None and done >= stop_after:
-                break
+        for it in iterations(cfg, start, stop_after):
             eps = runner.run(w, episode_seeds(cfg.seed, STREAM_TRAIN, it, cfg.algo.batch_episodes), greedy=False)
             rets = np.array([episode_return(e, gamma_d) for e in eps])
             ent = float(np.mean([np.mean(reinforce.entropy(linear.probs(w, e.x))) for e in eps]))
@@ -287,15 +327,10 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             else:
                 params, stats = update(cfg, params, eps, opt, it, bound)
             w = weights(cfg, params)
-            ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
-            last = it == cfg.iterations - 1
-            if cfg.eval.episodes and ((it + 1) % cfg.eval.every == 0 or last):
-                veps = runner.run(w, valid_seeds, greedy=True)
-                sc = score(veps, steps)
-                ev = {"eval_score": sc,
-                      "eval_v_target": np.mean([e.metrics["v_target"] for e in veps]),
-                      "eval_v_spill": np.mean([e.metrics["v_spill"] for e in veps]),
-                      "eval_finish_s": np.mean([e.metrics["finish_s"] for e in veps])}
+            history.append(w.copy())
+            ev, _ = validate(cfg, runner, w, valid_seeds, it)
+            if np.isfinite(ev["eval_score"]):
+                sc = ev["eval_score"]
                 if sc > best_score or not cfg.eval.select_best:
                     best_score, best_w = sc, w.copy()
             wall = wall_prev + time.monotonic() - t0
@@ -311,12 +346,11 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
             state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1, "wall_s": wall,
                      "config_digest": digest, **(opt.state_dict() if opt is not None else {}), **best_ep,
                      "anchor_params": anchor_params, "anchor_ret": anchor_ret, "anchor_se": anchor_se,
-                     "n_rollbacks": n_rollbacks}
+                     "n_rollbacks": n_rollbacks, "history_w": np.array(history)}
             # Log first, then the checkpoint: a crash in between leaves a log row the resume drops.
             write_log(log_path, rows)
             write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
             save_checkpoint(ckpt_path, state)
-            done += 1
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
