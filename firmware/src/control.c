@@ -46,7 +46,9 @@ static void start_afresh(pour_control_t *ctl) {
    * ramps from it through the slew limit, not from zero (found by tests/fuzz/fuzz_can_node). */
   (void)pour_safety_init(&ctl->safety, &ctl->config.safety);
   pour_safety_force(&ctl->safety, ctl->config.safe_torque);
-  (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
+  if (ctl->policy.weights != NULL) {
+    (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
+  }
   ctl->ms_since_fresh = 0u;
   ctl->ms_to_decision = 0u;
   const pour_state_t zero_state = {0u, 0, 0, 0, 0, 0};
@@ -60,6 +62,8 @@ static void start_afresh(pour_control_t *ctl) {
   }
   ctl->eval.action = 0u;
   ctl->probs_pending = false;
+  ctl->decision_due = false;
+  ctl->request = ctl->config.safe_torque;
   pour_supervisor_restart(&ctl->supervisor);
   pour_estimator_reset(&ctl->estimator);
   ctl->stop_ms = 0u;
@@ -71,12 +75,8 @@ static bool stop_config_ok(const pour_stop_config_t *s) {
          s->rest_theta_urad > 0 && s->rest_omega_urad_s > 0 && s->timeout_ms >= 1u;
 }
 
-pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
-                                const pour_policy_weights_t *weights) {
-  if (ctl == NULL || config == NULL) {
-    return POUR_EINVAL;
-  }
-  const pour_control_config_t *c = config;
+/* Validates the config and takes it; the policy (or none) is the caller's. */
+static pour_status_t init_config(pour_control_t *ctl, const pour_control_config_t *c) {
   if (c->input_timeout_ms < 1u || c->plausible_theta_urad <= 0 || c->plausible_omega_urad_s <= 0 ||
       c->plausible_volume_sum <= 0) {
     return POUR_EINVAL;
@@ -90,16 +90,47 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
   if (c->safe_torque > c->safety.tau_limit || c->safe_torque < -c->safety.tau_limit) {
     return POUR_EINVAL;
   }
-  const pour_status_t status = pour_policy_init(&ctl->policy, weights, c->policy_mode, c->seed);
-  if (status != POUR_OK) {
-    return status;
-  }
+  return POUR_OK;
+}
+
+static void start(pour_control_t *ctl, const pour_control_config_t *c, uint16_t decision_period_ms) {
   ctl->config = *c;
+  ctl->decision_period_ms = decision_period_ms;
   ctl->mode = POUR_MODE_IDLE;
   ctl->faults = 0u;
   ctl->tick = 0u;
   ctl->resets_refused = 0u;
   start_afresh(ctl);
+}
+
+pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
+                                const pour_policy_weights_t *weights) {
+  if (ctl == NULL || config == NULL) {
+    return POUR_EINVAL;
+  }
+  pour_status_t status = init_config(ctl, config);
+  if (status != POUR_OK) {
+    return status;
+  }
+  status = pour_policy_init(&ctl->policy, weights, config->policy_mode, config->seed);
+  if (status != POUR_OK) {
+    return status;
+  }
+  start(ctl, config, weights->decision_period_ms);
+  return POUR_OK;
+}
+
+pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control_config_t *config,
+                                         uint16_t decision_period_ms) {
+  if (ctl == NULL || config == NULL || decision_period_ms < 1u) {
+    return POUR_EINVAL;
+  }
+  const pour_status_t status = init_config(ctl, config);
+  if (status != POUR_OK) {
+    return status;
+  }
+  ctl->policy.weights = NULL;
+  start(ctl, config, decision_period_ms);
   return POUR_OK;
 }
 
@@ -144,11 +175,10 @@ static bool at_rest(const pour_stop_config_t *c, const pour_state_t *s) {
          s->omega_urad_s <= c->rest_omega_urad_s && s->omega_urad_s >= -c->rest_omega_urad_s;
 }
 
-/* FAULT: an active stop while the fault allows it and fresh states keep coming, else (and after it) the
- * safe torque with the brake engaged and the power cut. Returns the torque; *active tells which. */
-static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
+/* FAULT: an active stop while the fault allows it and fresh states keep coming; false once it is over (or
+ * never could act): then the safe torque with the brake engaged and the power cut. */
+static bool stop_active(pour_control_t *ctl) {
   const pour_stop_config_t *c = &ctl->config.stop;
-  *active = false;
   if (!ctl->stopped) {
     const bool can_act = (ctl->faults & ~(uint16_t)POUR_FAULT_ACTIVE_STOP) == 0u &&
                          ctl->ms_since_fresh <= ctl->config.input_timeout_ms && ctl->stop_ms < c->timeout_ms;
@@ -156,13 +186,9 @@ static q15_t controlled_stop(pour_control_t *ctl, bool *active) {
       ctl->stopped = true;
     } else {
       ctl->stop_ms++;
-      *active = true;
-      /* Through the envelope: the stop never steps the torque by more than the slew limit. */
-      return pour_safety_apply(&ctl->safety, stop_request(c, &ctl->state), ctl->state.theta_urad,
-                               ctl->state.omega_urad_s);
     }
   }
-  return force_safe(ctl);
+  return !ctl->stopped;
 }
 
 static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_output_t *out) {
@@ -179,15 +205,14 @@ static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_ou
   out->power = ctl->mode == POUR_MODE_RUN;
 }
 
-void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out) {
+bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in) {
   ctl->tick++;
+  ctl->decision_due = false;
   if (in->estop) {
     ctl->mode = POUR_MODE_ESTOP;
     ctl->faults |= POUR_FAULT_ESTOP;
-    pour_safety_force(&ctl->safety, 0);
     ctl->stopped = true; /* after the release: brake and power cut until a clear */
-    fill_output(ctl, 0, out);
-    return;
+    return false;
   }
   if (ctl->mode == POUR_MODE_ESTOP) {
     ctl->mode = POUR_MODE_FAULT;
@@ -260,37 +285,72 @@ void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour
       ctl->mode = POUR_MODE_FAULT;
     }
   }
-
-  q15_t torque;
   if (ctl->mode == POUR_MODE_RUN) {
-    const pour_policy_weights_t *w = ctl->policy.weights;
-    if (ctl->ms_to_decision == 0u) {
-      pour_obs_quantize(&w->norm, &ctl->state, &ctl->obs);
-      /* A greedy decision needs only the argmax; its probabilities (telemetry) follow on the next tick,
-       * which has the time: the decision tick stays the cheapest it can be. With a decision every tick
-       * there is no next tick to spare. */
-      ctl->probs_pending = !pour_policy_decide(&ctl->policy, &ctl->obs, &ctl->eval);
-      if (ctl->probs_pending && w->decision_period_ms == 1u) {
-        pour_policy_fill_probs(&ctl->policy, &ctl->eval);
-        ctl->probs_pending = false;
-      }
-      ctl->ms_to_decision = w->decision_period_ms;
-    } else if (ctl->probs_pending) {
-      pour_policy_fill_probs(&ctl->policy, &ctl->eval);
-      ctl->probs_pending = false;
+    ctl->decision_due = ctl->ms_to_decision == 0u;
+    if (ctl->decision_due) {
+      ctl->ms_to_decision = ctl->decision_period_ms;
     }
     ctl->ms_to_decision--;
-    torque = pour_safety_apply(&ctl->safety, w->action_levels[ctl->eval.action], ctl->state.theta_urad,
-                               ctl->state.omega_urad_s);
-    pour_supervisor_record(&ctl->supervisor, &ctl->state, torque);
-    fill_output(ctl, torque, out);
-  } else if (ctl->mode == POUR_MODE_FAULT) {
-    bool active = false;
-    torque = controlled_stop(ctl, &active);
-    fill_output(ctl, torque, out);
-    out->brake = !active;
-    out->power = active;
-  } else {
-    fill_output(ctl, force_safe(ctl), out);
   }
+  return ctl->decision_due;
+}
+
+const pour_state_t *pour_control_state(const pour_control_t *ctl) { return &ctl->state; }
+
+void pour_control_decide(pour_control_t *ctl) {
+  const pour_policy_weights_t *w = ctl->policy.weights;
+  if (w == NULL) {
+    return; /* an external controller: its request stays */
+  }
+  pour_obs_quantize(&w->norm, &ctl->state, &ctl->obs);
+  /* A greedy decision needs only the argmax; its probabilities (telemetry) follow on the next tick,
+   * which has the time: the decision tick stays the cheapest it can be. With a decision every tick
+   * there is no next tick to spare. */
+  ctl->probs_pending = !pour_policy_decide(&ctl->policy, &ctl->obs, &ctl->eval);
+  if (ctl->probs_pending && w->decision_period_ms == 1u) {
+    pour_policy_fill_probs(&ctl->policy, &ctl->eval);
+    ctl->probs_pending = false;
+  }
+  ctl->request = w->action_levels[ctl->eval.action];
+}
+
+void pour_control_request(pour_control_t *ctl, uint8_t action, q15_t torque) {
+  ctl->eval.action = action;
+  ctl->request = torque;
+}
+
+void pour_control_shape(pour_control_t *ctl, pour_control_output_t *out) {
+  if (ctl->mode == POUR_MODE_ESTOP) {
+    pour_safety_force(&ctl->safety, 0);
+    fill_output(ctl, 0, out);
+    return;
+  }
+  const bool run = ctl->mode == POUR_MODE_RUN;
+  const bool stopping = ctl->mode == POUR_MODE_FAULT && stop_active(ctl);
+  if (!run && !stopping) {
+    fill_output(ctl, force_safe(ctl), out); /* IDLE, and FAULT once the stop is over */
+    return;
+  }
+  if (run && !ctl->decision_due && ctl->probs_pending) {
+    pour_policy_fill_probs(&ctl->policy, &ctl->eval);
+    ctl->probs_pending = false;
+  }
+  /* The one place a request becomes a command: the decision's in RUN, the stop's in FAULT; neither ever
+   * steps the torque by more than the slew limit. */
+  const q15_t request = run ? ctl->request : stop_request(&ctl->config.stop, &ctl->state);
+  const q15_t torque = pour_safety_apply(&ctl->safety, request, ctl->state.theta_urad, ctl->state.omega_urad_s);
+  fill_output(ctl, torque, out);
+  if (run) {
+    pour_supervisor_record(&ctl->supervisor, &ctl->state, torque);
+  } else {
+    out->brake = false; /* the active stop drives the motor */
+    out->power = true;
+  }
+}
+
+void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out) {
+  if (pour_control_update(ctl, in)) {
+    pour_control_decide(ctl);
+  }
+  pour_control_shape(ctl, out);
 }

@@ -3,7 +3,7 @@
 
 #include <stddef.h>
 
-#include "pour/control.h"
+#include "pour/faults.h"
 
 /* docs/safety.md gives the reason for each default; the figures come from 20 held-out pours of the shipped
  * policy and 5 of the hand-written baseline in the simulator (tau_max 20 N·m, 10 kg of liquid), re-tuned for

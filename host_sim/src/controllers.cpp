@@ -6,80 +6,74 @@
 
 namespace poursim {
 
-namespace {
-
-// The firmware's defaults with the rig's encoder as the simulator models it.
 pour_control_config_t firmware_config(const poursim_config_t &sim) {
   pour_control_config_t c = pour_control_default_config();
   c.sensors.encoder_bits = static_cast<uint8_t>(sim.encoder_bits);
   return c;
 }
 
-class FirmwareController : public Controller {
+void CoreController::reset(uint32_t seed) {
+  status_ = init(&ctl_, firmware_config(sim_), seed);
+  out_ = pour_control_output_t{};
+  seq_ = 0;
+}
+
+double CoreController::command(const poursim_obs_t &obs) {
+  if (status_ != POUR_OK) return 0.0;
+  pour_control_input_t in{};
+  in.sensors_fresh = true;
+  in.sensors = to_sensor_sample(obs, seq_++);
+  if (pour_control_update(&ctl_, &in)) decide(&ctl_, *pour_control_state(&ctl_));
+  pour_control_shape(&ctl_, &out_);
+  return out_.torque / 32768.0;
+}
+
+std::string CoreController::failure() const {
+  return std::string("the firmware core refused its config or weights: ") + pour_status_name(status_);
+}
+
+namespace {
+
+class FirmwareController : public CoreController {
  public:
   FirmwareController(const poursim_weights_file_t &w, bool sampled, const poursim_config_t &sim)
-      : file_(w), sampled_(sampled), sim_(sim) {}
+      : CoreController(sim), file_(w), sampled_(sampled) {}
   std::string name() const override { return sampled_ ? "firmware (sampled)" : "firmware (greedy)"; }
-  void reset(uint32_t seed) override {
+
+ protected:
+  pour_status_t init(pour_control_t *ctl, const pour_control_config_t &config, uint32_t seed) override {
     poursim_weights_view(&file_, &view_);
-    pour_control_config_t cfg = firmware_config(sim_);
+    pour_control_config_t cfg = config;
     cfg.policy_mode = sampled_ ? POUR_POLICY_SAMPLED : POUR_POLICY_GREEDY;
     cfg.seed = seed;
-    status_ = pour_control_init(&ctl_, &cfg, &view_);
-    seq_ = 0;
+    return pour_control_init(ctl, &cfg, &view_);
   }
-  double command(const poursim_obs_t &obs) override {
-    if (status_ != POUR_OK) return 0.0;
-    pour_control_input_t in{};
-    in.sensors_fresh = true;
-    in.sensors = to_sensor_sample(obs, seq_++);
-    pour_control_step(&ctl_, &in, &out_);
-    return out_.torque / 32768.0;
-  }
-  int action() const override { return out_.action; }
+  void decide(pour_control_t *ctl, const pour_state_t &) override { pour_control_decide(ctl); }
 
  private:
   poursim_weights_file_t file_;
   pour_policy_weights_t view_{};
   bool sampled_;
-  poursim_config_t sim_;
-  pour_control_t ctl_{};
-  pour_control_output_t out_{};
-  pour_status_t status_ = POUR_EINVAL;
-  uint32_t seq_ = 0;
 };
 
-// Shared by the baselines: they see the rig through the firmware's estimator, as the policy does, and
-// command through the same envelope.
-class EnvelopedController : public Controller {
+// Shared by the baselines: a torque request every tick from the estimated state.
+class EnvelopedController : public CoreController {
  public:
-  explicit EnvelopedController(const poursim_config_t &sim) : fw_(firmware_config(sim)) {}
-  void reset(uint32_t) override {
-    pour_safety_init(&safety_, &fw_.safety);
-    pour_estimator_init(&est_, &fw_.sensors);
-    state_ = pour_state_t{};
-    t_ = 0.0;
-    seq_ = 0;
-  }
-  double command(const poursim_obs_t &obs) override {
-    const pour_sensors_t sample = to_sensor_sample(obs, seq_++);
-    pour_estimator_update(&est_, &sample, &state_);
-    double want = request(state_.theta_urad * 1e-6, state_.omega_urad_s * 1e-6);
-    t_ += 0.001;
-    q15_t cmd = pour_safety_apply(&safety_, poursim_fraction_to_q15(want), state_.theta_urad, state_.omega_urad_s);
-    return cmd / 32768.0;
-  }
+  explicit EnvelopedController(const poursim_config_t &sim) : CoreController(sim) {}
 
  protected:
+  pour_status_t init(pour_control_t *ctl, const pour_control_config_t &config, uint32_t) override {
+    t_ = 0.0;
+    return pour_control_init_external(ctl, &config, 1u);
+  }
+  void decide(pour_control_t *ctl, const pour_state_t &s) override {
+    const double want = request(s.theta_urad * 1e-6, s.omega_urad_s * 1e-6);
+    t_ += 0.001;
+    pour_control_request(ctl, 0u, poursim_fraction_to_q15(want));
+  }
   // The torque fraction wanted at tilt theta [rad] and rate omega [rad/s] (both estimated).
   virtual double request(double theta, double omega) = 0;
-  double t_ = 0.0; // [s] since reset
- private:
-  pour_control_config_t fw_;
-  pour_safety_t safety_{};
-  pour_estimator_t est_{};
-  pour_state_t state_{};
-  uint32_t seq_ = 0;
+  double t_ = 0.0; // [s] since the run started
 };
 
 // PD tracking of a reference angle; gains in N·m per rad and per rad/s.
@@ -90,7 +84,7 @@ double pd(double theta, double omega, double ref, double tau_max) {
 
 class RateController : public EnvelopedController {
  public:
-  RateController(double rate, const poursim_config_t &c) : EnvelopedController(c), rate_(rate), cfg_(c) {}
+  RateController(double rate, const poursim_config_t &c) : EnvelopedController(c), rate_(rate) {}
   std::string name() const override {
     char b[64];
     std::snprintf(b, sizeof b, "constant rate %.2f rad/s", rate_);
@@ -100,13 +94,12 @@ class RateController : public EnvelopedController {
  protected:
   double request(double theta, double omega) override {
     // The reference runs past the stop so the bucket is pressed onto it, as the paper's policy was.
-    double ref = std::min(rate_ * t_, cfg_.theta_max + 0.2);
-    return pd(theta, omega, ref, cfg_.tau_max);
+    double ref = std::min(rate_ * t_, sim_.theta_max + 0.2);
+    return pd(theta, omega, ref, sim_.tau_max);
   }
 
  private:
   double rate_;
-  poursim_config_t cfg_;
 };
 
 class FullTorqueController : public EnvelopedController {
@@ -120,7 +113,7 @@ class FullTorqueController : public EnvelopedController {
 
 class HandController : public EnvelopedController {
  public:
-  explicit HandController(const poursim_config_t &c) : EnvelopedController(c), cfg_(c) {}
+  explicit HandController(const poursim_config_t &c) : EnvelopedController(c) {}
   std::string name() const override { return "hand-written pour"; }
 
  protected:
@@ -131,11 +124,8 @@ class HandController : public EnvelopedController {
     const double fast = 2.0, slow = 0.3, knee = 0.6; // [rad/s], [rad/s], [rad]
     double t_knee = knee / fast;
     double ref = t_ < t_knee ? fast * t_ : knee + slow * (t_ - t_knee);
-    return pd(theta, omega, std::min(ref, cfg_.theta_max + 0.1), cfg_.tau_max);
+    return pd(theta, omega, std::min(ref, sim_.theta_max + 0.1), sim_.tau_max);
   }
-
- private:
-  poursim_config_t cfg_;
 };
 
 } // namespace

@@ -10,7 +10,6 @@
 
 extern "C" {
 #include "pour/control.h"
-#include "pour/safety.h"
 #include "pour/sensors.h"
 }
 #include "poursim/poursim.h"
@@ -33,6 +32,45 @@ class Controller {
   // After a failure command() returns 0 (no torque); the caller ends the run.
   virtual bool failed() const { return false; }
   virtual std::string failure() const { return {}; }
+  // Whether the holding brake is to be engaged for the coming step (the firmware core's output).
+  virtual bool brake() const { return false; }
+  // The core's latched POUR_FAULT_* bits after the last command (0 for a controller without a core).
+  virtual uint16_t faults() const { return 0; }
+};
+
+// The firmware's configuration for a simulated rig: its defaults, with the encoder as the simulator models
+// it. Every in-process caller of the core (host_sim's controllers, the rollouts, Python's core handle)
+// builds its config here.
+pour_control_config_t firmware_config(const poursim_config_t &sim);
+
+// The firmware's one pipeline (pour_control_update, a decision, pour_control_shape) fed the rig's sensor
+// sample each tick as it would cross the wire. The decision is decide()'s: the fixed-point policy of a
+// weights.h, or a request from outside (a float policy, a baseline) through pour_control_request. The
+// torque, the brake and the fault bits are the core's output.
+class CoreController : public Controller {
+ public:
+  void reset(uint32_t seed) override;
+  double command(const poursim_obs_t &obs) override;
+  int action() const override { return out_.action; }
+  bool failed() const override { return status_ != POUR_OK; }
+  std::string failure() const override;
+  bool brake() const override { return status_ == POUR_OK && out_.brake; }
+  uint16_t faults() const override { return out_.faults; }
+  const pour_control_output_t &output() const { return out_; }
+
+ protected:
+  explicit CoreController(const poursim_config_t &sim) : sim_(sim) {}
+  // Initialises ctl for the episode with seed (pour_control_init or pour_control_init_external on config).
+  virtual pour_status_t init(pour_control_t *ctl, const pour_control_config_t &config, uint32_t seed) = 0;
+  // The decision when one is due, on the state the core estimated: pour_control_decide or _request.
+  virtual void decide(pour_control_t *ctl, const pour_state_t &state) = 0;
+  const poursim_config_t sim_;
+
+ private:
+  pour_control_t ctl_{};
+  pour_control_output_t out_{};
+  pour_status_t status_ = POUR_EINVAL;
+  uint32_t seq_ = 0;
 };
 
 // The firmware core (pour_control_step) with a weights.h loaded at run time, fed the rig's sensor sample
@@ -40,8 +78,8 @@ class Controller {
 std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &weights, bool sampled,
                                                      const poursim_config_t &config);
 
-// Baselines, all seeing the rig through the firmware's estimator and commanding through its safety
-// envelope (default config).
+// Baselines, each a request from outside into the firmware's pipeline (default config): they see the rig
+// through its estimator and command through its envelope, supervisor and controlled stop.
 // Tilt at a constant rate [rad/s] to the stop, tracked by a PD loop (the paper's best binary policy).
 std::unique_ptr<Controller> make_rate_controller(double rate, const poursim_config_t &config);
 // +tau_max from start to end.

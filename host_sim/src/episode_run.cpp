@@ -46,6 +46,7 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
     poursim_particles(world, nullptr, rec->radius.data(), n);
     keep_frame(o);
   }
+  int fault_step = -1;
   while (!o.done) {
     const double a = ctl.command(o);
     if (ctl.failed()) {
@@ -53,7 +54,9 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
       e.status = POURSIM_ESTATE;
       return e;
     }
-    rc = poursim_step(world, a, &o);
+    if (fault_step < 0 && ctl.faults() != 0) fault_step = static_cast<int>(o.step);
+    rc = poursim_set_brake(world, ctl.brake() ? 1 : 0);
+    if (rc == POURSIM_OK) rc = poursim_step(world, a, &o);
     if (rc != POURSIM_OK) {
       e.error = world_failure(world, "poursim_step", rc);
       e.status = rc;
@@ -67,6 +70,8 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, Reco
     }
   }
   e.m = meter.result();
+  e.m.faults = ctl.faults();
+  e.m.fault_step = fault_step;
   return e;
 }
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Whole episodes in C for the trainer: a float softmax-linear policy decides every P steps on the state the
-// firmware's own estimator makes of the rig's sensors, its torque passes through the firmware's own safety
-// envelope (the motion envelope included), and the arrays Python asked for are filled. The episode itself is
+// Whole episodes in C for the trainer: a float softmax-linear policy decides every P steps of RUN inside the
+// firmware's own pipeline (estimator, supervisor, envelope with the motion limits, controlled stop), and
+// the arrays Python asked for are filled. The episode itself is
 // run_episode's (episode_run.cpp), as host_sim's are.
 #include <Eigen/Core>
 #include <algorithm>
@@ -14,8 +14,6 @@
 
 extern "C" {
 #include "pour/control.h"
-#include "pour/safety.h"
-#include "pour/sensors.h"
 }
 #include "controllers.hpp"
 #include "episode_run.hpp"
@@ -74,62 +72,53 @@ extern "C" int16_t poursim_fraction_to_q15(double fraction) {
 
 namespace {
 
-// The trainer's float policy as a Controller: every decision_period steps it picks an action from the
-// features of the state the firmware's estimator makes of the rig's sensors (greedy or sampled), and its
-// level passes through the firmware's safety envelope. As a StepHook it fills the arrays Python asked for.
-class RolloutPolicy : public poursim::Controller, public poursim::StepHook {
+// The trainer's float policy as the decision of the firmware's pipeline (CoreController): when a decision
+// is due it picks an action from the features of the state the core estimated (greedy or sampled), and
+// the level goes as a request through the core's envelope, supervisor and controlled stop. As a StepHook
+// it fills the arrays Python asked for.
+class RolloutPolicy : public poursim::CoreController, public poursim::StepHook {
  public:
   RolloutPolicy(const poursim_policy_t *policy, const poursim_config_t &config, const poursim_rollout_buffers_t *buf)
-      : p_(policy), buf_(buf), W_(policy->w, POURSIM_N_FEATURES, policy->n_actions), probs_(policy->n_actions) {
-    // The firmware's defaults, as the shipped controller runs them; the encoder as the rig has it.
-    fw_ = pour_control_default_config();
-    fw_.sensors.encoder_bits = static_cast<uint8_t>(config.encoder_bits);
-  }
+      : CoreController(config), p_(policy), buf_(buf), W_(policy->w, POURSIM_N_FEATURES, policy->n_actions),
+        probs_(policy->n_actions) {}
   std::string name() const override { return "rollout"; }
-  void reset(uint32_t seed) override {
-    init_failed_ = pour_safety_init(&safety_, &fw_.safety) != POUR_OK || pour_estimator_init(&est_, &fw_.sensors) != POUR_OK;
+
+ protected:
+  pour_status_t init(pour_control_t *ctl, const pour_control_config_t &config, uint32_t seed) override {
     // Sampling draws from its own stream so that greedy and sampled runs share the liquid of a seed.
     rng_ = poursim::Rng(0xA5A5A5A5ULL ^ (static_cast<unsigned long long>(seed) * 0x100000001B3ULL));
-    state_ = pour_state_t{};
-    action_ = 0;
     decision_ = -1;
     reversals_ = 0;
     t_ = 0;
+    return pour_control_init_external(ctl, &config, static_cast<uint16_t>(p_->decision_period));
   }
-  double command(const poursim_obs_t &o) override {
-    if (init_failed_) return 0.0;
-    t_ = static_cast<int>(o.step);
-    // A sample the estimator refuses (the firmware would fault) leaves the last state in place.
-    const pour_sensors_t sample = {o.step, o.encoder, o.scale_rotating_g, o.scale_target_g};
-    pour_estimator_update(&est_, &sample, &state_);
-    if (t_ % p_->decision_period == 0) decide();
-    const q15_t cmd = pour_safety_apply(&safety_, poursim_fraction_to_q15(p_->levels[action_]), state_.theta_urad,
-                                        state_.omega_urad_s);
-    return cmd / 32768.0;
+  void decide(pour_control_t *ctl, const pour_state_t &state) override {
+    decide_action(state);
+    pour_control_request(ctl, static_cast<uint8_t>(action_), poursim_fraction_to_q15(p_->levels[action_]));
   }
-  int action() const override { return action_; }
-  bool failed() const override { return init_failed_; }
-  std::string failure() const override { return "the firmware's safety envelope or estimator refused its defaults"; }
 
-  void after_step(const poursim_obs_t &o, double, const poursim::EpisodeMeter &meter) override {
+ public:
+  void after_step(const poursim_obs_t &o, double a, const poursim::EpisodeMeter &meter) override {
+    t_ = static_cast<int>(o.step) - 1;
     // Training's reward shaping: each torque reversal costs k_reversal (0: the world's reward as it is).
     const int new_reversals = meter.reversals() - reversals_;
     reversals_ += new_reversals;
     const double r = o.reward - p_->k_reversal * new_reversals;
     if (buf_ == nullptr) return;
-    if (decision_ < buf_->capacity && buf_->rewards != nullptr) buf_->rewards[decision_] += r;
+    if (decision_ >= 0 && decision_ < buf_->capacity && buf_->rewards != nullptr) buf_->rewards[decision_] += r;
     if (t_ < buf_->step_capacity) {
       if (buf_->step_rewards != nullptr) buf_->step_rewards[t_] = r;
       if (buf_->step_theta != nullptr) buf_->step_theta[t_] = o.theta;
+      if (buf_->step_torque != nullptr) buf_->step_torque[t_] = a;
     }
   }
   int decisions() const { return decision_ + 1; }
 
  private:
-  void decide() {
+  void decide_action(const pour_state_t &state) {
     ++decision_;
     const int n_act = p_->n_actions;
-    Features x = features_of(p_, state_);
+    Features x = features_of(p_, state);
     Eigen::VectorXd logits = (x * W_).transpose();
     probs_ = (logits.array() - logits.maxCoeff()).exp();
     probs_ /= probs_.sum();
@@ -163,12 +152,7 @@ class RolloutPolicy : public poursim::Controller, public poursim::StepHook {
   const poursim_rollout_buffers_t *buf_;
   Eigen::Map<const RowMatrix> W_;
   Eigen::VectorXd probs_;
-  pour_control_config_t fw_;
-  pour_safety_t safety_;
-  pour_estimator_t est_;
   poursim::Rng rng_{0};
-  pour_state_t state_{};
-  bool init_failed_ = false;
   int action_ = 0, decision_ = -1, reversals_ = 0, t_ = 0;
 };
 

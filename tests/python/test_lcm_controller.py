@@ -8,9 +8,10 @@ import pytest
 
 from lcm_helpers import Bus, Proc, binary, msgs, url
 from pour.lcm import channels
+from pour.policy import core
 
-FAULT_STALE_INPUT = 0x1
-MODE_RUN, MODE_FAULT = 1, 2
+FAULT_STALE_INPUT, FAULT_BAD_INPUT = core.FAULT_STALE_INPUT, core.FAULT_BAD_INPUT
+MODE_RUN, MODE_FAULT = core.MODE_RUN, core.MODE_FAULT
 
 
 @pytest.fixture
@@ -89,7 +90,6 @@ def test_controller_input_timeout_latches_fault_until_clear(controller):
         assert c.stop() == 0
 
 
-FAULT_BAD_INPUT = 0x4
 
 
 @pytest.mark.parametrize("raw", [

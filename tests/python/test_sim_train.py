@@ -25,8 +25,8 @@ def test_sim_gym_env_passes_the_checker():
 
 
 def test_gym_steps_reproduce_the_c_rollout():
-    """Tick-by-tick stepping (the firmware's estimator and envelope, in C through pour.policy.core) and the C
-    whole-episode rollout agree exactly."""
+    """Tick-by-tick stepping (the firmware's pipeline, in C through pour.policy.core) and the C whole-episode
+    rollout agree exactly."""
     sim = envs.make_env("sim", 11, 10, 0.6)
     w = np.zeros((6, 11))
     w[0, :] = np.linspace(30, -30, 11)  # torque falls as theta grows, so actions change along the way
@@ -35,7 +35,7 @@ def test_gym_steps_reproduce_the_c_rollout():
     env = pour.sim.gym_env.PourEnv("sim", episode_s=0.6)
     env._plant.reset(31)
     env._k, env._started = 0, True
-    assert isinstance(env._plant.safety, core.Envelope) and isinstance(env._plant.estimator, core.Estimator)
+    assert isinstance(env._plant.core, core.Controller)
     xs, rewards = [env._plant.features()], []
     for a in ep.actions:
         obs, r, term, trunc, info = env.step(int(a))

@@ -4,8 +4,6 @@
 #include <string.h>
 
 #include "pour/control.h"
-#include "pour/safety.h"
-#include "pour/sensors.h"
 #include "poursim/poursim.h"
 #include "unity.h"
 
@@ -21,10 +19,10 @@ static double levels[N_ACT] = {-1.0, -0.5, 0.0, 0.5, 1.0};
 static poursim_policy_t pol;
 static double features[MAX_DEC * POURSIM_N_FEATURES], rewards[MAX_DEC], probs[MAX_DEC * N_ACT];
 static int32_t actions[MAX_DEC];
-static double step_rewards[MAX_STEPS], step_theta[MAX_STEPS];
+static double step_rewards[MAX_STEPS], step_theta[MAX_STEPS], step_torque[MAX_STEPS];
 
 static poursim_rollout_buffers_t buffers(void) {
-  poursim_rollout_buffers_t b = {MAX_DEC, features, actions, rewards, probs, MAX_STEPS, step_rewards, step_theta};
+  poursim_rollout_buffers_t b = {MAX_DEC, features, actions, rewards, probs, MAX_STEPS, step_rewards, step_theta, step_torque};
   return b;
 }
 
@@ -85,10 +83,11 @@ static void test_rollout_FillsArraysConsistently(void) {
   TEST_ASSERT_TRUE(ep.max_theta > 0.2); /* the policy did tilt the bucket */
 }
 
-/* The rollout must equal a hand-written loop: the firmware's estimator makes the state of each step's
- * sensor readings, the policy decides at steps 0, P, 2P from that state, the level passes through
- * pour_safety_apply, step. Compared bit for bit through θ of every step. */
-static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
+/* The rollout must equal a hand-written loop around the firmware's pipeline: each step's sensor sample into
+ * pour_control_update, the policy's decision (at steps 0, P, 2P of the run) from the state the core
+ * estimated as a pour_control_request, pour_control_shape, the brake and the torque to the world. Compared
+ * bit for bit through the torque and θ of every step. */
+static void test_rollout_MatchesManualLoopThroughTheFirmwarePipeline(void) {
   poursim_rollout_buffers_t b = buffers();
   poursim_episode_t ep;
   pol.decision_period = 7;
@@ -98,22 +97,24 @@ static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
   poursim_reset(world, 3);
   pour_control_config_t fw = pour_control_default_config();
   fw.sensors.encoder_bits = (uint8_t)cfg.encoder_bits;
-  pour_safety_t safety;
-  pour_estimator_t est;
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &fw.safety));
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_estimator_init(&est, &fw.sensors));
-  pour_state_t s;
-  memset(&s, 0, sizeof s);
+  pour_control_t ctl;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &fw, 7u));
+  pour_control_input_t in;
+  memset(&in, 0, sizeof in);
+  pour_control_output_t out;
   poursim_obs_t o;
   poursim_observe(world, &o);
-  int action = 0, limited = 0;
+  int action = 0, limited = 0, decisions = 0;
   for (int t = 0; t < 3000; ++t) {
     const pour_sensors_t sample = {(uint32_t)t, o.encoder, o.scale_rotating_g, o.scale_target_g};
-    pour_estimator_update(&est, &sample, &s);
-    if (t % 7 == 0) {
-      const double th = s.theta_urad * 1e-6, om = s.omega_urad_s * 1e-6;
-      double x[6] = {fmin(fmax(th / 2.356194, 0), 1), fmin(fmax((om + 4.0) / 8.0, 0), 1), s.v_rotating / 32768.0,
-                     s.v_target / 32768.0, s.v_spill / 32768.0, 1.0};
+    in.sensors_fresh = true;
+    in.sensors = sample;
+    q15_t req = 0;
+    if (pour_control_update(&ctl, &in)) {
+      const pour_state_t *s = pour_control_state(&ctl);
+      const double th = s->theta_urad * 1e-6, om = s->omega_urad_s * 1e-6;
+      double x[6] = {fmin(fmax(th / 2.356194, 0), 1), fmin(fmax((om + 4.0) / 8.0, 0), 1), s->v_rotating / 32768.0,
+                     s->v_target / 32768.0, s->v_spill / 32768.0, 1.0};
       for (int k = 2; k < 5; ++k) x[k] = fmin(fmax(x[k], 0), 1);
       double best = -INFINITY;
       for (int a = 0; a < N_ACT; ++a) {
@@ -121,15 +122,20 @@ static void test_rollout_MatchesManualLoopThroughSafetyEnvelope(void) {
         for (int k = 0; k < 6; ++k) l += x[k] * w[k * N_ACT + a];
         if (l > best) best = l, action = a;
       }
-      TEST_ASSERT_EQUAL_INT(action, actions[t / 7]);
+      TEST_ASSERT_EQUAL_INT(action, actions[decisions++]);
+      const double q = nearbyint(levels[action] * 32768.0);
+      req = (q15_t)(q > 32767.0 ? 32767.0 : q);
+      pour_control_request(&ctl, (uint8_t)action, req);
     }
-    double q = nearbyint(levels[action] * 32768.0);
-    q15_t req = (q15_t)(q > 32767.0 ? 32767.0 : q);
-    q15_t cmd = pour_safety_apply(&safety, req, s.theta_urad, s.omega_urad_s);
-    limited |= cmd != req;
-    poursim_step(world, cmd / 32768.0, &o);
+    pour_control_shape(&ctl, &out);
+    limited |= out.limits != 0u;
+    TEST_ASSERT_EQUAL_DOUBLE(out.torque / 32768.0, step_torque[t]);
+    poursim_set_brake(world, out.brake ? 1 : 0);
+    poursim_step(world, out.torque / 32768.0, &o);
     TEST_ASSERT_EQUAL_DOUBLE(o.theta, step_theta[t]);
   }
+  TEST_ASSERT_EQUAL_INT(ep.n_decisions, decisions);
+  TEST_ASSERT_EQUAL_INT(out.faults, ep.faults);
   TEST_ASSERT_TRUE(limited); /* the envelope did shape the command (slew limit at least) */
 }
 
@@ -207,10 +213,29 @@ static void test_fraction_to_q15_RoundsHalfUpSaturatesAndMapsNanToZero(void) {
   TEST_ASSERT_EQUAL_INT16(-32768, poursim_fraction_to_q15(-32768.5 * lsb));
 }
 
+/* Training sees the core it will run on: full torque into the hard stop is more acceleration than the
+ * command can give (the supervisor's SCALE check), the core faults, the decisions end, the controlled stop
+ * takes over and the bucket ends held; the episode says so. */
+static void test_rollout_ReportsTheCoresFaultAndItsStop(void) {
+  poursim_rollout_buffers_t b = buffers();
+  poursim_episode_t ep;
+  memset(w, 0, sizeof w);
+  for (int a = 0; a < N_ACT; ++a) w[5 * N_ACT + a] = 3.0 * levels[a]; /* always the top level */
+  TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_rollout(world, &pol, 3, &b, &ep));
+  TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_SCALE, ep.faults);
+  TEST_ASSERT_TRUE(ep.fault_step > 0 && ep.fault_step < ep.n_steps);
+  TEST_ASSERT_EQUAL_INT((ep.fault_step + 9) / 10, ep.n_decisions); /* no decision once it faulted */
+  for (int t = ep.fault_step; t < ep.n_steps; ++t) {
+    TEST_ASSERT_TRUE(step_torque[t] <= 0.5); /* the stop's torque bound, never the policy's +1 */
+  }
+  TEST_ASSERT_EQUAL_DOUBLE(0.0, step_torque[ep.n_steps - 1]); /* stopped: the safe torque, brake engaged */
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_rollout_FillsArraysConsistently);
-  RUN_TEST(test_rollout_MatchesManualLoopThroughSafetyEnvelope);
+  RUN_TEST(test_rollout_MatchesManualLoopThroughTheFirmwarePipeline);
+  RUN_TEST(test_rollout_ReportsTheCoresFaultAndItsStop);
   RUN_TEST(test_rollout_IsDeterministicAndBatchMatchesSequential);
   RUN_TEST(test_rollout_EndsAtTheObservationThatSaysDone);
   RUN_TEST(test_rollout_RefusesBadPolicy);

@@ -297,6 +297,58 @@ static void test_control_step_IsDeterministic(void) {
   }
 }
 
+/* An outside decision that asks for what the policy chose gives the policy's run, tick for tick: the
+ * stages are one implementation whichever decides. */
+static void test_control_request_OfThePolicysLevelsRepeatsItsRun(void) {
+  pour_control_t ext;
+  TEST_ASSERT_EQUAL_INT(POUR_OK,
+                        pour_control_init_external(&ext, &config, pour_weights_compiled.decision_period_ms));
+  for (unsigned t = 0; t < 300u; ++t) {
+    sense((int32_t)(t * 2000u), FULL_G - (int32_t)(t * 10u), (int32_t)(t * 9u));
+    step(true);
+    pour_control_output_t got;
+    if (pour_control_update(&ext, &in)) {
+      pour_control_request(&ext, out.action, pour_weights_compiled.action_levels[out.action]);
+    }
+    pour_control_shape(&ext, &got);
+    TEST_ASSERT_EQUAL_INT16(out.torque, got.torque);
+    TEST_ASSERT_EQUAL_UINT8(out.action, got.action);
+    TEST_ASSERT_EQUAL_UINT8(out.mode, got.mode);
+    TEST_ASSERT_EQUAL_UINT16(out.faults, got.faults);
+    TEST_ASSERT_EQUAL_UINT8(out.limits, got.limits);
+    TEST_ASSERT_EQUAL_INT32(pour_control_state(&ctl)->theta_urad, pour_control_state(&ext)->theta_urad);
+  }
+}
+
+/* A request from outside passes the same envelope (slew, clamp) and, after a fault, the same stop. */
+static void test_control_request_GoesThroughTheEnvelopeAndTheStop(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init_external(&ctl, &config, 0u));
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init_external(NULL, &config, 1u));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &config, 5u));
+  unsigned due = 0u;
+  for (unsigned t = 0; t < 20u; ++t) {
+    in.sensors_fresh = true;
+    in.sensors.seq++;
+    if (pour_control_update(&ctl, &in)) {
+      due++;
+      pour_control_request(&ctl, 3u, POUR_Q15_MAX);
+    }
+    pour_control_shape(&ctl, &out);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+    TEST_ASSERT_TRUE(out.torque <= config.safety.tau_limit);
+    TEST_ASSERT_TRUE((int32_t)out.torque <= (int32_t)(t + 1u) * config.safety.slew_per_tick);
+    TEST_ASSERT_EQUAL_UINT8(3u, out.action);
+  }
+  TEST_ASSERT_EQUAL_UINT(4u, due); /* ticks 0, 5, 10, 15 of the run */
+  in.estop = true;
+  TEST_ASSERT_FALSE(pour_control_update(&ctl, &in));
+  pour_control_request(&ctl, 3u, POUR_Q15_MAX); /* ignored: ESTOP commands zero */
+  pour_control_shape(&ctl, &out);
+  TEST_ASSERT_EQUAL_INT16(0, out.torque);
+  TEST_ASSERT_TRUE(out.brake);
+  TEST_ASSERT_EQUAL_UINT16(POUR_FAULT_ESTOP, out.faults);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_control_init_RefusesBadConfig);
@@ -314,5 +366,7 @@ int main(void) {
   RUN_TEST(test_control_step_EachRunStartsTheEstimateAfresh);
   RUN_TEST(test_control_step_NoForwardTorquePastMaxAngle);
   RUN_TEST(test_control_step_IsDeterministic);
+  RUN_TEST(test_control_request_OfThePolicysLevelsRepeatsItsRun);
+  RUN_TEST(test_control_request_GoesThroughTheEnvelopeAndTheStop);
   return UNITY_END();
 }

@@ -44,3 +44,26 @@ def load() -> C.CDLL:
             return _lib
     raise SimError("libpoursim.so not found (looked at: " + ", ".join(map(str, tried)) +
                    "); build it with `cmake --workflow --preset host` or set POUR_SIM_LIB")
+
+
+def _name(fn_name: str, value: int, ctype: type) -> str | None:
+    fn = getattr(load(), fn_name)
+    fn.argtypes, fn.restype = [ctype], C.c_char_p
+    name = fn(value)
+    return name.decode() if name is not None else None
+
+
+def fault_name(bit: int) -> str | None:
+    """The firmware core's name of one POUR_FAULT_* bit ("STALE_INPUT", ...; pour_fault_name), None for
+    anything else."""
+    return _name("pour_fault_name", int(bit) & 0xFFFF, C.c_uint16)
+
+
+def fault_names(faults: int) -> list[str]:
+    """The names of the bits set in a fault word, lowest bit first (bits the core does not name are left out)."""
+    return [n for n in (fault_name(1 << i) for i in range(16) if faults >> i & 1) if n is not None]
+
+
+def mode_name(mode: int) -> str | None:
+    """The firmware core's name of a mode ("IDLE", "RUN", "FAULT", "ESTOP"; pour_mode_name), None outside."""
+    return _name("pour_mode_name", int(mode) & 0xFF, C.c_uint8)

@@ -7,6 +7,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "pour/faults.h"
 #include "pour/fixed.h"
 #include "pour/obs.h"
 #include "pour/policy.h"
@@ -18,30 +19,6 @@
  * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity.
  * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp). */
 #define POUR_FIRMWARE_VERSION 3u
-
-typedef enum {
-  POUR_MODE_IDLE = 0,  /* no state yet (or faults just cleared): safe torque */
-  POUR_MODE_RUN = 1,   /* policy in command, inside the envelope */
-  POUR_MODE_FAULT = 2, /* a latched fault: the controlled stop, then brake and power cut until clear_faults */
-  POUR_MODE_ESTOP = 3  /* e-stop asserted: zero torque, brake, power cut while it lasts, then FAULT */
-} pour_mode_t;
-
-/* Latched fault bits (pour_control_t.faults); only clear_faults resets them. */
-#define POUR_FAULT_STALE_INPUT 0x0001u /* no fresh sample for longer than input_timeout_ms */
-#define POUR_FAULT_ESTOP 0x0002u       /* e-stop was asserted */
-#define POUR_FAULT_BAD_INPUT 0x0004u   /* a sensor sample (or the state from it) outside its physical range */
-#define POUR_FAULT_POSITION 0x0008u    /* supervisor: θ outside [θmin - margin, θmax + margin] */
-#define POUR_FAULT_OVERSPEED 0x0010u   /* supervisor: |θ̇| above the overspeed limit */
-#define POUR_FAULT_TORQUE_SIGN 0x0020u /* supervisor: the axis accelerates against the commanded torque */
-#define POUR_FAULT_ENCODER 0x0040u     /* supervisor: the encoder does not move under sustained torque */
-#define POUR_FAULT_VOLUME 0x0080u      /* supervisor: a scale reading jumped faster than liquid can flow */
-#define POUR_FAULT_LINK 0x0100u        /* the transport's command watchdog tripped (the CAN node's) */
-#define POUR_FAULT_SEQ 0x0200u         /* supervisor: samples keep arriving but their seq does not advance */
-#define POUR_FAULT_SCALE 0x0400u       /* supervisor: the axis accelerates more than the command can (scale) */
-#define POUR_FAULT_ALL 0x07FFu
-/* Faults the controlled stop answers actively (the sensors and the motor are still trusted): decelerate,
- * return toward upright at a bounded speed, then brake. Every other fault brakes at once. */
-#define POUR_FAULT_ACTIVE_STOP (POUR_FAULT_POSITION | POUR_FAULT_OVERSPEED | POUR_FAULT_VOLUME)
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {
@@ -108,6 +85,9 @@ typedef struct {
   pour_obs_t obs;
   pour_policy_eval_t eval;
   bool probs_pending;     /* the latest greedy decision's probabilities are computed on the next tick */
+  bool decision_due;      /* this tick's update found a decision due */
+  uint16_t decision_period_ms; /* ticks between decisions in RUN */
+  q15_t request;          /* the latest decision's torque request, Q15 (into the envelope every RUN tick) */
   pour_supervisor_t supervisor;
   uint32_t stop_ms;       /* ticks of the active stop so far */
   bool stopped;           /* the stop is over: brake and power cut until a clear */
@@ -122,15 +102,42 @@ pour_control_config_t pour_control_default_config(void);
 pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
                                 const pour_policy_weights_t *weights);
 
-/* One 1 ms tick. Never fails: problems show as mode and fault bits in the output.
- * Order: e-stop (zero torque now, whatever else the input says), link fault (FAULT), clear request,
- * stop, reset, input (a seq that does not advance makes the sample not fresh; the estimator turns a fresh
- * one into the state, restarted in IDLE so that a run starts from its first sample; an implausible sample
- * or state: BAD_INPUT), timeout (STALE_INPUT, with SEQ if repeated samples were refused; armed in RUN
- * only), IDLE -> RUN on the first fresh sample, supervisor (RUN), policy decision on the first RUN tick
- * and every decision_period_ms ticks
- * after, envelope; in FAULT the controlled stop. A clear never bypasses the envelope: RUN resumes from the safe torque through the slew limit.
- * out->tick counts the steps including this one. */
+/* As pour_control_init, for a controller whose decisions come from outside (pour_control_request: a float
+ * policy, a baseline, an agent, a link) every decision_period_ms (>= 1) ticks of RUN; no policy of its own. */
+pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control_config_t *config,
+                                         uint16_t decision_period_ms);
+
+/* The 1 kHz tick is three stages, one implementation for every caller:
+ *   due = pour_control_update(ctl, in);          estimate and supervise
+ *   if (due) pour_control_decide(ctl);           or pour_control_request(ctl, action, torque)
+ *   pour_control_shape(ctl, out);                the envelope, the controlled stop, the outputs
+ * pour_control_step is exactly that with the fixed-point policy. A decision stays in force until the next. */
+
+/* Stage 1. Order: e-stop (ESTOP, whatever else the input says), link fault (FAULT), clear request, stop,
+ * reset, input (a seq that does not advance makes the sample not fresh; the estimator turns a fresh one into
+ * the state, restarted in IDLE so that a run starts from its first sample; an implausible sample or state:
+ * BAD_INPUT), timeout (STALE_INPUT, with SEQ if repeated samples were refused; armed in RUN only), IDLE ->
+ * RUN on the first fresh sample, supervisor (RUN). Returns whether a decision is due: in RUN, on its first
+ * tick and every decision period after. */
+bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in);
+
+/* The state estimated from the latest fresh, plausible sample (read-only; zero before the first). */
+const pour_state_t *pour_control_state(const pour_control_t *ctl);
+
+/* Stage 2, on the MCU: the fixed-point policy decides on the estimated state; the request becomes its
+ * action's level. Without a policy (pour_control_init_external) it does nothing. */
+void pour_control_decide(pour_control_t *ctl);
+
+/* Stage 2 from outside: the action index (telemetry) and the torque request [Q15 of tau_max]. */
+void pour_control_request(pour_control_t *ctl, uint8_t action, q15_t torque);
+
+/* Stage 3: in RUN the request through the envelope (and recorded for the supervisor), in FAULT the
+ * controlled stop, else the safe torque (zero in ESTOP). A clear never bypasses the envelope: RUN resumes
+ * from the safe torque through the slew limit. Fills out; out->tick counts the ticks including this one. */
+void pour_control_shape(pour_control_t *ctl, pour_control_output_t *out);
+
+/* One 1 ms tick with the fixed-point policy: update, decide when due, shape. Never fails: problems show as
+ * mode and fault bits in the output. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
 
 #endif /* POUR_CONTROL_H */

@@ -9,6 +9,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "pour/faults.h"
 #include "pour/fixed.h"
 #include "pour/obs.h"
 

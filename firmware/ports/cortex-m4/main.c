@@ -14,6 +14,7 @@
 #include "hal_power.h"
 #include "hal_timer.h"
 #include "hal_watchdog.h"
+#include "port_tick.h"
 #include "pour/can_node.h"
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
@@ -26,19 +27,6 @@ static pour_can_node_t can_node;
 static void transmit(const pour_can_frame_t *tx, uint8_t n) {
   for (uint8_t i = 0; i < n; ++i) {
     (void)pour_hal_can_transmit(&tx[i]);
-  }
-}
-
-/* Brake and power as the core asks, in the order that never lets the bucket drop: power comes on before
- * the brake releases, and the brake engages before the power goes off. */
-static void drive(const pour_control_output_t *out) {
-  pour_hal_motor_set_torque(out->power ? out->torque : 0);
-  if (out->brake) {
-    pour_hal_brake_set(true);
-    pour_hal_power_set(false);
-  } else {
-    pour_hal_power_set(true);
-    pour_hal_brake_set(false);
   }
 }
 
@@ -56,7 +44,7 @@ static void report_forever(void) {
     while (pour_hal_can_receive(&f) == 1) {
       (void)pour_can_node_receive(&can_node, &f);
     }
-    drive(&out);
+    pour_port_outputs(&out);
     /* The torque frame says IDLE and 0; the heartbeat and identity frames carry the reason. */
     transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
     pour_hal_watchdog_feed();
@@ -107,8 +95,7 @@ int main(void) {
     pour_can_node_begin_tick(&can_node, &in);
     in.estop = in.estop || pour_hal_estop_asserted(); /* the hardwired line, every tick, beside the frame */
     pour_control_output_t out;
-    pour_control_step(&controller, &in, &out);
-    drive(&out);
+    pour_port_tick(&controller, &in, &out);
     transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */

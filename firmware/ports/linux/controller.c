@@ -7,7 +7,9 @@
 
 #include "hal_brake.h"
 #include "hal_lines.h"
+#include "hal_motor.h"
 #include "hal_power.h"
+#include "port_tick.h"
 #include "pour_lcm/channels.h"
 
 #define PERIOD_NS 1000000LL
@@ -150,16 +152,8 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
 
   const uint16_t faults_before = l->out.faults;
   const int64_t t0 = mono_ns();
-  pour_control_step(&l->ctl, &ci, &l->out);
+  pour_port_tick(&l->ctl, &ci, &l->out);
   const int64_t dt = mono_ns() - t0;
-  /* As the Cortex-M4 port drives them: power on before the brake releases, brake on before power off. */
-  if (l->out.brake) {
-    pour_hal_brake_set(true);
-    pour_hal_power_set(false);
-  } else {
-    pour_hal_power_set(true);
-    pour_hal_brake_set(false);
-  }
   if ((l->out.faults & ~faults_before) != 0u) {
     fprintf(stderr, "pour_controller: fault 0x%04x latched at tick %lu (docs/safety.md names the bits); "
             "controlled stop, then safe until cleared (POUR_COMMAND clear_faults, e.g. pour-lcm-cmd --clear)\n",
@@ -301,6 +295,7 @@ int pour_linux_run(const pour_linux_config_t *config, pour_io_t *io, volatile si
   l.stats = stats;
   pour_hal_brake_init();
   pour_hal_power_init();
+  pour_hal_motor_init();
   const pour_status_t s = pour_control_init(&l.ctl, &config->control, config->weights);
   if (s != POUR_OK) {
     return (int)s;

@@ -225,6 +225,7 @@ typedef struct {
   int step_capacity;    /* steps the per-step arrays hold */
   double *step_rewards; /* [step_capacity] */
   double *step_theta;   /* [step_capacity] θ after each step [rad] */
+  double *step_torque;  /* [step_capacity] the core's torque command of each step, fraction of tau_max */
 } poursim_rollout_buffers_t;
 
 /* Metrics of one episode. */
@@ -243,11 +244,14 @@ typedef struct {
   double peak_omega;   /* max |θ̇| [rad/s] */
   double peak_alpha;   /* max |θ̈|, θ̇ differenced over 10 ms [rad/s²] */
   int reversals;       /* sign changes of the commanded torque beyond ±1 N·m */
+  int faults;          /* the firmware core's latched POUR_FAULT_* bits at the end (0: it never faulted) */
+  int fault_step;      /* the step whose sample first found the core faulted, -1 if none */
 } poursim_episode_t;
 
-/* Resets the world with seed, runs one full episode: at steps 0, P, 2P, … the policy picks an action
- * from the observation at that step; the torque goes through the firmware's safety envelope
- * (pour_safety_apply with its default config) before each step. */
+/* Resets the world with seed, runs one full episode through the firmware's pipeline (its default config,
+ * the rig's encoder): each step's sensor sample goes through the core's estimator and supervisor; at steps
+ * 0, P, 2P, … of its RUN the policy picks an action from the state the core estimated; the level goes
+ * through the core's envelope, or its controlled stop and brake once it faults (episode->faults). */
 int poursim_rollout(poursim_world_t *world, const poursim_policy_t *policy, uint32_t seed,
                     const poursim_rollout_buffers_t *buffers, poursim_episode_t *episode);
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import matplotlib
 
+from pour import libpoursim
 from pour.lcm import channels, messages, sensors
 
 
@@ -95,9 +96,10 @@ class LiveView:
         s = self.status
         if s is None:
             return "controller: no POUR_STATUS yet"
-        modes = {0: "IDLE", 1: "RUN", 2: "FAULT", 3: "E-STOP"}
-        return (f"controller {modes.get(s.mode, s.mode)}  faults 0x{s.faults & 0xffff:04x}  overruns {s.overruns}"
-                f"  dropped {s.messages_dropped}")
+        faults = s.faults & 0xFFFF
+        named = f" ({', '.join(libpoursim.fault_names(faults))})" if faults else ""
+        return (f"controller {libpoursim.mode_name(s.mode) or s.mode}  faults 0x{faults:04x}{named}"
+                f"  overruns {s.overruns}  dropped {s.messages_dropped}")
 
 
 def main(argv: list[str] | None = None) -> int:

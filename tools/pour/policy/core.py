@@ -2,19 +2,24 @@
 """The firmware core itself (firmware/src/*.c, linked into libpoursim), driven from Python through ctypes.
 
 Python keeps its own bit-exact copy of the fixed-point kernels only (pour.policy.fixedpoint: quantisation,
-logits, softmax, argmax); the stateful parts — the safety envelope, the sensor estimator and the 1 kHz
-control step — are the C code, called here, never a Python mirror of it:
+logits, softmax, argmax); the stateful parts — the safety envelope, the sensor estimator and the control
+pipeline — are the C code behind handles (host_sim/include/poursim/core.h), never a Python mirror of it:
 
     from pour.policy import core
-    env = core.Envelope()                          # pour_safety_t, default config
+    env = core.Envelope()                          # the safety envelope, default config
     cmd = env.apply(32767, theta_urad=0, omega_urad_s=0); env.active   # POUR_LIMIT_* bits
-    est = core.Estimator(encoder_bits=17)          # pour_estimator_t
+    est = core.Estimator(encoder_bits=17)          # the sensor estimator
     state = est.update(seq, encoder, scale_rotating_g, scale_target_g)  # None: a sample it refuses
-    ctl = core.Controller(weights_h.parse_weights_h(path), supervisor_checks=0)  # pour_control_t
+    ctl = core.Controller(weights_h.parse_weights_h(path))             # the pipeline with that policy
     out = ctl.step(sample=(seq, encoder, m_rot, m_tgt), estop=False)
+    ext = core.Controller(None, decision_period_ms=10)                 # decisions from outside
+    if ext.update(sample): ext.request(action, torque_q15)
+    out = ext.shape()
 
-The structures mirror firmware/include/pour/*.h field for field; tests/python/test_core_properties.py
-compiles a C program that checks every size and offset against them.
+A config (core.control_config()) is an opaque block whose fields are read and set by their C names
+(cfg.safety.tau_limit = 20000). Fault and mode names come from the core's own table (fault_name, mode_name).
+The only structs mirrored here are the plain records of a tick (a sample, a state, a tick's inputs and
+outputs); RECORDS lists them and tests/python/test_core_properties.py checks each size against C's.
 """
 from __future__ import annotations
 
@@ -29,102 +34,47 @@ from pour import libpoursim
 q15 = C.c_int16
 POLICY_MAX_ACTIONS = 16
 LIMIT_CLAMP, LIMIT_SLEW, LIMIT_ANGLE_MAX, LIMIT_ANGLE_MIN, LIMIT_SPEED, LIMIT_ACCEL = 0x01, 0x02, 0x04, 0x08, 0x10, 0x20
-MODE_IDLE, MODE_RUN, MODE_FAULT, MODE_ESTOP = 0, 1, 2, 3
-FAULT_STALE_INPUT, FAULT_ESTOP, FAULT_BAD_INPUT, FAULT_LINK = 0x0001, 0x0002, 0x0004, 0x0100
 SPEED_BAND_MAX_URAD_S = 100000000  # POUR_SAFETY_OMEGA_MAX_URAD_S
+ERR_LEN = 256
 
 
 class CoreError(RuntimeError):
     """The core refused a config (its pour_status_t name in the message)."""
 
 
-class _Struct(C.Structure):
+class _Record(C.Structure):
     def __repr__(self) -> str:
         return f"{type(self).__name__}(" + ", ".join(f"{k}={getattr(self, k)!r}" for k, _ in self._fields_) + ")"
 
 
-class SafetyConfig(_Struct):
-    _fields_ = [("tau_limit", q15), ("slew_per_tick", q15), ("theta_min_urad", C.c_int32),
-                ("theta_max_urad", C.c_int32), ("omega_max_urad_s", C.c_int32), ("alpha_max_urad_s2", C.c_int32),
-                ("omega_slack_urad_s", C.c_int32), ("torque_per_rad_s", q15)]
-
-
-class SafetyState(_Struct):
-    _fields_ = [("config", SafetyConfig), ("torque", q15), ("active", C.c_uint8), ("alpha_step_urad_s", C.c_int32),
-                ("gain_q32", C.c_int32), ("ceiling_urad_s", C.c_int32), ("floor_urad_s", C.c_int32)]
-
-
-class SensorsConfig(_Struct):
-    _fields_ = [("encoder_bits", C.c_uint8), ("bandwidth_rad_s", C.c_uint16), ("scale_min_g", C.c_int32),
-                ("scale_max_g", C.c_int32), ("mass_min_g", C.c_int32), ("jump_max_urad", C.c_int32)]
-
-
-class EstimatorState(_Struct):
-    _fields_ = [("config", SensorsConfig), ("gain_theta_q24", C.c_int32), ("gain_omega_q24", C.c_int32),
-                ("started", C.c_bool), ("last_seq", C.c_uint32), ("theta_q16", C.c_int64), ("omega_q16", C.c_int64),
-                ("m0_g", C.c_int32)]
-
-
-class PlantState(_Struct):
-    _fields_ = [("seq", C.c_uint32), ("theta_urad", C.c_int32), ("omega_urad_s", C.c_int32), ("v_rotating", q15),
-                ("v_target", q15), ("v_spill", q15)]
-
-
-class SensorSample(_Struct):
+class SensorSample(_Record):
+    """pour_sensors_t: one raw sample, as it crosses the wire."""
     _fields_ = [("seq", C.c_uint32), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
                 ("scale_target_g", C.c_int32)]
 
 
-class ObsNorm(_Struct):
-    _fields_ = [("theta_min_urad", C.c_int32), ("theta_max_urad", C.c_int32), ("omega_max_urad_s", C.c_int32)]
+class PlantState(_Record):
+    """pour_state_t: the state the estimator makes of the samples."""
+    _fields_ = [("seq", C.c_uint32), ("theta_urad", C.c_int32), ("omega_urad_s", C.c_int32), ("v_rotating", q15),
+                ("v_target", q15), ("v_spill", q15)]
 
 
-class PolicyWeights(_Struct):
-    _fields_ = [("n_actions", C.c_uint8), ("w_frac_bits", C.c_uint8), ("decision_period_ms", C.c_uint16),
-                ("w", C.POINTER(C.c_int16)), ("action_levels", C.POINTER(q15)), ("norm", ObsNorm),
-                ("tau_max_mnm", C.c_int32), ("content_hash", C.c_uint32)]
-
-
-class SupervisorConfig(_Struct):
-    _fields_ = [("checks", C.c_uint8), ("theta_margin_urad", C.c_int32), ("omega_max_urad_s", C.c_int32),
-                ("window_ms", C.c_uint8), ("torque_min", q15), ("omega_against_urad_s", C.c_int32),
-                ("against_ms", C.c_uint8), ("encoder_move_urad", C.c_int32), ("encoder_ms", C.c_uint8),
-                ("volume_step_max", q15), ("accel_full_urad_s2", C.c_int32), ("accel_passive_urad_s2", C.c_int32)]
-
-
-class StopConfig(_Struct):
-    _fields_ = [("torque_max", q15), ("return_speed_urad_s", C.c_int32), ("return_gain_per_s", C.c_uint16),
-                ("torque_per_rad_s", q15), ("rest_theta_urad", C.c_int32), ("rest_omega_urad_s", C.c_int32),
-                ("timeout_ms", C.c_uint16)]
-
-
-class ControlConfig(_Struct):
-    _fields_ = [("safety", SafetyConfig), ("sensors", SensorsConfig), ("input_timeout_ms", C.c_uint16),
-                ("safe_torque", q15), ("policy_mode", C.c_int), ("seed", C.c_uint32),
-                ("plausible_theta_urad", C.c_int32), ("plausible_omega_urad_s", C.c_int32),
-                ("plausible_volume_sum", C.c_int32), ("supervisor", SupervisorConfig), ("stop", StopConfig)]
-
-
-class ControlInput(_Struct):
+class ControlInput(_Record):
+    """pour_control_input_t: one tick's inputs."""
     _fields_ = [("sensors_fresh", C.c_bool), ("sensors", SensorSample), ("estop", C.c_bool),
                 ("clear_faults", C.c_bool), ("link_fault", C.c_bool), ("stop", C.c_bool), ("reset", C.c_bool)]
 
 
-class ControlOutput(_Struct):
+class ControlOutput(_Record):
+    """pour_control_output_t: one tick's outputs."""
     _fields_ = [("torque", q15), ("action", C.c_uint8), ("probs", q15 * POLICY_MAX_ACTIONS), ("mode", C.c_uint8),
                 ("faults", C.c_uint16), ("limits", C.c_uint8), ("tick", C.c_uint32), ("brake", C.c_bool),
                 ("power", C.c_bool)]
 
 
-# pour_control_t is opaque here: Python never reads it, only lends the core room for it (the layout test
-# checks that sizeof(pour_control_t) fits).
-CONTROL_STATE_BYTES = 4096
-MIRRORED = {"pour_safety_config_t": SafetyConfig, "pour_safety_t": SafetyState,
-            "pour_sensors_config_t": SensorsConfig, "pour_estimator_t": EstimatorState, "pour_state_t": PlantState,
-            "pour_sensors_t": SensorSample, "pour_obs_norm_t": ObsNorm, "pour_policy_weights_t": PolicyWeights,
-            "pour_supervisor_config_t": SupervisorConfig, "pour_stop_config_t": StopConfig,
-            "pour_control_config_t": ControlConfig, "pour_control_input_t": ControlInput,
-            "pour_control_output_t": ControlOutput}
+# The records that cross the C API on purpose, by their C names (poursim_sizeof checks each).
+RECORDS = {"pour_sensors_t": SensorSample, "pour_state_t": PlantState, "pour_control_input_t": ControlInput,
+           "pour_control_output_t": ControlOutput}
 
 _lib: C.CDLL | None = None
 
@@ -135,21 +85,36 @@ def load() -> C.CDLL:
     if _lib is not None:
         return _lib
     lib = libpoursim.load()
-    P = C.POINTER
+    P, V, err = C.POINTER, C.c_void_p, [C.c_char_p, C.c_size_t]
     sig: dict[str, tuple[list[Any], Any]] = {
         "pour_status_name": ([C.c_int], C.c_char_p),
-        "pour_safety_default_config": ([], SafetyConfig),
-        "pour_safety_init": ([P(SafetyState), P(SafetyConfig)], C.c_int),
-        "pour_safety_apply": ([P(SafetyState), q15, C.c_int32, C.c_int32], q15),
-        "pour_safety_force": ([P(SafetyState), q15], None),
-        "pour_sensors_default_config": ([], SensorsConfig),
-        "pour_estimator_init": ([P(EstimatorState), P(SensorsConfig)], C.c_int),
-        "pour_estimator_reset": ([P(EstimatorState)], None),
-        "pour_estimator_update": ([P(EstimatorState), P(SensorSample), P(PlantState)], C.c_bool),
         "pour_sensors_theta_urad": ([C.c_uint32, C.c_uint8], C.c_int32),
-        "pour_control_default_config": ([], ControlConfig),
-        "pour_control_init": ([C.c_void_p, P(ControlConfig), P(PolicyWeights)], C.c_int),
-        "pour_control_step": ([C.c_void_p, P(ControlInput), P(ControlOutput)], None),
+        "poursim_sizeof": ([C.c_char_p], C.c_size_t),
+        "poursim_fw_config_size": ([], C.c_size_t),
+        "poursim_fw_config_init": ([V, V], None),
+        "poursim_fw_config_field": ([C.c_int], C.c_char_p),
+        "poursim_fw_config_set": ([V, C.c_char_p, C.c_int64], C.c_int),
+        "poursim_fw_config_get": ([V, C.c_char_p, P(C.c_int64)], C.c_int),
+        "poursim_envelope_create": ([V] + err, V),
+        "poursim_envelope_destroy": ([V], None),
+        "poursim_envelope_apply": ([V, q15, C.c_int32, C.c_int32], q15),
+        "poursim_envelope_force": ([V, q15], None),
+        "poursim_envelope_active": ([V], C.c_uint8),
+        "poursim_envelope_torque": ([V], q15),
+        "poursim_envelope_band": ([V, P(C.c_int32), P(C.c_int32)], None),
+        "poursim_estimator_create": ([V] + err, V),
+        "poursim_estimator_destroy": ([V], None),
+        "poursim_estimator_reset": ([V], None),
+        "poursim_estimator_update": ([V, P(SensorSample), P(PlantState)], C.c_int),
+        "poursim_core_create": ([V, C.c_int, C.c_int, C.c_int, P(C.c_int16), P(C.c_int16), C.c_int32, C.c_int32,
+                                 C.c_int32, C.c_int32, C.c_uint32] + err, V),
+        "poursim_core_destroy": ([V], None),
+        "poursim_core_update": ([V, P(ControlInput)], C.c_int),
+        "poursim_core_state": ([V, P(PlantState)], None),
+        "poursim_core_decide": ([V], None),
+        "poursim_core_request": ([V, C.c_uint8, q15], None),
+        "poursim_core_shape": ([V, P(ControlOutput)], None),
+        "poursim_core_step": ([V, P(ControlInput), P(ControlOutput)], None),
     }
     try:
         for name, (args, res) in sig.items():
@@ -161,79 +126,200 @@ def load() -> C.CDLL:
     return lib
 
 
-def _check(status: int, what: str) -> None:
-    if status != 0:
-        raise CoreError(f"{what}: {load().pour_status_name(status).decode()}")
+def _names(fn: Any, count: int) -> dict[int, str]:
+    out = {}
+    for i in range(count):
+        name = fn(i)
+        if name is not None:
+            out[i] = name.decode()
+    return out
 
 
-def _with(struct: C.Structure, overrides: dict[str, int]) -> C.Structure:
-    names = {f for f, _ in struct._fields_}
+fault_name, fault_names, mode_name = libpoursim.fault_name, libpoursim.fault_names, libpoursim.mode_name
+
+
+def __getattr__(name: str) -> int:
+    """FAULT_<NAME> and MODE_<NAME>, read from the core's name table."""
+    if name.startswith("FAULT_"):
+        table = {n: 1 << i for i in range(16) if (n := fault_name(1 << i)) is not None}
+    elif name.startswith("MODE_"):
+        table = {n: m for m in range(256) if (n := mode_name(m)) is not None}
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    key = name.split("_", 1)[1]
+    if key not in table:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r} (the core names {sorted(table)})")
+    return table[key]
+
+
+def _check_handle(h: int | None, err: C.Array, what: str) -> int:
+    if not h:
+        raise CoreError(f"{what}: {err.value.decode(errors='replace') or 'out of memory'}")
+    return h
+
+
+class Config:
+    """pour_control_config_t as an opaque block; fields by their C names: cfg.input_timeout_ms,
+    cfg.safety.tau_limit (the groups are the nested configs). Unknown names and values a field's type cannot
+    hold raise CoreError."""
+
+    def __init__(self, rig: C.Structure | None = None):
+        lib = load()
+        object.__setattr__(self, "_buf", (C.c_uint8 * lib.poursim_fw_config_size())())
+        lib.poursim_fw_config_init(self._buf, C.byref(rig) if rig is not None else None)
+        names = _names(lib.poursim_fw_config_field, 4096).values()
+        object.__setattr__(self, "_fields", tuple(names))
+
+    @property
+    def ptr(self) -> C.Array:
+        return self._buf
+
+    def fields(self) -> tuple[str, ...]:
+        return self._fields
+
+    def get(self, name: str) -> int:
+        v = C.c_int64()
+        if load().poursim_fw_config_get(self._buf, name.encode(), C.byref(v)) != 0:
+            raise CoreError(f"unknown field {name!r} of the core's config")
+        return int(v.value)
+
+    def set(self, name: str, value: int) -> None:
+        if load().poursim_fw_config_set(self._buf, name.encode(), int(value)) != 0:
+            why = "unknown field" if name not in self._fields else f"value {value!r} out of its type's range for"
+            raise CoreError(f"{why} {name!r} of the core's config")
+
+    def _group(self, name: str) -> bool:
+        return any(f.startswith(name + ".") for f in self._fields)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        if self._group(name):
+            return _Group(self, name)
+        return self.get(name)
+
+    def __setattr__(self, name: str, value: int) -> None:
+        self.set(name, value)
+
+    def copy(self) -> "Config":
+        c = Config()
+        C.memmove(c._buf, self._buf, C.sizeof(self._buf))
+        return c
+
+
+class _Group:
+    """One nested config of a Config (cfg.safety): its fields by name. The envelope and the estimator take
+    one as their config (the whole block goes to C; each reads its own group)."""
+
+    def __init__(self, config: Config, prefix: str):
+        object.__setattr__(self, "_config", config)
+        object.__setattr__(self, "_prefix", prefix)
+
+    @property
+    def ptr(self) -> C.Array:
+        return self._config.ptr
+
+    def __getattr__(self, name: str) -> int:
+        return self._config.get(f"{self._prefix}.{name}")
+
+    def __setattr__(self, name: str, value: int) -> None:
+        self._config.set(f"{self._prefix}.{name}", value)
+
+
+def control_config(rig: C.Structure | None = None, **overrides: int) -> Config:
+    """pour_control_default_config(), or with rig (a poursim config) the firmware's config for that simulated
+    rig (the one function the rollouts and host_sim use too), with the named top-level fields replaced."""
+    c = Config(rig)
     for k, v in overrides.items():
-        if k not in names:
-            raise CoreError(f"unknown field {k!r} of {type(struct).__name__}")
-        setattr(struct, k, int(v))
-    return struct
+        c.set(k, v)
+    return c
 
 
-def safety_config(**overrides: int) -> SafetyConfig:
-    """pour_safety_default_config() with the named fields replaced."""
-    return _with(load().pour_safety_default_config(), overrides)
+def _group_config(group: str, overrides: dict[str, int]) -> _Group:
+    g = _Group(Config(), group)
+    for k, v in overrides.items():
+        setattr(g, k, v)
+    return g
 
 
-def sensors_config(**overrides: int) -> SensorsConfig:
-    """pour_sensors_default_config() with the named fields replaced."""
-    return _with(load().pour_sensors_default_config(), overrides)
+def safety_config(**overrides: int) -> _Group:
+    """The default config's safety.* group (the envelope's), with the named fields replaced."""
+    return _group_config("safety", overrides)
 
 
-def control_config() -> ControlConfig:
-    """pour_control_default_config() (set nested fields on the result: cfg.safety.tau_limit = ...)."""
-    return load().pour_control_default_config()
+def sensors_config(**overrides: int) -> _Group:
+    """The default config's sensors.* group (the estimator's), with the named fields replaced."""
+    return _group_config("sensors", overrides)
 
 
-class Envelope:
-    """pour_safety_t: apply(requested, θ, θ̇) -> the command; .active holds the POUR_LIMIT_* bits."""
+class _Handle:
+    _destroy = ""
 
-    def __init__(self, config: SafetyConfig | None = None):
+    def __del__(self) -> None:
+        h = getattr(self, "_h", None)
+        if h:
+            getattr(self._lib, self._destroy)(h)
+            self._h = None
+
+
+class Envelope(_Handle):
+    """The safety envelope on config's safety.* fields: apply(requested, θ, θ̇) -> the command; .active holds
+    the POUR_LIMIT_* bits."""
+    _destroy = "poursim_envelope_destroy"
+
+    def __init__(self, config: Config | _Group | None = None):
         self._lib = load()
-        self.config = config if config is not None else self._lib.pour_safety_default_config()
-        self.s = SafetyState()
-        _check(self._lib.pour_safety_init(C.byref(self.s), C.byref(self.config)), "pour_safety_init")
+        self.config = config if config is not None else safety_config()
+        err = C.create_string_buffer(ERR_LEN)
+        self._h = _check_handle(self._lib.poursim_envelope_create(self.config.ptr, err, ERR_LEN), err, "envelope")
 
     def apply(self, requested: int, theta_urad: int, omega_urad_s: int) -> int:
-        return int(self._lib.pour_safety_apply(C.byref(self.s), int(requested), int(theta_urad), int(omega_urad_s)))
+        return int(self._lib.poursim_envelope_apply(self._h, int(requested), int(theta_urad), int(omega_urad_s)))
 
     def force(self, torque: int) -> None:
-        self._lib.pour_safety_force(C.byref(self.s), int(torque))
+        self._lib.poursim_envelope_force(self._h, int(torque))
 
     @property
     def active(self) -> int:
-        return int(self.s.active)
+        return int(self._lib.poursim_envelope_active(self._h))
 
     @property
     def torque(self) -> int:
-        return int(self.s.torque)
+        return int(self._lib.poursim_envelope_torque(self._h))
+
+    @property
+    def band(self) -> tuple[int, int]:
+        """(floor, ceiling) of the speed band [µrad/s]."""
+        f, c = C.c_int32(), C.c_int32()
+        self._lib.poursim_envelope_band(self._h, C.byref(f), C.byref(c))
+        return int(f.value), int(c.value)
 
 
-class Estimator:
-    """pour_estimator_t: update(seq, encoder, scale_rotating_g, scale_target_g) -> (seq, θ, θ̇, V_rot, V_tgt,
-    V_spill), or None for a sample the firmware refuses (nothing changes then)."""
+def _state_tuple(s: PlantState) -> tuple[int, int, int, int, int, int]:
+    return (int(s.seq), int(s.theta_urad), int(s.omega_urad_s), int(s.v_rotating), int(s.v_target), int(s.v_spill))
 
-    def __init__(self, config: SensorsConfig | None = None, **overrides: int):
+
+class Estimator(_Handle):
+    """The sensor estimator on config's sensors.* fields: update(seq, encoder, scale_rotating_g,
+    scale_target_g) -> (seq, θ, θ̇, V_rot, V_tgt, V_spill), or None for a sample the firmware refuses (nothing
+    changes then)."""
+    _destroy = "poursim_estimator_destroy"
+
+    def __init__(self, config: Config | _Group | None = None, **overrides: int):
         self._lib = load()
         self.config = config if config is not None else sensors_config(**overrides)
-        self.s = EstimatorState()
         self._state = PlantState()
-        _check(self._lib.pour_estimator_init(C.byref(self.s), C.byref(self.config)), "pour_estimator_init")
+        err = C.create_string_buffer(ERR_LEN)
+        self._h = _check_handle(self._lib.poursim_estimator_create(self.config.ptr, err, ERR_LEN), err, "estimator")
 
     def reset(self) -> None:
-        self._lib.pour_estimator_reset(C.byref(self.s))
+        self._lib.poursim_estimator_reset(self._h)
 
     def update(self, seq: int, encoder: int, scale_rotating_g: int, scale_target_g: int) -> tuple | None:
         smp = SensorSample(int(seq) & 0xFFFFFFFF, int(encoder) & 0xFFFFFFFF, int(scale_rotating_g), int(scale_target_g))
-        if not self._lib.pour_estimator_update(C.byref(self.s), C.byref(smp), C.byref(self._state)):
+        if not self._lib.poursim_estimator_update(self._h, C.byref(smp), C.byref(self._state)):
             return None
-        s = self._state
-        return (int(s.seq), int(s.theta_urad), int(s.omega_urad_s), int(s.v_rotating), int(s.v_target), int(s.v_spill))
+        return _state_tuple(self._state)
 
 
 def theta_urad(count: int, bits: int) -> int:
@@ -254,35 +340,75 @@ class Output:
     power: bool
 
 
-class Controller:
-    """pour_control_t on a parsed weights.h (pour.policy.weights_h.WeightsH): step() is one 1 ms tick of
-    pour_control_step()."""
+class Controller(_Handle):
+    """The firmware's control pipeline. With weights (a parsed weights.h, pour.policy.weights_h.WeightsH) its
+    fixed-point policy decides and step() is one 1 ms tick of pour_control_step(); with None the decisions
+    come from outside every decision_period_ms ticks of RUN: update() says when one is due, request() makes
+    it, shape() gives the tick's output (the envelope, the controlled stop)."""
+    _destroy = "poursim_core_destroy"
 
-    def __init__(self, weights: Any, config: ControlConfig | None = None):
+    def __init__(self, weights: Any, config: Config | None = None, decision_period_ms: int = 1):
         self._lib = load()
-        self.config = config if config is not None else control_config()
-        self._w = np.ascontiguousarray(weights.w_q, dtype=np.int16)
-        self._levels = np.ascontiguousarray(weights.levels_q15, dtype=np.int16)
-        n = weights.norm
-        self.weights = PolicyWeights(int(weights.n_actions), int(weights.w_frac_bits), int(weights.decision_period_ms),
-                                     self._w.ctypes.data_as(C.POINTER(C.c_int16)),
-                                     self._levels.ctypes.data_as(C.POINTER(q15)),
-                                     ObsNorm(n.theta_min_urad, n.theta_max_urad, n.omega_max_urad_s),
-                                     int(weights.tau_max_mnm), int(weights.content_hash))
-        self._ctl = (C.c_uint64 * (CONTROL_STATE_BYTES // 8))()
-        self._in, self._out = ControlInput(), ControlOutput()
-        _check(self._lib.pour_control_init(self._ctl, C.byref(self.config), C.byref(self.weights)),
-               "pour_control_init")
+        self.config = config if config is not None else Config()
+        err = C.create_string_buffer(ERR_LEN)
+        P16 = C.POINTER(C.c_int16)
+        if weights is None:
+            h = self._lib.poursim_core_create(self.config.ptr, 0, 0, int(decision_period_ms), None, None, 0, 0, 0, 0,
+                                              0, err, ERR_LEN)
+        else:
+            w = np.ascontiguousarray(weights.w_q, dtype=np.int16)
+            levels = np.ascontiguousarray(weights.levels_q15, dtype=np.int16)
+            n = weights.norm
+            h = self._lib.poursim_core_create(self.config.ptr, int(weights.n_actions), int(weights.w_frac_bits),
+                                              int(weights.decision_period_ms), w.ctypes.data_as(P16),
+                                              levels.ctypes.data_as(P16), int(n.theta_min_urad),
+                                              int(n.theta_max_urad), int(n.omega_max_urad_s),
+                                              int(weights.tau_max_mnm), int(weights.content_hash) & 0xFFFFFFFF,
+                                              err, ERR_LEN)
+        self._h = _check_handle(h, err, "pour_control_init")
+        self._in, self._out, self._state = ControlInput(), ControlOutput(), PlantState()
 
-    def step(self, sample: Sequence[int] | None = None, estop: bool = False, clear_faults: bool = False,
-             link_fault: bool = False, stop: bool = False, reset: bool = False) -> Output:
-        """sample (seq, encoder, scale_rotating_g, scale_target_g), or None for no fresh sample this tick."""
+    def _input(self, sample: Sequence[int] | None, estop: bool, clear_faults: bool, link_fault: bool, stop: bool,
+               reset: bool) -> ControlInput:
         i = self._in
         i.sensors_fresh = sample is not None
         smp = sample if sample is not None else (0, 0, 0, 0)
         i.sensors = SensorSample(int(smp[0]) & 0xFFFFFFFF, int(smp[1]) & 0xFFFFFFFF, int(smp[2]), int(smp[3]))
         i.estop, i.clear_faults, i.link_fault, i.stop, i.reset = estop, clear_faults, link_fault, stop, reset
-        self._lib.pour_control_step(self._ctl, C.byref(i), C.byref(self._out))
+        return i
+
+    def _output(self) -> Output:
         o = self._out
         return Output(int(o.torque), int(o.action), list(o.probs), int(o.mode), int(o.faults), int(o.limits),
                       int(o.tick), bool(o.brake), bool(o.power))
+
+    def step(self, sample: Sequence[int] | None = None, estop: bool = False, clear_faults: bool = False,
+             link_fault: bool = False, stop: bool = False, reset: bool = False) -> Output:
+        """sample (seq, encoder, scale_rotating_g, scale_target_g), or None for no fresh sample this tick."""
+        i = self._input(sample, estop, clear_faults, link_fault, stop, reset)
+        self._lib.poursim_core_step(self._h, C.byref(i), C.byref(self._out))
+        return self._output()
+
+    def update(self, sample: Sequence[int] | None = None, estop: bool = False, clear_faults: bool = False,
+               link_fault: bool = False, stop: bool = False, reset: bool = False) -> bool:
+        """The pipeline's first stage (estimate, supervise); True when a decision is due."""
+        i = self._input(sample, estop, clear_faults, link_fault, stop, reset)
+        return bool(self._lib.poursim_core_update(self._h, C.byref(i)))
+
+    def state(self) -> tuple[int, int, int, int, int, int]:
+        """The estimated state (seq, θ [µrad], θ̇ [µrad/s], V_rot, V_tgt, V_spill Q15)."""
+        self._lib.poursim_core_state(self._h, C.byref(self._state))
+        return _state_tuple(self._state)
+
+    def decide(self) -> None:
+        """The fixed-point policy's decision (nothing without weights)."""
+        self._lib.poursim_core_decide(self._h)
+
+    def request(self, action: int, torque_q15: int) -> None:
+        """A decision from outside: the action index and the torque request [Q15 of tau_max]."""
+        self._lib.poursim_core_request(self._h, int(action) & 0xFF, int(torque_q15))
+
+    def shape(self) -> Output:
+        """The pipeline's last stage: the envelope (RUN), the controlled stop (FAULT), the outputs."""
+        self._lib.poursim_core_shape(self._h, C.byref(self._out))
+        return self._output()

@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: MIT
 """The trainer's glue onto libpoursim, built on the binding in pour.sim.poursim.
 
-SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy, the
-firmware's safety envelope on every torque) and returns it as an Episode. SimStepper advances the world
-tick by tick for the Gymnasium environment through the same C code: the firmware's estimator and envelope
-(pour.policy.core, from the same library), so a stepped episode equals the C rollout's. Failures come out as
+SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy inside the
+firmware's pipeline) and returns it as an Episode. SimStepper advances the world tick by tick for the
+Gymnasium environment through the same pipeline (pour.policy.core, from the same library), so a stepped
+episode equals the C rollout's. Failures come out as
 EnvError, which the trainer reports; pour.libpoursim finds the library.
 """
 from __future__ import annotations
@@ -78,39 +78,45 @@ class SimEnv:
                    "finish_s": ro.finish_time, "return": ro.ret, "reward_sum": ro.reward_sum,
                    "max_theta": ro.max_theta, "liquid_l": ro.metrics["liquid_l"],
                    "peak_omega": ro.metrics["peak_omega"], "peak_alpha": ro.metrics["peak_alpha"],
-                   "reversals": ro.metrics["reversals"]}
+                   "reversals": ro.metrics["reversals"], "faults": ro.metrics["faults"],
+                   "fault_step": ro.metrics["fault_step"]}
         return episode.Episode(ro.features, ro.actions.astype(np.int64), ro.rewards, metrics, int(seed))
 
 
 class SimStepper:
-    """Tick-by-tick access for the Gymnasium env, as the firmware sees the rig: the sensor sample through the
-    firmware's estimator (firmware/src/sensors.c), torques through its safety envelope with the motion limits
-    (firmware/src/safety.c), both called in C through pour.policy.core with the defaults poursim_rollout uses."""
+    """Tick-by-tick access for the Gymnasium environment through the firmware's own pipeline (pour.policy.core:
+    pour_control_update, the agent's level as a request, pour_control_shape), on the firmware config for the
+    simulated rig that poursim_rollout uses: the same estimator, supervisor, envelope and controlled stop, so a
+    stepped episode equals the C rollout's tick for tick. The core's fault bits are in .faults."""
 
-    def __init__(self, options: dict[str, Any] | None = None):
+    def __init__(self, options: dict[str, Any] | None = None, decision_period_ms: int = 1):
         self.world = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
+        self.period = int(decision_period_ms)
         with _env_errors("the firmware core in libpoursim"):
-            fw = core.control_config()
-        self.safety_config = fw.safety
-        self.sensors_config = fw.sensors
-        self.sensors_config.encoder_bits = int(self.world.config.encoder_bits)
+            self.fw_config = core.control_config(self.world.config)
 
     def reset(self, seed: int) -> None:
         with _env_errors("poursim_reset"):
             self.obs = self.world.reset(seed)
-        self.safety = core.Envelope(self.safety_config)
-        self.estimator = core.Estimator(self.sensors_config)
+        try:
+            self.core = core.Controller(None, self.fw_config, decision_period_ms=self.period)
+        except core.CoreError as exc:
+            raise episode.EnvError(f"the firmware core refused its config: {exc}") from exc
         self.seq = 0
-        self.state = (0, 0, 0, 0, 0, 0)
+        self.out: core.Output | None = None
+        self.torques: list[int] = []  # the core's command of every tick so far, Q15
         self._sense()
 
     def _sense(self) -> None:
+        """The latest sample into the pipeline's first stage; whether a decision is due comes back."""
         o = self.obs
-        s = self.estimator.update(self.seq, o.encoder, o.scale_rotating_g, o.scale_target_g)
-        if s is not None:  # a sample the firmware would refuse leaves the last state in place
-            self.state = s
+        self.due = self.core.update((self.seq, o.encoder, o.scale_rotating_g, o.scale_target_g))
         self.seq += 1
+
+    @property
+    def faults(self) -> int:
+        return self.out.faults if self.out is not None else 0
 
     @property
     def v_tgt(self) -> float:
@@ -121,16 +127,21 @@ class SimStepper:
         return float(self.obs.v_spill)
 
     def features(self) -> np.ndarray:
-        _, theta, omega, v_rot, v_tgt, v_spill = self.state
+        _, theta, omega, v_rot, v_tgt, v_spill = self.core.state()
         return episode.normalise(theta * 1e-6, omega * 1e-6, v_rot / 32768.0, v_tgt / 32768.0, v_spill / 32768.0)
 
-    def advance(self, level: float, ticks: int) -> float:
+    def advance(self, level: float, ticks: int, action: int = 0) -> float:
+        """ticks steps with level (a fraction of tau_max) as the request of each decision due meanwhile."""
         req = fp.float_to_q15(level)
         r = 0.0
         with _env_errors("poursim_step"):
             for _ in range(ticks):
-                cmd = self.safety.apply(req, self.state[1], self.state[2])
-                self.obs = self.world.step(cmd / 32768.0)
+                if self.due:
+                    self.core.request(action, req)
+                self.out = self.core.shape()
+                self.torques.append(self.out.torque)
+                self.world.set_brake(self.out.brake)
+                self.obs = self.world.step(self.out.torque / 32768.0)
                 self._sense()
                 r += self.obs.reward
         return r

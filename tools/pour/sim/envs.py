@@ -128,5 +128,5 @@ def make_stepper(kind: str, n_actions: int, decision_period_ms: int, episode_s: 
         return ToyEnv(n_actions, decision_period_ms, episode_s, options)
     if kind == "sim":
         from pour.sim import adapter
-        return adapter.SimStepper(options)
+        return adapter.SimStepper(options, decision_period_ms)
     raise EnvError(f"unknown env kind {kind!r}: expected 'sim' or 'toy'")

@@ -7,7 +7,9 @@
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
 
 One env step is one decision period (10 ms by default) at the torque level of the action, exactly as
-training rollouts and the firmware hold an action between decisions. Observation: the five normalised
+training rollouts and the firmware hold an action between decisions: the level is a request into the
+firmware's own pipeline (estimator, supervisor, envelope, controlled stop), as in the rollouts; info["faults"]
+holds the core's latched fault bits (0 while it runs). Observation: the five normalised
 state variables [θn, ωn, V_rotating, V_target, V_spill] in [0, 1] (float32). Reward: the per-tick
 reward K_target·V_target − K_spill·V_spill summed over the decision period. The 10 s episode ends by
 time limit (truncated=True); nothing terminates it earlier.
@@ -70,7 +72,7 @@ class PourEnv(gym.Env):
         if truncated:
             self._started = False
         info = {"v_target": float(self._plant.v_tgt), "v_spill": float(self._plant.v_spill),
-                "t_s": self._k * self.period * 1e-3}
+                "t_s": self._k * self.period * 1e-3, "faults": int(getattr(self._plant, "faults", 0))}
         return self._obs(), reward, False, truncated, info
 
 

@@ -84,6 +84,7 @@ class BuffersStruct(C.Structure):
     _fields_ = [
         ("capacity", C.c_int), ("features", _DP), ("actions", C.POINTER(C.c_int32)), ("rewards", _DP),
         ("probs", _DP), ("step_capacity", C.c_int), ("step_rewards", _DP), ("step_theta", _DP),
+        ("step_torque", _DP),
     ]
 
 
@@ -92,7 +93,8 @@ class EpisodeStruct(C.Structure):
         ("n_steps", C.c_int), ("n_decisions", C.c_int), ("poured", C.c_double), ("spilled", C.c_double),
         ("remaining", C.c_double), ("finish_time", C.c_double), ("ret", C.c_double),
         ("reward_sum", C.c_double), ("max_theta", C.c_double), ("liquid_l", C.c_double),
-        ("peak_omega", C.c_double), ("peak_alpha", C.c_double), ("reversals", C.c_int),
+        ("peak_omega", C.c_double), ("peak_alpha", C.c_double), ("reversals", C.c_int), ("faults", C.c_int),
+        ("fault_step", C.c_int),
     ]
 
 
@@ -135,6 +137,12 @@ class SensorCheckStruct(C.Structure):
 
 CONFIG_KEYS: tuple[str, ...] = tuple(name for name, _ in ConfigStruct._fields_)
 
+# The plain records that cross the C API on purpose, by their C names (poursim_sizeof checks each).
+RECORDS = {"poursim_config_t": ConfigStruct, "poursim_obs_t": ObsStruct, "poursim_policy_t": PolicyStruct,
+           "poursim_rollout_buffers_t": BuffersStruct, "poursim_episode_t": EpisodeStruct,
+           "poursim_retention_t": RetentionStruct, "poursim_slosh_t": SloshStruct,
+           "poursim_drive_check_t": DriveCheckStruct, "poursim_sensor_check_t": SensorCheckStruct}
+
 _lib: C.CDLL | None = None
 
 
@@ -170,6 +178,7 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
         "poursim_step": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
         "poursim_step_servo": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_set_brake": ([C.c_void_p, C.c_int], C.c_int),
         "poursim_world_error": ([C.c_void_p], C.c_char_p),
         "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
         "poursim_measure_retention": ([P(ConfigStruct), C.c_uint32, C.c_int, C.c_double, C.c_double,
@@ -295,6 +304,7 @@ class Rollout:
     probs: np.ndarray         # [D, n_actions]
     step_rewards: np.ndarray  # [T] (empty unless asked for)
     step_theta: np.ndarray    # [T] (empty unless asked for)
+    step_torque: np.ndarray   # [T] the core's command, fraction of tau_max (empty unless asked for)
     poured: float
     spilled: float
     remaining: float
@@ -319,20 +329,23 @@ class _Buffers:
         self.probs = np.zeros((n_decisions, n_actions))
         self.step_rewards = np.zeros(n_steps)
         self.step_theta = np.zeros(n_steps)
+        self.step_torque = np.zeros(n_steps)
         self.struct = BuffersStruct(
             n_decisions, self.features.ctypes.data_as(_DP), self.actions.ctypes.data_as(C.POINTER(C.c_int32)),
             self.rewards.ctypes.data_as(_DP), self.probs.ctypes.data_as(_DP), n_steps,
             self.step_rewards.ctypes.data_as(_DP) if n_steps else None,
-            self.step_theta.ctypes.data_as(_DP) if n_steps else None)
+            self.step_theta.ctypes.data_as(_DP) if n_steps else None,
+            self.step_torque.ctypes.data_as(_DP) if n_steps else None)
 
     def result(self, seed: int, e: EpisodeStruct) -> Rollout:
         d = e.n_decisions
         m = {"poured": e.poured, "spilled": e.spilled, "remaining": e.remaining, "finish_time": e.finish_time,
              "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta, "liquid_l": e.liquid_l,
-             "peak_omega": e.peak_omega, "peak_alpha": e.peak_alpha, "reversals": e.reversals}
+             "peak_omega": e.peak_omega, "peak_alpha": e.peak_alpha, "reversals": e.reversals,
+             "faults": e.faults, "fault_step": e.fault_step}
         return Rollout(seed, self.features[:d], self.actions[:d], self.rewards[:d], self.probs[:d],
-                       self.step_rewards[:e.n_steps], self.step_theta[:e.n_steps], e.poured, e.spilled, e.remaining, e.finish_time,
-                       e.ret, e.reward_sum, e.max_theta, m)
+                       self.step_rewards[:e.n_steps], self.step_theta[:e.n_steps], self.step_torque[:e.n_steps],
+                       e.poured, e.spilled, e.remaining, e.finish_time, e.ret, e.reward_sum, e.max_theta, m)
 
 
 class World:
@@ -379,6 +392,11 @@ class World:
                 raise SimError(self._lib.poursim_world_error(self._check()).decode(errors="replace"))
             raise SimError(f"step refused action {action!r} (must be a finite number)")
         return Obs.from_struct(o)
+
+    def set_brake(self, engaged: bool) -> None:
+        """The holding brake on the bucket's axis for the steps that follow (poursim_set_brake)."""
+        if self._lib.poursim_set_brake(self._check(), 1 if engaged else 0) != 0:
+            raise SimError("set_brake refused (no world)")
 
     def observe(self) -> Obs:
         o = ObsStruct()

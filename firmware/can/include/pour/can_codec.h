@@ -6,7 +6,7 @@
 
 #include <stdint.h>
 
-#include "pour/control.h"
+#include "pour/faults.h"
 #include "pour/fixed.h"
 
 #define POUR_CAN_NODE_ID_MAX 63u /* node ids 0 .. 63 (6 bits) */
@@ -40,7 +40,7 @@
                                          * refuses a count >= 2^encoder_bits (BAD_INPUT) */
 #define POUR_CAN_SCALE_MAX_G 32767     /* |scale| <= 32.767 kg [g]; -32768 is the load cell amplifier's
                                          * overload code, out of range */
-#define POUR_CAN_MODE_MAX 3u               /* pour_mode_t */
+#define POUR_CAN_MODE_MAX (POUR_MODE_COUNT - 1u) /* pour_mode_t */
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */

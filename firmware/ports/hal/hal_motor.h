@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* hal_motor: the torque command to the motor driver. */
+/* hal_motor: the torque command to the motor driver. One implementation per port: the Cortex-M4 keeps it for
+ * the drive (hal_motor.c); the Linux process sends it in its answer and keeps the line for its summary. */
 #ifndef POUR_HAL_MOTOR_H
 #define POUR_HAL_MOTOR_H
 
