@@ -10,6 +10,7 @@
 #define DEFAULT_PLAUSIBLE_THETA_URAD 3141593   /* π: the tilt cannot pass half a turn */
 #define DEFAULT_PLAUSIBLE_OMEGA_URAD_S 50000000 /* 50 rad/s, ~8 turns/s */
 #define DEFAULT_PLAUSIBLE_VOLUME_SUM 65536      /* off: load-cell volumes pass 1 under impact and slosh */
+#define DEFAULT_RESTART_JUMP_MAX_URAD 52360     /* 3 deg: the gearbox's backlash and the brake's give */
 #define DEFAULT_STOP_TORQUE_MAX 16384            /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s */
 #define DEFAULT_STOP_RETURN_SPEED_URAD_S 1000000 /* 1 rad/s back toward upright: no slosh over the lip */
 #define DEFAULT_STOP_RETURN_GAIN_PER_S 2u
@@ -29,6 +30,7 @@ pour_control_config_t pour_control_default_config(void) {
   config.plausible_theta_urad = DEFAULT_PLAUSIBLE_THETA_URAD;
   config.plausible_omega_urad_s = DEFAULT_PLAUSIBLE_OMEGA_URAD_S;
   config.plausible_volume_sum = DEFAULT_PLAUSIBLE_VOLUME_SUM;
+  config.restart_jump_max_urad = DEFAULT_RESTART_JUMP_MAX_URAD;
   config.supervisor = pour_supervisor_default_config();
   config.stop.torque_max = DEFAULT_STOP_TORQUE_MAX;
   config.stop.return_speed_urad_s = DEFAULT_STOP_RETURN_SPEED_URAD_S;
@@ -43,10 +45,11 @@ pour_control_config_t pour_control_default_config(void) {
 /* The run's state as at power-on: no state seen, zero torque, the decision schedule and the PRNG
  * from their start (init and an accepted reset; config and weights were validated at init). */
 static void start_afresh(pour_control_t *ctl) {
-  /* A reset is taken in IDLE or FAULT, which command the safe torque: a run started in the same tick
-   * ramps from it through the slew limit, not from zero (found by tests/fuzz/fuzz_can_node). */
+  /* The envelope starts again from the command on the wire, not from the safe torque or zero: a run that
+   * starts in the same tick ramps from what the motor has now, through the slew limit. */
+  const q15_t on_wire = ctl->safety.torque;
   (void)pour_safety_init(&ctl->safety, &ctl->config.safety);
-  pour_safety_force(&ctl->safety, ctl->config.safe_torque);
+  pour_safety_force(&ctl->safety, on_wire);
   if (ctl->policy.weights != NULL) {
     (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
   }
@@ -79,7 +82,7 @@ static bool stop_config_ok(const pour_stop_config_t *s) {
 /* Validates the config and takes it; the policy (or none) is the caller's. */
 static pour_status_t init_config(pour_control_t *ctl, const pour_control_config_t *c) {
   if (c->input_timeout_ms < 1u || c->plausible_theta_urad <= 0 || c->plausible_omega_urad_s <= 0 ||
-      c->plausible_volume_sum <= 0) {
+      c->plausible_volume_sum <= 0 || c->restart_jump_max_urad <= 0) {
     return POUR_EINVAL;
   }
   if (pour_safety_init(&ctl->safety, &c->safety) != POUR_OK || !stop_config_ok(&c->stop) ||
@@ -100,8 +103,10 @@ static void start(pour_control_t *ctl, const pour_control_config_t *c, uint16_t 
   ctl->mode = POUR_MODE_IDLE;
   ctl->faults = 0u;
   ctl->tick = 0u;
-  ctl->resets_refused = 0u;
-  start_afresh(ctl);
+  ctl->refused = 0u;
+  ctl->check_restart = false;
+  ctl->have_trusted = false;
+  start_afresh(ctl); /* the envelope at zero, as pour_safety_init left it: the motor has no current yet */
 }
 
 pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t *config,
@@ -148,16 +153,34 @@ static bool plausible(const pour_control_config_t *c, const pour_state_t *s) {
   return (int32_t)s->v_rotating + s->v_target + s->v_spill <= c->plausible_volume_sum;
 }
 
-/* Safe torque, at once, unless it would drive further past an angle limit (then zero). */
-static q15_t force_safe(pour_control_t *ctl) {
+/* Toward the safe torque (zero where it would drive further past an angle limit): at once when that is
+ * less torque, else through the slew limit, so that no transition steps the command away from zero. */
+static q15_t hold_safe(pour_control_t *ctl) {
   const pour_safety_config_t *sc = &ctl->config.safety;
   const int32_t theta = ctl->state.theta_urad;
   q15_t torque = ctl->config.safe_torque;
   if ((torque > 0 && theta >= sc->theta_max_urad) || (torque < 0 && theta <= sc->theta_min_urad)) {
     torque = 0;
   }
-  pour_safety_force(&ctl->safety, torque);
-  return torque;
+  const q15_t now = ctl->safety.torque;
+  if ((now > 0 && theta >= sc->theta_max_urad) || (now < 0 && theta <= sc->theta_min_urad)) {
+    pour_safety_force(&ctl->safety, 0); /* no torque past an angle limit, not even on the way: zero first */
+    return 0;
+  }
+  return pour_safety_hold(&ctl->safety, torque);
+}
+
+static void count_refused(pour_control_t *ctl) {
+  if (ctl->refused != UINT32_MAX) {
+    ctl->refused++;
+  }
+}
+
+/* A restart of an axis the brake holds: its first sample must find the bucket where it was last seen. */
+static void expect_held_angle(pour_control_t *ctl) {
+  if (ctl->mode == POUR_MODE_FAULT && ctl->stopped && ctl->have_trusted) {
+    ctl->check_restart = true;
+  }
 }
 
 /* The active stop's request: a speed reference that returns toward upright at a bounded speed, tracked by
@@ -200,6 +223,7 @@ static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_ou
   out->faults = ctl->faults;
   out->limits = ctl->safety.active;
   out->tick = ctl->tick;
+  out->refused = ctl->refused;
   out->brake = ctl->mode != POUR_MODE_RUN;
   out->power = ctl->mode == POUR_MODE_RUN;
 }
@@ -231,6 +255,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->mode = POUR_MODE_FAULT;
   }
   if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
+    expect_held_angle(ctl);
     /* Back to IDLE: RUN (and the timeout) start again only with the next fresh state, from the safe
      * torque the envelope holds now, through the slew limit. */
     ctl->faults = 0u;
@@ -239,15 +264,22 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->stop_ms = 0u;
     ctl->stopped = false;
   }
-  if (in->stop && ctl->mode == POUR_MODE_RUN) {
-    ctl->mode = POUR_MODE_IDLE;
+  if (in->stop) {
+    if (ctl->mode == POUR_MODE_RUN) {
+      ctl->mode = POUR_MODE_IDLE;
+    } else {
+      count_refused(ctl); /* nothing to end */
+    }
   }
   if (in->reset) {
-    /* Re-initialising under a running policy would drop the envelope's torque in one tick: refused. */
-    if (ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) {
+    /* A restart under a running policy, or in the middle of the active stop, would drop a torque that is
+     * holding or braking the bucket, and start the speed estimate from rest while it turns: refused. */
+    const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+    if ((ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) && !stopping) {
+      expect_held_angle(ctl);
       start_afresh(ctl);
     } else {
-      ctl->resets_refused++;
+      count_refused(ctl);
     }
   }
 
@@ -258,10 +290,19 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
   }
   if (in->sensors_fresh && pour_supervisor_accept(&ctl->supervisor, in->sensors.seq)) {
     pour_state_t state;
-    if (!pour_estimator_update(&ctl->estimator, &in->sensors, &state) || !plausible(&ctl->config, &state)) {
+    bool ok = pour_estimator_update(&ctl->estimator, &in->sensors, &state) && plausible(&ctl->config, &state);
+    if (ok && ctl->check_restart) {
+      /* The restarted estimator would take any angle: the brake held the bucket, so it must be where it was. */
+      const int64_t moved = (int64_t)state.theta_urad - ctl->trusted_theta_urad;
+      ok = moved <= ctl->config.restart_jump_max_urad && moved >= -(int64_t)ctl->config.restart_jump_max_urad;
+    }
+    if (!ok) {
       ctl->faults |= POUR_FAULT_BAD_INPUT;
       ctl->mode = POUR_MODE_FAULT;
     } else {
+      ctl->check_restart = false;
+      ctl->have_trusted = true;
+      ctl->trusted_theta_urad = state.theta_urad;
       ctl->state = state;
       ctl->ms_since_fresh = 0u;
       fresh = true;
@@ -335,7 +376,7 @@ STAGE void shape_stage(pour_control_t *ctl, pour_control_output_t *out) {
   const bool run = ctl->mode == POUR_MODE_RUN;
   const bool stopping = ctl->mode == POUR_MODE_FAULT && stop_active(ctl);
   if (!run && !stopping) {
-    fill_output(ctl, force_safe(ctl), out); /* IDLE, and FAULT once the stop is over */
+    fill_output(ctl, hold_safe(ctl), out); /* IDLE, and FAULT once the stop is over */
     return;
   }
   if (run && !ctl->decision_due && ctl->probs_pending) {

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "pour/safety.h"
 
+#include <stdbool.h>
 #include <stddef.h>
 
 /* docs/safety.md gives the reasons for each default. */
@@ -145,4 +146,18 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
 void pour_safety_force(pour_safety_t *safety, q15_t torque) {
   safety->torque = torque;
   safety->active = 0u;
+}
+
+q15_t pour_safety_hold(pour_safety_t *safety, q15_t target) {
+  const int32_t now = safety->torque;
+  const bool toward_zero = (now >= 0 && target >= 0 && target <= now) || (now <= 0 && target <= 0 && target >= now);
+  const int32_t slew = safety->config.slew_per_tick;
+  int32_t cmd = target;
+  safety->active = 0u;
+  if (!toward_zero && (cmd > now + slew || cmd < now - slew)) {
+    cmd = cmd > now ? now + slew : now - slew;
+    safety->active = POUR_LIMIT_SLEW;
+  }
+  safety->torque = (q15_t)cmd;
+  return safety->torque;
 }

@@ -320,13 +320,13 @@ static void test_can_node_ResetIsRefusedInRunAndAcceptedAfterStop(void) {
   send_sample(seq++, 0);
   core_tick(&out);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
-  TEST_ASSERT_EQUAL_UINT32(1, ctl.resets_refused);
+  TEST_ASSERT_EQUAL_UINT32(1, ctl.refused);
   TEST_ASSERT_TRUE(out.torque >= running - ccfg.safety.slew_per_tick); /* no drop to a fresh start */
   receive_command(POUR_CAN_CMD_STOP);
   receive_command(POUR_CAN_CMD_RESET);
   core_tick(&out);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
-  TEST_ASSERT_EQUAL_UINT32(1, ctl.resets_refused);
+  TEST_ASSERT_EQUAL_UINT32(1, ctl.refused);
 }
 
 static void test_can_node_EstopLevelReachesTheNextTick(void) {
@@ -491,7 +491,7 @@ static void test_can_node_RefusedResetInRunChangesNothing(void) {
   const uint32_t seq_before = node.sensors.seq;
   receive_command(POUR_CAN_CMD_RESET);
   run_ticks(300u, &seq, &out);
-  TEST_ASSERT_EQUAL_UINT32(1u, ctl.resets_refused);
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.refused);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_EQUAL_UINT32(0u, out.faults);
   TEST_ASSERT_EQUAL_UINT32(seq_before + 300u, node.sensors.seq);

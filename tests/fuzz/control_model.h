@@ -20,9 +20,8 @@ extern "C" {
 
 class ControlModel {
  public:
-  // Before its first tick the controller is in IDLE, whose command is the safe torque.
-  explicit ControlModel(const pour_control_config_t &c, uint8_t n_actions)
-      : c_(c), n_actions_(n_actions), torque_(c.safe_torque) {}
+  // Before its first tick the controller is in IDLE at zero torque: power-on, nothing on the wire yet.
+  explicit ControlModel(const pour_control_config_t &c, uint8_t n_actions) : c_(c), n_actions_(n_actions), torque_(0) {}
 
   // Rule 5: a raw sample no sensor can give (a count beyond the encoder's bits, a scale beyond its range).
   bool raw_plausible(const pour_sensors_t &s) const {
@@ -49,20 +48,18 @@ class ControlModel {
     }
     // The mode the tick's requests leave before the state is looked at: a released e-stop and a link
     // fault are FAULT; a clear takes FAULT to IDLE (all faults cleared); stop takes RUN to IDLE; a reset
-    // is taken in IDLE or FAULT. Through IDLE or FAULT, a new run may also ramp from the safe torque.
+    // is taken in IDLE, or in FAULT once the active stop is over; a refused Stop or Reset is counted.
     uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault ? static_cast<uint8_t>(POUR_MODE_FAULT) : mode_;
     uint16_t kept = faults_;
-    bool via_safe = false;
     if (in.clear_faults && mode == POUR_MODE_FAULT) {
       kept = 0;
       mode = POUR_MODE_IDLE;
-      via_safe = true;
     }
-    if (in.stop && mode == POUR_MODE_RUN) {
-      mode = POUR_MODE_IDLE;
-      via_safe = true;
-    }
-    if (in.reset && (mode == POUR_MODE_IDLE || mode == POUR_MODE_FAULT)) via_safe = true;
+    const bool stop_refused = in.stop && mode != POUR_MODE_RUN;
+    if (in.stop && mode == POUR_MODE_RUN) mode = POUR_MODE_IDLE;
+    const bool reset_refused = in.reset && (mode == POUR_MODE_RUN || (mode == POUR_MODE_FAULT && mode_ == POUR_MODE_FAULT && power_));
+    FUZZ_CHECK(out.refused == refused_ + (stop_refused ? 1u : 0u) + (reset_refused ? 1u : 0u),
+               "refused %u after %u (stop %d reset %d in mode %u)", out.refused, refused_, in.stop, in.reset, mode);
     stale_ = in.sensors_fresh ? 0u : stale_ + 1u;
     if (in.sensors_fresh && new_seq && !raw_plausible(in.sensors))
       FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible sample did not latch BAD_INPUT");
@@ -78,20 +75,19 @@ class ControlModel {
       FUZZ_CHECK(mode == POUR_MODE_RUN || (mode == POUR_MODE_IDLE && in.sensors_fresh), "RUN from mode %u", mode);
       FUZZ_CHECK(stale_ <= c_.input_timeout_ms, "RUN after %u ticks without a state", stale_);
       FUZZ_CHECK(out.action < n_actions_ && out.power, "action %u power %d", out.action, out.power);
-    } else if (out.mode == POUR_MODE_IDLE) {
-      FUZZ_CHECK(out.brake && (out.torque == c_.safe_torque || out.torque == 0), "torque %d in IDLE", out.torque);
+    } else if (out.mode == POUR_MODE_IDLE) { // braked, on the way from the last command to the safe torque
+      FUZZ_CHECK(out.brake && on_the_way(out.torque, torque_), "torque %d in IDLE after %d", out.torque, torque_);
     } else {
       FUZZ_CHECK(out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
     }
-    // The envelope in RUN and in the active stop: the slew limit from the last command (less torque, toward
-    // zero, or through IDLE or FAULT the safe torque, never waits for it) ...
+    // Continuity across every transition (power-on, stop, reset, clear, a fault, the stop's end): at most the
+    // slew limit from the last command, or less torque toward zero, which never waits ...
     const auto toward_zero = [&out](int32_t from) {
       return (from >= 0 && out.torque >= 0 && out.torque <= from) || (from <= 0 && out.torque <= 0 && out.torque >= from);
     };
-    if (out.power)
-      FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || toward_zero(torque_) ||
-                     (via_safe && (std::abs(out.torque - c_.safe_torque) <= s.slew_per_tick || toward_zero(c_.safe_torque))),
-                 "torque %d -> %d breaks the slew limit %d", torque_, out.torque, s.slew_per_tick);
+    FUZZ_CHECK(std::abs(out.torque - torque_) <= s.slew_per_tick || toward_zero(torque_),
+               "torque %d -> %d breaks the slew limit %d (mode %u -> %u)", torque_, out.torque, s.slew_per_tick, mode_,
+               out.mode);
     // ... and no torque that speeds the bucket beyond ±omega_max: τ <= max(K (ω_max - θ̇), 0) and
     // τ >= min(-K (ω_max + θ̇), 0), K = torque_per_rad_s per rad/s, 1 LSB for rounding.
     if (out.power && omega != INT32_MIN) {
@@ -112,6 +108,14 @@ class ControlModel {
     mode_ = out.mode;
     faults_ = out.faults;
     torque_ = out.torque;
+    power_ = out.power;
+    refused_ = out.refused;
+  }
+
+  // Between the last command and the safe torque, or between it and zero (the safe torque cut at a limit).
+  bool on_the_way(int32_t x, int32_t from) const {
+    const auto between = [&](int32_t to) { return std::min(from, to) <= x && x <= std::max(from, to); };
+    return between(c_.safe_torque) || between(0);
   }
 
   pour_control_config_t c_;
@@ -120,6 +124,8 @@ class ControlModel {
   uint8_t mode_ = POUR_MODE_IDLE;
   uint16_t faults_ = 0;
   q15_t torque_;
+  bool power_ = false;  // the last tick drove the motor (RUN, the active stop)
+  uint32_t refused_ = 0;
 };
 
 // A controller config drawn from the fuzz input: every field in the range pour_control_init accepts, or

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Property fuzzer of the 1 kHz control step: a fuzzed controller config, then a sequence of ticks whose
 // inputs (fresh or not, any sensor sample, e-stop, clear, link fault, stop, reset) come from the fuzz input. After every tick the rules
-// of docs/safety.md must hold (control_model.h).
+// of docs/safety.md must hold (control_model.h), and a Reset the core refuses changes nothing else.
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
@@ -57,8 +57,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     const int repeat = (flags & 0x0f) == 0 ? fdp.ConsumeIntegralInRange<int>(1, 40) : 1;
     if (in.sensors_fresh) in.sensors = fuzz_sample(fdp, tick + 1u, cfg, &count);
     for (int r = 0; r < repeat; ++r) {
+      // A refused Reset changes nothing but the count of refusals: the same tick without it gives the same.
+      static pour_control_t shadow;
+      pour_control_output_t shadow_out{};
+      const uint32_t refused_before = ctl.refused;
+      if (in.reset && !in.stop) {
+        shadow = ctl;
+        pour_control_input_t plain = in;
+        plain.reset = false;
+        pour_control_step(&shadow, &plain, &shadow_out);
+      }
       pour_control_output_t out{};
       pour_control_step(&ctl, &in, &out);
+      if (in.reset && !in.stop && out.refused != refused_before)
+        FUZZ_CHECK(out.torque == shadow_out.torque && out.mode == shadow_out.mode && out.faults == shadow_out.faults &&
+                       out.brake == shadow_out.brake && ctl.state.theta_urad == shadow.state.theta_urad &&
+                       ctl.state.omega_urad_s == shadow.state.omega_urad_s && ctl.safety.torque == shadow.safety.torque,
+                   "a refused reset changed the tick: torque %d vs %d, mode %u vs %u", out.torque, shadow_out.torque,
+                   out.mode, shadow_out.mode);
       if (trace)
         std::fprintf(stderr, "tick: fresh %d encoder %u scales %d %d estop %d clear %d link %d stop %d reset %d -> mode %u "
                      "faults %x torque %d\n", in.sensors_fresh, in.sensors.encoder, in.sensors.scale_rotating_g,

@@ -105,6 +105,11 @@ def envelope_cases(draw):
     return cfg, draw(envelope_ticks(cfg))
 
 
+def _on_the_way(x: int, frm: int, safe: int) -> bool:
+    """x lies between frm and the safe torque, or between frm and zero (the safe torque cut at an angle limit)."""
+    return any(min(frm, t) <= x <= max(frm, t) for t in (safe, 0))
+
+
 def _between_zero_and(x: int, ref: int) -> bool:
     return min(0, ref) <= x <= max(0, ref)
 
@@ -300,7 +305,7 @@ def test_control_step_holds_the_safety_rules_after_every_tick(example_weights, c
     cfg, ticks = case
     ctl = core.Controller(example_weights, cfg)
     tau, slew, safe = cfg.safety.tau_limit, cfg.safety.slew_per_tick, cfg.safe_torque
-    prev = core.Output(safe, 0, [], core.MODE_IDLE, 0, 0, 0, True, False)  # init holds the safe torque
+    prev = core.Output(0, 0, [], core.MODE_IDLE, 0, 0, 0, 0, True, False)  # power-on: no torque on the wire yet
     since_fresh = 0  # ticks since a sample was offered (the core's own count is since one was accepted: >=)
     outs = []
     for t, tk in enumerate(ticks):
@@ -325,12 +330,14 @@ def test_control_step_holds_the_safety_rules_after_every_tick(example_weights, c
         if o.mode == core.MODE_RUN:
             assert o.faults == 0 and o.power and not o.brake
             assert since_fresh <= cfg.input_timeout_ms  # the input timeout, armed in RUN
+        # braked (IDLE, FAULT after the stop): on the way from the last command to the safe torque (or to zero
+        # at an angle limit), never beyond it
         if o.mode == core.MODE_IDLE:
-            assert o.brake and not o.power and o.torque in (safe, 0)
+            assert o.brake and not o.power and _on_the_way(o.torque, prev.torque, safe)
         if o.mode == core.MODE_FAULT:
             assert o.brake != o.power
             if o.brake:
-                assert o.torque in (safe, 0)
+                assert _on_the_way(o.torque, prev.torque, safe)
         if prev.mode == core.MODE_RUN and not (tk["estop"] or tk["stop"] or tk["link_fault"]) \
                 and since_fresh > cfg.input_timeout_ms:
             assert o.faults & core.FAULT_STALE_INPUT
@@ -340,10 +347,9 @@ def test_control_step_holds_the_safety_rules_after_every_tick(example_weights, c
         smp = tk["sample"]
         if smp is not None and smp[1] >= (1 << cfg.sensors.encoder_bits) and not tk["estop"]:
             assert o.faults & core.FAULT_BAD_INPUT and o.mode == core.MODE_FAULT
-        # every torque the envelope shapes (RUN, the active stop) moves by at most the slew limit, or toward
-        # zero; forced ones (IDLE, e-stop, the brake) only ever drop to the safe torque or zero
-        if o.power and not tk["reset"]:
-            assert abs(o.torque - prev.torque) <= slew or _between_zero_and(o.torque, prev.torque)
+        # continuity across every transition (power-on, stop, reset, clear, the stop's end, the e-stop): the
+        # command moves by at most the slew limit a tick, or toward zero
+        assert abs(o.torque - prev.torque) <= slew or _between_zero_and(o.torque, prev.torque), (prev, o)
         prev = o
     # the step is a pure function of the config and the inputs
     again = core.Controller(example_weights, cfg)

@@ -349,8 +349,148 @@ static void test_control_request_GoesThroughTheEnvelopeAndTheStop(void) {
   TEST_ASSERT_EQUAL_UINT16(POUR_FAULT_ESTOP, out.faults);
 }
 
+/* Continuity (docs/safety.md, transitions): the command moves by at most the slew limit a tick, or toward zero. */
+static void assert_continuous(q15_t before, q15_t after) {
+  const int32_t d = (int32_t)after - before;
+  const bool toward_zero = (before >= 0 && after >= 0 && after <= before) || (before <= 0 && after <= 0 && after >= before);
+  TEST_ASSERT_TRUE_MESSAGE((d <= config.safety.slew_per_tick && d >= -config.safety.slew_per_tick) || toward_zero,
+                           "the command stepped beyond the slew limit");
+}
+
+/* One tick of an external controller that requests `torque` when a decision is due; returns the command. */
+static q15_t external_tick(q15_t torque) {
+  if (pour_control_update(&ctl, &in)) {
+    pour_control_request(&ctl, 0u, torque);
+  }
+  pour_control_shape(&ctl, &out);
+  return out.torque;
+}
+
+/* A run that ends at +0.4 tau_max, then Stop, Reset and the new run's first sample in one tick, and a first
+ * decision across zero: the new run starts from the torque on the bus, through the slew limit (it used to
+ * start from the safe torque: a step of 16,384 across zero). */
+static void test_control_transitions_StopResetAndFirstSampleInOneTickKeepTheTorque(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &config, 1u));
+  q15_t prev = 0;
+  for (unsigned t = 0; t < 10u; ++t) {
+    in.sensors_fresh = true;
+    in.sensors.seq++;
+    const q15_t now = external_tick(13107);
+    assert_continuous(prev, now);
+    prev = now;
+  }
+  TEST_ASSERT_EQUAL_INT16(13107, prev);
+  in.stop = true;
+  in.reset = true;
+  in.sensors.seq++;
+  const q15_t first = external_tick(-3277);
+  in.stop = false;
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  assert_continuous(prev, first);
+  TEST_ASSERT_EQUAL_INT16(13107 - config.safety.slew_per_tick, first);
+}
+
+/* A non-zero safe torque is reached through the slew limit from power-on's zero, and from the e-stop's zero
+ * after a release, clear and reset in one tick. */
+static void test_control_transitions_SafeTorqueIsReachedThroughTheSlew(void) {
+  config.safe_torque = 10000;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &config, &pour_weights_compiled));
+  step(false);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_INT16(config.safety.slew_per_tick, out.torque);
+  q15_t prev = out.torque;
+  for (unsigned t = 0; t < 5u; ++t) {
+    step(false);
+    assert_continuous(prev, out.torque);
+    prev = out.torque;
+  }
+  TEST_ASSERT_EQUAL_INT16(10000, out.torque);
+  in.estop = true;
+  step(true);
+  TEST_ASSERT_EQUAL_INT16(0, out.torque);
+  in.estop = false;
+  in.clear_faults = true;
+  in.reset = true;
+  step(false);
+  in.clear_faults = false;
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_INT16(config.safety.slew_per_tick, out.torque);
+}
+
+/* Tilts an external controller's bucket at 2 rad/s until the supervisor proves POSITION (past 140 deg):
+ * FAULT with the active stop running. */
+static void run_into_the_active_stop(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &config, 1u));
+  int32_t theta = 0;
+  for (unsigned t = 0; t < 2000u && out.mode != POUR_MODE_FAULT; ++t) {
+    theta += 2000;
+    sense(theta, FULL_G, 0);
+    in.sensors_fresh = true;
+    in.sensors.seq++;
+    (void)external_tick(8000);
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_POSITION, out.faults);
+  TEST_ASSERT_TRUE(out.power); /* the active stop */
+}
+
+/* A Reset in FAULT during the active stop is refused like one in RUN: the braking goes on, unchanged, and the
+ * estimate does not restart from rest (it used to drop the stop's torque and restart the speed estimate). */
+static void test_control_transitions_ResetIsRefusedDuringTheActiveStop(void) {
+  run_into_the_active_stop();
+  pour_control_t without = ctl;
+  pour_control_output_t out_without;
+  in.sensors_fresh = true;
+  in.sensors.seq++;
+  pour_control_step(&without, &in, &out_without);
+  const q15_t before = out.torque;
+  in.reset = true;
+  pour_control_step(&ctl, &in, &out);
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT32(1u, out.refused);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_TRUE(out.power);
+  assert_continuous(before, out.torque);
+  TEST_ASSERT_EQUAL_INT16(out_without.torque, out.torque);
+  TEST_ASSERT_EQUAL_INT32(without.state.omega_urad_s, ctl.state.omega_urad_s);
+}
+
+/* Once the stop is over and the brake holds the bucket, a Reset is accepted, and the restarted estimator checks
+ * its first sample against the last trusted angle: a 155 deg jump is BAD_INPUT, not a new run. */
+static void test_control_transitions_RestartOfAHeldAxisRefusesAJump(void) {
+  run_into_the_active_stop();
+  const int32_t held = 2450000;
+  sense(held, FULL_G, 0);
+  for (unsigned t = 0; t < 6000u && out.power; ++t) {
+    step(true); /* the bucket does not follow the stop: it ends at the stop's timeout, braked */
+  }
+  TEST_ASSERT_TRUE(out.brake);
+  in.reset = true;
+  step(false);
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT32(0u, out.refused);
+  sense(held - 2705260, FULL_G, 0); /* 155 deg away */
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_BAD_INPUT, out.faults);
+  /* A clear of the held axis checks the same way; with the bucket where it was, its sample is taken. */
+  in.clear_faults = true;
+  step(false);
+  in.clear_faults = false;
+  sense(held, FULL_G, 0);
+  step(true);
+  TEST_ASSERT_BITS_LOW(POUR_FAULT_BAD_INPUT, out.faults);
+  TEST_ASSERT_INT32_WITHIN(1000, held, ctl.state.theta_urad);
+}
+
 int main(void) {
   UNITY_BEGIN();
+  RUN_TEST(test_control_transitions_StopResetAndFirstSampleInOneTickKeepTheTorque);
+  RUN_TEST(test_control_transitions_SafeTorqueIsReachedThroughTheSlew);
+  RUN_TEST(test_control_transitions_ResetIsRefusedDuringTheActiveStop);
+  RUN_TEST(test_control_transitions_RestartOfAHeldAxisRefusesAJump);
   RUN_TEST(test_control_init_RefusesBadConfig);
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);

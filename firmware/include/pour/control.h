@@ -43,6 +43,9 @@ typedef struct {
   int32_t plausible_theta_urad;    /* |θ| <= this [µrad], > 0 */
   int32_t plausible_omega_urad_s;  /* |θ̇| <= this [µrad/s], > 0 */
   int32_t plausible_volume_sum;    /* V_rot + V_tgt + V_spill <= this, Q15 (32768 = all the liquid) */
+  /* The first sample after a restart of an axis the brake held (a Reset or a clear in FAULT once the stop is
+   * over) lies within this of the last trusted angle, or it is BAD_INPUT [µrad], > 0. */
+  int32_t restart_jump_max_urad;
   pour_supervisor_config_t supervisor;
   pour_stop_config_t stop;
 } pour_control_config_t;
@@ -68,6 +71,7 @@ typedef struct {
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
   uint32_t tick;   /* ticks since init */
+  uint32_t refused; /* Reset and Stop requests refused so far (they changed nothing else) */
   bool brake;      /* engage the holding brake (IDLE, ESTOP, and FAULT once the stop is done) */
   bool power;      /* motor power stage enabled (RUN and an active stop only) */
 } pour_control_output_t;
@@ -92,7 +96,10 @@ typedef struct {
   pour_supervisor_t supervisor;
   uint32_t stop_ms;       /* ticks of the active stop so far */
   bool stopped;           /* the stop is over: brake and power cut until a clear */
-  uint32_t resets_refused; /* reset requests refused because the core was in RUN or ESTOP */
+  uint32_t refused;       /* Reset requests refused (RUN, ESTOP, an active stop) and Stops outside RUN */
+  bool have_trusted;      /* a fresh, plausible sample was taken since init */
+  int32_t trusted_theta_urad; /* the angle of the latest one: a restart of a held axis must find it again [µrad] */
+  bool check_restart;     /* the next fresh sample is the first after a restart of a held axis */
 } pour_control_t;
 
 /* Defaults: docs/safety.md lists them with their reasons. */

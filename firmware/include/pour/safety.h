@@ -55,4 +55,8 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
 /* Sets the command at once, bypassing the slew limit (e-stop and faults must not wait). */
 void pour_safety_force(pour_safety_t *safety, q15_t torque);
 
+/* Moves the command toward a torque to hold without a step: there at once when it lies between zero and the
+ * present command (less torque never waits), else by at most slew_per_tick (POUR_LIMIT_SLEW). Returns it. */
+q15_t pour_safety_hold(pour_safety_t *safety, q15_t target);
+
 #endif /* POUR_SAFETY_H */

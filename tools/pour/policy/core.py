@@ -68,7 +68,7 @@ class ControlInput(_Record):
 class ControlOutput(_Record):
     """pour_control_output_t: one tick's outputs."""
     _fields_ = [("torque", q15), ("action", C.c_uint8), ("probs", q15 * POLICY_MAX_ACTIONS), ("mode", C.c_uint8),
-                ("faults", C.c_uint16), ("limits", C.c_uint8), ("tick", C.c_uint32), ("brake", C.c_bool),
+                ("faults", C.c_uint16), ("limits", C.c_uint8), ("tick", C.c_uint32), ("refused", C.c_uint32), ("brake", C.c_bool),
                 ("power", C.c_bool)]
 
 
@@ -336,6 +336,7 @@ class Output:
     faults: int
     limits: int
     tick: int
+    refused: int
     brake: bool
     power: bool
 
@@ -380,7 +381,7 @@ class Controller(_Handle):
     def _output(self) -> Output:
         o = self._out
         return Output(int(o.torque), int(o.action), list(o.probs), int(o.mode), int(o.faults), int(o.limits),
-                      int(o.tick), bool(o.brake), bool(o.power))
+                      int(o.tick), int(o.refused), bool(o.brake), bool(o.power))
 
     def step(self, sample: Sequence[int] | None = None, estop: bool = False, clear_faults: bool = False,
              link_fault: bool = False, stop: bool = False, reset: bool = False) -> Output:
