@@ -65,7 +65,7 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
     import cantools
 
     from pour.can import dbc
-    db = cantools.database.load_file(str(dbc.DBC_PATH))
+    db = cantools.database.load_file(str(dbc.default_dbc()))
     lines = []
 
     def frame(t: float, name: str, **sig) -> None:

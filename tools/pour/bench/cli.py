@@ -10,7 +10,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from pour import atomic
+from pour import atomic, cli
 from pour.bench import node as bn
 from pour.policy import weights_h
 
@@ -63,7 +63,7 @@ def _seconds(text: str) -> float:
 
 
 def parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
+    ap = cli.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
     ap.add_argument("--iface", default="vcan0", help="CAN interface (python-can channel; default %(default)s)")
     ap.add_argument("--interface", default="socketcan", help="python-can interface (default %(default)s)")
     ap.add_argument("--node", type=_node_id, default=0, help="controller node id, 0..63 (default 0)")

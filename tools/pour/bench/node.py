@@ -91,8 +91,9 @@ def fault_signals(db: cantools.database.can.Database) -> list[str]:
     return [s.name for s in sorted(hb.signals, key=lambda s: s.start) if s.name.startswith("Fault_")]
 
 
-def load_dbc(path: Path = dbc.DBC_PATH) -> cantools.database.can.Database:
-    return cantools.database.load_file(str(path))
+def load_dbc(path: Path | None = None) -> cantools.database.can.Database:
+    """The protocol's DBC: path, or the one pour.can.dbc finds (the checkout's or the package's)."""
+    return cantools.database.load_file(str(path if path is not None else dbc.default_dbc()))
 
 
 def param_names(db: cantools.database.can.Database) -> dict[int, str]:
@@ -124,7 +125,7 @@ class Bench:
     """One CAN bus. channel/interface are python-can's; bus: an open python-can bus instead."""
 
     def __init__(self, channel: str = "vcan0", interface: str = "socketcan", bus: can.BusABC | None = None,
-                 dbc_path: Path = dbc.DBC_PATH) -> None:
+                 dbc_path: Path | None = None) -> None:
         self.db = load_dbc(dbc_path)
         self.channel = channel
         try:

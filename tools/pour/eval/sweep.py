@@ -149,7 +149,7 @@ def run_trial(doc: dict[str, Any], run_dir: str, held_out: int) -> dict[str, Any
     return {"iterations": res.iterations, "wall_s": res.wall_s, "best_score": res.best_score,
             "return_mean_last": float(log[-1]["return_mean"]) if log else float("nan"),
             "held_out": [{"poured_pct": 100 * e.metrics["v_target"], "spilled_pct": 100 * e.metrics["v_spill"],
-                          "finish_s": e.metrics["finish_s"],
+                          "finish_s": e.metrics["finish_s"], "reversals": e.metrics.get("reversals", float("nan")),  # the toy env counts none
                           "return": e.metrics.get("return", float(np.sum(e.rewards)))} for e in eps]}
 
 
@@ -211,7 +211,8 @@ def report(out: Path, config_path: str, trials: list[dict[str, Any]], pts: list[
         rows.append(results._row(label, f"output float policies of {len(mine)} runs (seeds "
                                  f"{', '.join(str(t['seed']) for t in mine)}), greedy",
                                  [e["poured_pct"] for e in eps], [e["spilled_pct"] for e in eps],
-                                 [e["finish_s"] for e in eps], [e["return"] for e in eps]))
+                                 [e["finish_s"] for e in eps], [e["return"] for e in eps],
+                                 [e["reversals"] for e in eps]))
         groups[label] = [Path(out) / "runs" / t["trial"] for t in mine]
     order = sorted(range(len(rows)), key=lambda k: -rows[k]["return"])
     table = (f"Sweep of `{config_path}`: {len(pts)} point(s) x {len(trials) // max(1, len(pts))} seed(s), best "

@@ -197,3 +197,6 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
         runner.close()
     final = trainer.load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
     return trainer.RunResult(run_dir, w, best_w, best_score, int(final["iteration"]), float(final["wall_s"]))
+
+
+trainer.SEARCH_METHODS.update(ars=train, cem=train)

@@ -10,6 +10,7 @@ never from the worker that runs them, so the number of workers does not change t
 from __future__ import annotations
 
 import csv
+import importlib
 import io
 import json
 import os
@@ -244,14 +245,20 @@ def validate(cfg: cfgmod.TrainConfig, runner: Any, w: np.ndarray, seeds: Sequenc
     return ev, float(np.std([np.sum(e.rewards) for e in veps])) / steps / np.sqrt(len(veps))
 
 
+# algo.kind -> its train(cfg, run_dir, resume, quiet, stop_after, make_runner); pour.train.ars registers
+# 'ars' and 'cem' when it is imported, which train() does by name for those kinds (ars builds on this module).
+SEARCH_METHODS: dict[str, Any] = {}
+SEARCH_MODULE = "pour.train.ars"
+
+
 def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, quiet: bool = False,
           stop_after: int | None = None, make_runner: Any = Runner) -> RunResult:
     """Trains (or resumes) a run in run_dir. stop_after: return after that many iterations this call.
     make_runner: cfg -> the episode runner (Runner, the local pool, or executors.RayRunner): same results."""
     run_dir = Path(run_dir)
     if cfg.algo.kind in ("ars", "cem"):
-        from pour.train import ars  # the search methods build on this module's run directory
-        return ars.train(cfg, run_dir, resume, quiet, stop_after, make_runner)
+        importlib.import_module(SEARCH_MODULE)  # the search methods build on this module's run directory
+        return SEARCH_METHODS[cfg.algo.kind](cfg, run_dir, resume, quiet, stop_after, make_runner)
     run_dir.mkdir(parents=True, exist_ok=True)
     ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
     digest = cfg.digest()
