@@ -149,6 +149,30 @@ def test_controller_estop_zeroes_torque_and_latches(controller):
     assert "brake_engagements 1 power_cuts 1" in c.out, c.out
 
 
+def test_controller_drops_a_clear_sent_while_the_estop_is_held(controller):
+    """docs/safety.md, transitions: "clear" with the e-stop still held, then the release, both before the next
+    tick (lockstep: no sample between them), clears nothing; a clear after the release does."""
+    u = url(9)
+    bus = Bus(u)
+    with Proc([controller, "--io", f"lcm:{u}", "--lockstep"]) as c:
+        bus.ask(0, theta=0.5)
+        bus.command(estop=True)
+        bus.pump(0.05)
+        assert bus.ask(1, theta=0.5).mode == 3
+        bus.command(estop=True, clear_faults=True)  # the clear arrives with the e-stop held
+        bus.command(estop=False)
+        bus.pump(0.05)
+        a = bus.ask(2, theta=0.5)  # the held e-stop of the clear's own message still counts in this tick
+        assert a.mode == 3 and a.torque_q15 == 0
+        a = bus.ask(3, theta=0.5)
+        assert a.mode == MODE_FAULT and a.faults & 0x2 and a.torque_q15 == 0
+        bus.command(clear_faults=True)
+        bus.pump(0.05)
+        bus.ask(4, theta=0.5)
+        assert bus.ask(5, theta=0.5).mode == MODE_RUN
+        assert c.stop() == 0
+
+
 def test_controller_real_time_ticks_without_states_and_counts(controller):
     u = url(5)
     bus = Bus(u)

@@ -46,10 +46,7 @@ typedef struct {
   pour_io_t *io;
   pour_control_t ctl;
   pour_linux_stats_t *stats;
-  bool estop;             /* level from the latest command */
-  bool clear_pending;     /* a clear request waiting for the next tick */
-  bool stop_pending;      /* a stop request waiting for the next tick */
-  bool reset_pending;     /* a reset request waiting for the next tick */
+  pour_commands_t commands; /* the commands since the last tick, in their order (the transport feeds it) */
   bool have_last;         /* an answer was sent (for lockstep resends) */
   int32_t last_episode;
   int64_t last_seq;
@@ -116,16 +113,10 @@ static void maybe_send_status(loop_t *l, bool force) {
   l->period_step_max_ns = 0;
 }
 
-/* Folds one wait's input into the loop: counters and the command level. */
+/* Folds one wait's counters into the loop (its commands went into l->commands as they arrived). */
 static void absorb(loop_t *l, const pour_io_input_t *in) {
   l->stats->states_received += in->n_samples;
   l->stats->messages_dropped += in->n_dropped;
-  if (in->have_command) {
-    l->estop = in->estop;
-    l->clear_pending = l->clear_pending || in->clear_faults;
-    l->stop_pending = l->stop_pending || in->stop;
-    l->reset_pending = l->reset_pending || in->reset;
-  }
 }
 
 static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
@@ -135,13 +126,7 @@ static void tick(loop_t *l, const pour_io_input_t *in, bool fresh) {
   if (fresh) {
     ci.sensors = in->sensors;
   }
-  ci.estop = l->estop;
-  ci.clear_faults = l->clear_pending;
-  ci.stop = l->stop_pending;
-  ci.reset = l->reset_pending;
-  l->clear_pending = false;
-  l->stop_pending = false;
-  l->reset_pending = false;
+  pour_commands_take(&l->commands, &ci);
   if (l->io->service != NULL) {
     l->io->service(l->io, &l->ctl);
   }
@@ -213,6 +198,7 @@ static void run_realtime(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
     }
     pour_io_input_t in;
     memset(&in, 0, sizeof in);
+    in.commands = &l->commands;
     int r;
     int n_waits = 0;
     while ((r = l->io->wait(l->io, 0, &in)) > 0 && n_waits < 1000) {
@@ -256,6 +242,7 @@ static void run_lockstep(loop_t *l, volatile sig_atomic_t *stop, int64_t t_end_n
     const int64_t timeout_us = until > now ? (until - now) / 1000 : 0;
     pour_io_input_t in;
     memset(&in, 0, sizeof in);
+    in.commands = &l->commands;
     const int r = l->io->wait(l->io, timeout_us, &in);
     if (r < 0) {
       l->stats->io_errors++;
@@ -292,6 +279,7 @@ int pour_linux_run(const pour_linux_config_t *config, pour_io_t *io, volatile si
                    pour_linux_stats_t *stats) {
   static loop_t l; /* large (the core's state); one loop per process */
   memset(&l, 0, sizeof l);
+  pour_commands_init(&l.commands);
   memset(stats, 0, sizeof *stats);
   l.config = config;
   l.io = io;

@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "pour/commands.h"
 #include "pour/control.h"
 #include "pour/sensors.h"
 
@@ -19,10 +20,8 @@ typedef struct {
   int64_t sample_seq;     /* its full sequence number (sensors.seq is the low 32 bits) */
   int32_t episode;        /* its episode index (transports without one report 0) */
   bool have_command;     /* a command arrived */
-  bool estop;            /* e-stop level of the latest command */
-  bool clear_faults;     /* any command during this wait asked to clear faults */
-  bool stop;             /* any command during this wait asked to end the run */
-  bool reset;            /* any command during this wait asked for a new run */
+  pour_commands_t *commands; /* the loop's, or NULL: a transport feeds each command into it as it arrives, so
+                              * that the order within a tick keeps its meaning (docs/safety.md) */
   uint32_t n_dropped;    /* messages on our channels that failed to decode */
 } pour_io_input_t;
 

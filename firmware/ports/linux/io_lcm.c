@@ -58,10 +58,19 @@ static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *us
     return;
   }
   s->in->have_command = true;
-  s->in->estop = msg.estop != 0;
-  s->in->clear_faults = s->in->clear_faults || msg.clear_faults != 0;
-  s->in->stop = s->in->stop || msg.stop != 0;
-  s->in->reset = s->in->reset || msg.reset != 0;
+  pour_commands_t *c = s->in->commands;
+  if (c != NULL) { /* one message: its e-stop level first, then what it asks for under that level */
+    pour_commands_estop(c, msg.estop != 0);
+    if (msg.clear_faults != 0) {
+      pour_commands_clear(c);
+    }
+    if (msg.stop != 0) {
+      pour_commands_stop(c);
+    }
+    if (msg.reset != 0) {
+      pour_commands_reset(c);
+    }
+  }
 }
 
 static int64_t now_us(void) {
