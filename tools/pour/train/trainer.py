@@ -362,7 +362,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: str | Path, resume: bool = True, qui
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} H {ent:.2f} "
                       f"KL {stats['kl']:.4f} eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s, "
-                      f"{cli.time_left(done, cfg.iterations - start, time.monotonic() - t0)} left]",
+                      f"{cli.time_left(it + 1 - start, cfg.iterations - start, time.monotonic() - t0)} left]",
                       file=sys.stderr, flush=True)
         runner.close()
     final = load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
