@@ -134,17 +134,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     model.check(in, out, ctl.state.theta_urad);
     pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
     const uint8_t n_tx = pour_can_node_end_tick(&node, &out, fdp.ConsumeIntegral<uint8_t>(), tx);
-    FUZZ_CHECK(n_tx == 1 || n_tx == 3, "%u frames", n_tx);
+    FUZZ_CHECK(n_tx >= 1 && n_tx <= POUR_CAN_NODE_MAX_TX, "%u frames", n_tx);
     pour_can_torque_t t{};
     FUZZ_CHECK(pour_can_unpack_torque(&tx[0], &t) == POUR_CAN_RX_OK && tx[0].id == pour_can_id(ncfg.node_id, POUR_CAN_CMD_TORQUE),
                "the first frame is not our torque frame (id 0x%03x)", tx[0].id);
     FUZZ_CHECK(t.torque == out.torque && t.mode == out.mode, "the torque frame says %d/%u, the core %d/%u", t.torque,
                t.mode, out.torque, out.mode);
-    if (n_tx == 3) {
+    // After the torque frame: the heartbeat and identity when due, a CalibrationResult when one was asked for;
+    // each decodes.
+    for (uint8_t k = 1; k < n_tx; ++k) {
+      const uint8_t cmd = static_cast<uint8_t>(tx[k].id & POUR_CAN_CMD_MASK);
       pour_can_heartbeat_t hb{};
       pour_can_identity_t id{};
-      FUZZ_CHECK(pour_can_unpack_heartbeat(&tx[1], &hb) == POUR_CAN_RX_OK, "bad heartbeat frame");
-      FUZZ_CHECK(pour_can_unpack_identity(&tx[2], &id) == POUR_CAN_RX_OK, "bad identity frame");
+      pour_can_calibration_result_t cal{};
+      const bool ok = (cmd == POUR_CAN_CMD_HEARTBEAT && pour_can_unpack_heartbeat(&tx[k], &hb) == POUR_CAN_RX_OK) ||
+                      (cmd == POUR_CAN_CMD_IDENTITY && pour_can_unpack_identity(&tx[k], &id) == POUR_CAN_RX_OK) ||
+                      (cmd == POUR_CAN_CMD_CALIBRATION_RESULT &&
+                       pour_can_unpack_calibration_result(&tx[k], &cal) == POUR_CAN_RX_OK);
+      FUZZ_CHECK(ok, "frame %u (cmd 0x%02x) does not decode", k, cmd);
     }
     if (trace)
       std::fprintf(stderr, "tick %u: fresh %d estop %d clear %d | core mode %u faults %x torque %d | link fault %d since_valid %u | bus %d\n",
