@@ -16,6 +16,6 @@ case "${1:-}" in
   "") ;;
   *) echo "build.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
 esac
-./scripts/setup.sh
+./scripts/setup.sh --build
 cmake --preset host >/dev/null
 cmake --build --preset host --target "${TARGETS[@]}"

@@ -3,12 +3,27 @@
 # Installs everything pour needs on Debian 12 (bookworm): apt packages, a pinned Python venv in .venv,
 # the Unity test framework in .deps/unity, and ST's register description of the STM32G4 (the stm32g4 crate,
 # in cargo's home). Idempotent: a second run checks and changes nothing.
+#   ./scripts/setup.sh              all of that
+#   ./scripts/setup.sh --build      what the build and the README's commands need: not the stm32g4 crate, which
+#                                   only a test reads (scripts/build.sh, scripts/demo.sh; Debian 12's own cargo
+#                                   fetches it through crates.io's git index, a long download)
+#   ./scripts/setup.sh --with-sb3   and the optional Stable-Baselines3 extra in .venv (stable-baselines3 and
+#                                   torch from tools/requirements-sb3.lock, about 2.9 GB: pour.examples.sb3_ppo)
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
 . scripts/lib/cli.sh
 pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
+WITH_SB3=0
+WITH_CRATE=1
+for arg in "$@"; do
+  case "$arg" in
+    --with-sb3) WITH_SB3=1 ;;
+    --build) WITH_CRATE=0 ;;
+    *) echo "setup.sh: unknown argument '$arg' (see --help)" >&2; exit 2 ;;
+  esac
+done
 
 log() { printf '[setup] %s\n' "$*" >&2; }
 
@@ -58,6 +73,16 @@ if [ "$(cat .venv/.pour-stamp 2>/dev/null)" != "$stamp_want" ]; then
   .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e tools
   echo "$stamp_want" > .venv/.pour-stamp
 fi
+if [ "$WITH_SB3" = 1 ]; then
+  sb3_want=$(cat tools/requirements.lock tools/requirements-sb3.lock | sha256sum | cut -c1-16)
+  if [ "$(cat .venv/.pour-sb3-stamp 2>/dev/null)" != "$sb3_want" ]; then
+    log "venv: installing tools/requirements-sb3.lock (Stable-Baselines3, torch)"
+    # Both locks at once, so that pip checks the extra's pins against the main lock's.
+    .venv/bin/python -m pip install -q --disable-pip-version-check --require-hashes \
+      -r tools/requirements.lock -r tools/requirements-sb3.lock
+    echo "$sb3_want" > .venv/.pour-sb3-stamp
+  fi
+fi
 
 # Unity 2.5 (ThrowTheSwitch), as carried in Debian's ntpsec source package, pinned by hash.
 UNITY_DIR=.deps/unity
@@ -96,8 +121,8 @@ SVD_CRATE_VERSION=0.16.0
 SVD_CRATE_SHA256=97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d
 SVD_WORK=.deps/stm32g4
 svd_dir=$(cat "$SVD_WORK/crate-dir" 2>/dev/null || true)
-if [ -z "$svd_dir" ] || [ ! -f "$svd_dir/src/stm32g431/mod.rs" ] \
-   || ! cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"; then
+if [ "$WITH_CRATE" = 1 ] && { [ -z "$svd_dir" ] || [ ! -f "$svd_dir/src/stm32g431/mod.rs" ] \
+   || ! cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"; }; then
   log "stm32g4: fetching the $SVD_CRATE $SVD_CRATE_VERSION crate with cargo"
   mkdir -p "$SVD_WORK/src"
   cp scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"
