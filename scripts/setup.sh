@@ -71,6 +71,9 @@ if [ "$(cat .venv/.pour-stamp 2>/dev/null)" != "$stamp_want" ]; then
   .venv/bin/python -m pip install -q --disable-pip-version-check --require-hashes -r tools/requirements.lock
   # The build runs in the venv (setuptools, wheel and lcm from the lock): nothing unpinned is fetched for it.
   .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e tools
+  # A wheel carries the start-up hook that registers the Gymnasium ids (tools/setup.py); an editable install
+  # does not, so the same file goes into the venv's site-packages here.
+  cp tools/_pour_gymnasium.pth "$(.venv/bin/python -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')/"
   echo "$stamp_want" > .venv/.pour-stamp
 fi
 if [ "$WITH_SB3" = 1 ]; then

@@ -2,7 +2,8 @@
 """Build hook of the pour-tools wheel: it carries the CAN protocol's DBC and the generated Python LCM types
 as package data (pour/data/), made at build time from their one source in the checkout (can/pour.dbc,
 lcmtypes/pour/*.lcm, through the LCM wheel's lcm-gen), so an installed package needs no checkout. An
-editable install reads them from the checkout and its build tree instead (pour.paths)."""
+editable install reads them from the checkout and its build tree instead (pour.paths). The wheel also
+carries _pour_gymnasium.pth, the start-up hook that registers the Gymnasium ids (_pour_gymnasium.py)."""
 from __future__ import annotations
 
 import shutil
@@ -17,6 +18,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 from pour import paths  # noqa: E402  (stdlib only: the names of the data files and folders)
+
+GYM_HOOK_PTH = "_pour_gymnasium.pth"
 
 
 def lcm_gen() -> str:
@@ -39,6 +42,8 @@ class BuildWithData(build_py):
         super().run()
         if getattr(self, "editable_mode", False):
             return
+        # site runs a .pth only from site-packages itself, so it sits beside the packages, not in one.
+        shutil.copyfile(HERE / GYM_HOOK_PTH, Path(self.build_lib) / GYM_HOOK_PTH)
         data = Path(self.build_lib) / "pour" / paths.PACKAGE_DATA.name
         data.mkdir(parents=True, exist_ok=True)
         for name, source in paths.DATA_SOURCES.items():

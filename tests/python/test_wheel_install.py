@@ -7,6 +7,7 @@ pour-lcm-cmd, pour-lcmlog on a log recorded with lcm-logger).
 No network: the wheel builds without build isolation in the project's venv, installs with --no-index
 --no-deps, and the fresh venv sees its dependencies (the lock's packages) through a .pth line to the
 project venv's site-packages, after its own, so `pour` itself comes from the wheel alone."""
+import csv
 import json
 import os
 import shutil
@@ -115,3 +116,53 @@ def test_lcm_tools_read_the_packaged_types(installed, tmp_path):
     assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
     (ep,) = json.loads(r.stdout)["episodes"]
     assert ep["last_seq"] >= 900
+
+
+# Run in the wheel's venv: a program that imports gymnasium, never pour, and makes pour's id. The start-up
+# hook (_pour_gymnasium.pth) must not have imported either before the program did.
+GYM_PROGRAM = r"""
+import json, sys
+assert "gymnasium" not in sys.modules and "pour" not in sys.modules, "imported at start-up"
+import gymnasium as gym
+from gymnasium.utils.env_checker import check_env
+assert "pour.sim.gym_env" not in sys.modules  # registered lazily: the env module loads at make
+env = gym.make("pour/Pour-v0", render_mode="rgb_array")
+assert env.spec.max_episode_steps == 1000
+check_env(env.unwrapped, skip_render_check=False)
+obs, info = env.reset(seed=int(sys.argv[1]))
+v_target, v_spill = [], []
+for a in sys.argv[2].split(","):
+    obs, reward, terminated, truncated, info = env.step(int(a))
+    v_target.append(info["v_target"])
+    v_spill.append(info["v_spill"])
+print(json.dumps({"v_target": v_target, "v_spill": v_spill, "truncated": truncated,
+                  "frame": list(env.render().shape), "module": sys.modules["pour"].__file__}))
+"""
+
+
+def test_gymnasium_makes_pour_ids_without_importing_pour(installed, source_dir, tmp_path):
+    """gymnasium.make("pour/Pour-v0", render_mode="rgb_array") in a program that never imports pour; check_env
+    passes; reset(seed=1000001), then host_sim's own decisions, give host_sim --seed 1000001's episode."""
+    bin_dir, work, env = installed
+    seed = 1000001
+    steps = tmp_path / "steps.csv"
+    r = run([BUILD_DIR / "bin" / "host_sim", "--policy", source_dir / "policy" / "weights.h", "--seed", seed,
+             "--json", "--quiet", "--csv", steps])
+    assert r.returncode == 0, r.stderr
+    want = json.loads(r.stdout)
+    with steps.open() as f:
+        rows = list(csv.DictReader(f))
+    # One decision per 10 ms: the action in force at its first tick; the volumes after its last.
+    actions = [row["action"] for row in rows[::10]]
+    assert len(actions) == 1000 and len(set(actions)) > 1
+    r = run([bin_dir / "python", "-c", GYM_PROGRAM, seed, ",".join(actions)], cwd=work,
+            env=dict(env, POUR_SIM_LIB=str(BUILD_DIR / "lib" / "libpoursim.so")))
+    assert r.returncode == 0, r.stderr
+    got = json.loads(r.stdout)
+    assert Path(got["module"]).is_relative_to(bin_dir.parent)  # pour came from the wheel, through the hook
+    assert got["truncated"] and got["frame"][2] == 3
+    # The same episode: host_sim's figures, and its volumes (%.6f in the CSV) after every decision.
+    assert round(100.0 * got["v_target"][-1], 3) == want["poured_pct"] and want["poured_pct"] > 90
+    assert round(100.0 * got["v_spill"][-1], 3) == want["spilled_pct"]
+    assert [round(v, 6) for v in got["v_target"]] == [float(row["v_target"]) for row in rows[9::10]]
+    assert [round(v, 6) for v in got["v_spill"]] == [float(row["v_spill"]) for row in rows[9::10]]

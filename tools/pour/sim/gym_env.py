@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: MIT
 """A Gymnasium environment over the pour simulator, for users who bring their own RL library.
 
-    import gymnasium, pour.sim.gym_env
+    import gymnasium                                # the installed package registers pour's ids
     env = gymnasium.make("pour/Pour-v0")            # Box2D simulator (libpoursim), 11 torque levels
-    env = gymnasium.make("pour.sim.gym_env:pour/Pour-v0", render_mode="rgb_array")  # imports pour itself
+    env = gymnasium.make("pour.sim.gym_env:pour/Pour-v0", render_mode="rgb_array")  # Gymnasium's own way
     env = gymnasium.make("pour/PourRandomised-v0")  # the rig randomised as training randomises it
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
@@ -25,13 +25,7 @@ import numpy as np
 from gymnasium import spaces
 
 from pour.policy import linear
-from pour.sim import envs
-
-
-# The rig's spread that training randomises over (configs/train/pour11.toml's [env.options]), for
-# pour/PourRandomised-v0.
-RANDOMISED_RIG = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0.02, "rand_motor": 0.15,
-                  "rand_bucket_mass": 0.2, "rand_liquid": 0.2, "rand_sensor": 0.5}
+from pour.sim import envs, gym_ids
 
 
 class PourEnv(gym.Env):
@@ -68,6 +62,11 @@ class PourEnv(gym.Env):
         self.observation_space = spaces.Box(0.0, 1.0, shape=(5,), dtype=np.float32)
         self._k = 0
         self._started = False
+
+    @property
+    def tau_max_nm(self) -> float:
+        """The plant's full-scale torque [N.m] (the actions' levels are fractions of it)."""
+        return float(self._plant.tau_max_nm)
 
     def _obs(self) -> np.ndarray:
         return np.asarray(self._plant.features()[:5], dtype=np.float32)
@@ -155,9 +154,4 @@ def scene_rgb(world: Any, width: int = 320, height: int = 240) -> np.ndarray:
     return img
 
 
-# max_episode_steps: decisions in the default 10 s episode at the default 10 ms period.
-gym.register(id="pour/Pour-v0", entry_point="pour.sim.gym_env:PourEnv", max_episode_steps=1000)
-gym.register(id="pour/PourRandomised-v0", entry_point="pour.sim.gym_env:PourEnv", max_episode_steps=1000,
-             kwargs={"options": RANDOMISED_RIG})
-gym.register(id="pour/PourToy-v0", entry_point="pour.sim.gym_env:PourEnv", kwargs={"backend": "toy"},
-             max_episode_steps=1000)
+gym_ids.register_all()
