@@ -131,6 +131,7 @@ ALLOWED: dict[str, set[str]] = {
     "lcm": {"eval", "sim"},
     "can": set(),
     "bench": {"can", "policy"},
+    "examples": {"sim", "policy"},
 }
 
 

@@ -58,6 +58,20 @@ def _matrix(path: Path, name: str, value: Any, n_actions: int) -> np.ndarray:
     return np.array(value, dtype=np.float64)
 
 
+POLICY_FORMAT = "pour-policy-1"
+
+
+def write_policy(path: str | Path, n_actions: int, decision_period_ms: int, tau_max_nm: float,
+                 norm: dict[str, float], w: np.ndarray, best_w: np.ndarray, **fields: Any) -> None:
+    """Writes a policy.json that load_policy reads (atomically, deterministic bytes: sorted keys, no times):
+    the trainer's output and any other learner's (pour.examples.sb3_ppo). norm: theta_min_rad,
+    theta_max_rad, omega_max_rad_s; fields: anything else the writer records (config, iteration, ...)."""
+    doc = dict(fields, format=POLICY_FORMAT, n_actions=int(n_actions), decision_period_ms=int(decision_period_ms),
+               tau_max_nm=float(tau_max_nm), norm=dict(norm), w=np.asarray(w).tolist(),
+               best_w=np.asarray(best_w).tolist())
+    atomic.write_atomic(path, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
+
+
 def load_policy(path: str | Path) -> dict[str, Any]:
     """Reads a run's policy.json (or the run directory holding it) and checks every field the export uses:
     one ExportError naming the first bad field. Numbers come back as int/float, W as arrays."""
@@ -70,8 +84,8 @@ def load_policy(path: str | Path) -> dict[str, Any]:
         raise ExportError(f"{path}: cannot read ({exc.strerror})") from exc
     except (json.JSONDecodeError, UnicodeDecodeError, RecursionError) as exc:
         raise ExportError(f"{path}: not valid JSON ({str(exc)[:80]})") from exc
-    if not isinstance(doc, dict) or doc.get("format") != "pour-policy-1":
-        raise ExportError(f"{path}: not a pour policy file (format 'pour-policy-1' expected)")
+    if not isinstance(doc, dict) or doc.get("format") != POLICY_FORMAT:
+        raise ExportError(f"{path}: not a pour policy file (format '{POLICY_FORMAT}' expected)")
     for key in ("n_actions", "decision_period_ms", "tau_max_nm", "norm", "w", "best_w"):
         if key not in doc:
             raise ExportError(f"{path}: missing field {key!r}")

@@ -15,8 +15,8 @@ import numpy as np
 
 from pour.policy import linear
 from pour.sim.poursim import Reward
-from pour.sim.episode import (N_FEATURES, OMEGA_MAX_RAD_S, THETA_MAX_RAD, THETA_MIN_RAD, EnvError,  # noqa: F401
-                              Episode, normalise)
+from pour.sim.episode import (N_FEATURES, NORM, OMEGA_MAX_RAD_S, THETA_MAX_RAD, THETA_MIN_RAD,  # noqa: F401
+                              EnvError, Episode, normalise)
 
 
 def choose(w: np.ndarray, x: np.ndarray, greedy: bool, rng: np.random.Generator) -> int:

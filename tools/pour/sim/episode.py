@@ -16,6 +16,8 @@ from pour.policy import linear
 THETA_MIN_RAD = 0.0
 THETA_MAX_RAD = 2.356194        # 135 deg
 OMEGA_MAX_RAD_S = 4.0
+# The normalisation as a policy.json records it (pour.policy.export.write_policy).
+NORM = {"theta_min_rad": THETA_MIN_RAD, "theta_max_rad": THETA_MAX_RAD, "omega_max_rad_s": OMEGA_MAX_RAD_S}
 N_FEATURES = 6
 
 

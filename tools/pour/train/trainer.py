@@ -23,7 +23,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from pour import cli
-from pour.policy import linear
+from pour.policy import export, linear
 from pour.sim import envs
 from pour.train import config as cfgmod
 from pour.train import executors, reinforce
@@ -115,13 +115,8 @@ def write_policy_json(path: Path, cfg: cfgmod.TrainConfig, tau_max_nm: float, it
     and nothing else), so a re-run exports the same weights.h whatever its worker count."""
     config = cfg.to_dict()
     del config["workers"]
-    doc = {"format": "pour-policy-1", "config": config, "config_digest": cfg.digest(),
-           "iteration": iteration, "n_actions": cfg.policy.n_actions,
-           "decision_period_ms": cfg.policy.decision_period_ms, "tau_max_nm": tau_max_nm,
-           "norm": {"theta_min_rad": envs.THETA_MIN_RAD, "theta_max_rad": envs.THETA_MAX_RAD,
-                    "omega_max_rad_s": envs.OMEGA_MAX_RAD_S},
-           "best_score": best_score, "w": w.tolist(), "best_w": best_w.tolist()}
-    atomic_write_bytes(path, (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
+    export.write_policy(path, cfg.policy.n_actions, cfg.policy.decision_period_ms, tau_max_nm, envs.NORM, w, best_w,
+                        config=config, config_digest=cfg.digest(), iteration=iteration, best_score=best_score)
 
 
 def episode_return(ep: envs.Episode, gamma_decision: float) -> float:

@@ -1,0 +1,155 @@
+# SPDX-License-Identifier: MIT
+"""Stable-Baselines3's PPO on pour/Pour-v0, restricted to the policy class the firmware runs, exported to
+weights.h through pour-export's own code.
+
+The firmware runs softmax-linear policies only, pi(a|x) = softmax(x.W) over the six features (the five
+normalised state variables and a bias): a fixed-point dot product per action fits a Cortex-M4's 1 ms step
+with a bounded, checkable worst case. So the actor here has no hidden layer: SB3's MlpPolicy with
+net_arch pi=[] puts one nn.Linear(5, n_actions) on the observation under a categorical distribution,
+which is that class exactly (its weight and bias are W's rows). The critic is an MLP: it only trains and
+is not exported.
+
+    ./scripts/setup.sh --with-sb3                                      # the extra: SB3 and torch
+    .venv/bin/python -m pour.examples.sb3_ppo --steps 200000 --out runs/sb3_ppo
+    .venv/bin/pour-export runs/sb3_ppo --out policy/weights.h          # or --header here
+
+    from pour.examples import sb3_ppo
+    w = sb3_ppo.train_linear(steps=200_000, seed=1)                    # W [6][n_actions], float
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any, Sequence
+
+import gymnasium as gym
+import numpy as np
+
+from pour import atomic, cli
+from pour.policy import export
+from pour.sim import episode, gym_env
+
+ENV_ID = "pour/Pour-v0"
+# PPO's settings: one rollout of 1024 decisions (10.24 s of pour) per update, 10 epochs of minibatches of 256.
+PPO_DEFAULTS: dict[str, Any] = {"n_steps": 1024, "batch_size": 256, "n_epochs": 10, "gamma": 0.99,
+                                "learning_rate": 3e-4, "ent_coef": 0.0}
+CRITIC = [64, 64]
+
+
+class ExampleError(RuntimeError):
+    """The sb3 extra is missing, or the run cannot be written."""
+
+
+def _sb3():
+    try:
+        import stable_baselines3
+        import torch
+    except ImportError as exc:
+        raise ExampleError(f"{exc.name} is not installed: this example needs the sb3 extra "
+                           "(./scripts/setup.sh --with-sb3, or pip install './tools[sb3]')") from None
+    return stable_baselines3, torch
+
+
+def make_model(env: Any, seed: int, **ppo_kwargs: Any) -> Any:
+    """A PPO whose actor is softmax-linear (no hidden layer) and whose critic is an MLP, on CPU, seeded."""
+    sb3, torch = _sb3()
+    # One thread: the networks are tiny, and a single-threaded CPU run is reproducible from its seed.
+    torch.set_num_threads(1)
+    kwargs = dict(PPO_DEFAULTS, **ppo_kwargs)
+    return sb3.PPO("MlpPolicy", env, seed=seed, device="cpu", verbose=0,
+                   policy_kwargs={"net_arch": {"pi": [], "vf": CRITIC}}, **kwargs)
+
+
+def linear_weights(model: Any) -> np.ndarray:
+    """The actor as the firmware's W [6][n_actions]: the linear layer's weight (transposed) over its bias."""
+    if getattr(model.policy.mlp_extractor, "latent_dim_pi", None) != model.observation_space.shape[0]:
+        raise ExampleError("the policy's actor has a hidden layer: it is not softmax-linear")
+    layer = model.policy.action_net
+    weight = layer.weight.detach().cpu().numpy().astype(np.float64)
+    bias = layer.bias.detach().cpu().numpy().astype(np.float64)
+    return np.vstack([weight.T, bias[None, :]])
+
+
+def _progress_callback(total: int, quiet: bool) -> Any:
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Progress(BaseCallback):
+        def _on_training_start(self) -> None:
+            self.bar = cli.bar(total, desc="PPO", quiet=quiet, unit="step")
+
+        def _on_step(self) -> bool:
+            self.bar.update(self.training_env.num_envs)
+            return True
+
+        def _on_training_end(self) -> None:
+            self.bar.close()
+
+    return Progress()
+
+
+def train(steps: int, seed: int = 1, env_id: str = ENV_ID, quiet: bool = True, env_kwargs: dict | None = None,
+          **ppo_kwargs: Any) -> tuple[Any, np.ndarray]:
+    """Trains PPO for `steps` env steps (decisions) on env_id; returns (the SB3 model, its W [6][n_actions])."""
+    if steps < 1:
+        raise ExampleError(f"steps = {steps}: expected at least 1")
+    env = gym.make(env_id, **(env_kwargs or {}))
+    model = make_model(env, seed, **ppo_kwargs)
+    model.learn(total_timesteps=int(steps), callback=_progress_callback(int(steps), quiet))
+    return model, linear_weights(model)
+
+
+def train_linear(steps: int, seed: int = 1, env_id: str = ENV_ID, **kwargs: Any) -> np.ndarray:
+    """W [6][n_actions] of a PPO run (train), for callers that want the weights only."""
+    return train(steps, seed, env_id, **kwargs)[1]
+
+
+def _make_dir(path: str | Path) -> Path:
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ExampleError(f"{path}: cannot create ({exc.strerror})") from None
+    return path
+
+
+def write_run(run_dir: str | Path, model: Any, w: np.ndarray, steps: int, seed: int, env_id: str) -> Path:
+    """run_dir/policy.json (what pour-export reads) and run_dir/sb3_model.zip (SB3's own save)."""
+    run_dir = _make_dir(run_dir)
+    pe = model.get_env().envs[0].unwrapped
+    if not isinstance(pe, gym_env.PourEnv):
+        raise ExampleError(f"{env_id} is not a pour environment")
+    path = run_dir / "policy.json"
+    export.write_policy(path, pe.action_space.n, pe.period, pe.tau_max_nm, episode.NORM, w, w,
+                        learner="stable-baselines3 PPO", env_id=env_id, steps=int(steps), seed=int(seed),
+                        ppo=dict(PPO_DEFAULTS), critic=list(CRITIC))
+    model.save(run_dir / "sb3_model.zip")
+    return path
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = cli.ArgumentParser(prog="python -m pour.examples.sb3_ppo", description=__doc__.split("\n")[0])
+    ap.add_argument("--steps", type=int, default=200_000, help="env steps (10 ms decisions) to train")
+    ap.add_argument("--seed", type=int, default=1, help="PPO's and the env's seed")
+    ap.add_argument("--env", default=ENV_ID, help=f"Gymnasium id (default {ENV_ID}; pour/PourRandomised-v0)")
+    ap.add_argument("-o", "--out", required=True, type=Path, help="run directory: policy.json, sb3_model.zip")
+    ap.add_argument("--header", type=Path, help="also export weights.h here (as pour-export RUN --out HEADER)")
+    ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    args = ap.parse_args(argv)
+    try:
+        _make_dir(args.out)
+        if args.header is not None:
+            atomic.check_output_path(args.header, "--header")
+        model, w = train(args.steps, args.seed, args.env, quiet=args.quiet)
+        path = write_run(args.out, model, w, args.steps, args.seed, args.env)
+        print(f"{path}: W [6][{w.shape[1]}] of PPO, {args.steps} steps, seed {args.seed}")
+        if args.header is not None:
+            export.export(path, args.header)
+            print(f"{args.header}: exported")
+    except (ExampleError, export.ExportError, episode.EnvError, gym.error.Error, ValueError) as exc:
+        print(f"sb3_ppo: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
