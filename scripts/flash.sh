@@ -8,6 +8,8 @@
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+. "$ROOT/scripts/lib/cli.sh"
+pour_script_cli "$ROOT/scripts/$(basename "$0")" "$@"
 IMAGE=${1:-$ROOT/build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf}
 OPENOCD=${OPENOCD:-openocd}
 

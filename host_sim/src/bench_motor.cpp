@@ -15,8 +15,8 @@
 
 namespace {
 
-int usage() {
-  std::fprintf(stderr,
+int usage(FILE *f = stderr) {
+  std::fprintf(f,
                "usage: bench_motor [--weights FILE] [--seed S] [--step-csv FILE] [--bus-csv FILE]\n"
                "  prints the current step, the torque against speed, the bus through the pour with flux\n"
                "  braking on and off, and the full drive's cost; the CSVs are the traces for the plots\n");
@@ -46,6 +46,14 @@ double seconds_per_episode(const poursim_config_t &c, const std::string &weights
 int main(int argc, char **argv) {
   std::string weights = "policy/weights.h", step_csv, bus_csv;
   uint32_t seed = 1;
+  if (argc == 2 && std::string(argv[1]) == "--help") {
+    usage(stdout);
+    return 0;
+  }
+  if (argc == 2 && std::string(argv[1]) == "--version") {
+    std::printf("bench_motor %s\n", POUR_VERSION);
+    return 0;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc) return usage();

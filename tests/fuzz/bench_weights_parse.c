@@ -51,6 +51,15 @@ static size_t make(int kind, const char *good, size_t good_len, size_t size, cha
 }
 
 int main(int argc, char **argv) {
+  if (argc == 2 && strcmp(argv[1], "--help") == 0) {
+    printf("usage: bench_weights_parse [EXAMPLE.h]\n  times host_sim's weights.h parser on 128 KiB .. 1 MiB "
+           "headers grown from EXAMPLE.h\n  (default policy/example_weights.h): two accepted, one refused\n");
+    return 0;
+  }
+  if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+    printf("bench_weights_parse %s\n", POUR_VERSION);
+    return 0;
+  }
   const char *example = argc > 1 ? argv[1] : "policy/example_weights.h";
   size_t good_len = 0;
   char *good = read_file(example, &good_len);

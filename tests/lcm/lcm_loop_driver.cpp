@@ -86,6 +86,9 @@ int main(int argc, char **argv) {
     } else if (a == "--help") {
       usage(stdout);
       return 0;
+    } else if (a == "--version") {
+      std::printf("lcm_loop_driver %s\n", POUR_VERSION);
+      return 0;
     } else {
       std::fprintf(stderr, "lcm_loop_driver: unknown or incomplete option '%s'\n", a.c_str());
       usage(stderr);

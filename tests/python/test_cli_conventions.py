@@ -16,9 +16,10 @@ from lcm_helpers import compiled_weights
 
 VERSION = re.search(r'^version = "([0-9.]+)"$', (SOURCE_DIR / "tools" / "pyproject.toml").read_text(),
                     re.MULTILINE).group(1)
-C_PROGRAMS = ["host_sim", "pour_controller", "can_bridge", "fault_pour"]
+C_PROGRAMS = ["host_sim", "pour_controller", "can_bridge", "fault_pour",
+              "bench_fluid", "bench_motor", "bench_weights_parse", "lcm_loop_driver"]  # the last four: benchmarks, test drivers
 WITH_WEIGHTS = {"pour_controller", "fault_pour"}
-SCRIPTS = ["setup.sh", "build.sh", "demo.sh", "test.sh", "bench.sh"]
+SCRIPTS = ["setup.sh", "build.sh", "demo.sh", "test.sh", "bench.sh", "flash.sh"]
 ENTRY_POINTS = sorted(e.name for e in metadata.distribution("pour-tools").entry_points
                       if e.group == "console_scripts")
 
@@ -92,3 +93,8 @@ def test_host_sim_suggests_a_key(key, hint):
 def test_host_sim_bad_value_of_a_known_key_has_no_suggestion():
     r = run(BUILD_DIR / "bin" / "host_sim", "--baseline", "rate", "--set", "substeps=99")
     assert r.returncode == 2 and "out of range" in r.stderr and "did you mean" not in r.stderr, r.stderr
+
+
+def test_bench_fluid_refuses_an_argument_instead_of_timing():
+    r = run(BUILD_DIR / "bin" / "bench_fluid", "--steps")
+    assert r.returncode == 2 and r.stdout == "" and "takes no arguments" in r.stderr, r.stderr
