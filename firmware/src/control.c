@@ -288,6 +288,8 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     if ((ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) && !stopping) {
       expect_held_angle(ctl);
       start_afresh(ctl);
+      /* In FAULT the run's state restarts, but the brake keeps holding: only a clear releases it. */
+      ctl->stopped = ctl->mode == POUR_MODE_FAULT;
     } else {
       count_refused(ctl);
     }

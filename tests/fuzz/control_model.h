@@ -85,6 +85,8 @@ class ControlModel {
       FUZZ_CHECK(out.brake && on_the_way(out.torque, torque_), "torque %d in IDLE after %d", out.torque, torque_);
     } else {
       FUZZ_CHECK(out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
+      // Once a fault's stop is over the brake holds until a clear: no Reset, sample or storm releases it.
+      FUZZ_CHECK(!(held_ && mode == POUR_MODE_FAULT && out.power), "the brake released in FAULT after the stop ended");
     }
     // Continuity across every transition (power-on, stop, reset, clear, a fault, the stop's end): at most the
     // slew limit from the last command, or less torque toward zero, which never waits ...
@@ -116,6 +118,7 @@ class ControlModel {
     torque_ = out.torque;
     power_ = out.power;
     refused_ = out.refused;
+    held_ = (out.mode == POUR_MODE_FAULT || out.mode == POUR_MODE_ESTOP) && !out.power;
   }
 
   // Between the last command and the safe torque, or between it and zero (the safe torque cut at a limit).
@@ -131,6 +134,7 @@ class ControlModel {
   uint16_t faults_ = 0;
   q15_t torque_;
   bool power_ = false;  // the last tick drove the motor (RUN, the active stop)
+  bool held_ = false;   // the last tick was FAULT or ESTOP with the brake holding (the stop over, or none)
   uint32_t refused_ = 0;
 };
 

@@ -45,6 +45,8 @@ void setUp(void) {
   sense(0, FULL_G, 0); /* upright, still, the liquid in the rotating bucket: the example policy pushes */
   in.estop = false;
   in.clear_faults = false;
+  in.stop = false;
+  in.reset = false;
 }
 
 void tearDown(void) {}
@@ -471,6 +473,36 @@ static void test_control_transitions_ClearIsRefusedDuringTheActiveStop(void) {
   assert_refused_during_the_active_stop(&in.clear_faults);
 }
 
+/* A Reset accepted once the stop is over restarts the run's state, not the motion: with fresh samples coming,
+ * the brake keeps holding and the fault stays latched (it used to re-arm the active stop and release the
+ * brake) until a clear. A Reset and a Stop every tick for a second change nothing of that. */
+static void test_control_transitions_ResetOfAHeldAxisKeepsTheBrakeUntilAClear(void) {
+  run_into_the_active_stop();
+  const int32_t held = 2450000;
+  sense(held, FULL_G, 0);
+  for (unsigned t = 0; t < 6000u && out.power; ++t) {
+    step(true);
+  }
+  TEST_ASSERT_TRUE(out.brake);
+  for (unsigned t = 0; t < 1000u; ++t) {
+    in.reset = true;
+    in.stop = true;
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+    TEST_ASSERT_BITS_HIGH(POUR_FAULT_POSITION, out.faults);
+    TEST_ASSERT_TRUE(out.brake);
+    TEST_ASSERT_FALSE(out.power);
+  }
+  in.reset = false;
+  in.stop = false;
+  TEST_ASSERT_EQUAL_UINT32(1000u, out.refused); /* the Stops; each Reset was taken */
+  in.clear_faults = true;
+  step(false);
+  in.clear_faults = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_UINT16(0u, out.faults);
+}
+
 /* Once the stop is over and the brake holds the bucket, a Reset is accepted, and the restarted estimator checks
  * its first sample against the last trusted angle: a 155 deg jump is BAD_INPUT, not a new run. */
 static void test_control_transitions_RestartOfAHeldAxisRefusesAJump(void) {
@@ -506,6 +538,7 @@ int main(void) {
   RUN_TEST(test_control_transitions_ResetIsRefusedDuringTheActiveStop);
   RUN_TEST(test_control_transitions_ClearIsRefusedDuringTheActiveStop);
   RUN_TEST(test_control_transitions_RestartOfAHeldAxisRefusesAJump);
+  RUN_TEST(test_control_transitions_ResetOfAHeldAxisKeepsTheBrakeUntilAClear);
   RUN_TEST(test_control_init_RefusesBadConfig);
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);
