@@ -39,6 +39,7 @@ class FocDrive {
   // Ends a running self-calibration as a stop or the e-stop does (pour_drive_calibrate_abort).
   void abort_calibration() { pour_drive_calibrate_abort(&drv_); }
   const pour_drive_t &drive() const { return drv_; }
+  pour_drive_t &drive() { return drv_; } // for a port's code around the drive (the calibration's flow)
   // One step of dt: the command [N·m at the output] to the 1 kHz tick, then the periods of the current
   // loop at output speed omega [rad/s]. Returns the mean torque at the output [N·m].
   double step(double tau_cmd, double omega, double dt);

@@ -8,11 +8,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <vector>
 
 #include "foc_drive.hpp"
 #include "poursim/poursim.h"
 
 extern "C" {
+#include "calibration_flow.h"
+#include "flash_page_file.h"
 #include "unity.h"
 }
 
@@ -184,6 +188,7 @@ static void test_motor_cal_AFaultEndsItHeld(void) {
   const Run r = run(foc);
   assert_refused(r, POUR_MOTOR_CAL_ABORTED);
   TEST_ASSERT_TRUE((r.faults & (POUR_DRIVE_FAULT_OVERCURRENT | POUR_DRIVE_FAULT_PHASE)) != 0);
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, foc.calibrate()); // a fault of the power stage stands in its way
 }
 
 static void test_motor_cal_AStopEndsItHeld(void) {
@@ -191,13 +196,140 @@ static void test_motor_cal_AStopEndsItHeld(void) {
   assert_refused(run(foc, 30000), POUR_MOTOR_CAL_ABORTED); // in the forward turn
 }
 
-static void test_motor_cal_RefusedUnlessTheDriveRuns(void) {
+static void test_motor_cal_RefusedWhileRunningAndRetriedAfterAStop(void) {
   poursim::FocDrive foc = drive_with(nullptr, 0);
   TEST_ASSERT_EQUAL_INT(POUR_OK, foc.calibrate());
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, foc.calibrate()); // already measuring
   foc.abort_calibration();
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, foc.drive().state);
-  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, foc.calibrate()); // faulted
+  TEST_ASSERT_EQUAL_UINT16(POUR_DRIVE_FAULT_CALIBRATION, foc.drive().faults);
+  // uncalibrated is the one fault a calibration starts from: the retry runs to the end
+  const Run r = run(foc);
+  TEST_ASSERT_EQUAL_INT(POUR_MOTOR_CAL_OK, r.status);
+  TEST_ASSERT_EQUAL_UINT16(0, foc.drive().faults);
+}
+
+// The board's flow around it, tick by tick as main.c runs it: CalibrationStart frames into the CAN node, the
+// core's mode, the flow, the node's frames out, and the 20 current-loop periods of each millisecond.
+struct Bench {
+  poursim::FocDrive foc = drive_with(nullptr, 0);
+  pour_can_node_t node{};
+  pour_calibration_flow_t flow{};
+  double omega = 0, theta = 0, peak = 0;
+  std::vector<pour_can_calibration_result_t> results; // every CalibrationResult sent
+  bool released_outside = false; // the brake released while the flow says nothing runs
+
+  Bench() {
+    flash_page_file_reset();
+    pour_can_node_config_t nc = pour_can_node_default_config();
+    nc.can_calibrate = true;
+    nc.identity.init_status = (int8_t)POUR_ECALIBRATION;
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &nc));
+    pour_calibration_t none{};
+    pour_calibration_flow_init(&flow, pour_calibration_load(&f, &none), nullptr);
+    TEST_ASSERT_EQUAL_INT(POUR_CAL_EMPTY, flow.stored);
+  }
+  void start() {
+    pour_can_frame_t fr;
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(0, POUR_CAN_CMD_CALIBRATION_START, &fr));
+    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &fr));
+  }
+  void tick(pour_mode_t mode) {
+    pour_control_input_t in;
+    pour_can_node_begin_tick(&node, &in);
+    const bool measuring = pour_calibration_flow_tick(&flow, &node, &foc.drive(), (uint8_t)mode, &f);
+    pour_control_output_t out{};
+    out.mode = (uint8_t)mode;
+    pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+    const uint8_t n = pour_can_node_end_tick(&node, &out, 0, tx);
+    for (uint8_t k = 0; k < n; ++k) {
+      pour_can_calibration_result_t r;
+      if (pour_can_unpack_calibration_result(&tx[k], &r) == POUR_CAN_RX_OK) results.push_back(r);
+    }
+    for (int p = 0; p < 20; ++p) {
+      const double tau = foc.period(omega);
+      const bool brake = foc.output().brake != 0 || !measuring;
+      if (!brake && !measuring) released_outside = true;
+      omega = brake ? 0.0 : omega + 5e-5 * (tau - kFriction * omega) / kInertia;
+      theta += omega * 5e-5;
+      peak = std::max(peak, std::fabs(theta));
+    }
+  }
+};
+
+static void test_calibration_flow_AGoodResultIsStoredAndTheBoardIsCalibrated(void) {
+  Bench b;
+  b.start();
+  for (int ms = 0; ms < 4000; ++ms) b.tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_size_t(2, b.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, b.results[0].status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_EMPTY, b.results[0].stored);
+  const pour_can_calibration_result_t &done = b.results[1];
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, done.status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, done.stored);
+  TEST_ASSERT_EQUAL_UINT8(8, done.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT8(0, done.encoder_reversed);
+  TEST_ASSERT_TRUE(std::abs(done.resistance_mohm - 287) <= 14);
+  TEST_ASSERT_TRUE(std::abs(done.inductance_uh - 151) <= 8);
+  // in flash, as a reboot would load it; Identity no longer says uncalibrated
+  pour_calibration_t got{};
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_load(&f, &got));
+  TEST_ASSERT_EQUAL_UINT32(b.foc.drive().config.r_phase_uohm, got.r_phase_uohm);
+  TEST_ASSERT_EQUAL_INT8(POUR_OK, b.node.config.identity.init_status);
+  TEST_ASSERT_FALSE(b.released_outside);
+  TEST_ASSERT_TRUE(b.peak <= 10.0 * kPi / 180);
+}
+
+static void test_calibration_flow_AFailedFlashWriteIsReported(void) {
+  Bench b;
+  regs[POUR_FLASH_SR] = 1u << 4; // WRPERR: the page is write-protected
+  b.start();
+  for (int ms = 0; ms < 4000; ++ms) b.tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_size_t(2, b.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_WRITE_FAILED, b.results[1].status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_WRITE_FAILED, b.results[1].stored);
+  TEST_ASSERT_EQUAL_INT8(POUR_ECALIBRATION, b.node.config.identity.init_status); // still uncalibrated
+}
+
+static void test_calibration_flow_TheEstopEndsItHeldAndSaysSo(void) {
+  Bench b;
+  b.start();
+  for (int ms = 0; ms < 1500; ++ms) b.tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_MEASURING, b.foc.drive().state);
+  b.tick(POUR_MODE_ESTOP);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, b.foc.drive().state);
+  TEST_ASSERT_EQUAL_UINT8(1, b.foc.output().brake);
+  b.tick(POUR_MODE_ESTOP);
+  TEST_ASSERT_EQUAL_size_t(2, b.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, b.results[1].status);
+  TEST_ASSERT_EQUAL_UINT32(0xFFFFFFFFu, page[0]); // nothing stored
+  // a start while the e-stop is asserted: refused by name, the drive left as it is
+  b.start();
+  b.tick(POUR_MODE_ESTOP);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_ESTOP, b.results.back().status);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, b.foc.drive().state);
+}
+
+static void test_calibration_flow_ABadResultIsNamedOnTheBus(void) {
+  Bench b;
+  poursim::MotorParams p = other_motor(b.foc);
+  p.pole_pairs = 1;
+  p.flux = 0.0404 / 1.5;
+  b.foc.set_motor(p, 7);
+  b.start();
+  for (int ms = 0; ms < 4000; ++ms) b.tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_size_t(2, b.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MOTION_RANGE, b.results[1].status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_EMPTY, b.results[1].stored);
+}
+
+static void test_calibration_flow_RefusedInRun(void) {
+  Bench b;
+  b.start();
+  b.tick(POUR_MODE_RUN);
+  TEST_ASSERT_EQUAL_size_t(1, b.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, b.results[0].status);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, b.foc.drive().state);
 }
 
 int main(void) {
@@ -210,6 +342,11 @@ int main(void) {
   RUN_TEST(test_motor_cal_MotionBeyondTheRangeStopsTheSequence);
   RUN_TEST(test_motor_cal_AFaultEndsItHeld);
   RUN_TEST(test_motor_cal_AStopEndsItHeld);
-  RUN_TEST(test_motor_cal_RefusedUnlessTheDriveRuns);
+  RUN_TEST(test_motor_cal_RefusedWhileRunningAndRetriedAfterAStop);
+  RUN_TEST(test_calibration_flow_AGoodResultIsStoredAndTheBoardIsCalibrated);
+  RUN_TEST(test_calibration_flow_AFailedFlashWriteIsReported);
+  RUN_TEST(test_calibration_flow_TheEstopEndsItHeldAndSaysSo);
+  RUN_TEST(test_calibration_flow_ABadResultIsNamedOnTheBus);
+  RUN_TEST(test_calibration_flow_RefusedInRun);
   return UNITY_END();
 }

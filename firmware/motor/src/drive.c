@@ -193,7 +193,10 @@ static int32_t vmax_of(q15_t vbus) { return (int32_t)(((int64_t)vbus * VMAX_OF_B
 
 pour_status_t pour_drive_calibrate(pour_drive_t *drv) {
   const pour_drive_config_t *c = &drv->config;
-  if (drv->state != POUR_DRIVE_RUN) return POUR_EINVAL;
+  /* a missing calibration is the one latched fault a calibration may start from (it clears it) */
+  const int uncalibrated = drv->state == POUR_DRIVE_FAULTED && drv->faults == POUR_DRIVE_FAULT_CALIBRATION &&
+                           drv->sense.calibrated;
+  if (drv->state != POUR_DRIVE_RUN && !uncalibrated) return POUR_EINVAL;
   const pour_motor_cal_config_t mc = {
       c->pwm_hz, I_BASE, V_BASE, c->cal_current_ma, c->cal_l_test_mv, c->encoder_cpr,
       (uint32_t)((uint64_t)c->cal_motion_urad * c->gear_ratio * c->encoder_cpr / TWO_PI_URAD)};

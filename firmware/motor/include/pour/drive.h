@@ -148,8 +148,9 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
  * output's motion since the last tick output_delta_urad [µrad]. */
 void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta_urad);
 
-/* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: only from RUN (the current offsets
- * measured), else POUR_EINVAL. The brake is released while it runs (2.9 s). Success applies the results to
+/* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: from RUN, or FAULTED with
+ * POUR_DRIVE_FAULT_CALIBRATION alone (no valid calibration, or the last one failed) once the current offsets
+ * are measured; else POUR_EINVAL. The brake is released while it runs (2.9 s). Success applies the results to
  * the configuration (R, L, pole pairs, encoder direction and offset) and restarts the drive as at power-on
  * (offsets with the PWM off and the brake engaged, then RUN); a failure or a fault latches
  * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. */
