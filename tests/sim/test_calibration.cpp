@@ -151,10 +151,14 @@ static void test_motor_cal_TheDefaultMotorMeasuresAsConfigured(void) {
   TEST_ASSERT_EQUAL_INT32(1, r.result.encoder_direction);
   TEST_ASSERT_TRUE(offset_error_deg(r.result.electrical_offset, 0.0) <= 3.0);
   // 8 pole pairs through 1:20: an electrical turn is 2.25° of output
+  printf("default motor: R %.4f ohm, L %.1f uH, pole pairs %u, offset error %.2f deg, peak output motion %.2f deg\n",
+         r.result.r_phase_uohm * 1e-6, r.result.l_phase_nh * 1e-3, (unsigned)r.result.pole_pairs,
+         offset_error_deg(r.result.electrical_offset, 0.0), r.peak_motion * 180 / kPi);
   TEST_ASSERT_TRUE(r.peak_motion <= 5.0 * kPi / 180);
 }
 
 static void assert_refused(const Run &r, pour_motor_cal_status_t why) {
+  printf("refused %d after %.3f s, peak output motion %.2f deg\n", (int)r.status, r.seconds, r.peak_motion * 180 / kPi);
   TEST_ASSERT_EQUAL_INT(why, r.status);
   TEST_ASSERT_TRUE(r.brake_at_end);
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULT_CALIBRATION, r.faults & POUR_DRIVE_FAULT_CALIBRATION);
@@ -180,6 +184,7 @@ static void test_motor_cal_MotionBeyondTheRangeStopsTheSequence(void) {
   foc.set_motor(p, 7);
   const Run r = run(foc);
   assert_refused(r, POUR_MOTOR_CAL_MOTION);
+  printf("motion range: stopped at %.2f deg of output after %.3f s\n", r.peak_motion * 180 / kPi, r.seconds);
   TEST_ASSERT_TRUE(r.peak_motion >= 9.0 * kPi / 180); // it did get there: the check is what stopped it
 }
 

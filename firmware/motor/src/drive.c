@@ -48,7 +48,7 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.phase_loss_ms = 20;
   c.encoder_check_urad = 3000;
   c.encoder_reversed = 0;
-  c.cal_current_ma = 4000;    /* 1.2× the nominal current for 2.9 s: 0.16 N·m of hold at the motor */
+  c.cal_current_ma = 4000;    /* 1.2× the nominal current for 3.1 s: 0.16 N·m of hold at the motor */
   c.cal_l_test_mv = 1000;     /* 0.33 A of ripple a period on the rig's 150 µH */
   c.cal_motion_urad = 174533; /* 10° of output; an electrical turn of this motor is 2.25° through 1:20 */
   return c;

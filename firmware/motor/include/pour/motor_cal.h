@@ -9,7 +9,7 @@
  *     (encoder_cpr / counts per electrical turn) and the electrical offset (the commanded angle less the
  *     encoder's, averaged over both sweeps so that the rotor's lag cancels).
  * The encoder's motion is watched every period: beyond motion_counts from where it started, the sequence
- * ends at once. Takes 2.9 s. Fixed point, no float, no malloc, no I/O. */
+ * ends at once. Takes 3.1 s. Fixed point, no float, no malloc, no I/O. */
 #ifndef POUR_MOTOR_CAL_H
 #define POUR_MOTOR_CAL_H
 
