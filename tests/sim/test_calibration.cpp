@@ -175,6 +175,26 @@ static void test_motor_cal_AnUnpluggedEncoderIsNamed(void) {
   assert_refused(run(foc), POUR_MOTOR_CAL_NO_ENCODER);
 }
 
+static void test_motor_cal_AnInductanceBelowAnyMotorsIsRefused(void) {
+  poursim::FocDrive foc = drive_with(nullptr, 0);
+  poursim::MotorParams p = other_motor(foc);
+  // an air-core winding, or the leads shorted past the motor; with R·Ts/2 = 5 µH (what a period's full settling
+  // reads as) below the 10 µH floor
+  p.r_phase = 0.2;
+  p.ld = p.lq = 3e-6;
+  foc.set_motor(p, 7);
+  assert_refused(run(foc), POUR_MOTOR_CAL_INDUCTANCE);
+}
+
+static void test_motor_cal_MorePolePairsThanAnyMotorIsRefused(void) {
+  poursim::FocDrive foc = drive_with(nullptr, 0);
+  poursim::MotorParams p = other_motor(foc);
+  p.pole_pairs = 33; // 124 counts an electrical turn: more than the 32 the drive supports
+  p.flux = 0.0404 / (1.5 * p.pole_pairs);
+  foc.set_motor(p, 7);
+  assert_refused(run(foc), POUR_MOTOR_CAL_POLE_PAIRS);
+}
+
 static void test_motor_cal_MotionBeyondTheRangeStopsTheSequence(void) {
   // one pole pair through 1:20: an electrical turn would be 18° of output, the range is 10°
   poursim::FocDrive foc = drive_with(nullptr, 0);
@@ -344,6 +364,8 @@ int main(void) {
   RUN_TEST(test_motor_cal_TheDefaultMotorMeasuresAsConfigured);
   RUN_TEST(test_motor_cal_AnOpenPhaseIsAResistanceOutOfRange);
   RUN_TEST(test_motor_cal_AnUnpluggedEncoderIsNamed);
+  RUN_TEST(test_motor_cal_AnInductanceBelowAnyMotorsIsRefused);
+  RUN_TEST(test_motor_cal_MorePolePairsThanAnyMotorIsRefused);
   RUN_TEST(test_motor_cal_MotionBeyondTheRangeStopsTheSequence);
   RUN_TEST(test_motor_cal_AFaultEndsItHeld);
   RUN_TEST(test_motor_cal_AStopEndsItHeld);
