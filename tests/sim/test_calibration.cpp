@@ -118,7 +118,8 @@ static void test_motor_cal_MeasuresAMotorUnlikeTheConfiguration(void) {
   TEST_ASSERT_EQUAL_INT32(-1, r.result.encoder_direction);
   TEST_ASSERT_TRUE(off <= 3.0);
   TEST_ASSERT_TRUE(r.peak_motion <= 10.0 * kPi / 180);
-  // applied: the drive restarted with them
+  // applied: the drive runs with them, at zero current
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, foc.drive().state);
   const pour_drive_config_t &c = foc.drive().config;
   TEST_ASSERT_EQUAL_UINT32(r.result.r_phase_uohm, c.r_phase_uohm);
   TEST_ASSERT_EQUAL_UINT32(4, c.pole_pairs);
@@ -128,7 +129,7 @@ static void test_motor_cal_MeasuresAMotorUnlikeTheConfiguration(void) {
 
 static void test_motor_cal_CalibratedDriveDeliversTheCommandedTorque(void) {
   // With the configuration's pole pairs, offset and direction the loop would push the wrong way; measured, the
-  // commanded torque arrives at the output (rotor held: the offsets run first).
+  // commanded torque arrives at the output (the rotor held still).
   poursim::FocDrive foc = drive_with(nullptr, 0);
   foc.set_motor(other_motor(foc), 7);
   TEST_ASSERT_EQUAL_INT(POUR_MOTOR_CAL_OK, run(foc).status);

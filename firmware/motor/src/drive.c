@@ -240,15 +240,26 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
     c.pole_pairs = r.pole_pairs;
     c.encoder_reversed = r.encoder_direction < 0 ? 1u : 0u;
     c.encoder_offset = r.electrical_offset;
-    const pour_drive_config_t old = drv->config;
-    if (pour_drive_init(drv, &c) == POUR_OK) {
+    /* Only the motor's numbers change: the current loop's gains from them, the rest (the offsets, the bases,
+     * the limits) stays, so this period costs two gain computations rather than a whole init. */
+    pour_current_pi_t pi_d, pi_q;
+    if (pour_drive_config_check(&c) == NULL &&
+        pour_current_pi_init(&pi_d, c.bandwidth_rad_s, c.ld_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK &&
+        pour_current_pi_init(&pi_q, c.bandwidth_rad_s, c.lq_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK) {
+      drv->config = c;
+      drv->pi_d = pi_d;
+      drv->pi_q = pi_q;
       drv->cal_status = POUR_MOTOR_CAL_OK;
       drv->cal_result = r;
+      drv->faults = 0; /* nothing else can be latched: a trip would have ended the sequence */
+      drv->iq_cmd_q15 = 0;
+      drv->motor_counts = drv->output_urad = 0;
+      drv->phase_loss_count = 0;
+      drv->last_encoder = encoder;
+      drv->state = POUR_DRIVE_RUN; /* at zero current from the next period */
       hold(drv, out);
-      out->pwm_enable = 0;
       return;
     }
-    (void)pour_drive_init(drv, &old); /* valid, as it was at the first init */
   }
   pour_drive_trip(drv, POUR_DRIVE_FAULT_CALIBRATION);
   /* R and L in range whose current-loop gains (Kp = ωc·L) do not fit Q16.16: L is what is implausible */

@@ -151,8 +151,8 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
 /* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: from RUN, or FAULTED with
  * POUR_DRIVE_FAULT_CALIBRATION alone (no valid calibration, or the last one failed) once the current offsets
  * are measured; else POUR_EINVAL. The brake is released while it runs (3.1 s). Success applies the results to
- * the configuration (R, L, pole pairs, encoder direction and offset) and restarts the drive as at power-on
- * (offsets with the PWM off and the brake engaged, then RUN); a failure or a fault latches
+ * the configuration (R, L, pole pairs, encoder direction and offset; the current loop's gains from R and L),
+ * the brake requested for that period, then RUN at zero current; a failure or a fault latches
  * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. */
 pour_status_t pour_drive_calibrate(pour_drive_t *drv);
 

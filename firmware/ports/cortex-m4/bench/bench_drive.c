@@ -34,7 +34,7 @@ static void make_sample(pour_drive_sample_t *s) {
   s->encoder = (uint16_t)(next() & 4095u);
 }
 
-/* The self-calibration's periods (pour_drive_isr while MEASURING, the last one restarting the drive), around
+/* The self-calibration's periods (pour_drive_isr while MEASURING, the last one applying the results), around
  * a plant outside the timed window: the default motor's R and L per axis (exact first-order steps), the legs'
  * dead time, the rotor aligned with the current vector at once (8 pole pairs), the compares a period late. */
 static int bench_calibration(uint64_t insn_per_kilotick, uint32_t empty) {
@@ -86,7 +86,7 @@ static int bench_calibration(uint64_t insn_per_kilotick, uint32_t empty) {
   pour_motor_cal_result_t res = {0};
   const pour_motor_cal_status_t st = pour_drive_calibration(&drv, &res);
   printf("self-calibration interrupt (pour_drive_isr while MEASURING): worst %u instructions, average %u; the last "
-         "(results applied, the drive restarted) %u; %u periods, status %d: R %u uohm, L %u nH, %u pole pairs, "
+         "(results applied, the current loop's gains recomputed) %u; %u periods, status %d: R %u uohm, L %u nH, %u pole pairs, "
          "direction %d, offset %u\n",
          (unsigned)(worst * insn_per_kilotick / 1000u), (unsigned)(sum * insn_per_kilotick / 1000u / (n ? n : 1u)),
          (unsigned)(last * insn_per_kilotick / 1000u), (unsigned)n, (int)st, (unsigned)res.r_phase_uohm,
