@@ -219,7 +219,7 @@ pour_motor_cal_status_t pour_drive_calibration(const pour_drive_t *drv, pour_mot
 }
 
 /* A period of the self-calibration: its voltage vector through the same modulation as the current loop's;
- * at its end, the results into the configuration and the drive restarted, or the reason latched. */
+ * at its end, the results into the configuration and RUN, or the reason latched. */
 static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t alpha, q15_t beta,
                     pour_drive_output_t *out) {
   q15_t va, vb;
