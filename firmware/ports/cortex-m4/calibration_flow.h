@@ -17,7 +17,8 @@
 
 typedef struct {
   pour_motor_cal_status_t seen;   /* the drive's calibration status at the last tick */
-  pour_cal_status_t stored;       /* the flash block's state */
+  pour_cal_status_t stored;       /* the flash block's state: POUR_CAL_OK is the board's calibration_valid
+                                     (board_guard), which RUN needs */
   pour_calibration_t calibration; /* the stored calibration, when stored is POUR_CAL_OK */
 } pour_calibration_flow_t;
 
