@@ -86,6 +86,7 @@ def test_an_actor_with_a_hidden_layer_is_refused():
     (["--steps", "0"], "steps = 0: expected at least 1"),
     (["--env", "pour/Nope-v0"], "Nope"),
     (["--header", "/nonexistent/dir/w.h"], "--header"),
+    (["--init-header", "/nonexistent/w.h"], "cannot read"),
 ])
 def test_bad_input_is_a_clear_error(tmp_path, argv, message):
     r = subprocess.run([sys.executable, "-m", "pour.examples.sb3_ppo", "--steps", "64", "--out",
@@ -99,3 +100,32 @@ def test_without_the_extra_it_says_how_to_install_it(tmp_path):
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert r.returncode == 1 and "Traceback" not in r.stderr, r.stderr
     assert "--with-sb3" in r.stderr
+
+
+def test_started_from_the_shipped_header_it_still_pours(source_dir, tmp_path):
+    """--init-header: the actor starts as the shipped W (to float32), so two short PPO updates later the
+    exported policy still pours, where one started from SB3's initial layer pours nothing."""
+    shipped = sb3_ppo.header_weights(source_dir / "policy" / "weights.h")
+    out, header = tmp_path / "run", tmp_path / "run" / "weights.h"
+    r = subprocess.run([sys.executable, "-m", "pour.examples.sb3_ppo", "--steps", str(STEPS), "--quiet",
+                        "--init-header", str(source_dir / "policy" / "weights.h"), "--out", str(out),
+                        "--header", str(header)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((out / "policy.json").read_text())
+    assert doc["init_header"].endswith("weights.h")
+    assert np.abs(np.array(doc["w"]) - shipped).max() < 0.05 * np.abs(shipped).max()  # moved a little
+    r = subprocess.run([str(BUILD_DIR / "bin" / "host_sim"), "--policy", str(header), "--seed", "1000001",
+                        "--episodes", "2", "--json", "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["poured_pct"] > 90
+
+
+def test_set_and_read_linear_weights_round_trip():
+    import gymnasium as gym
+
+    model = sb3_ppo.make_model(gym.make("pour/PourToy-v0"), seed=1)
+    w = np.random.default_rng(1).normal(size=(6, 11))
+    sb3_ppo.set_linear_weights(model, w)
+    np.testing.assert_allclose(sb3_ppo.linear_weights(model), w, rtol=1e-6)  # float32
+    with pytest.raises(sb3_ppo.ExampleError, match="6 x 11"):
+        sb3_ppo.set_linear_weights(model, w[:, :5])

@@ -12,9 +12,11 @@ is not exported.
     ./scripts/setup.sh --with-sb3                                      # the extra: SB3 and torch
     .venv/bin/python -m pour.examples.sb3_ppo --steps 200000 --out runs/sb3_ppo
     .venv/bin/pour-export runs/sb3_ppo --out policy/weights.h          # or --header here
+    .venv/bin/python -m pour.examples.sb3_ppo --init-header policy/weights.h ...   # fine-tune the shipped W
 
     from pour.examples import sb3_ppo
     w = sb3_ppo.train_linear(steps=200_000, seed=1)                    # W [6][n_actions], float
+    w = sb3_ppo.train_linear(steps=20_000, init_w=sb3_ppo.header_weights("policy/weights.h"))
 """
 from __future__ import annotations
 
@@ -26,7 +28,7 @@ import gymnasium as gym
 import numpy as np
 
 from pour import atomic, cli
-from pour.policy import export
+from pour.policy import export, weights_h
 from pour.sim import episode, gym_env
 
 ENV_ID = "pour/Pour-v0"
@@ -70,6 +72,28 @@ def linear_weights(model: Any) -> np.ndarray:
     return np.vstack([weight.T, bias[None, :]])
 
 
+def set_linear_weights(model: Any, w: np.ndarray) -> None:
+    """Sets the softmax-linear actor to W [6][n_actions] (the inverse of linear_weights, to float32)."""
+    _, torch = _sb3()
+    layer = model.policy.action_net
+    w = np.asarray(w, dtype=np.float64)
+    if w.shape != (layer.in_features + 1, layer.out_features):
+        raise ExampleError(f"W is {w.shape[0]} x {w.shape[1]}: this actor takes "
+                           f"{layer.in_features + 1} x {layer.out_features}")
+    with torch.no_grad():
+        layer.weight.copy_(torch.as_tensor(w[:-1].T, dtype=layer.weight.dtype))
+        layer.bias.copy_(torch.as_tensor(w[-1], dtype=layer.bias.dtype))
+
+
+def header_weights(path: str | Path) -> np.ndarray:
+    """W of a weights.h, to start PPO from: its float reference if it has one, else the dequantised table."""
+    try:
+        h = weights_h.parse_weights_h(path)
+    except OSError as exc:
+        raise ExampleError(f"{path}: cannot read ({exc.strerror})") from None
+    return np.asarray(h.w_float if h.w_float is not None else h.w_dequantized, dtype=np.float64)
+
+
 def _progress_callback(total: int, quiet: bool) -> Any:
     from stable_baselines3.common.callbacks import BaseCallback
 
@@ -88,12 +112,15 @@ def _progress_callback(total: int, quiet: bool) -> Any:
 
 
 def train(steps: int, seed: int = 1, env_id: str = ENV_ID, quiet: bool = True, env_kwargs: dict | None = None,
-          **ppo_kwargs: Any) -> tuple[Any, np.ndarray]:
-    """Trains PPO for `steps` env steps (decisions) on env_id; returns (the SB3 model, its W [6][n_actions])."""
+          init_w: np.ndarray | None = None, **ppo_kwargs: Any) -> tuple[Any, np.ndarray]:
+    """Trains PPO for `steps` env steps (decisions) on env_id, from SB3's initial actor or from init_w
+    [6][n_actions]; returns (the SB3 model, its W [6][n_actions])."""
     if steps < 1:
         raise ExampleError(f"steps = {steps}: expected at least 1")
     env = gym.make(env_id, **(env_kwargs or {}))
     model = make_model(env, seed, **ppo_kwargs)
+    if init_w is not None:
+        set_linear_weights(model, init_w)
     model.learn(total_timesteps=int(steps), callback=_progress_callback(int(steps), quiet))
     return model, linear_weights(model)
 
@@ -112,8 +139,10 @@ def _make_dir(path: str | Path) -> Path:
     return path
 
 
-def write_run(run_dir: str | Path, model: Any, w: np.ndarray, steps: int, seed: int, env_id: str) -> Path:
-    """run_dir/policy.json (what pour-export reads) and run_dir/sb3_model.zip (SB3's own save)."""
+def write_run(run_dir: str | Path, model: Any, w: np.ndarray, steps: int, seed: int, env_id: str,
+              **fields: Any) -> Path:
+    """run_dir/policy.json (what pour-export reads; fields are recorded in it too) and run_dir/sb3_model.zip
+    (SB3's own save)."""
     run_dir = _make_dir(run_dir)
     pe = model.get_env().envs[0].unwrapped
     if not isinstance(pe, gym_env.PourEnv):
@@ -121,7 +150,7 @@ def write_run(run_dir: str | Path, model: Any, w: np.ndarray, steps: int, seed: 
     path = run_dir / "policy.json"
     export.write_policy(path, pe.action_space.n, pe.period, pe.tau_max_nm, episode.NORM, w, w,
                         learner="stable-baselines3 PPO", env_id=env_id, steps=int(steps), seed=int(seed),
-                        ppo=dict(PPO_DEFAULTS), critic=list(CRITIC))
+                        ppo=dict(PPO_DEFAULTS), critic=list(CRITIC), **fields)
     model.save(run_dir / "sb3_model.zip")
     return path
 
@@ -131,6 +160,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--steps", type=int, default=200_000, help="env steps (10 ms decisions) to train")
     ap.add_argument("--seed", type=int, default=1, help="PPO's and the env's seed")
     ap.add_argument("--env", default=ENV_ID, help=f"Gymnasium id (default {ENV_ID}; pour/PourRandomised-v0)")
+    ap.add_argument("--init-header", type=Path, help="start the actor from this weights.h's W (e.g. policy/weights.h)")
     ap.add_argument("-o", "--out", required=True, type=Path, help="run directory: policy.json, sb3_model.zip")
     ap.add_argument("--header", type=Path, help="also export weights.h here (as pour-export RUN --out HEADER)")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -139,13 +169,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         _make_dir(args.out)
         if args.header is not None:
             atomic.check_output_path(args.header, "--header")
-        model, w = train(args.steps, args.seed, args.env, quiet=args.quiet)
-        path = write_run(args.out, model, w, args.steps, args.seed, args.env)
+        init_w = header_weights(args.init_header) if args.init_header is not None else None
+        model, w = train(args.steps, args.seed, args.env, quiet=args.quiet, init_w=init_w)
+        path = write_run(args.out, model, w, args.steps, args.seed, args.env,
+                         init_header=None if args.init_header is None else str(args.init_header))
         print(f"{path}: W [6][{w.shape[1]}] of PPO, {args.steps} steps, seed {args.seed}")
         if args.header is not None:
             export.export(path, args.header)
             print(f"{args.header}: exported")
-    except (ExampleError, export.ExportError, episode.EnvError, gym.error.Error, ValueError) as exc:
+    except (ExampleError, export.ExportError, weights_h.WeightsHError, episode.EnvError, gym.error.Error,
+            ValueError) as exc:
         print(f"sb3_ppo: {exc}", file=sys.stderr)
         return 1
     return 0
