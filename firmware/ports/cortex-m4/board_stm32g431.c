@@ -167,6 +167,19 @@ static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R
 #define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
 
 
+/* The NVIC is the core's (ARMv7-M): the same addresses on every Cortex-M4. */
+#define NVIC_ISER0 (*(volatile uint32_t *)0xE000E100u)
+#define NVIC_ICER0 (*(volatile uint32_t *)0xE000E180u)
+
+void pour_hal_drive_mask(bool masked) {
+  if (masked) {
+    NVIC_ICER0 = 1u << POUR_ADC_IRQ;
+    __asm volatile("dsb\n isb" ::: "memory"); /* no interrupt of the loop's after this returns */
+  } else {
+    NVIC_ISER0 = 1u << POUR_ADC_IRQ;
+  }
+}
+
 pour_status_t pour_hal_drive_init(void) {
   for (unsigned i = 0; i < 6u; ++i) {
     pour_gpio_output(gates[i].pin, false); /* all six off while TIM1 is set up */
@@ -194,6 +207,7 @@ pour_status_t pour_hal_drive_init(void) {
                     ADC_REGULATOR_WAIT) != POUR_OK) {
     return POUR_EINVAL;
   }
+  pour_hal_drive_mask(false); /* the current loop runs from now on (ADC1's end of sequence: pour_adc_init) */
   return POUR_OK;
 }
 
