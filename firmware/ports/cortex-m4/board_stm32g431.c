@@ -20,6 +20,7 @@
 #include "fdcan.h"
 #include "gpio.h"
 #include "hal_drive.h"
+#include "hal_drive_g4.h"
 #include "ocp.h"
 #include "opamp.h"
 #include "pwm_tim1.h"
@@ -53,8 +54,6 @@ static const pour_gpio_t can_tx = {GPIOB_R, 9u};
 static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
 static const pour_gpio_t can_termination = {GPIOC_R, 14u};
 
-static pour_pwm_t pwm;
-static pour_adc_t adc;
 static pour_ocp_t ocp;
 
 static void clock_on(uint32_t enr, uint32_t mask) {
@@ -191,6 +190,8 @@ pour_status_t pour_hal_drive_init(void) {
     pour_gpio_analog(analog_pins[i]);
   }
   const pour_pwm_config_t pc = pour_pwm_default_config();
+  pour_pwm_t pwm;
+  pour_adc_t adc;
   if (pour_pwm_init(&pwm, POUR_PERIPH(TIM1), &pc) != POUR_OK) {
     return POUR_EINVAL;
   }
@@ -207,34 +208,9 @@ pour_status_t pour_hal_drive_init(void) {
                     ADC_REGULATOR_WAIT) != POUR_OK) {
     return POUR_EINVAL;
   }
+  pour_hal_drive_attach(&pwm, &adc, POUR_PERIPH(TIM4));
   pour_hal_drive_mask(false); /* the current loop runs from now on (ADC1's end of sequence: pour_adc_init) */
   return POUR_OK;
-}
-
-uint16_t pour_hal_drive_period(void) { return pwm.period; }
-
-bool pour_hal_drive_sample(pour_hal_drive_sample_t *sample) {
-  pour_adc_sample_t s;
-  if (adc.adc1 == NULL || !pour_adc_read(&adc, &s)) {
-    return false;
-  }
-  for (unsigned i = 0; i < 3u; ++i) {
-    sample->phase[i] = s.phase[i];
-  }
-  sample->vbus = s.vbus;
-  sample->ntc = s.ntc;
-  sample->encoder = pour_encoder_count(POUR_PERIPH(TIM4));
-  return true;
-}
-
-void pour_hal_drive_set_compares(const uint16_t compare[3]) { pour_pwm_set_compares(&pwm, compare); }
-
-void pour_hal_drive_enable(bool on) { pour_pwm_enable(&pwm, on); }
-
-void pour_hal_drive_short_low_sides(void) {
-  if (pwm.regs != NULL) {
-    pour_pwm_short_low_sides(&pwm);
-  }
 }
 
 pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
@@ -242,9 +218,6 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
   return pour_ocp_init(&ocp, POUR_PERIPH(COMP), POUR_PERIPH(DAC3), &oc, offset_counts);
 }
 
-bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
-
-void pour_hal_drive_clear_overcurrent(void) { pour_pwm_clear_break(&pwm); }
 
 /* The calibration: the block in the page the linker script leaves (hal_calibration). */
 static pour_calibration_t calibration;
