@@ -142,7 +142,7 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       if (rc != POUR_CAN_RX_OK) {
         return drop(node, rc);
       }
-      pour_commands_estop(&node->commands, e.assert_estop != 0u);
+      pour_commands_estop(&node->commands, POUR_ESTOP_BUS, e.assert_estop != 0u);
       kick(node);
       break;
     }
@@ -169,6 +169,10 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
 
 static bool tripped(const pour_can_node_t *node) {
   return node->armed && node->ms_since_valid > node->config.watchdog_ms;
+}
+
+void pour_can_node_estop_line(pour_can_node_t *node, bool asserted) {
+  pour_commands_estop(&node->commands, POUR_ESTOP_LINE, asserted);
 }
 
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
@@ -214,6 +218,7 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
   hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
   hb.overruns = (uint16_t)(overruns & 0xFFFFu);
   hb.counter = node->heartbeat_counter;
+  hb.refused = (uint8_t)((out->refused + node->commands.clears_dropped) & POUR_CAN_REFUSED_MAX);
   if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[0]) != POUR_OK ||
       pour_can_pack_identity(node->config.node_id, &node->config.identity, &tx[1]) != POUR_OK) {
     return 0u;

@@ -61,6 +61,7 @@
 #define POUR_CAN_SCALE_MAX_G 32767     /* |scale| <= 32.767 kg [g]; -32768 is the load cell amplifier's
                                          * overload code, out of range */
 #define POUR_CAN_MODE_MAX (POUR_MODE_COUNT - 1u) /* pour_mode_t */
+#define POUR_CAN_REFUSED_MAX 0x0Fu                /* Heartbeat.Refused: a count mod 16 */
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
@@ -113,11 +114,12 @@ typedef struct {
 } pour_can_torque_t;
 
 typedef struct {
-  uint8_t mode;        /* pour_mode_t, 0 .. 3 */
+  uint8_t mode;        /* pour_mode_t, 0 .. 3 (bits 0..3) */
   uint16_t faults;     /* POUR_FAULT_* | POUR_CAN_FAULT_*; only the bits the DBC names are carried */
   uint16_t rx_dropped; /* malformed frames dropped, wraps */
   uint16_t overruns;   /* missed control deadlines, wraps */
   uint8_t counter;     /* +1 per heartbeat, wraps */
+  uint8_t refused;     /* commands refused or dropped (Stop, Reset, ClearErrors), mod 16 (bits 4..7) */
 } pour_can_heartbeat_t;
 
 typedef struct {

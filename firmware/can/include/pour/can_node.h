@@ -81,6 +81,11 @@ void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemet
 /* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
 
+/* A sample of the port's hardwired e-stop input, taken before the tick's frames are fed and again after
+ * them: the e-stop is asserted while the line or the bus asserts it, and a ClearErrors counts only if both
+ * were released when it arrived and stayed released until the tick. */
+void pour_can_node_estop_line(pour_can_node_t *node, bool asserted);
+
 /* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick (the
  * latest Sensors sample, as the sensors read it), the watchdog's state as in->link_fault, no drive fault. The frame's
  * 8-bit seq reaches the core extended to 32 bits by its forward distance (it wraps every 256 ms at 1 kHz;
@@ -101,7 +106,8 @@ bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms);
 /* The frames end_tick is made of, for a port that schedules them itself (the Linux one, by wall clock). */
 pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour_control_output_t *out,
                                          pour_can_frame_t *frame);
-/* Heartbeat (counter advanced) then identity: 2 frames, or 0 if the output cannot be packed. */
+/* Heartbeat (counter advanced; Refused = the core's refused Stops, Resets and clears plus the clears dropped
+ * here, mod 16) then identity: 2 frames, or 0 if the output cannot be packed. */
 uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                     pour_can_frame_t tx[2]);
 
