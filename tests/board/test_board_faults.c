@@ -10,7 +10,8 @@
  * nothing while the gates are off or the coupling has slipped, and a spring-applied brake on the output
  * shaft that holds 20 N·m once engaged for 20 ms. The core's sensors are the plant's: the output encoder
  * (17 bits) and the two scales. Injected at 300 ms into a tilt at 0.5 rad/s: the comparators' break, a
- * sagging and a pumped-up bus, a hot power stage, a slipping coupling; and a missing calibration at boot.
+ * sagging and a pumped-up bus, a hot power stage, a slipping coupling; and a missing calibration at boot; a
+ * ClearErrors in the middle of an active stop, which releases nothing.
  * Checked: the fault named in the drive's word and the core in FAULT with POUR_FAULT_DRIVE, an active stop
  * (power on) where the drive is still trusted and the phases shorted where it is not, the brake engaged
  * and holding at the end, within 10° of where the fault began, and no tick between the fault and the
@@ -137,7 +138,7 @@ static pour_sensors_t sample_of(uint32_t seq) {
   return s;
 }
 
-typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION } fault_t;
+typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED } fault_t;
 
 typedef struct {
   double theta_fault, theta_end, theta_max_dev;
@@ -173,6 +174,7 @@ static result_t pour_with(fault_t fault) {
       switch (fault) {
       case F_BREAK: plant.comparator_trip = ms < fault_ms + 5; break; /* a 5 ms current spike */
       case F_UNDERVOLTAGE: plant.vbus_v = fmax(0.0, 24.0 - 0.5 * (ms - fault_ms)); break; /* sags at 0.5 V/ms */
+      case F_SAG_CLEARED: plant.vbus_v = r.detected_ms < 0 ? 24.0 - 0.5 * (ms - fault_ms) : 24.0; break;
       case F_OVERVOLTAGE: plant.vbus_v = 24.0 + 0.5 * (ms - fault_ms); break;
       case F_OVERTEMP: plant.temp_c = 40.0 + 2.0 * (ms - fault_ms); break;
       case F_SLIP: plant.slipping = true; break;
@@ -186,6 +188,9 @@ static result_t pour_with(fault_t fault) {
     memset(&in, 0, sizeof in);
     in.sensors_fresh = ms >= WARMUP_MS;
     in.sensors = sample_of((uint32_t)ms);
+    /* A ClearErrors 3 ms into the active stop, the sag already over: the core refuses it, and so must the
+     * protection (else the brake would be released under a stop that returns the bucket upright). */
+    in.clear_faults = fault == F_SAG_CLEARED && r.detected_ms >= 0 && ms == fault_ms + r.detected_ms + 3;
     /* The decisions: tilt at 0.5 rad/s with gravity feed-forward (the core's own stop takes over in FAULT). */
     const double ref = 40.0 * PI / 180.0 + 0.5 * (t - WARMUP_MS * DT);
     const double ff = MASS * G * ARM * sin(plant.theta);
@@ -267,6 +272,13 @@ static void test_faults_UndervoltageStopsActivelyAndTheBrakeHolds(void) {
   assert_active_stop(&r);
 }
 
+static void test_faults_AClearDuringTheActiveStopReleasesNothing(void) {
+  const result_t r = pour_with(F_SAG_CLEARED);
+  assert_held(&r, POUR_DRIVE_FAULT_UNDERVOLTAGE, 20);
+  assert_active_stop(&r);
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.refused);
+}
+
 static void test_faults_OvervoltageShortsThePhasesAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_OVERVOLTAGE);
   assert_held(&r, POUR_DRIVE_FAULT_OVERVOLTAGE, 20);
@@ -296,6 +308,7 @@ int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_faults_BreakShortsThePhasesAndTheBrakeHolds);
   RUN_TEST(test_faults_UndervoltageStopsActivelyAndTheBrakeHolds);
+  RUN_TEST(test_faults_AClearDuringTheActiveStopReleasesNothing);
   RUN_TEST(test_faults_OvervoltageShortsThePhasesAndTheBrakeHolds);
   RUN_TEST(test_faults_OvertemperatureStopsActivelyAndTheBrakeHolds);
   RUN_TEST(test_faults_SlippingCouplingIsAMismatchAndTheBrakeHolds);

@@ -21,6 +21,7 @@ static struct {
   uint32_t guard_seq;              /* the core's state the protection saw last: a new one is a fresh output angle */
   int32_t last_theta_urad;
   bool have_theta;                 /* last_theta_urad is a trusted angle */
+  bool clear;                      /* the core accepted a ClearErrors last tick: the protection clears now */
   uint16_t faults;                 /* the loop's and the protection's, as the core and the bus see them */
 } bd;
 
@@ -33,6 +34,7 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   bd.guard_seq = 0u;
   bd.last_theta_urad = 0;
   bd.have_theta = false;
+  bd.clear = false;
   bd.tau_max_mnm = tau_max_mnm;
   bd.calibration_valid = calibration_valid;
   if (config == NULL || tau_max_mnm <= 0 || pour_drive_init(&bd.drive, config) != POUR_OK) {
@@ -95,8 +97,9 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   const bool fresh = ctl->have_trusted && state->seq != bd.guard_seq;
   bd.guard_seq = state->seq;
   pour_protect_output_t p;
+  /* The protection clears only what the core cleared (a clear it refuses, in an active stop, keeps both). */
   pour_guard_tick(&bd.guard, sampled ? &s : NULL, loop_faults, state->theta_urad, fresh, bd.calibration_valid,
-                  in->clear_faults, &p);
+                  bd.clear, &p);
 
   pour_hal_drive_mask(true);
   if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && bd.drive.state != POUR_DRIVE_FAULTED) {
@@ -109,6 +112,7 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   pour_hal_drive_mask(false);
 
   pour_control_step(ctl, in, out);
+  bd.clear = in->clear_faults && out->faults == 0u;
   if (p.brake) {
     /* A drive fault: the brake engages at once; until it holds, the power stage stays on for the active
      * stop (a trusted drive) or the shorted phases (one that is not). */
