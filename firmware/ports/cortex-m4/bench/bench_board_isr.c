@@ -31,23 +31,16 @@ void pour_hal_power_init(void) {}
 void pour_hal_power_set(bool on) { (void)on; }
 bool pour_hal_power_on(void) { return false; }
 
-static uint32_t rng = 0x2545F491u;
-static uint32_t next(void) {
-  rng ^= rng << 13;
-  rng ^= rng >> 17;
-  rng ^= rng << 5;
-  return rng;
-}
-
-/* One period's conversions: phase currents within ±3 A summing to zero, the bus at 24 V, any encoder count. */
-static void convert(void) {
-  const int32_t ia = (int32_t)(next() % 201u) - 100, ib = (int32_t)(next() % 201u) - 100;
+/* Period i's conversions: phase currents within ±3 A summing to zero (a sweep that visits each pair of
+ * values), the bus at 24 V, the encoder turning. */
+static void convert(uint32_t i) {
+  const int32_t ia = (int32_t)((i * 37u) % 201u) - 100, ib = (int32_t)((i * 91u + 50u) % 201u) - 100;
   adc1[POUR_ADC_JDR1] = (uint32_t)(2048 + ia);
   adc2[POUR_ADC_JDR1] = (uint32_t)(2048 + ib);
   adc1[POUR_ADC_JDR2] = (uint32_t)(2048 - ia - ib);
   adc1[POUR_ADC_JDR3] = 1554u;
   adc1[POUR_ADC_JDR4] = 1309u;
-  tim4[POUR_TIM4_CNT] = next() & 0xFFFFu;
+  tim4[POUR_TIM4_CNT] = (i * 7919u) & 0xFFFFu;
   adc1[POUR_ADC_ISR] = (1u << 5) | (1u << 6); /* JEOC, JEOS */
 }
 
@@ -82,7 +75,7 @@ int main(void) {
   uint32_t worst = 0u, n = 0u;
   uint64_t sum = 0u;
   for (uint32_t i = 0; i < N_CALLS && pour_board_drive_state()->state == POUR_DRIVE_RUN; ++i) {
-    convert();
+    convert(i);
     const uint32_t t0 = now();
     pour_board_drive_isr();
     const uint32_t t = elapsed(t0, now()) - empty;
