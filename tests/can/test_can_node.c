@@ -89,6 +89,36 @@ static void test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason(vo
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
 }
 
+static void test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows(void) {
+  cfg.can_calibrate = true;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_ESTOP, calibration_answer((uint8_t)POUR_MODE_ESTOP).status);
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node)); /* refused: nothing for the port */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, calibration_answer((uint8_t)POUR_MODE_IDLE).status);
+  TEST_ASSERT_TRUE(pour_can_node_take_calibration_start(&node));
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node)); /* once */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, calibration_answer((uint8_t)POUR_MODE_FAULT).status);
+  TEST_ASSERT_TRUE(pour_can_node_take_calibration_start(&node));
+  /* the outcome, unasked, once */
+  const pour_can_calibration_result_t done = {.status = POUR_CAN_CAL_NO_ENCODER, .stored = POUR_CAN_CAL_EMPTY};
+  pour_can_node_report_calibration(&node, &done);
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  int seen = 0;
+  for (int t = 0; t < 3; ++t) {
+    const uint8_t n = tick(0, &in, tx);
+    for (uint8_t i = 0; i < n; ++i) {
+      pour_can_calibration_result_t r;
+      if (tx[i].id != pour_can_id(cfg.node_id, POUR_CAN_CMD_CALIBRATION_RESULT)) continue;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&tx[i], &r));
+      TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_NO_ENCODER, r.status);
+      ++seen;
+    }
+  }
+  TEST_ASSERT_EQUAL_INT(1, seen);
+}
+
 static void test_can_node_init_RejectsBadConfig(void) {
   pour_can_node_config_t bad = cfg;
   bad.node_id = 64;
@@ -620,6 +650,7 @@ int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_node_init_RejectsBadConfig);
   RUN_TEST(test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason);
+  RUN_TEST(test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows);
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);

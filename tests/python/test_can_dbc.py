@@ -4,6 +4,7 @@ packed by both; random bytes, unpacked by both; the C range checks are the DBC's
 from __future__ import annotations
 
 import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -308,6 +309,16 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "DriveFault_HwOvercurrent: 1" in text and "DriveFault_EncoderMismatch: 1" in text
     assert "ClearErrors(" in text
     assert "Stop(" in text and "Reset(" in text
+
+
+def test_calibration_status_names_are_the_codec_s(db):
+    """CalibrationResult.Status's choices are the codec's POUR_CAN_CAL_* values, name for name."""
+    header = (Path(SOURCE_DIR) / "firmware/can/include/pour/can_codec.h").read_text()
+    ours = {int(v): k for k, v in re.findall(r"#define POUR_CAN_CAL_(\w+) (\d+)u", header)
+            if not k.endswith("_MAX")}
+    choices = db.get_message_by_name("CalibrationResult").get_signal_by_name("Status").choices
+    assert {int(k): str(v) for k, v in choices.items()} == ours
+    assert len(ours) == 16 and "MEASURING" in ours.values()
 
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):

@@ -19,6 +19,7 @@ pour_can_node_config_t pour_can_node_default_config(void) {
   c.identity.tau_max_cnm = 0u;
   c.identity.fw_version = (uint8_t)POUR_FIRMWARE_VERSION;
   c.identity.init_status = (int8_t)POUR_OK;
+  c.can_calibrate = false;
   return c;
 }
 
@@ -248,11 +249,19 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
       r.status = POUR_CAN_CAL_REFUSED_RUNNING;
     } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
       r.status = POUR_CAN_CAL_REFUSED_ESTOP;
+    } else if (node->config.can_calibrate) {
+      r.status = POUR_CAN_CAL_MEASURING;
+      node->calibration_start = true;
     }
     if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
       ++n;
     }
     node->calibration_requested = false;
+  } else if (node->calibration_report) {
+    if (pour_can_pack_calibration_result(node->config.node_id, &node->calibration, &tx[n]) == POUR_OK) {
+      ++n;
+    }
+    node->calibration_report = false;
   }
   return n;
 }
@@ -260,6 +269,17 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
 void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemetry_t *drive) {
   node->drive = *drive;
   node->have_drive = true;
+}
+
+void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
+  node->calibration = *result;
+  node->calibration_report = true;
+}
+
+bool pour_can_node_take_calibration_start(pour_can_node_t *node) {
+  const bool start = node->calibration_start;
+  node->calibration_start = false;
+  return start;
 }
 
 void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
