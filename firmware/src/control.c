@@ -43,6 +43,10 @@ pour_control_config_t pour_control_default_config(void) {
   return config;
 }
 
+/* No experiment armed or running. The estimator still takes an empty bucket for one (the identify
+ * experiment's stays empty, held or stopping) until a Reset starts a run that needs liquid. */
+static void end_experiment(pour_control_t *ctl) { ctl->experiment.kind = (uint8_t)POUR_EXPERIMENT_NONE; }
+
 /* The run's state as at power-on: no state seen, zero torque, the decision schedule and the PRNG
  * from their start (init and an accepted reset; config and weights were validated at init). */
 static void start_afresh(pour_control_t *ctl) {
@@ -74,7 +78,8 @@ static void start_afresh(pour_control_t *ctl) {
   ctl->stop_ms = 0u;
   ctl->stopped = false;
   ctl->held = false;
-  ctl->experiment.kind = (uint8_t)POUR_EXPERIMENT_NONE; /* a Reset disarms it too */
+  end_experiment(ctl); /* a Reset disarms it too */
+  pour_estimator_expect_empty(&ctl->estimator, false);
 }
 
 static bool stop_config_ok(const pour_stop_config_t *s) {
@@ -250,6 +255,7 @@ static void take_experiment_request(pour_control_t *ctl) {
     answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_FAULT;
   } else {
     pour_experiment_start(&ctl->experiment, &ctl->config.experiment, ctl->experiment_kind);
+    pour_estimator_expect_empty(&ctl->estimator, ctl->experiment_kind == (uint8_t)POUR_EXPERIMENT_IDENTIFY);
     ctl->held = false;
   }
   ctl->experiment_answer = answer;
@@ -265,7 +271,7 @@ static void experiment_tick(pour_control_t *ctl) {
   if (ctl->mode != POUR_MODE_RUN) {
     if (ctl->mode == POUR_MODE_FAULT || e->started) {
       ctl->held = ctl->mode == POUR_MODE_IDLE;
-      e->kind = (uint8_t)POUR_EXPERIMENT_NONE;
+      end_experiment(ctl);
     }
     return;
   }
@@ -277,6 +283,7 @@ static void experiment_tick(pour_control_t *ctl) {
   if (ended) {
     ctl->mode = POUR_MODE_IDLE;
     ctl->held = true;
+    end_experiment(ctl);
   }
 }
 
@@ -295,7 +302,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->mode = POUR_MODE_ESTOP;
     ctl->faults |= POUR_FAULT_ESTOP;
     ctl->stopped = true; /* after the release: brake and power cut until a clear */
-    ctl->experiment.kind = (uint8_t)POUR_EXPERIMENT_NONE;
+    end_experiment(ctl);
     if (ctl->experiment_asked) {
       ctl->experiment_asked = false;
       ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP;

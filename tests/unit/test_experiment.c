@@ -210,6 +210,25 @@ static void test_experiment_tilt_TracksTheSlowTiltAndComesBack(void) {
   TEST_ASSERT_INT_WITHIN(35000, 0, ctl.state.theta_urad);
 }
 
+static void test_experiment_identify_RunsOnAnEmptyBucket_ARunAfterAResetDoesNot(void) {
+  in.sensors.scale_rotating_g = 0; /* empty, as the identify experiment wants it */
+  tick();
+  TEST_ASSERT_EQUAL_UINT16(POUR_FAULT_BAD_INPUT, out.faults); /* a run needs liquid to weigh */
+  in.clear_faults = true;
+  pour_control_experiment(&ctl, POUR_EXPERIMENT_IDENTIFY);
+  for (int k = 0; k < 200; ++k) tick();
+  TEST_ASSERT_EQUAL_UINT16(0u, out.faults);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_INT16(0, ctl.state.v_spill); /* nothing to spill */
+  in.stop = true;
+  tick();
+  tick();
+  TEST_ASSERT_EQUAL_UINT16(0u, out.faults); /* held, empty */
+  in.reset = true;
+  tick();
+  TEST_ASSERT_EQUAL_UINT16(POUR_FAULT_BAD_INPUT, out.faults);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_experiment_validate_RefusesBadConfig);
@@ -219,5 +238,6 @@ int main(void) {
   RUN_TEST(test_experiment_LeavingTheRange_EndsItHeld);
   RUN_TEST(test_experiment_StopEndsItHeld_AndAFaultEndsItForGood);
   RUN_TEST(test_experiment_tilt_TracksTheSlowTiltAndComesBack);
+  RUN_TEST(test_experiment_identify_RunsOnAnEmptyBucket_ARunAfterAResetDoesNot);
   return UNITY_END();
 }
