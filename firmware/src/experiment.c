@@ -23,6 +23,9 @@ pour_experiment_config_t pour_experiment_default_config(void) {
   c.kd_per_rad_s = 1638;       /* 0.05 tau_max per rad/s: damping ratio ~0.8 on the empty bucket */
   c.step_torque = 2458;        /* 0.075 tau_max: ~0.15 rad against the hold stiffness */
   c.chirp_torque = 1966;       /* 0.06 tau_max */
+  c.prbs_torque = 1638;        /* 0.05 tau_max: each flip one slew step, an edge every ~16 ms whose timing
+                                * shows the command's latency to the tick */
+  c.prbs_bit_ms = 8u;
   c.chirp_f0_mhz = 500u;       /* 0.5 Hz .. */
   c.chirp_f1_mhz = 6000u;      /* .. 6 Hz: past the hold's resonance, into the inertia's range */
   c.tilt_theta_urad = 1570796; /* 90 deg: all of the liquid is out */
@@ -37,7 +40,7 @@ pour_status_t pour_experiment_validate(const pour_experiment_config_t *c) {
   if (c == NULL || c->hold_theta_urad <= 0 || c->hold_theta_urad > ANGLE_MAX_URAD || c->range_urad < c->hold_theta_urad ||
       c->range_urad > ANGLE_MAX_URAD || c->tilt_theta_urad > ANGLE_MAX_URAD || c->tilt_margin_urad > ANGLE_MAX_URAD ||
       c->tilt_speed_urad_s > SPEED_MAX_URAD_S || c->kp_per_rad <= 0 ||
-      c->kd_per_rad_s < 0 || c->step_torque <= 0 || c->chirp_torque <= 0 || c->chirp_f0_mhz == 0u ||
+      c->kd_per_rad_s < 0 || c->step_torque <= 0 || c->chirp_torque <= 0 || c->prbs_torque < 0 || c->prbs_bit_ms < 1u || c->chirp_f0_mhz == 0u ||
       c->chirp_f1_mhz <= c->chirp_f0_mhz || c->chirp_f1_mhz > 50000u || c->tilt_theta_urad <= 0 ||
       c->tilt_speed_urad_s <= 0 || c->tilt_margin_urad <= 0 || c->tilt_kp_per_rad <= 0 || c->tilt_kd_per_rad_s < 0) {
     return POUR_EINVAL;
@@ -70,6 +73,7 @@ void pour_experiment_start(pour_experiment_t *e, const pour_experiment_config_t 
   e->ms = 0u;
   e->start_theta_urad = 0;
   e->phase_turn = 0u;
+  e->lfsr = 0xACE1u;
 }
 
 /* a + (b - a) * num / den [µrad], den > 0, 0 <= num <= den. */
@@ -110,6 +114,11 @@ static int32_t identify(pour_experiment_t *e, const pour_state_t *s) {
   } else if (t < RAMP_MS + STEPS_MS) {
     e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_STEPS;
     excite = (((t - RAMP_MS) / STEP_HALF_MS) & 1u) == 0u ? c->step_torque : -c->step_torque;
+    if ((t - RAMP_MS) % c->prbs_bit_ms == 0u) {
+      const uint16_t bit = (uint16_t)(((e->lfsr >> 0) ^ (e->lfsr >> 2) ^ (e->lfsr >> 3) ^ (e->lfsr >> 5)) & 1u);
+      e->lfsr = (uint16_t)((e->lfsr >> 1) | (bit << 15));
+    }
+    excite += (e->lfsr & 1u) != 0u ? c->prbs_torque : -c->prbs_torque;
   } else if (t < RAMP_MS + STEPS_MS + CHIRP_MS) {
     e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_CHIRP;
     /* One tick advances the phase by f [mHz] * 2^32 / 10^6 (f <= 50 Hz: < 2^28 a tick). */

@@ -23,7 +23,7 @@ typedef enum {
  * how it ended. */
 typedef enum {
   POUR_EXPERIMENT_PHASE_RAMP = 1,   /* identify: to the hold angle */
-  POUR_EXPERIMENT_PHASE_STEPS = 2,  /* identify: torque steps about it */
+  POUR_EXPERIMENT_PHASE_STEPS = 2,  /* identify: torque steps about it, a binary sequence on them */
   POUR_EXPERIMENT_PHASE_CHIRP = 3,  /* identify: a chirp about it */
   POUR_EXPERIMENT_PHASE_BACK = 4,   /* identify: back to the start angle */
   POUR_EXPERIMENT_PHASE_TILT = 5,   /* tilt: up at the tilt speed */
@@ -42,6 +42,8 @@ typedef struct {
   int32_t kd_per_rad_s;      /* identify: hold damping [Q15 / (rad/s)], >= 0 */
   q15_t step_torque;         /* identify: the steps' amplitude, Q15, > 0 */
   q15_t chirp_torque;        /* identify: the chirp's amplitude, Q15, > 0 */
+  q15_t prbs_torque;         /* identify: a pseudo-random binary sequence on the steps, its amplitude, Q15, >= 0 */
+  uint8_t prbs_bit_ms;       /* identify: ... one bit this long [ms], >= 1 */
   uint16_t chirp_f0_mhz;     /* identify: the chirp's start frequency [mHz], > 0 */
   uint16_t chirp_f1_mhz;     /* identify: ... and its end frequency [mHz], > f0, <= 50 Hz */
   int32_t tilt_theta_urad;   /* tilt: up to this angle [µrad], > 0 */
@@ -59,6 +61,7 @@ typedef struct {
   uint32_t ms;             /* ticks since the first state [ms] */
   int32_t start_theta_urad; /* the angle it started from, and returns to [µrad] */
   uint32_t phase_turn;     /* the chirp's phase [2^-32 turn] */
+  uint16_t lfsr;           /* the sequence's shift register (x^16 + x^14 + x^13 + x^11 + 1) */
 } pour_experiment_t;
 
 pour_experiment_config_t pour_experiment_default_config(void);

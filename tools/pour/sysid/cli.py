@@ -39,7 +39,7 @@ def parser():
 
 
 def figure(fit: sf.Fit, path: Path) -> None:
-    """Three panels: the torque commanded against the fitted model's, the angle against the fitted model
+    """Three panels: the acceleration against the fitted model's, the angle against the fitted model
     run from the measured state every 0.5 s, and the rotating scale's readings against the fitted cell's."""
     import matplotlib
     matplotlib.use("Agg")
@@ -47,9 +47,9 @@ def figure(fit: sf.Fit, path: Path) -> None:
     s = fit.series
     t, use = s["t"], s["use"]
     fig, ax = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
-    ax[0].plot(t, s["tau"], lw=0.8, label="commanded (filtered), measured")
-    ax[0].plot(t[use], s["tau_model"][use], ".", ms=1, label="the fitted model's")
-    ax[0].set_ylabel("torque [N m]")
+    ax[0].plot(t, s["accel"], lw=0.8, label="measured (filtered)")
+    ax[0].plot(t[use], s["accel_model"][use], ".", ms=1, label="the fitted model's, from the commanded torque")
+    ax[0].set_ylabel("θ̈ [rad/s²]")
     ax[1].plot(t, np.degrees(s["theta"]), lw=0.8, label="measured")
     ax[1].plot(t, np.degrees(s["theta_sim"]), lw=0.8, label="simulated: the fit, from the measured state every 0.5 s")
     ax[1].set_ylabel("θ [deg]")

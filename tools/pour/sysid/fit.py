@@ -6,12 +6,12 @@ The axis, at the output, with the command of L ticks before acting now:
     J θ̈ = s τ(t - L) - F_c sgn θ̇ - b θ̇ - G sin θ
 
 τ is what the controller commanded (its Torque frames), s the torque scale (what the drive delivers per
-N m commanded), G = m g d the empty bucket's gravity arm. Only ratios to s show in the motion, so the
-equation is fitted as τ(t - L) = (J/s) θ̈ + (F_c/s) sgn θ̇ + (b/s) θ̇ + (G/s) sin θ by least squares, for
+N m commanded), G = m g d the empty bucket's gravity arm. Only ratios to J show in the motion, so the
+equation is fitted as θ̈ = (s/J) τ(t - L) - (F_c/J) sgn θ̇ - (b/J) θ̇ - (G/J) sin θ by least squares, for
 each latency L, and G, known from the bucket's mass and drawing (the rig file's bucket_mass and geometry),
-sets s. θ̇ and θ̈ come from a Savitzky-Golay filter of the encoder's angle, and the other terms pass the
-same filter, so the filter's lag is the same on both sides. Samples near standstill (stiction: the
-friction is anything up to F_c there) are left out.
+sets J. θ̇ and θ̈ are the encoder angle's first and second differences, and every term passes one
+smoothing filter (Savitzky-Golay), under which the equation stays exact. Samples near standstill
+(stiction: the friction is anything up to F_c there) are left out.
 
 The pivot's load cell carries the bucket's inertial load m a_y = m d (θ̈ sin θ + θ̇² cos θ) [g]; each of
 its conversions reports the mean load over the scale's delay before it. The delay is the span that best
@@ -52,12 +52,12 @@ class Fit:
     series: dict[str, np.ndarray] = field(default_factory=dict)    # for the figure
 
 
-def savgol(x: np.ndarray, deriv: int, dt: float) -> np.ndarray:
-    """x's local cubic fit over ±SG_HALF ticks, or its first or second derivative (ends: edge values)."""
-    k = np.arange(-SG_HALF, SG_HALF + 1, dtype=float)
+def savgol(x: np.ndarray, deriv: int, dt: float, half: int = SG_HALF) -> np.ndarray:
+    """x's local cubic fit over ±half ticks, or its first or second derivative (ends: edge values)."""
+    k = np.arange(-half, half + 1, dtype=float)
     V = np.vander(k, SG_ORDER + 1, increasing=True)
     c = np.linalg.pinv(V)[deriv] * float(np.prod(range(1, deriv + 1)) if deriv else 1.0) / dt ** deriv
-    xp = np.concatenate([np.full(SG_HALF, x[0]), x, np.full(SG_HALF, x[-1])])
+    xp = np.concatenate([np.full(half, x[0]), x, np.full(half, x[-1])])
     return np.convolve(xp, c[::-1], mode="valid")
 
 
@@ -95,12 +95,16 @@ def fit_identify(run: Run, rig: dict) -> Fit:
                        "(bucket empty), which excites the drive's parameters")
     dt = rig["dt"]
     theta = run.theta(int(rig["encoder_bits"]))
+    n = len(theta)
+    # The physics' own differences (a semi-implicit step: ω_k = (θ_k - θ_k-1)/dt, the tick's acceleration
+    # the second difference), then one smoothing filter for every term: the equation stays exact under it.
+    accel = np.zeros(n)
+    accel[1:-1] = (theta[2:] - 2 * theta[1:-1] + theta[:-2]) / dt ** 2
     th = savgol(theta, 0, dt)
-    om = savgol(theta, 1, dt)
-    al = savgol(theta, 2, dt)
+    om = savgol(np.diff(theta, prepend=theta[0]) / dt, 0, dt)
+    al = savgol(accel, 0, dt)
     sgn = savgol(np.sign(om), 0, dt)
     sin = savgol(np.sin(th), 0, dt)
-    n = len(theta)
     edge = np.zeros(n, dtype=bool)
     edge[SG_HALF + LATENCY_MAX:n - SG_HALF] = True
     # Moving one way over the whole window: the Coulomb term is then exactly ±F_c.
@@ -110,19 +114,22 @@ def fit_identify(run: Run, rig: dict) -> Fit:
     if use.sum() < 200:
         raise LogError("cannot identify inertia, friction or torque scale: the bucket hardly moved "
                        f"({int(use.sum())} usable ticks of steps and chirp): the experiment did not excite them")
-    X = np.column_stack([al, sgn, om, sin])[use]
     fit = Fit()
-    best = None
-    for lat in range(0, LATENCY_MAX + 1):
-        tau = savgol(np.concatenate([np.zeros(lat), run.torque[:n - lat]]), 0, dt)
-        coef, cov, rss = _lsq(X, tau[use])
-        fit.latency_rss[lat] = rss
-        if best is None or rss < best[3]:
-            best = (lat, coef, cov, rss, tau)
-    lat, coef, cov, rss, tau = best
     md, j_bucket = bucket_arm_and_inertia(rig)
     g_known = md * G0
-    names = ["inertia", "friction_coulomb", "friction_viscous", "gravity"]
+    # The acceleration is the dependent variable: it carries the encoder's quantisation noise, which in a
+    # regressor would bias the inertia low. α = (s/J) τ(t - L) - (F_c/J) sgn θ̇ - (b/J) θ̇ - (G/J) sin θ.
+    y = al[use]
+    rest = np.column_stack([-sgn, -om, -sin])[use]
+    def shifted(lat: int) -> np.ndarray:
+        return savgol(np.concatenate([np.zeros(lat), run.torque[:n - lat]]), 0, dt)
+    for lat in range(0, LATENCY_MAX + 1):
+        fit.latency_rss[lat] = _lsq(np.column_stack([shifted(lat)[use], rest]), y)[2]
+    lat = min(fit.latency_rss, key=fit.latency_rss.get)
+    tau = shifted(lat)
+    X = np.column_stack([tau[use], rest])
+    coef, cov, rss = _lsq(X, y)
+    names = ["torque_scale", "friction_coulomb", "friction_viscous", "inertia"]
     rel = np.sqrt(np.diag(cov)) / np.maximum(np.abs(coef), 1e-12)
     weak = [names[i] for i in (0, 1, 3) if rel[i] > REL_SIGMA_MAX or coef[i] <= 0]
     if weak:
@@ -135,22 +142,22 @@ def fit_identify(run: Run, rig: dict) -> Fit:
         # F_c is what friction is left beyond it (rather than F_c taking b's share).
         b_ratio = rig["friction_viscous"] * coef[3] / g_known
         keep = [0, 1, 3]
-        sub, sub_cov, rss = _lsq(X[:, keep], tau[use] - b_ratio * X[:, 2])
+        sub, sub_cov, rss = _lsq(X[:, keep], y - b_ratio * X[:, 2])
         coef = np.array([sub[0], sub[1], b_ratio, sub[2]])
         cov = np.zeros((4, 4))
         cov[np.ix_(keep, keep)] = sub_cov
-    # s = G / (G/s); every other figure is s times its ratio (delta method for the uncertainties).
-    s = g_known / coef[3]
-    grad_s = np.array([0, 0, 0, -g_known / coef[3] ** 2])
+    # J = G / (G/J); every other figure is J times its ratio (delta method for the uncertainties).
+    J = g_known / coef[3]
+    grad_J = np.array([0, 0, 0, -g_known / coef[3] ** 2])
     def scaled(i: int) -> tuple[float, float]:
-        v = s * coef[i]
-        g = grad_s * coef[i]
-        g[i] += s
-        return v, float(np.sqrt(g @ cov @ g))
-    J, sJ = scaled(0)
+        g = grad_J * coef[i]
+        g[i] += J
+        return J * coef[i], float(np.sqrt(g @ cov @ g))
+    s_, s_sigma = scaled(0)
     Fc, sFc = scaled(1)
     b, sb = scaled(2) if viscous_fitted else (rig["friction_viscous"], float("nan"))
-    s_sigma = float(np.sqrt(grad_s @ cov @ grad_s))
+    sJ = float(np.sqrt(grad_J @ cov @ grad_J))
+    s = s_
     N2 = rig["gear_ratio"] ** 2
     est = fit.estimates
     est["torque_scale"] = Estimate(s, s_sigma, "-", "delivered / commanded torque (the torque constant's error)")
@@ -160,11 +167,11 @@ def fit_identify(run: Run, rig: dict) -> Fit:
     est["friction_coulomb"] = Estimate(Fc, sFc, "N m", "Coulomb friction at the output")
     est["friction_viscous"] = Estimate(b, sb, "N m s/rad", "viscous friction at the output" + (
         "" if viscous_fitted else ": not identified (b θ̇ too small beside F_c at these speeds), the base rig's kept"))
-    second = sorted(fit.latency_rss.values())[1]
+    ranked = sorted(fit.latency_rss.values())
     est["command_latency_ticks"] = Estimate(float(lat), 0.0, "ticks",
-                                            f"a command acts this many ticks later (next best "
-                                            f"{second / rss:.2f}x the residual)")
-    fit.series.update(t=run.t - run.t[0], theta=theta, tau=tau, tau_model=np.column_stack([al, sgn, om, sin]) @ coef,
+                                            f"a command acts this many ticks later (the next best latency "
+                                            f"leaves {ranked[1] / ranked[0]:.2f}x the residual)")
+    fit.series.update(t=run.t - run.t[0], theta=theta, accel=al, accel_model=np.column_stack([tau, -sgn, -om, -sin]) @ coef,
                       use=use)
     _fit_scale(run, rig, th, om, al, md, fit)
     return fit
