@@ -335,6 +335,56 @@ class Node:
     def zero(self, timeout: float = DEFAULT_TIMEOUT_S) -> None:
         self._request("Zero", 0, timeout)
 
+    # -- identification ------------------------------------------------------------------------------------
+    def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
+        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
+        writes the bus as a candump -L log (atomically, the start frame included) until the node reports how
+        it ended (Torque.Action outside RUN) and 0.2 s more, or seconds pass. Returns (frames, how it ended).
+        ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
+        atomic.check_output_path(path, "log")
+        kinds = {str(v): int(k) for k, v in self.bench.message("ExperimentStart").get_signal_by_name("Kind").choices.items()}
+        cmd = self.bench.message("ExperimentStart").frame_id
+        phases = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return",
+                  8: "done", 9: "out of range"}
+        n, answered, ended, tail_end = 0, False, None, None
+        with atomic.atomic_path(path) as tmp:
+            writer = can.CanutilsLogWriter(str(tmp), channel=self.bench.channel)
+            try:
+                m = self.bench.message("ExperimentStart")
+                start = can.Message(timestamp=time.time(), arbitration_id=dbc.can_id(self.id, m.frame_id),
+                                    data=m.encode({"Kind": kinds[kind]}, scaling=False, strict=True),
+                                    is_extended_id=False, channel=self.bench.channel)
+                self.bench.send(self.id, "ExperimentStart", Kind=kinds[kind])
+                writer.on_message_received(start)
+                for msg in self.bench.frames(seconds):
+                    writer.on_message_received(msg)
+                    n += 1
+                    d = self.bench.decode(msg)
+                    if d is None or d[0] != self.id:
+                        continue
+                    name, s = d[1], d[2]
+                    if name == "ParamAck" and s["Request"] == cmd:
+                        answered = True
+                        if s["Result"] != 0:
+                            result = str(self.bench.message("ParamAck").get_signal_by_name("Result").choices[s["Result"]])
+                            reason = {"REFUSED_RUNNING": "the controller runs: stop it first",
+                                      "REFUSED_ESTOP": "the e-stop is asserted",
+                                      "REFUSED_FAULT": "the controller is in FAULT: clear it first"}.get(result, "")
+                            raise ParamRefused(f"node {self.id} refused the {kind} experiment: {result} ({reason})",
+                                               "ExperimentStart", result)
+                    elif name == "Torque" and answered and ended is None and s["Mode"] != 1 and s["Action"] >= 8:
+                        ended, tail_end = phases.get(s["Action"], str(s["Action"])), time.monotonic() + 0.2
+                    if tail_end is not None and time.monotonic() >= tail_end:
+                        break
+            finally:
+                writer.stop()
+            if not answered:
+                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart: no log written", self.state)
+            if ended is None:
+                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s: no log "
+                                  "written", self.state)
+        return n, ended
+
     # -- telemetry -----------------------------------------------------------------------------------------
     def stream(self, seconds: float) -> Iterator[tuple[float, str, dict]]:
         """(time [s], message name, raw signals) of this node's frames for the given time."""

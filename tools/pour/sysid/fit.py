@@ -33,6 +33,7 @@ OMEGA_MIN = 0.05     # [rad/s] below it the axis may stick: left out
 DELAY_MAX = 400      # [ticks] of scale delay searched
 FIT_PHASES = (2, 3)  # steps and chirp: the excitation (pour/experiment.h)
 REL_SIGMA_MAX = 0.25  # a parameter known worse than this is not identified by the log
+BATCHES = 8          # batch means for the reported uncertainties
 TRUST_SIGMA_MAX = 0.05
 
 
@@ -77,7 +78,9 @@ def bucket_arm_and_inertia(rig: dict) -> tuple[float, float]:
 
 def _lsq(X: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Least squares: coefficients, their covariance and the RSS. The residuals of filtered signals are
-    correlated over the filter's window: the covariance counts one independent sample per window."""
+    correlated over the filter's window: the covariance counts one independent sample per window (a
+    conservative bound, used to tell a parameter the log does not excite; the figures' reported
+    uncertainties are _batch_sigma's)."""
     coef, *_ = np.linalg.lstsq(X, y, rcond=None)
     r = y - X @ coef
     rss = float(r @ r)
@@ -85,6 +88,24 @@ def _lsq(X: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     var = rss / max(1, n - p)
     cov = var * np.linalg.pinv(X.T @ X) * (2 * SG_HALF + 1)
     return coef, cov, rss
+
+
+def _batch_sigma(X: np.ndarray, y: np.ndarray, coef: np.ndarray, figures, free: bool, k: int = BATCHES) -> np.ndarray:
+    """Standard deviations of figures(coef) by batch means: the samples dealt round-robin, in runs of two
+    filter windows (longer than the residuals' correlation), into k batches each fitted on its own; the
+    spread of the k fits over sqrt(k). free: the viscous ratio was fitted (else it stays coef's)."""
+    run = 2 * (2 * SG_HALF + 1)
+    batch = (np.arange(len(y)) // run) % k
+    keep = [0, 1, 2, 3] if free else [0, 1, 3]
+    out = []
+    for i in range(k):
+        m = batch == i
+        yi = y[m] - (0.0 if free else coef[2] * X[m, 2])
+        c, *_ = np.linalg.lstsq(X[m][:, keep], yi, rcond=None)
+        full = coef.copy()
+        full[keep] = c
+        out.append(figures(full))
+    return np.std(np.array(out), axis=0, ddof=1) / np.sqrt(k)
 
 
 def fit_identify(run: Run, rig: dict) -> Fit:
@@ -146,18 +167,15 @@ def fit_identify(run: Run, rig: dict) -> Fit:
         coef = np.array([sub[0], sub[1], b_ratio, sub[2]])
         cov = np.zeros((4, 4))
         cov[np.ix_(keep, keep)] = sub_cov
-    # J = G / (G/J); every other figure is J times its ratio (delta method for the uncertainties).
-    J = g_known / coef[3]
-    grad_J = np.array([0, 0, 0, -g_known / coef[3] ** 2])
-    def scaled(i: int) -> tuple[float, float]:
-        g = grad_J * coef[i]
-        g[i] += J
-        return J * coef[i], float(np.sqrt(g @ cov @ g))
-    s_, s_sigma = scaled(0)
-    Fc, sFc = scaled(1)
-    b, sb = scaled(2) if viscous_fitted else (rig["friction_viscous"], float("nan"))
-    sJ = float(np.sqrt(grad_J @ cov @ grad_J))
-    s = s_
+    # J = G / (G/J); every other figure is J times its ratio.
+    def figures(c: np.ndarray) -> np.ndarray:
+        j = g_known / c[3]
+        return np.array([j * c[0], j * c[1], j * c[2], j])
+    s, Fc, b, J = figures(coef)
+    sigma = _batch_sigma(X, y, coef, figures, free=viscous_fitted)
+    s_sigma, sFc, sb, sJ = sigma
+    if not viscous_fitted:
+        b, sb = rig["friction_viscous"], float("nan")
     N2 = rig["gear_ratio"] ** 2
     est = fit.estimates
     est["torque_scale"] = Estimate(s, s_sigma, "-", "delivered / commanded torque (the torque constant's error)")

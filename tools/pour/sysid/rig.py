@@ -89,3 +89,28 @@ def save(path: Path, rig: Rig, header: list[str]) -> None:
             lines.append(f"{k} = {_num(k, v)}" + (f"  # sigma {s:.3g}" if s is not None else ""))
     with atomic.atomic_path(path) as tmp:
         Path(tmp).write_text("\n".join(lines) + "\n")
+
+
+# The simulator's randomisation keys that spread each fitted figure (config_fields.h, "domain randomisation").
+SPREAD = {"motor_rotor_inertia": "rand_motor", "friction_coulomb": "rand_motor", "friction_viscous": "rand_motor",
+          "scale_delay_s": "rand_sensor", "scale_noise_g": "rand_sensor"}
+
+
+def centred(options: dict, rig: Rig) -> dict:
+    """Simulator options with rig's values as the nominal and each randomisation width set by the fit: a
+    uniform spread of half-width √3 σ (the same standard deviation) relative to the value, the widest of the
+    figures one key spreads; keys with no σ keep the options' width."""
+    out = {**options, **rig.values}
+    info = poursim.describe()
+    widths: dict[str, float] = {}
+    for k, key in SPREAD.items():
+        v, s = rig.values.get(k), rig.sigma.get(k)
+        if v and s is not None:
+            widths[key] = max(widths.get(key, 0.0), min(info[key].max, math.sqrt(3.0) * s / abs(v)))
+    out.update(widths)
+    return out
+
+
+def host_sim_sets(rig: Rig) -> list[str]:
+    """rig's values as host_sim --set arguments."""
+    return [a for k, v in rig.values.items() for a in ("--set", f"{k}={_num(k, v)}")]
