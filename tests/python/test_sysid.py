@@ -170,3 +170,29 @@ def test_host_sim_experiment_usage_errors(tmp_path, argv, why):
     r = subprocess.run([str(HOST_SIM)] + argv, capture_output=True, text=True, cwd=tmp_path, timeout=30)
     assert r.returncode == 2 and why in r.stderr, r.stderr
     assert not (tmp_path / "x.log").exists()
+
+
+def test_the_rig_centres_the_randomisation_with_its_uncertainties():
+    from pour.sysid import rig as srig
+    r = srig.Rig({"torque_scale": 0.8, "friction_coulomb": 0.5, "motor_rotor_inertia": 2e-5, "scale_delay_s": 0.04},
+                 {"friction_coulomb": 0.01, "motor_rotor_inertia": 1e-6, "scale_delay_s": 0.002})
+    opts = srig.centred({"rand_motor": 0.15, "rand_fill": 0.2, "friction_coulomb": 0.6}, r)
+    assert opts["torque_scale"] == 0.8 and opts["friction_coulomb"] == 0.5 and opts["rand_fill"] == 0.2
+    # The widest of the motor's figures: the rotor's 5 % -> a uniform ±√3·5 %.
+    assert opts["rand_motor"] == pytest.approx(3 ** 0.5 * 0.05)
+    assert opts["rand_sensor"] == pytest.approx(3 ** 0.5 * 0.05)
+    assert srig.host_sim_sets(srig.Rig({"command_latency_ticks": 3.0})) == ["--set", "command_latency_ticks=3"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["pour-train", "configs/train/toy.toml", "--out", "{tmp}/run", "--rig", "{rig}"],
+    ["pour-eval", "robust", "--header", "policy/weights.h", "--out", "{tmp}/rob", "--rig", "{rig}"],
+])
+def test_train_and_robust_refuse_a_bad_rig_file(tmp_path, argv):
+    from conftest import SOURCE_DIR
+    rig = tmp_path / "rig.toml"
+    rig.write_text("torque_scale = 7\n")  # outside [0.5, 2]
+    cmd = [str(Path(sys.executable).parent / argv[0])] + [a.format(tmp=tmp_path, rig=rig) for a in argv[1:]]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=SOURCE_DIR, timeout=120)
+    assert r.returncode == 2 and "torque_scale = 7 is out of range" in r.stderr, r.stderr
+    assert not (tmp_path / "run").exists() and not (tmp_path / "rob").exists()

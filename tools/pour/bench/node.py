@@ -337,8 +337,8 @@ class Node:
 
     # -- identification ------------------------------------------------------------------------------------
     def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
-        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
-        writes the bus as a candump -L log (atomically, the start frame included) until the node reports how
+        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h; after a
+        Stop when the node runs) and writes the bus as a candump -L log (atomically, the start frame included) until the node reports how
         it ended (Torque.Action outside RUN) and 0.2 s more, or seconds pass. Returns (frames, how it ended).
         ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
         atomic.check_output_path(path, "log")
@@ -354,6 +354,9 @@ class Node:
                 start = can.Message(timestamp=time.time(), arbitration_id=dbc.can_id(self.id, m.frame_id),
                                     data=m.encode({"Kind": kinds[kind]}, scaling=False, strict=True),
                                     is_extended_id=False, channel=self.bench.channel)
+                if self.state is not None and self.state.mode == "RUN":
+                    # A run in progress (a sample stream starts one): a Stop in the same tick lets it start.
+                    self.bench.send(self.id, "Stop")
                 self.bench.send(self.id, "ExperimentStart", Kind=kinds[kind])
                 writer.on_message_received(start)
                 for msg in self.bench.frames(seconds):
