@@ -174,6 +174,8 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     log = tmp_path / "identify.log"
     try:
+        with bn.Bench("vcan0") as b:
+            b.node(0).wait_mode({"RUN"}, timeout=20)  # the plant's samples flow
         r = bench("identify", str(log))
         assert r.returncode == 2 and "--expect-hash" in r.stderr, r.stderr
         assert "mode ESTOP" in ok("estop")

@@ -25,6 +25,7 @@ from pour import atomic
 from pour.can import dbc
 
 DEFAULT_TIMEOUT_S = 1.0
+START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent again
 HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
 TARE_ROTATING = 1
 TARE_TARGET = 2
@@ -337,28 +338,33 @@ class Node:
 
     # -- identification ------------------------------------------------------------------------------------
     def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
-        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h; after a
-        Stop when the node runs) and writes the bus as a candump -L log (atomically, the start frame included) until the node reports how
+        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
+        writes the bus as a candump -L log (atomically, the start frames included) until the node reports how
         it ended (Torque.Action outside RUN) and 0.2 s more, or seconds pass. Returns (frames, how it ended).
-        ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
+        A node in RUN gets a Stop just before the start: the two must land in one control tick, since the
+        next sample starts a new run; a start refused as REFUSED_RUNNING is tried again, START_TRIES times
+        in all. ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
         atomic.check_output_path(path, "log")
         kinds = {str(v): int(k) for k, v in self.bench.message("ExperimentStart").get_signal_by_name("Kind").choices.items()}
         cmd = self.bench.message("ExperimentStart").frame_id
         phases = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return",
                   8: "done", 9: "out of range"}
-        n, answered, ended, tail_end = 0, False, None, None
+        n, answered, ended, tail_end, tries = 0, False, None, None, 0
+        m = self.bench.message("ExperimentStart")
         with atomic.atomic_path(path) as tmp:
             writer = can.CanutilsLogWriter(str(tmp), channel=self.bench.channel)
-            try:
-                m = self.bench.message("ExperimentStart")
-                start = can.Message(timestamp=time.time(), arbitration_id=dbc.can_id(self.id, m.frame_id),
-                                    data=m.encode({"Kind": kinds[kind]}, scaling=False, strict=True),
-                                    is_extended_id=False, channel=self.bench.channel)
+
+            def start() -> None:
                 if self.state is not None and self.state.mode == "RUN":
-                    # A run in progress (a sample stream starts one): a Stop in the same tick lets it start.
                     self.bench.send(self.id, "Stop")
                 self.bench.send(self.id, "ExperimentStart", Kind=kinds[kind])
-                writer.on_message_received(start)
+                writer.on_message_received(can.Message(
+                    timestamp=time.time(), arbitration_id=dbc.can_id(self.id, m.frame_id), is_extended_id=False,
+                    data=m.encode({"Kind": kinds[kind]}, scaling=False, strict=True), channel=self.bench.channel))
+
+            try:
+                start()
+                tries = 1
                 for msg in self.bench.frames(seconds):
                     writer.on_message_received(msg)
                     n += 1
@@ -367,9 +373,13 @@ class Node:
                         continue
                     name, s = d[1], d[2]
                     if name == "ParamAck" and s["Request"] == cmd:
+                        result = str(self.bench.message("ParamAck").get_signal_by_name("Result").choices[s["Result"]])
+                        if result == "REFUSED_RUNNING" and tries < START_TRIES:
+                            start()
+                            tries += 1
+                            continue
                         answered = True
                         if s["Result"] != 0:
-                            result = str(self.bench.message("ParamAck").get_signal_by_name("Result").choices[s["Result"]])
                             reason = {"REFUSED_RUNNING": "the controller runs: stop it first",
                                       "REFUSED_ESTOP": "the e-stop is asserted",
                                       "REFUSED_FAULT": "the controller is in FAULT: clear it first"}.get(result, "")

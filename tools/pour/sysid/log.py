@@ -76,21 +76,26 @@ def read(path: Path, node_id: int) -> Run:
             kind = int(s["Kind"])
         elif name == "ParamAck" and s["Request"] == EXPERIMENT_START:
             answer = int(s["Result"])
+            samples, rows = [], []  # what came before the accepted start is another run
         elif name == "Identity":
             tau_max = s["TauMax"] * 0.01
         elif name == "Sensors":
             samples.append((m.timestamp, s))
-        elif name == "Torque" and samples:
+        elif name == "Torque" and samples and answer == 0:
             rows.append((samples[-1][0], samples[-1][1], s))
-    if not rows:
+    if node_id not in seen:
         others = ", ".join(str(n) for n in sorted(seen)) or "none"
-        raise LogError(f"{path}: no Sensors and Torque frames of node {node_id} (nodes in the log: {others}); "
-                       "--node-id names the controller")
+        raise LogError(f"{path}: no frames of node {node_id} (nodes in the log: {others}); --node names the "
+                       "controller")
     if kind is None:
         raise LogError(f"{path}: no ExperimentStart for node {node_id}: not a log of pour-bench identify")
-    if answer is not None and answer != 0:
+    if answer is None:
+        raise LogError(f"{path}: node {node_id}'s answer to the ExperimentStart (a ParamAck) is not in the log")
+    if answer != 0:
         result = bn.load_dbc().get_message_by_name("ParamAck").get_signal_by_name("Result").choices.get(answer, answer)
         raise LogError(f"{path}: the controller refused the experiment ({result}): nothing ran")
+    if not rows:
+        raise LogError(f"{path}: truncated: no Sensors and Torque frames of node {node_id} after its start")
     if tau_max is None:
         raise LogError(f"{path}: no Identity frame of node {node_id}: the torque's scale (TauMax) is unknown")
     mode = np.array([r[2]["Mode"] for r in rows])
