@@ -26,6 +26,10 @@ from pour.can import dbc
 
 DEFAULT_TIMEOUT_S = 1.0
 START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent again
+# pour/experiment.h's phases: Torque.Action while an experiment runs, and how it ended (8, 9) after it.
+EXPERIMENT_PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
+                     9: "out of range"}
+EXPERIMENT_ENDED = 8  # Action >= this outside RUN: the experiment is over
 HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
 TARE_ROTATING = 1
 TARE_TARGET = 2
@@ -347,8 +351,6 @@ class Node:
         atomic.check_output_path(path, "log")
         kinds = {str(v): int(k) for k, v in self.bench.message("ExperimentStart").get_signal_by_name("Kind").choices.items()}
         cmd = self.bench.message("ExperimentStart").frame_id
-        phases = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return",
-                  8: "done", 9: "out of range"}
         n, answered, ended, tail_end, tries = 0, False, None, None, 0
         m = self.bench.message("ExperimentStart")
         with atomic.atomic_path(path) as tmp:
@@ -385,8 +387,10 @@ class Node:
                                       "REFUSED_FAULT": "the controller is in FAULT: clear it first"}.get(result, "")
                             raise ParamRefused(f"node {self.id} refused the {kind} experiment: {result} ({reason})",
                                                "ExperimentStart", result)
-                    elif name == "Torque" and answered and ended is None and s["Mode"] != 1 and s["Action"] >= 8:
-                        ended, tail_end = phases.get(s["Action"], str(s["Action"])), time.monotonic() + 0.2
+                    elif (name == "Torque" and answered and ended is None and s["Mode"] != 1
+                          and s["Action"] >= EXPERIMENT_ENDED):
+                        ended = EXPERIMENT_PHASES.get(s["Action"], str(s["Action"]))
+                        tail_end = time.monotonic() + 0.2
                     if tail_end is not None and time.monotonic() >= tail_end:
                         break
             finally:

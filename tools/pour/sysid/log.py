@@ -12,13 +12,10 @@ import numpy as np
 
 from pour.bench import node as bn
 
-# pour/experiment.h: the phases (Torque.Action while it runs) and how it ended (Action in IDLE after it).
-PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
-          9: "out of range"}
+PHASES = bn.EXPERIMENT_PHASES
 PHASE_DONE = 8
 PHASE_OUT_OF_RANGE = 9
 MODE_RUN = 1
-EXPERIMENT_START = 15  # the cmd id of ExperimentStart, as ParamAck.Request names it
 
 
 class LogError(ValueError):
@@ -59,7 +56,9 @@ def read(path: Path, node_id: int) -> Run:
         raise LogError(f"{path}: not a candump -L log ({e}); truncated mid-line?") from e
     if not msgs:
         raise LogError(f"{path}: no frames")
-    decoder = bn.Decoder(bn.load_dbc())
+    db = bn.load_dbc()
+    decoder = bn.Decoder(db)
+    start_cmd = db.get_message_by_name("ExperimentStart").frame_id  # as ParamAck.Request names it
     seen: set[int] = set()
     kind, tau_max, answer = None, None, None
     samples: list[tuple[float, dict]] = []
@@ -74,7 +73,7 @@ def read(path: Path, node_id: int) -> Run:
             continue
         if name == "ExperimentStart":
             kind = int(s["Kind"])
-        elif name == "ParamAck" and s["Request"] == EXPERIMENT_START:
+        elif name == "ParamAck" and s["Request"] == start_cmd:
             answer = int(s["Result"])
             samples, rows = [], []  # what came before the accepted start is another run
         elif name == "Identity":
@@ -92,7 +91,7 @@ def read(path: Path, node_id: int) -> Run:
     if answer is None:
         raise LogError(f"{path}: node {node_id}'s answer to the ExperimentStart (a ParamAck) is not in the log")
     if answer != 0:
-        result = bn.load_dbc().get_message_by_name("ParamAck").get_signal_by_name("Result").choices.get(answer, answer)
+        result = db.get_message_by_name("ParamAck").get_signal_by_name("Result").choices.get(answer, answer)
         raise LogError(f"{path}: the controller refused the experiment ({result}): nothing ran")
     if not rows:
         raise LogError(f"{path}: truncated: no Sensors and Torque frames of node {node_id} after its start")
