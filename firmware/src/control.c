@@ -307,6 +307,12 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
       ctl->experiment_asked = false;
       ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP;
     }
+    if (in->stop) {
+      count_refused(ctl);
+    }
+    if (in->reset) {
+      count_refused(ctl);
+    }
     return false;
   }
   if (ctl->mode == POUR_MODE_ESTOP) {
@@ -318,7 +324,12 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->faults |= POUR_FAULT_LINK;
     ctl->mode = POUR_MODE_FAULT;
   }
-  if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
+  /* A clear or a restart in the middle of the active stop would drop a torque that is braking the bucket
+   * and start the speed estimate from rest while it turns: both wait until the stop is over. */
+  const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+  if (in->clear_faults && stopping) {
+    count_refused(ctl);
+  } else if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
     expect_held_angle(ctl);
     /* Back to IDLE: RUN (and the timeout) start again only with the next fresh state, from the safe
      * torque the envelope holds now, through the slew limit. */
@@ -337,12 +348,13 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
   }
   if (in->reset) {
-    /* A restart under a running policy, or in the middle of the active stop, would drop a torque that is
-     * holding or braking the bucket, and start the speed estimate from rest while it turns: refused. */
-    const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+    /* A restart under a running policy would drop the torque that holds the bucket: refused, as during the
+     * active stop. */
     if ((ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) && !stopping) {
       expect_held_angle(ctl);
       start_afresh(ctl);
+      /* In FAULT the run's state restarts, but the brake keeps holding: only a clear releases it. */
+      ctl->stopped = ctl->mode == POUR_MODE_FAULT;
     } else {
       count_refused(ctl);
     }

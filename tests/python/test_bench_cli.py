@@ -82,7 +82,7 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
         if k % 100 == 0:
             late = k >= 200
             frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
-                  Overruns=0, Counter=k // 100)
+                  Overruns=0, Counter=k // 100, Refused=0)
             frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
     path.write_text("\n".join(lines) + "\n")
 

@@ -121,7 +121,7 @@ static void test_motor_BrokenAmplifierLatchesTheOffsetFault(void) {
 }
 
 static void test_motor_ConfigRefusesDriveKeysOutOfRange(void) {
-  const char *bad[][2] = {{"drive", "2"}, {"drive_regen", "-1"}, {"drive_fault", "5"}, {"supply_voltage", "30"},
+  const char *bad[][2] = {{"drive", "2"}, {"drive_regen", "-1"}, {"drive_fault", "6"}, {"supply_voltage", "30"},
                           {"bus_capacitance", "0"}};
   for (const auto &kv : bad) {
     poursim_config_t c = poursim_default_config();

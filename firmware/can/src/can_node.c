@@ -21,6 +21,7 @@ pour_can_node_config_t pour_can_node_default_config(void) {
   c.identity.tau_max_cnm = 0u;
   c.identity.fw_version = (uint8_t)POUR_FIRMWARE_VERSION;
   c.identity.init_status = (int8_t)POUR_OK;
+  c.can_calibrate = false;
   return c;
 }
 
@@ -144,7 +145,7 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       if (rc != POUR_CAN_RX_OK) {
         return drop(node, rc);
       }
-      pour_commands_estop(&node->commands, e.assert_estop != 0u);
+      pour_commands_estop(&node->commands, POUR_ESTOP_BUS, e.assert_estop != 0u);
       kick(node);
       break;
     }
@@ -182,6 +183,10 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
 
 static bool tripped(const pour_can_node_t *node) {
   return node->armed && node->ms_since_valid > node->config.watchdog_ms;
+}
+
+void pour_can_node_estop_line(pour_can_node_t *node, bool asserted) {
+  pour_commands_estop(&node->commands, POUR_ESTOP_LINE, asserted);
 }
 
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
@@ -225,6 +230,7 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
   hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
   hb.overruns = (uint16_t)(overruns & 0xFFFFu);
   hb.counter = node->heartbeat_counter;
+  hb.refused = (uint8_t)((out->refused + node->commands.clears_dropped) & POUR_CAN_REFUSED_MAX);
   if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[0]) != POUR_OK ||
       pour_can_pack_identity(node->config.node_id, &node->config.identity, &tx[1]) != POUR_OK) {
     return 0u;
@@ -251,13 +257,32 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
       r.status = POUR_CAN_CAL_REFUSED_RUNNING;
     } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
       r.status = POUR_CAN_CAL_REFUSED_ESTOP;
+    } else if (node->config.can_calibrate) {
+      r.status = POUR_CAN_CAL_MEASURING;
+      node->calibration_start = true;
     }
     if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
       ++n;
     }
     node->calibration_requested = false;
+  } else if (node->calibration_report) {
+    if (pour_can_pack_calibration_result(node->config.node_id, &node->calibration, &tx[n]) == POUR_OK) {
+      ++n;
+    }
+    node->calibration_report = false;
   }
   return n;
+}
+
+void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
+  node->calibration = *result;
+  node->calibration_report = true;
+}
+
+bool pour_can_node_take_calibration_start(pour_can_node_t *node) {
+  const bool start = node->calibration_start;
+  node->calibration_start = false;
+  return start;
 }
 
 void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {

@@ -246,12 +246,5 @@ pour_status_t pour_hal_calibration_load(void) {
 int pour_hal_calibration_reason(void) { return (int)calibration_status; }
 
 void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
-  const bool ok = calibration_status == POUR_CAL_OK;
-  r->status = POUR_CAN_CAL_UNAVAILABLE;
-  r->stored = (uint8_t)calibration_status; /* POUR_CAN_CAL_OK .. _WRITE_FAILED are pour_cal_status_t's values */
-  r->encoder_reversed = ok && calibration.encoder_direction < 0 ? 1u : 0u;
-  r->pole_pairs = ok ? (uint8_t)calibration.pole_pairs : 0u;
-  r->resistance_mohm = ok ? (uint16_t)(calibration.r_phase_uohm / 1000u) : 0u;
-  r->inductance_uh = ok ? (uint16_t)(calibration.l_phase_nh / 1000u) : 0u;
-  r->electrical_offset = ok ? (uint8_t)(calibration.electrical_offset >> 8) : 0u;
+  pour_calibration_can_result(calibration_status, &calibration, POUR_CAN_CAL_UNAVAILABLE, r);
 }

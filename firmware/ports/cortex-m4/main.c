@@ -95,14 +95,16 @@ int main(void) {
   for (;;) {
     const uint32_t missed = pour_hal_timer_wait_tick();
     overruns += missed;
+    /* The hardwired line around the tick's frames: a clear counts only if the line was released at both. */
+    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
     pour_hal_can_poll();
     pour_can_frame_t f;
     while (pour_hal_can_receive(&f) == 1) {
       (void)pour_can_node_receive(&can_node, &f);
     }
+    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
     pour_control_input_t in;
     pour_can_node_begin_tick(&can_node, &in);
-    in.estop = in.estop || pour_hal_estop_asserted(); /* the hardwired line, every tick, beside the frame */
     pour_control_output_t out;
     pour_port_tick(&controller, &in, &out);
     pour_hal_led_show(out.mode, false);
