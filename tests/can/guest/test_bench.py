@@ -189,8 +189,11 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
         ok("--expect-hash", f"0x{policy_hash:08x}", "--yes", "clear")
         with bn.Bench("vcan0") as b:
             b.node(0).wait_mode({"RUN"}, timeout=20)
-        out = ok("--expect-hash", f"0x{policy_hash:08x}", "--yes", "identify", str(log), "--seconds", "120")
-        assert "the identify experiment ended: out of range (bucket held)" in out, out
+        # The guest makes ~300 samples/s, fewer on a loaded machine: minutes for the experiment's seconds.
+        r = bench("--expect-hash", f"0x{policy_hash:08x}", "--yes", "identify", str(log), "--seconds", "200",
+                  timeout=240)
+        assert r.returncode == 0, (r.stdout, r.stderr)
+        assert "the identify experiment ended: out of range (bucket held)" in r.stdout, r.stdout
         lines = log.read_text().splitlines()
         assert any(" 00F#01" in x for x in lines) and any(" 00C#0F0100" in x for x in lines)  # start, accepted
         assert "mode IDLE" in ok("faults")
