@@ -166,8 +166,8 @@ def test_save_without_storage_is_refused():
 
 def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
     """pour-bench identify over the bus: refused with the e-stop asserted (its reason named), then run with
-    host_sim as the plant; the full bucket leaves the empty-bucket experiment's angle range, which ends it
-    held, and pour-sysid says so of the log."""
+    host_sim as the plant, whose policy has tilted the full bucket beyond the empty-bucket experiment's angle
+    range: it ends at its first tick with the bucket held, and pour-sysid says so of the log."""
     policy_hash = weights_h.parse_weights_h(WEIGHTS).content_hash
     ctl = Controller(*LOCKSTEP, io="can:vcan0")
     bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
@@ -199,7 +199,7 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
         assert "mode IDLE" in ok("faults")
         r = subprocess.run([sys.executable, "-m", "pour.sysid.cli", str(log), "--out", str(tmp_path / "rig.toml")],
                            capture_output=True, text=True, timeout=120)
-        assert r.returncode == 1 and "left its angle range" in r.stderr, r.stderr
+        assert r.returncode == 1 and "left its angle range" in r.stderr, r.stderr  # the policy had tilted it
     finally:
         stop(plant)
         stop(bridge)

@@ -72,15 +72,15 @@ def read(path: Path, node_id: int) -> Run:
         if nid != node_id:
             continue
         if name == "ExperimentStart":
-            kind = int(s["Kind"])
+            # What came before the (last) start is another run; its answer may follow the first tick.
+            kind, answer, samples, rows = int(s["Kind"]), None, [], []
         elif name == "ParamAck" and s["Request"] == start_cmd:
             answer = int(s["Result"])
-            samples, rows = [], []  # what came before the accepted start is another run
         elif name == "Identity":
             tau_max = s["TauMax"] * 0.01
         elif name == "Sensors":
             samples.append((m.timestamp, s))
-        elif name == "Torque" and samples and answer == 0:
+        elif name == "Torque" and samples:
             rows.append((samples[-1][0], samples[-1][1], s))
     if node_id not in seen:
         others = ", ".join(str(n) for n in sorted(seen)) or "none"
@@ -100,6 +100,9 @@ def read(path: Path, node_id: int) -> Run:
     mode = np.array([r[2]["Mode"] for r in rows])
     running = np.flatnonzero(mode == MODE_RUN)
     if running.size == 0:
+        if PHASE_OUT_OF_RANGE in {r[2]["Action"] for r in rows}:
+            raise LogError(f"{path}: the experiment left its angle range at its first tick: the bucket was outside "
+                           "it when it started (start it upright, at rest)")
         raise LogError(f"{path}: node {node_id} never ran the experiment (no Torque frame in RUN)")
     rows = rows[running[0]:]
     seq = np.array([r[1]["Seq"] for r in rows])
