@@ -117,6 +117,7 @@ static void start(pour_control_t *ctl, const pour_control_config_t *c, uint16_t 
   ctl->have_trusted = false;
   ctl->experiment_asked = false;
   ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_NO_ANSWER;
+  ctl->drive_untrusted = false;
   start_afresh(ctl); /* the envelope at zero, as pour_safety_init left it: the motor has no current yet */
 }
 
@@ -215,7 +216,8 @@ static bool at_rest(const pour_stop_config_t *c, const pour_state_t *s) {
 static bool stop_active(pour_control_t *ctl) {
   const pour_stop_config_t *c = &ctl->config.stop;
   if (!ctl->stopped) {
-    const bool can_act = (ctl->faults & ~(uint16_t)POUR_FAULT_ACTIVE_STOP) == 0u &&
+    const uint16_t active = (uint16_t)(POUR_FAULT_ACTIVE_STOP | (ctl->drive_untrusted ? 0u : POUR_FAULT_DRIVE));
+    const bool can_act = (ctl->faults & (uint16_t)~active) == 0u &&
                          ctl->ms_since_fresh <= ctl->config.input_timeout_ms && ctl->stop_ms < c->timeout_ms;
     if (!can_act || at_rest(c, &ctl->state)) {
       ctl->stopped = true;
@@ -324,6 +326,12 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->faults |= POUR_FAULT_LINK;
     ctl->mode = POUR_MODE_FAULT;
   }
+  if (in->drive_faults != 0u) {
+    /* The drive's own fault, a level as the link's: its word names it on the bus (DriveTelemetry). */
+    ctl->faults |= POUR_FAULT_DRIVE;
+    ctl->drive_untrusted = ctl->drive_untrusted || !in->drive_trusted;
+    ctl->mode = POUR_MODE_FAULT;
+  }
   /* A clear or a restart in the middle of the active stop would drop a torque that is braking the bucket
    * and start the speed estimate from rest while it turns: both wait until the stop is over. */
   const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
@@ -338,6 +346,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->ms_since_fresh = 0u;
     ctl->stop_ms = 0u;
     ctl->stopped = false;
+    ctl->drive_untrusted = false;
   }
   if (in->stop) {
     if (ctl->mode == POUR_MODE_RUN) {

@@ -48,6 +48,8 @@ class FocDrive {
   // One PWM period at output speed omega (the step above is made of these); the torque at the output.
   double period(double omega);
   bool brake_requested() const { return out_.brake != 0 && drv_.state != POUR_DRIVE_CALIBRATING; }
+  // The current loop runs (it follows the torque command): not calibrating, not faulted.
+  bool running() const { return drv_.state == POUR_DRIVE_RUN; }
   const FocTelemetry &telemetry() const { return tel_; }
   // The highest bus voltage of each step since the reset [V] (for plots).
   const std::vector<float> &vbus_trace() const { return vbus_trace_; }

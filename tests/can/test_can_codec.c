@@ -113,7 +113,7 @@ static void test_can_heartbeat_CarriesOnlyNamedFaultBits(void) {
                              .counter = 255, .refused = 0xA};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_heartbeat(0, &hb, &f));
-  const uint8_t want[8] = {0xA2, 0xFF, 0x07, 0x34, 0x12, 0xFF, 0xFF, 0xFF}; /* Refused in Mode's high nibble */
+  const uint8_t want[8] = {0xA2, 0xFF, 0x0F, 0x34, 0x12, 0xFF, 0xFF, 0xFF}; /* Refused in Mode's high nibble; 12 fault bits */
   TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
   pour_can_heartbeat_t back;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&f, &back));

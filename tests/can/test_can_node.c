@@ -5,6 +5,7 @@
 
 #include "pour/can_node.h"
 #include "pour/params.h"
+#include "pour/drive_faults.h"
 #include "pour/weights_compiled.h"
 #include "unity.h"
 
@@ -187,6 +188,50 @@ static void test_can_node_HeartbeatAtConfiguredPeriod(void) {
   }
   TEST_ASSERT_EQUAL_UINT(3, heartbeats);
   TEST_ASSERT_EQUAL_UINT8(2, last_counter);
+}
+
+static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  TEST_ASSERT_EQUAL_UINT8(3, tick(0, &in, tx)); /* no drive of its own: torque, heartbeat, identity */
+  const pour_can_drive_telemetry_t d = {-1234, 5678, 24000u,
+                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP};
+  pour_can_node_set_drive(&node, &d);
+  unsigned telemetry = 0;
+  for (unsigned t = 1; t < 12; ++t) {
+    const uint8_t n = tick(0, &in, tx);
+    if (t % 4u == 0u) {
+      TEST_ASSERT_EQUAL_UINT8(4, n);
+      pour_can_drive_telemetry_t back;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_drive_telemetry(&tx[3], &back));
+      TEST_ASSERT_EQUAL_INT16(-1234, back.id_2ma);
+      TEST_ASSERT_EQUAL_INT16(5678, back.iq_2ma);
+      TEST_ASSERT_EQUAL_UINT16(24000u, back.vbus_mv);
+      TEST_ASSERT_EQUAL_HEX16(d.drive_faults, back.drive_faults);
+      ++telemetry;
+    } else {
+      TEST_ASSERT_EQUAL_UINT8(1, n);
+    }
+  }
+  TEST_ASSERT_EQUAL_UINT(2, telemetry);
+}
+
+static void test_can_node_DriveFaultFaultsTheCoreAndTheHeartbeatNamesIt(void) {
+  pour_control_input_t in;
+  pour_can_node_begin_tick(&node, &in);
+  TEST_ASSERT_EQUAL_HEX16(0u, in.drive_faults); /* the bus carries no drive */
+  TEST_ASSERT_TRUE(in.drive_trusted);
+  in.drive_faults = POUR_DRIVE_FAULT_OVERTEMP; /* the port's drive, as board_drive fills it in */
+  pour_control_output_t out;
+  pour_control_step(&ctl, &in, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_TRUE(out.brake);
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  TEST_ASSERT_EQUAL_UINT8(3, pour_can_node_end_tick(&node, &out, 0, tx));
+  pour_can_heartbeat_t hb;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[1], &hb));
+  TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_DRIVE, hb.faults);
+  TEST_ASSERT_EQUAL_STRING("DRIVE", pour_fault_name(POUR_FAULT_DRIVE));
 }
 
 static void test_can_node_SilenceTripsWatchdogAfterTimeout(void) {
@@ -667,6 +712,8 @@ int main(void) {
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);
+  RUN_TEST(test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet);
+  RUN_TEST(test_can_node_DriveFaultFaultsTheCoreAndTheHeartbeatNamesIt);
   RUN_TEST(test_can_node_SilenceTripsWatchdogAfterTimeout);
   RUN_TEST(test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew);
   RUN_TEST(test_can_node_EstopWinsOverWatchdogSafeTorque);

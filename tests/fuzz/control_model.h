@@ -48,11 +48,12 @@ class ControlModel {
       end(out);
       return;
     }
-    // The mode the tick's requests leave before the state is looked at: a released e-stop and a link
-    // fault are FAULT; a clear takes FAULT to IDLE (all faults cleared) once the active stop is over; stop
+    // The mode the tick's requests leave before the state is looked at: a released e-stop, a link fault
+    // and a drive fault are FAULT; a clear takes FAULT to IDLE (all faults cleared) once the active stop is over; stop
     // takes RUN to IDLE; a reset is taken in IDLE, or in FAULT once the active stop is over; a refused
     // Stop, Reset or clear is counted.
-    uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault ? static_cast<uint8_t>(POUR_MODE_FAULT) : mode_;
+    uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault || in.drive_faults != 0 ? static_cast<uint8_t>(POUR_MODE_FAULT)
+                                                                                   : mode_;
     const bool stopping = mode_ == POUR_MODE_FAULT && power_; // the last tick ran the active stop
     uint16_t kept = faults_;
     const bool clear_refused = in.clear_faults && mode == POUR_MODE_FAULT && stopping;
@@ -70,9 +71,12 @@ class ControlModel {
     if (in.sensors_fresh && new_seq && !raw_plausible(in.sensors))
       FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible sample did not latch BAD_INPUT");
     if (in.link_fault && !in.clear_faults) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
+    if (in.drive_faults != 0 && !in.clear_faults)
+      FUZZ_CHECK(out.faults & POUR_FAULT_DRIVE, "a drive fault did not latch DRIVE");
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
     const uint16_t new_bits = static_cast<uint16_t>(out.faults & ~kept);
-    FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)),
+    FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)) &&
+                   (in.drive_faults != 0 || !(new_bits & POUR_FAULT_DRIVE)),
                "fault without a cause: %x (kept %x)", out.faults, kept);
     FUZZ_CHECK((out.faults != 0) == (out.mode == POUR_MODE_FAULT), "faults %x in mode %u", out.faults, out.mode);
     FUZZ_CHECK(out.brake == !out.power, "brake %d and power %d together", out.brake, out.power);

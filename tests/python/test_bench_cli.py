@@ -74,7 +74,7 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
         lines.append(f"({1700000000 + t:.6f}) vcan0 {dbc.can_id(node, m.frame_id):03X}#{data.hex().upper()}")
 
     faults = {f"Fault_{n}": 0 for n in ("StaleInput", "EStop", "BadInput", "Position", "Overspeed", "TorqueSign",
-                                         "Encoder", "Volume", "CanWatchdog", "Seq", "Scale")}
+                                         "Encoder", "Volume", "CanWatchdog", "Seq", "Scale", "Drive")}
     for k in range(samples):
         t = k * 0.001
         frame(t, "Sensors", Seq=k % 256, Encoder=k, ScaleRotating=10000 - k, ScaleTarget=k)

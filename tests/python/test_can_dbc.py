@@ -47,7 +47,7 @@ SIGNAL_FREE = ("clear_errors", "stop", "reset", "calibration_start", "param_save
 FAULT_BITS = {"Fault_StaleInput": 0x0001, "Fault_EStop": 0x0002, "Fault_BadInput": 0x0004,
               "Fault_Position": 0x0008, "Fault_Overspeed": 0x0010, "Fault_TorqueSign": 0x0020,
               "Fault_Encoder": 0x0040, "Fault_Volume": 0x0080, "Fault_CanWatchdog": 0x0100,
-              "Fault_Seq": 0x0200, "Fault_Scale": 0x0400}
+              "Fault_Seq": 0x0200, "Fault_Scale": 0x0400, "Fault_Drive": 0x0800}
 # The drive's fault word (pour/drive_faults.h) in DriveTelemetry, the same way.
 DRIVE_FAULT_BITS = {"DriveFault_Overcurrent": 0x0001, "DriveFault_HwOvercurrent": 0x0002,
                     "DriveFault_Overvoltage": 0x0004, "DriveFault_Undervoltage": 0x0008,

@@ -194,6 +194,8 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
   in->sensors = node->sensors;
   pour_commands_take(&node->commands, in);
   in->link_fault = tripped(node);
+  in->drive_faults = 0u; /* the bus carries no drive: a port with one of its own fills these in */
+  in->drive_trusted = true;
   node->sensors_fresh = false;
 }
 
@@ -248,6 +250,9 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
   }
   if (node->ms_to_heartbeat == 0u) {
     n = (uint8_t)(n + pour_can_node_status_frames(node, out, overruns, &tx[n]));
+    if (node->have_drive && pour_can_pack_drive_telemetry(node->config.node_id, &node->drive, &tx[n]) == POUR_OK) {
+      ++n;
+    }
     node->ms_to_heartbeat = node->config.heartbeat_period_ms;
   }
   --node->ms_to_heartbeat;
@@ -272,6 +277,11 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
     node->calibration_report = false;
   }
   return n;
+}
+
+void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemetry_t *drive) {
+  node->drive = *drive;
+  node->have_drive = true;
 }
 
 void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {

@@ -71,6 +71,10 @@ typedef struct {
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
   bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
   bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN and ESTOP */
+  uint16_t drive_faults; /* level: the drive's latched fault word (POUR_DRIVE_FAULT_*; 0: none, or no drive of
+                          * its own); any bit latches POUR_FAULT_DRIVE */
+  bool drive_trusted;    /* with drive_faults: the drive still follows a torque (the controlled stop runs); false:
+                          * it does not (its phases are shorted), the stop is over at once */
 } pour_control_input_t;
 
 /* Outputs of one tick. */
@@ -118,6 +122,7 @@ typedef struct {
   uint8_t experiment_kind; /* ... of this kind */
   uint8_t experiment_answer; /* pour_control_experiment_answer_t of the latest request */
   bool held;              /* an experiment ended in IDLE: the brake holds until a Reset or another experiment */
+  bool drive_untrusted;   /* a drive fault since the last clear came with a drive that no longer follows a torque */
 } pour_control_t;
 
 /* Defaults: docs/safety.md lists them with their reasons. */
