@@ -19,7 +19,7 @@ namespace poursim {
 
 namespace {
 
-constexpr uint32_t kTailTicks = 200;  // logged after the experiment ended: the held bucket at rest
+constexpr uint32_t kTailTicks = 1000; // logged after the experiment ended: the held bucket at rest (the scale's noise)
 constexpr uint32_t kSpareTicks = 3000; // beyond the experiment's duration, a run that never ends is cut
 
 // One frame as candump -L prints it: (seconds.micros) interface id#data, the time that of tick [ms].

@@ -26,6 +26,7 @@ from pour.can import dbc
 
 DEFAULT_TIMEOUT_S = 1.0
 START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent again
+REST_S = 1.0  # identify: recorded after the end
 # pour/experiment.h's phases: Torque.Action while an experiment runs, and how it ended (8, 9) after it.
 EXPERIMENT_PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
                      9: "out of range"}
@@ -365,7 +366,8 @@ class Node:
     def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
         """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
         writes the bus as a candump -L log (atomically, the start frames included) until the node reports how
-        it ended (Torque.Action outside RUN) and 0.2 s more, or seconds pass. Returns (frames, how it ended).
+        it ended (Torque.Action outside RUN) and REST_S more (the held bucket at rest: the scale's noise), or
+        seconds pass. Returns (frames, how it ended).
         A node in RUN gets a Stop just before the start: the two must land in one control tick, since the
         next sample starts a new run; a start refused as REFUSED_RUNNING is tried again, START_TRIES times
         in all. ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
@@ -411,7 +413,7 @@ class Node:
                     elif (name == "Torque" and answered and ended is None and s["Mode"] != 1
                           and s["Action"] >= EXPERIMENT_ENDED):
                         ended = EXPERIMENT_PHASES.get(s["Action"], str(s["Action"]))
-                        tail_end = time.monotonic() + 0.2
+                        tail_end = time.monotonic() + REST_S
                     if tail_end is not None and time.monotonic() >= tail_end:
                         break
             finally:

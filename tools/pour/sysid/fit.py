@@ -15,7 +15,7 @@ smoothing filter (Savitzky-Golay), under which the equation stays exact. Samples
 
 The pivot's load cell carries the bucket's inertial load m a_y = m d (θ̈ sin θ + θ̇² cos θ) [g]; each of
 its conversions reports the mean load over the scale's delay before it. The delay is the span that best
-explains the readings; the noise is what is left beyond the cell's resolution.
+explains the readings; the noise is their spread while the bucket is at rest, beyond the cell's resolution.
 """
 from __future__ import annotations
 
@@ -34,6 +34,7 @@ DELAY_MAX = 400      # [ticks] of scale delay searched
 FIT_PHASES = (2, 3)  # steps and chirp: the excitation (pour/experiment.h)
 REL_SIGMA_MAX = 0.25  # a parameter known worse than this is not identified by the log
 BATCHES = 8          # batch means for the reported uncertainties
+REST_TICKS_MIN = 250  # [ticks] at rest (the filter settled) for the scale's noise: ~20 conversions
 TRUST_SIGMA_MAX = 0.05
 
 
@@ -225,11 +226,22 @@ def _fit_scale(run: Run, rig: dict, th: np.ndarray, om: np.ndarray, al: np.ndarr
     curv = (rss[hi] - 2 * rss[D] + rss[lo]) / (((hi - lo) / 2) ** 2) if hi > lo else 0.0
     sD = float(np.sqrt(2 * var / curv)) if curv > 0 else float("inf")
     res = rig["scale_resolution_g"]
-    noise = float(np.sqrt(max(0.0, var - res * res / 12.0)))
+    # The noise where the bucket is at rest (held after the end, still before it breaks away): the load is
+    # constant there, so the readings' spread is the cell's own; the fit's residual also holds its misfit.
+    still = np.abs(om) < OMEGA_MIN / 10
+    quiet = np.convolve(still.astype(float), np.ones(DELAY_MAX), mode="full")[:len(still)] >= DELAY_MAX
+    held = reading[quiet]
+    if held.size >= REST_TICKS_MIN:
+        # Every tick repeats the latest conversion: the ticks' spread weighs each conversion alike.
+        noise = float(np.sqrt(max(0.0, float(np.var(held, ddof=1)) - res * res / 12.0)))
+        n_rest = held.size * rig["scale_rate_hz"] * dt
+    else:
+        noise = float(np.sqrt(max(0.0, var - res * res / 12.0)))
+        n_rest = conv.size
     est = fit.estimates
     est["scale_delay_s"] = Estimate(D * dt, sD * dt, "s", "the load cell's filter: a mean over this span")
-    est["scale_noise_g"] = Estimate(noise, noise / np.sqrt(2 * (conv.size - 2)), "g",
-                                    "a conversion's noise, beyond the resolution's")
+    est["scale_noise_g"] = Estimate(noise, noise / np.sqrt(2 * max(1, n_rest - 2)), "g",
+                                    "a conversion's noise, beyond the resolution's (at rest)")
     est["bucket_arm_check"] = Estimate(coef[0] * G0 / 1000.0, 0.0, "kg m",
                                        f"m d as the scale weighs it (the rig file's bucket: {md:.4f})")
     fit.delay_rss = rss
