@@ -151,7 +151,7 @@ def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed:
         with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
             rows = list(ex.map(one, todo))
     doc = {"header": header, "seed": seed, "nominal_episodes": nominal_episodes, "edge_episodes": edge_episodes,
-           "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
+           "rig": list(rig_sets[1::2]), "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
     atomic.write_atomic(out / "robustness.json", json.dumps(doc, indent=1) + "\n")
     atomic.write_atomic(out / "robustness.md", table(rows, header, seed))
     plot(rows, out / "robustness.png")
