@@ -39,8 +39,13 @@ pour_control_config_t pour_control_default_config(void) {
   config.stop.rest_theta_urad = DEFAULT_STOP_REST_THETA_URAD;
   config.stop.rest_omega_urad_s = DEFAULT_STOP_REST_OMEGA_URAD_S;
   config.stop.timeout_ms = DEFAULT_STOP_TIMEOUT_MS;
+  config.experiment = pour_experiment_default_config();
   return config;
 }
+
+/* No experiment armed or running. The estimator still takes an empty bucket for one (the identify
+ * experiment's stays empty, held or stopping) until a Reset starts a run that needs liquid. */
+static void end_experiment(pour_control_t *ctl) { ctl->experiment.kind = (uint8_t)POUR_EXPERIMENT_NONE; }
 
 /* The run's state as at power-on: no state seen, zero torque, the decision schedule and the PRNG
  * from their start (init and an accepted reset; config and weights were validated at init). */
@@ -72,6 +77,9 @@ static void start_afresh(pour_control_t *ctl) {
   pour_estimator_reset(&ctl->estimator);
   ctl->stop_ms = 0u;
   ctl->stopped = false;
+  ctl->held = false;
+  end_experiment(ctl); /* a Reset disarms it too */
+  pour_estimator_expect_empty(&ctl->estimator, false);
 }
 
 static bool stop_config_ok(const pour_stop_config_t *s) {
@@ -86,6 +94,7 @@ static pour_status_t init_config(pour_control_t *ctl, const pour_control_config_
     return POUR_EINVAL;
   }
   if (pour_safety_init(&ctl->safety, &c->safety) != POUR_OK || !stop_config_ok(&c->stop) ||
+      pour_experiment_validate(&c->experiment) != POUR_OK ||
       pour_estimator_init(&ctl->estimator, &c->sensors) != POUR_OK ||
       pour_supervisor_init(&ctl->supervisor, &c->supervisor, c->safety.theta_min_urad, c->safety.theta_max_urad) !=
           POUR_OK) {
@@ -106,6 +115,8 @@ static void start(pour_control_t *ctl, const pour_control_config_t *c, uint16_t 
   ctl->refused = 0u;
   ctl->check_restart = false;
   ctl->have_trusted = false;
+  ctl->experiment_asked = false;
+  ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_NO_ANSWER;
   ctl->drive_untrusted = false;
   start_afresh(ctl); /* the envelope at zero, as pour_safety_init left it: the motor has no current yet */
 }
@@ -230,6 +241,54 @@ static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_ou
   out->power = ctl->mode == POUR_MODE_RUN;
 }
 
+/* The request of pour_control_experiment, after this tick's Stop and Reset (so that a Stop and a start
+ * in one tick start the experiment). */
+static void take_experiment_request(pour_control_t *ctl) {
+  if (!ctl->experiment_asked) {
+    return;
+  }
+  ctl->experiment_asked = false;
+  uint8_t answer = (uint8_t)POUR_CONTROL_EXPERIMENT_ACCEPTED;
+  if (ctl->experiment_kind == (uint8_t)POUR_EXPERIMENT_NONE || ctl->experiment_kind > POUR_EXPERIMENT_KIND_MAX) {
+    answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_KIND;
+  } else if (ctl->mode == POUR_MODE_RUN) {
+    answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_RUNNING;
+  } else if (ctl->mode == POUR_MODE_FAULT) {
+    answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_FAULT;
+  } else {
+    pour_experiment_start(&ctl->experiment, &ctl->config.experiment, ctl->experiment_kind);
+    pour_estimator_expect_empty(&ctl->estimator, ctl->experiment_kind == (uint8_t)POUR_EXPERIMENT_IDENTIFY);
+    ctl->held = false;
+  }
+  ctl->experiment_answer = answer;
+}
+
+/* An armed experiment runs in RUN: its request every tick, in place of any decision; its end (or a Stop)
+ * leaves the axis held in IDLE; a fault ends it as it ends any run. */
+static void experiment_tick(pour_control_t *ctl) {
+  pour_experiment_t *e = &ctl->experiment;
+  if (e->kind == (uint8_t)POUR_EXPERIMENT_NONE) {
+    return;
+  }
+  if (ctl->mode != POUR_MODE_RUN) {
+    if (ctl->mode == POUR_MODE_FAULT || e->started) {
+      ctl->held = ctl->mode == POUR_MODE_IDLE;
+      end_experiment(ctl);
+    }
+    return;
+  }
+  bool ended = false;
+  ctl->request = pour_experiment_step(e, &ctl->state, &ended);
+  ctl->eval.action = e->phase;
+  ctl->decision_due = false;
+  ctl->probs_pending = false;
+  if (ended) {
+    ctl->mode = POUR_MODE_IDLE;
+    ctl->held = true;
+    end_experiment(ctl);
+  }
+}
+
 /* The stages' one implementation, inlined into pour_control_step so that the MCU's tick pays no calls
  * between them (its image keeps only the step: --gc-sections drops the public stage entry points). */
 #if defined(__GNUC__)
@@ -245,6 +304,11 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->mode = POUR_MODE_ESTOP;
     ctl->faults |= POUR_FAULT_ESTOP;
     ctl->stopped = true; /* after the release: brake and power cut until a clear */
+    end_experiment(ctl);
+    if (ctl->experiment_asked) {
+      ctl->experiment_asked = false;
+      ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP;
+    }
     if (in->stop) {
       count_refused(ctl);
     }
@@ -287,6 +351,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
   if (in->stop) {
     if (ctl->mode == POUR_MODE_RUN) {
       ctl->mode = POUR_MODE_IDLE;
+      ctl->held = ctl->experiment.kind != (uint8_t)POUR_EXPERIMENT_NONE; /* an experiment's run ends held */
     } else {
       count_refused(ctl); /* nothing to end */
     }
@@ -303,6 +368,8 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
       count_refused(ctl);
     }
   }
+
+  take_experiment_request(ctl);
 
   bool fresh = false;
   if (in->sensors_fresh && ctl->mode == POUR_MODE_IDLE) {
@@ -342,7 +409,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
   }
 
-  if (ctl->mode == POUR_MODE_IDLE && fresh) {
+  if (ctl->mode == POUR_MODE_IDLE && fresh && !ctl->held) {
     ctl->mode = POUR_MODE_RUN;
     ctl->ms_to_decision = 0u;
     pour_supervisor_restart(&ctl->supervisor); /* the new run's windows start empty */
@@ -361,6 +428,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
     ctl->ms_to_decision--;
   }
+  experiment_tick(ctl);
   return ctl->decision_due;
 }
 
@@ -381,6 +449,17 @@ STAGE void decide_stage(pour_control_t *ctl) {
     ctl->probs_pending = false;
   }
   ctl->request = w->action_levels[ctl->eval.action];
+}
+
+void pour_control_experiment(pour_control_t *ctl, uint8_t kind) {
+  ctl->experiment_asked = true;
+  ctl->experiment_kind = kind;
+}
+
+uint8_t pour_control_experiment_answer(pour_control_t *ctl) {
+  const uint8_t a = ctl->experiment_answer;
+  ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_NO_ANSWER;
+  return a;
 }
 
 void pour_control_request(pour_control_t *ctl, uint8_t action, q15_t torque) {

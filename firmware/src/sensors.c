@@ -45,9 +45,12 @@ pour_status_t pour_estimator_init(pour_estimator_t *est, const pour_sensors_conf
   const int64_t bw = c->bandwidth_rad_s;
   est->gain_theta_q24 = (int32_t)((2 * bw * (1 << 24) + 500) / 1000);
   est->gain_omega_q24 = (int32_t)((bw * bw * (1 << 24) + 500000) / 1000000);
+  est->empty_ok = false;
   pour_estimator_reset(est);
   return POUR_OK;
 }
+
+void pour_estimator_expect_empty(pour_estimator_t *est, bool empty) { est->empty_ok = empty; }
 
 void pour_estimator_reset(pour_estimator_t *est) {
   est->started = false;
@@ -90,7 +93,8 @@ bool pour_estimator_update(pour_estimator_t *est, const pour_sensors_t *sample, 
     return false;
   }
   const int32_t m0 = est->started ? est->m0_g : sample->scale_rotating_g + sample->scale_target_g;
-  if (m0 < c->mass_min_g) {
+  const bool empty = m0 < c->mass_min_g;
+  if (empty && !est->empty_ok) {
     return false;
   }
   const int32_t theta = pour_sensors_theta_urad(sample->encoder, c->encoder_bits);
@@ -131,10 +135,10 @@ bool pour_estimator_update(pour_estimator_t *est, const pour_sensors_t *sample, 
    * does not. Its price, the quantisation noise through k1, is measured in docs/safety.md.
    * µrad/tick Q16 -> µrad/s: · 1000, rounded. */
   state->omega_urad_s = pour_sat_i32((advance_q16 * 1000 + 32768) >> 16);
-  state->v_rotating = mass_ratio_q15(sample->scale_rotating_g, m0);
-  state->v_target = mass_ratio_q15(sample->scale_target_g, m0);
-  /* What neither cell carries: spilled, or in flight between the buckets. */
-  const int32_t spill = POUR_Q15_ONE_INT - state->v_rotating - state->v_target;
+  state->v_rotating = empty ? 0 : mass_ratio_q15(sample->scale_rotating_g, m0);
+  state->v_target = empty ? 0 : mass_ratio_q15(sample->scale_target_g, m0);
+  /* What neither cell carries: spilled, or in flight between the buckets (none of an empty bucket). */
+  const int32_t spill = empty ? 0 : POUR_Q15_ONE_INT - state->v_rotating - state->v_target;
   state->v_spill = (q15_t)(spill < 0 ? 0 : (spill > POUR_Q15_MAX ? POUR_Q15_MAX : spill));
   return true;
 }

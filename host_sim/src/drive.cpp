@@ -11,6 +11,7 @@ void Drive::reset(const poursim_config_t &c, uint32_t seed) {
   queue_.assign(static_cast<size_t>(std::max(1, c.command_latency_ticks)), 0.0);
   head_ = 0;
   peak_ = c.motor_peak_torque;
+  scale_ = c.torque_scale;
   no_load_ = c.motor_no_load_speed;
   dt_ = c.dt;
   foc_on_ = c.drive == 1;
@@ -18,7 +19,7 @@ void Drive::reset(const poursim_config_t &c, uint32_t seed) {
 }
 
 double Drive::step(double tau_cmd, double omega) {
-  const double due = queue_[head_];
+  const double due = scale_ * queue_[head_];
   queue_[head_] = tau_cmd;
   head_ = (head_ + 1) % queue_.size();
   return foc_on_ ? foc_.step(due, omega, dt_) : limit(due, omega, peak_, no_load_);

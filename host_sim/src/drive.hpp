@@ -31,6 +31,7 @@ class Drive {
   std::vector<double> queue_; // commands in flight, oldest at head_
   size_t head_ = 0;
   double peak_ = 0.0, no_load_ = 0.0, dt_ = 0.001;
+  double scale_ = 1.0; // torque_scale: the command as the drive delivers it
   bool foc_on_ = false;
   FocDrive foc_;
 };

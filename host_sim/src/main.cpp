@@ -18,6 +18,7 @@
 #include "bench.hpp"
 #include "controllers.hpp"
 #include "episode_run.hpp"
+#include "experiment_log.hpp"
 #include "lcm_link.hpp"
 #include "outputs.hpp"
 #include "poursim/poursim.h"
@@ -28,7 +29,7 @@
 namespace {
 
 const char *kUsage =
-    "usage: host_sim (--policy WEIGHTS_H | --baseline NAME | --bench) [options]\n"
+    "usage: host_sim (--policy WEIGHTS_H | --baseline NAME | --bench | --experiment KIND --candump LOG) [options]\n"
     "\n"
     "Pours a bucket of simulated liquid (150 particles of a fluid, Box2D) into a second bucket and reports how\n"
     "much landed in the target, how much was spilled, how long the pour took and the return.\n"
@@ -46,6 +47,11 @@ const char *kUsage =
     "                      POUR_TRUTH, POUR_PARTICLES for viewers); lockstep unless --realtime. With\n"
     "                      --policy, the file sets tau_max and the controller must run that policy.\n"
     "                      Exit status 3 if the controller does not answer, 4 if it runs other weights.\n"
+    "  --experiment KIND   the controller's own identification experiment (docs/bench.md), started over\n"
+    "                      its CAN node as pour-bench identify starts it: identify (bucket emptied: torque\n"
+    "                      steps and a chirp about 20 deg) or tilt (with the liquid: to 90 deg at 0.1 rad/s\n"
+    "                      and back); --candump LOG gets the bus traffic as candump -L writes it, for\n"
+    "                      pour-sysid. Exit status 1 if it did not run to its end (out of range, a fault)\n"
     "\n"
     "Options:\n"
     "  --episodes N        episodes to run (default 1), seeds S, S+1, ...\n"
@@ -62,6 +68,8 @@ const char *kUsage =
     "  --quiet             only the summary\n"
     "  --realtime          with --lcm: pace at 1 kHz wall clock, use the latest torque, count misses\n"
     "  --lcm-timeout-ms T  with --lcm in lockstep: give up after T ms without an answer (default 2000)\n"
+    "  --candump LOG       with --experiment: the log to write\n"
+    "  --node-id N         with --experiment: the controller's CAN node id (default 0)\n"
     "  --list-config       every config key with its unit, range and default\n"
     "  --help, --version   this text; the version\n"
     "Options take their value as --key VALUE or --key=VALUE (--lcm: --lcm=URL, --lcm URL or --lcm alone).\n"
@@ -85,12 +93,14 @@ const char *kUsage =
     "Examples:\n"
     "  host_sim --policy policy/weights.h --render pour.gif\n"
     "  host_sim --baseline rate --episodes 5 --json\n"
-    "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n";
+    "  host_sim --policy policy/weights.h --episodes 20 --set k_spill=10 --csv run.csv\n"
+    "  host_sim --experiment identify --candump identify.log\n";
 
 constexpr int kFrameEverySteps = 80; // 12.5 frames/s at 1 ms: smooth enough, and a GIF of 10 s renders in seconds
 
 struct Options {
-  std::string policy, baseline, config_path, csv, render;
+  std::string policy, baseline, config_path, csv, render, experiment, candump;
+  int node_id = 0;
   bool bench = false, sampled = false, json = false, quiet = false;
   int episodes = 1;
   long long seed = -1;
@@ -170,7 +180,8 @@ std::string key_hint(const std::string &key) {
 
 enum {
   kOptPolicy = 256, kOptBaseline, kOptConfig, kOptCsv, kOptRender, kOptEpisodes, kOptSeed, kOptSet, kOptRate,
-  kOptLcm, kOptRealtime, kOptLcmTimeout, kOptBench, kOptSampled, kOptJson, kOptQuiet, kOptListConfig, kOptVersion
+  kOptLcm, kOptRealtime, kOptLcmTimeout, kOptBench, kOptSampled, kOptJson, kOptQuiet, kOptListConfig, kOptVersion,
+  kOptExperiment, kOptCandump, kOptNodeId
 };
 
 const option kOptions[] = {
@@ -193,6 +204,9 @@ const option kOptions[] = {
     {"sampled", no_argument, nullptr, kOptSampled},
     {"json", no_argument, nullptr, kOptJson},
     {"quiet", no_argument, nullptr, kOptQuiet},
+    {"experiment", required_argument, nullptr, kOptExperiment},
+    {"candump", required_argument, nullptr, kOptCandump},
+    {"node-id", required_argument, nullptr, kOptNodeId},
     {nullptr, 0, nullptr, 0},
 };
 
@@ -254,20 +268,65 @@ int parse_args(int argc, char **argv, Options &o) {
     case kOptSampled: o.sampled = true; break;
     case kOptJson: o.json = true; break;
     case kOptQuiet: o.quiet = true; break;
+    case kOptExperiment:
+      if (std::strcmp(v, "identify") != 0 && std::strcmp(v, "tilt") != 0)
+        return usage_error("--experiment wants identify or tilt, got '%s'", v);
+      o.experiment = v;
+      break;
+    case kOptCandump:
+      if (*v == '\0') return usage_error("%s", "--candump: the file name is empty");
+      o.candump = v;
+      break;
+    case kOptNodeId:
+      if (!parse_long(v, 0, 63, n)) return usage_error("--node-id wants an integer 0..63, got '%s'", v);
+      o.node_id = static_cast<int>(n);
+      break;
     case ':': return usage_error("%s needs a value", a);
     default: return usage_error("unknown option '%s'", a);
     }
   }
   if (optind < argc) return usage_error("unexpected argument '%s'", argv[optind]);
   // --bench may take a --policy (its rollouts then run that policy).
-  int modes = (o.policy.empty() || o.bench ? 0 : 1) + (o.baseline.empty() ? 0 : 1) + (o.bench ? 1 : 0);
+  int modes = (o.policy.empty() || o.bench ? 0 : 1) + (o.baseline.empty() ? 0 : 1) + (o.bench ? 1 : 0) +
+              (o.experiment.empty() ? 0 : 1);
+  if (o.experiment.empty() != o.candump.empty()) return usage_error("%s", "--experiment and --candump go together");
+  if (!o.experiment.empty() && (o.lcm || !o.policy.empty()))
+    return usage_error("%s", "--experiment runs the controller in-process, with no policy: no --lcm, no --policy");
   if (o.lcm && (o.bench || !o.baseline.empty())) return usage_error("%s", "--lcm goes with --policy FILE or alone");
   if (o.realtime && !o.lcm) return usage_error("%s", "--realtime needs --lcm");
   if (o.lcm && modes == 0) modes = 1;
-  if (modes != 1) return usage_error("%s", "choose exactly one of --policy FILE, --baseline NAME, --bench");
+  if (modes != 1)
+    return usage_error("%s", "choose exactly one of --policy FILE, --baseline NAME, --bench, --experiment KIND");
   if (!o.baseline.empty() && o.baseline != "rate" && o.baseline != "full" && o.baseline != "hand")
     return usage_error("unknown baseline '%s' (rate, full or hand)", o.baseline.c_str());
   return -1;
+}
+
+// --experiment: the log written, how the experiment ended on stdout; exit 1 unless it ran to its end.
+int run_experiment_cli(const Options &o, const poursim_config_t &cfg) {
+  std::string why;
+  if (!poursim::check_outputs({{"--candump", o.candump}}, {{"--config", o.config_path}}, &why)) {
+    std::fprintf(stderr, "host_sim: %s\n", why.c_str());
+    return 2;
+  }
+  poursim::ExperimentRun run;
+  run.kind = o.experiment == "tilt" ? POUR_EXPERIMENT_TILT : POUR_EXPERIMENT_IDENTIFY;
+  run.seed = o.seed >= 0 ? static_cast<uint32_t>(o.seed) : cfg.seed;
+  run.node_id = static_cast<uint8_t>(o.node_id);
+  run.path = o.candump;
+  poursim::ExperimentResult r;
+  if (!poursim::run_experiment(cfg, run, &r, &why)) {
+    std::fprintf(stderr, "host_sim: --experiment %s: %s\n", o.experiment.c_str(), why.c_str());
+    return 1;
+  }
+  const bool done = r.phase == POUR_EXPERIMENT_PHASE_DONE && r.faults == 0u;
+  std::printf("experiment %s: %u ticks logged to %s; %s (mode %s, faults 0x%04x)\n", o.experiment.c_str(), r.ticks,
+              o.candump.c_str(),
+              done ? "ran to its end, bucket held"
+                   : (r.phase == POUR_EXPERIMENT_PHASE_OUT_OF_RANGE ? "ENDED EARLY: the angle left its range"
+                                                                     : "ENDED EARLY: a fault or no end"),
+              pour_mode_name(r.mode), static_cast<unsigned>(r.faults));
+  return done ? 0 : 1;
 }
 
 } // namespace
@@ -321,6 +380,7 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (o.bench) return poursim::run_bench(cfg, o.policy, o.episodes);
+  if (!o.experiment.empty()) return run_experiment_cli(o, cfg);
 
   // Every output checked before any work: none may name an input or another output, all must be writable.
   std::string render_base, render_json, renderer;

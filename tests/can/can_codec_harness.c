@@ -6,6 +6,7 @@
  * msg: sensors (seq_low encoder scale_rotating scale_target), torque (seq torque action mode limits),
  * heartbeat (mode faults rx_dropped overruns counter refused), estop (assert), identity (hash tau_max fw init),
  * param_read (id), param_value and param_write (id value), param_ack (request id result), tare (scales),
+ * experiment_start (kind),
  * clear_errors, stop, reset, param_save and zero (no fields).
  *   param <id>                          -> "ok <name> <unit or -> <min> <max>" | "none" (pour/params.h's table)
  * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
@@ -116,6 +117,9 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "param_ack") == 0 && n == 4) {
     pour_can_param_ack_t m = {(uint8_t)v[1], (uint8_t)v[2], (uint8_t)v[3]};
     print_frame(pour_can_pack_param_ack(node, &m, &f), &f);
+  } else if (strcmp(msg, "experiment_start") == 0 && n == 2) {
+    pour_can_experiment_start_t m = {(uint8_t)v[1]};
+    print_frame(pour_can_pack_experiment_start(node, &m, &f), &f);
   } else if (strcmp(msg, "tare") == 0 && n == 2) {
     pour_can_tare_t m = {(uint8_t)v[1]};
     print_frame(pour_can_pack_tare(node, &m, &f), &f);
@@ -210,6 +214,10 @@ static void do_unpack(const char *msg, char *rest) {
     pour_can_param_ack_t m = {0, 0, 0};
     rc = pour_can_unpack_param_ack(&f, &m);
     snprintf(out, sizeof out, "%u %u %u", (unsigned)m.request, (unsigned)m.param_id, (unsigned)m.result);
+  } else if (strcmp(msg, "experiment_start") == 0) {
+    pour_can_experiment_start_t m = {0};
+    rc = pour_can_unpack_experiment_start(&f, &m);
+    snprintf(out, sizeof out, "%u", (unsigned)m.kind);
   } else if (strcmp(msg, "tare") == 0) {
     pour_can_tare_t m = {0};
     rc = pour_can_unpack_tare(&f, &m);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "pour/can_node.h"
+#include "pour/params.h"
 #include "pour/drive_faults.h"
 #include "pour/weights_compiled.h"
 #include "unity.h"
@@ -572,6 +573,63 @@ static void test_can_node_RefusedResetInRunChangesNothing(void) {
   TEST_ASSERT_EQUAL_UINT32(seq_before + 300u, node.sensors.seq);
 }
 
+/* An ExperimentStart through node and core as the port runs them: the core's answer becomes a ParamAck with
+ * its reason, and an accepted experiment drives the run's torque (Action = its phase). */
+static pour_can_param_ack_t experiment_answer(uint8_t kind, bool estop) {
+  const pour_can_experiment_start_t m = {.kind = kind};
+  pour_can_frame_t f;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_experiment_start(cfg.node_id, &m, &f));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+  uint8_t got = 0u;
+  TEST_ASSERT_TRUE(pour_can_node_take_experiment(&node, &got));
+  TEST_ASSERT_FALSE(pour_can_node_take_experiment(&node, &got)); /* taken once */
+  TEST_ASSERT_EQUAL_UINT8(kind, got);
+  pour_control_experiment(&ctl, got);
+  pour_control_input_t in;
+  pour_can_node_begin_tick(&node, &in);
+  in.estop = estop;
+  pour_control_output_t out;
+  pour_control_step(&ctl, &in, &out);
+  pour_can_frame_t ack;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_experiment_ack(&node, kind, pour_control_experiment_answer(&ctl), &ack));
+  TEST_ASSERT_EQUAL_UINT16(pour_can_id(cfg.node_id, POUR_CAN_CMD_PARAM_ACK), ack.id);
+  pour_can_param_ack_t a;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_param_ack(&ack, &a));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CMD_EXPERIMENT_START, a.request);
+  TEST_ASSERT_EQUAL_UINT8(kind, a.param_id);
+  return a;
+}
+
+static void test_can_node_ExperimentStart_AnsweredWithTheCoresReason(void) {
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_ESTOP, experiment_answer(POUR_EXPERIMENT_IDENTIFY, true).result);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_FAULT, experiment_answer(POUR_EXPERIMENT_IDENTIFY, false).result);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
+  TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, experiment_answer(POUR_EXPERIMENT_IDENTIFY, false).result);
+  send_sample(1, 0);
+  pour_control_input_t in;
+  pour_can_node_begin_tick(&node, &in);
+  pour_control_output_t out;
+  pour_control_step(&ctl, &in, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_UINT8(POUR_EXPERIMENT_PHASE_RAMP, out.action);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_RUNNING, experiment_answer(POUR_EXPERIMENT_TILT, false).result);
+  /* Nothing asked, nothing to answer. */
+  pour_can_frame_t ack;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_node_experiment_ack(&node, 1u, pour_control_experiment_answer(&ctl), &ack));
+}
+
+static void test_can_node_ExperimentStart_OfAnUnknownKindIsDropped(void) {
+  pour_can_frame_t f = {.id = pour_can_id(cfg.node_id, POUR_CAN_CMD_EXPERIMENT_START), .dlc = 1u, .data = {3u}};
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_node_receive(&node, &f));
+  f.data[0] = 0u;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_node_receive(&node, &f));
+  f.dlc = 0u;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_DLC, pour_can_node_receive(&node, &f));
+  uint8_t kind = 0u;
+  TEST_ASSERT_FALSE(pour_can_node_take_experiment(&node, &kind));
+  TEST_ASSERT_EQUAL_UINT32(3u, pour_can_node_dropped(&node));
+}
+
 /* The hardwired line, sampled before and after the tick's frames (main.c), joins the bus's e-stop: a clear that
  * arrives while the line is held is dropped even if the line is released by the second sample, a bus release
  * does not release a held line, and a clear with the line released at both samples counts. */
@@ -668,6 +726,8 @@ int main(void) {
   RUN_TEST(test_can_node_ClearCountsOnlyAfterTheReleaseAndWhileReleased);
   RUN_TEST(test_can_node_ClearStormWhileEstopHeldClearsNothing);
   RUN_TEST(test_can_node_RefusedResetInRunChangesNothing);
+  RUN_TEST(test_can_node_ExperimentStart_AnsweredWithTheCoresReason);
+  RUN_TEST(test_can_node_ExperimentStart_OfAnUnknownKindIsDropped);
   RUN_TEST(test_can_node_HardwiredLineHeldDropsAClearAndOutranksTheBus);
   RUN_TEST(test_can_node_HeartbeatCountsRefusedCommands);
   return UNITY_END();

@@ -105,7 +105,7 @@ static void test_can_params_node_DropsAndCountsBadFrames(void) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_node_receive(&node, &f));
   f = raw(POUR_CAN_CMD_PARAM_VALUE, 5, d);
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_node_receive(&node, &f));
-  f = raw(0x0F, 0, d); /* reserved */
+  f = raw(0x11, 0, d); /* reserved */
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_BAD_ID, pour_can_node_receive(&node, &f));
   pour_can_param_request_t r;
   TEST_ASSERT_FALSE(pour_can_node_take_param_request(&node, &r));

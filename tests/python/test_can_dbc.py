@@ -39,6 +39,7 @@ MESSAGES = {
     "param_write": ("ParamWrite", ["ParamId", "Value"]),
     "param_ack": ("ParamAck", ["Request", "ParamId", "Result"]),
     "tare": ("Tare", ["Scales"]),
+    "experiment_start": ("ExperimentStart", ["Kind"]),
     "param_save": ("ParamSave", []),
     "zero": ("Zero", []),
 }
@@ -202,7 +203,7 @@ def test_pack_refuses_what_the_dbc_calls_out_of_range(db, harness, cname):
                 msg.encode(to_signals(cname, case), scaling=False, strict=True)
             refused += 1
     if cname in ("sensors", "torque", "heartbeat", "estop", "identity", "calibration_result", "drive_telemetry",
-                 "param_ack", "tare"):
+                 "param_ack", "tare", "experiment_start"):
         assert refused > 0
 
 
@@ -261,7 +262,7 @@ def test_cmd_ids_and_lengths_match_the_c_header(db, source_dir):
              "Identity": "IDENTITY", "CalibrationStart": "CALIBRATION_START",
              "CalibrationResult": "CALIBRATION_RESULT", "DriveTelemetry": "DRIVE_TELEMETRY",
              "ParamRead": "PARAM_READ", "ParamValue": "PARAM_VALUE",
-             "ParamWrite": "PARAM_WRITE", "ParamSave": "PARAM_SAVE", "ParamAck": "PARAM_ACK", "Tare": "TARE",
+             "ParamWrite": "PARAM_WRITE", "ParamSave": "PARAM_SAVE", "ParamAck": "PARAM_ACK", "Tare": "TARE", "ExperimentStart": "EXPERIMENT_START",
              "Zero": "ZERO"}
     assert sorted(m.name for m in db.messages) == sorted(names)
     for m in db.messages:
@@ -323,7 +324,7 @@ def test_calibration_status_names_are_the_codec_s(db):
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):
     """ParamId's value table in every parameter message names the ids of firmware/include/pour/params.h, the
-    one declaration; ParamAck's results are pour_param_result_t's."""
+    one declaration; ParamAck's results are pour_param_result_t's, then an ExperimentStart's refusals."""
     table = {}
     for i in range(256):
         ans = harness.ask(f"param {i}").split()
@@ -335,7 +336,12 @@ def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):
         assert {int(k): str(v) for k, v in choices.items()} == table, name
     results = db.get_message_by_name("ParamAck").get_signal_by_name("Result").choices
     assert [str(results[k]) for k in sorted(results)] == ["OK", "UNKNOWN_ID", "OUT_OF_RANGE", "BUSY",
-                                                          "INCONSISTENT", "NO_STORAGE", "NO_SAMPLE"]
+                                                          "INCONSISTENT", "NO_STORAGE", "NO_SAMPLE",
+                                                          "REFUSED_RUNNING", "REFUSED_ESTOP", "REFUSED_FAULT"]
+    # The ExperimentStart's refusals, beyond pour_param_result_t, are can_codec.h's.
+    header = (SOURCE_DIR / "firmware" / "can" / "include" / "pour" / "can_codec.h").read_text()
+    for k in (7, 8, 9):
+        assert f"#define POUR_CAN_ACK_{results[k]} {k}u" in header
 
 
 def test_dbc_for_node_shifts_every_id(db):

@@ -126,12 +126,13 @@ def test_only_paths_looks_for_the_build_tree(tmp_path):
 ALLOWED: dict[str, set[str]] = {
     "policy": set(),
     "sim": {"policy"},
-    "train": {"sim", "policy"},
-    "eval": {"train", "sim", "policy"},
+    "train": {"sim", "policy", "sysid"},
+    "eval": {"train", "sim", "policy", "sysid"},
     "lcm": {"eval", "sim"},
     "can": set(),
     "bench": {"can", "policy"},
     "examples": {"sim", "policy"},
+    "sysid": {"bench", "sim"},
 }
 
 

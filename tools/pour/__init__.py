@@ -16,17 +16,20 @@
     pour.can      the CAN protocol's DBC (dbc) and bus load (bus_load)
     pour.bench    the bench over CAN: scan, state, commands, parameters, logs (node); pour-bench (cli)
     pour.examples other libraries training the firmware's policy class: Stable-Baselines3's PPO (sb3_ppo)
+    pour.sysid    system identification: the experiment's log (log), the fit (fit), rig files (rig);
+                  pour-sysid (cli)
 
 A subpackage imports only those on its row (and the shared modules, which import no subpackage);
 tests/python/test_imports.py checks it:
 
     pour.policy    -
     pour.sim       policy
-    pour.train     sim, policy
-    pour.eval      train, sim, policy
+    pour.train     sim, policy, sysid
+    pour.eval      train, sim, policy, sysid
     pour.lcm       eval, sim
     pour.can       -
     pour.bench     can, policy
+    pour.sysid     bench, sim
     pour.examples  sim, policy
 
 So the simulator never reaches the trainer, and nothing but the evaluation (a sweep trains its trials;

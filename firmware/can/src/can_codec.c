@@ -190,6 +190,18 @@ pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, po
   return POUR_OK;
 }
 
+static int kind_ok(uint8_t kind) { return kind >= POUR_CAN_EXPERIMENT_KIND_MIN && kind <= POUR_CAN_EXPERIMENT_KIND_MAX; }
+
+pour_status_t pour_can_pack_experiment_start(uint8_t node_id, const pour_can_experiment_start_t *msg,
+                                             pour_can_frame_t *frame) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !kind_ok(msg->kind)) {
+    return POUR_EINVAL;
+  }
+  frame_begin(frame, node_id, POUR_CAN_CMD_EXPERIMENT_START, POUR_CAN_DLC_EXPERIMENT_START);
+  frame->data[0] = msg->kind;
+  return POUR_OK;
+}
+
 static int is_signal_free_command(uint8_t cmd) {
   return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET ||
          cmd == POUR_CAN_CMD_CALIBRATION_START || cmd == POUR_CAN_CMD_PARAM_SAVE || cmd == POUR_CAN_CMD_ZERO;
@@ -223,6 +235,7 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_PARAM_ACK: return (int)POUR_CAN_DLC_PARAM_ACK;
     case POUR_CAN_CMD_TARE: return (int)POUR_CAN_DLC_TARE;
     case POUR_CAN_CMD_ZERO: return (int)POUR_CAN_DLC_ZERO;
+    case POUR_CAN_CMD_EXPERIMENT_START: return (int)POUR_CAN_DLC_EXPERIMENT_START;
     default: return -1;
   }
 }
@@ -366,6 +379,18 @@ pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
   msg->scales = frame->data[0];
+  return POUR_CAN_RX_OK;
+}
+
+pour_can_rx_t pour_can_unpack_experiment_start(const pour_can_frame_t *frame, pour_can_experiment_start_t *msg) {
+  const pour_can_rx_t rc = check_unpack(frame, POUR_CAN_CMD_EXPERIMENT_START, msg);
+  if (rc != POUR_CAN_RX_OK) {
+    return rc;
+  }
+  if (!kind_ok(frame->data[0])) {
+    return POUR_CAN_RX_OUT_OF_RANGE;
+  }
+  msg->kind = frame->data[0];
   return POUR_CAN_RX_OK;
 }
 

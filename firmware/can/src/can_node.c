@@ -3,12 +3,14 @@
 
 #include <stddef.h>
 
+#include "pour/params.h"
+
 /* Commands a controller accepts; HEARTBEAT, IDENTITY and TORQUE are its own transmissions. */
 #define PARAM_MASK ((1u << POUR_CAN_CMD_PARAM_READ) | (1u << POUR_CAN_CMD_PARAM_WRITE) | \
                     (1u << POUR_CAN_CMD_PARAM_SAVE) | (1u << POUR_CAN_CMD_TARE) | (1u << POUR_CAN_CMD_ZERO))
 #define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_SENSORS) | \
                      (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET) |                             \
-                     (1u << POUR_CAN_CMD_CALIBRATION_START) | PARAM_MASK)
+                     (1u << POUR_CAN_CMD_CALIBRATION_START) | (1u << POUR_CAN_CMD_EXPERIMENT_START) | PARAM_MASK)
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
@@ -155,6 +157,17 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       pour_commands_reset(&node->commands);
       kick(node);
       break;
+    case POUR_CAN_CMD_EXPERIMENT_START: {
+      pour_can_experiment_start_t m;
+      rc = pour_can_unpack_experiment_start(frame, &m);
+      if (rc != POUR_CAN_RX_OK) {
+        return drop(node, rc);
+      }
+      node->experiment_requested = true;
+      node->experiment_kind = m.kind;
+      kick(node);
+      break;
+    }
     case POUR_CAN_CMD_CALIBRATION_START: /* answered, or refused with its reason, at the end of the tick */
       node->calibration_requested = true;
       kick(node);
@@ -284,4 +297,27 @@ bool pour_can_node_take_calibration_start(pour_can_node_t *node) {
 
 void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
   node->calibration = *result;
+}
+
+bool pour_can_node_take_experiment(pour_can_node_t *node, uint8_t *kind) {
+  if (!node->experiment_requested) {
+    return false;
+  }
+  *kind = node->experiment_kind;
+  node->experiment_requested = false;
+  return true;
+}
+
+pour_status_t pour_can_node_experiment_ack(const pour_can_node_t *node, uint8_t kind, uint8_t answer,
+                                           pour_can_frame_t *frame) {
+  pour_can_param_ack_t ack = {.request = POUR_CAN_CMD_EXPERIMENT_START, .param_id = kind, .result = 0u};
+  switch (answer) {
+    case POUR_CONTROL_EXPERIMENT_ACCEPTED: ack.result = (uint8_t)POUR_PARAM_OK; break;
+    case POUR_CONTROL_EXPERIMENT_REFUSED_RUNNING: ack.result = POUR_CAN_ACK_REFUSED_RUNNING; break;
+    case POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP: ack.result = POUR_CAN_ACK_REFUSED_ESTOP; break;
+    case POUR_CONTROL_EXPERIMENT_REFUSED_FAULT: ack.result = POUR_CAN_ACK_REFUSED_FAULT; break;
+    case POUR_CONTROL_EXPERIMENT_REFUSED_KIND: ack.result = (uint8_t)POUR_PARAM_OUT_OF_RANGE; break;
+    default: return POUR_EINVAL; /* nothing was answered */
+  }
+  return pour_can_pack_param_ack(node->config.node_id, &ack, frame);
 }

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "pour/faults.h"
+#include "pour/experiment.h"
 #include "pour/fixed.h"
 #include "pour/obs.h"
 #include "pour/policy.h"
@@ -48,7 +49,18 @@ typedef struct {
   int32_t restart_jump_max_urad;
   pour_supervisor_config_t supervisor;
   pour_stop_config_t stop;
+  pour_experiment_config_t experiment; /* the identification experiments (pour_control_experiment) */
 } pour_control_config_t;
+
+/* The answer to pour_control_experiment, given by the next update. */
+typedef enum {
+  POUR_CONTROL_EXPERIMENT_NO_ANSWER = 0,      /* nothing asked since the last answer was read */
+  POUR_CONTROL_EXPERIMENT_ACCEPTED = 1,       /* armed: it runs from the next fresh sample on */
+  POUR_CONTROL_EXPERIMENT_REFUSED_RUNNING = 2, /* asked for in RUN: Stop first */
+  POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP = 3,  /* asked for while the e-stop is asserted */
+  POUR_CONTROL_EXPERIMENT_REFUSED_FAULT = 4,  /* asked for in FAULT: clear first */
+  POUR_CONTROL_EXPERIMENT_REFUSED_KIND = 5    /* not a pour_experiment_kind_t that runs */
+} pour_control_experiment_answer_t;
 
 /* Inputs of one tick. */
 typedef struct {
@@ -105,6 +117,11 @@ typedef struct {
   bool have_trusted;      /* a fresh, plausible sample was taken since init */
   int32_t trusted_theta_urad; /* the angle of the latest one: a restart of a held axis must find it again [µrad] */
   bool check_restart;     /* the next fresh sample is the first after a restart of a held axis */
+  pour_experiment_t experiment; /* armed or running identification experiment (kind NONE: none) */
+  bool experiment_asked;  /* a pour_control_experiment waits for the next update */
+  uint8_t experiment_kind; /* ... of this kind */
+  uint8_t experiment_answer; /* pour_control_experiment_answer_t of the latest request */
+  bool held;              /* an experiment ended in IDLE: the brake holds until a Reset or another experiment */
   bool drive_untrusted;   /* a drive fault since the last clear came with a drive that no longer follows a torque */
 } pour_control_t;
 
@@ -144,6 +161,18 @@ void pour_control_decide(pour_control_t *ctl);
 
 /* Stage 2 from outside: the action index (telemetry) and the torque request [Q15 of tau_max]. */
 void pour_control_request(pour_control_t *ctl, uint8_t action, q15_t torque);
+
+/* Asks for an identification experiment (pour/experiment.h), answered by the next update: accepted in IDLE
+ * (it runs from the next fresh sample, the decisions coming from it every tick through the envelope and
+ * supervisor), refused in RUN, ESTOP and FAULT. It ends with the bucket held: at its end, on leaving its
+ * angle range or on a Stop the core goes to IDLE with the brake engaged and stays there until a Reset or
+ * another experiment (the Action output says how it ended: pour_experiment_phase_t); a fault or the e-stop
+ * ends it as they end any run. */
+void pour_control_experiment(pour_control_t *ctl, uint8_t kind);
+
+/* The answer to the latest pour_control_experiment (pour_control_experiment_answer_t), once: NO_ANSWER
+ * after it was read. */
+uint8_t pour_control_experiment_answer(pour_control_t *ctl);
 
 /* Stage 3: in RUN the request through the envelope (and recorded for the supervisor), in FAULT the
  * controlled stop, else the safe torque (zero in ESTOP). A clear never bypasses the envelope: RUN resumes

@@ -47,6 +47,7 @@ typedef struct {
   int64_t theta_q16;      /* tracking loop's position θ̂ [µrad] Q16 */
   int64_t omega_q16;      /* tracking loop's speed ω̂ [µrad per tick] Q16 */
   int32_t m0_g;           /* all the liquid: m_rot + m_tgt of the first sample [g] */
+  bool empty_ok;          /* an empty bucket is expected (pour_estimator_expect_empty) */
 } pour_estimator_t;
 
 /* Defaults for the bench rig (17-bit encoder, 80 Hz load cells of 30 kg, 10 L of soymilk). */
@@ -63,9 +64,13 @@ void pour_estimator_reset(pour_estimator_t *est);
  * over a seq gap, 1 .. GAP_MAX ticks),
  * V_rot = m_rot/m0, V_tgt = m_tgt/m0 in Q15, each rounded and clipped to [0, 32767], V_spill = 1 - V_rot -
  * V_tgt clipped to [0, 32767]. false: an implausible sample (encoder count >= 2^bits, a scale outside its
- * limits, m0 too small, θ farther from the loop's prediction than jump_max · n²); then neither the
+ * limits, m0 too small unless an empty bucket is expected, θ farther from the loop's prediction than jump_max · n²); then neither the
  * estimator nor *state changes. */
 bool pour_estimator_update(pour_estimator_t *est, const pour_sensors_t *sample, pour_state_t *state);
+
+/* empty: the bucket is empty on purpose (the identify experiment, pour/experiment.h), so an m0 below
+ * mass_min_g is no fault: the volumes are then all 0. Kept across pour_estimator_reset; off at init. */
+void pour_estimator_expect_empty(pour_estimator_t *est, bool empty);
 
 /* θ [µrad] of a raw count, as the estimator computes it (bits within POUR_ENCODER_BITS_MIN .. _MAX). */
 int32_t pour_sensors_theta_urad(uint32_t count, uint8_t bits);

@@ -111,6 +111,12 @@ int main(void) {
     pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
     pour_control_input_t in;
     pour_can_node_begin_tick(&can_node, &in);
+    /* An ExperimentStart goes to the core before the tick; this tick's update answers it. */
+    uint8_t kind = 0u;
+    const bool asked = pour_can_node_take_experiment(&can_node, &kind);
+    if (asked) {
+      pour_control_experiment(&controller, kind);
+    }
     pour_control_output_t out;
     pour_board_drive_tick(&controller, &in, &out);
     pour_hal_led_show(out.mode, false);
@@ -118,6 +124,11 @@ int main(void) {
     pour_board_drive_telemetry(&drive);
     pour_can_node_set_drive(&can_node, &drive);
     transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
+    pour_can_frame_t ack;
+    if (asked && pour_can_node_experiment_ack(&can_node, kind, pour_control_experiment_answer(&controller), &ack) ==
+                     POUR_OK) {
+      transmit(&ack, 1u);
+    }
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */
     }

@@ -27,6 +27,8 @@ typedef struct {
   uint32_t overruns;
   pour_params_t params;      /* in force; saved on ParamSave */
   pour_control_t *ctl;       /* the core, while can_service runs (what an accepted write reconfigures) */
+  bool experiment_asked;     /* an ExperimentStart went to the core: its answer comes from the next update */
+  uint8_t experiment_kind;
 } socketcan_t;
 
 static socketcan_t g_can; /* one transport per process */
@@ -149,10 +151,34 @@ static pour_status_t save_params(void *user, const pour_params_t *params) {
   return pour_params_file_save(s->config.params_path, params) == 0 ? POUR_OK : POUR_EINVAL;
 }
 
+/* An ExperimentStart goes to the core before the step; the update of that step answers it, and the next
+ * tick's service sends the answer (a ParamAck). */
+static void serve_experiment(socketcan_t *s, pour_control_t *ctl) {
+  if (s->experiment_asked) {
+    s->experiment_asked = false;
+    const uint8_t answer = pour_control_experiment_answer(ctl);
+    pour_can_frame_t ack;
+    if (pour_can_node_experiment_ack(&s->node, s->experiment_kind, answer, &ack) == POUR_OK) {
+      if (answer != (uint8_t)POUR_CONTROL_EXPERIMENT_ACCEPTED) {
+        fprintf(stderr, "pour_controller: experiment %u refused (ParamAck result %u)\n", (unsigned)s->experiment_kind,
+                (unsigned)ack.data[2]);
+      }
+      (void)send_frame(s, &ack);
+    }
+  }
+  uint8_t kind = 0u;
+  if (pour_can_node_take_experiment(&s->node, &kind)) {
+    pour_control_experiment(ctl, kind);
+    s->experiment_asked = true;
+    s->experiment_kind = kind;
+  }
+}
+
 /* One parameter request per tick, answered before the step; the node id in force stays the one bound at
  * start (a new node_id takes effect at the next start). */
 static void can_service(pour_io_t *io, pour_control_t *ctl) {
   socketcan_t *s = io->ctx;
+  serve_experiment(s, ctl);
   pour_can_param_request_t r;
   if (!pour_can_node_take_param_request(&s->node, &r)) {
     return;

@@ -54,6 +54,7 @@
   X(DOUBLE, friction_coulomb, 0.6, 0.0, 100.0, "N m", "Coulomb friction at the output, holds at standstill") \
   X(DOUBLE, friction_viscous, 0.02, 0.0, 100.0, "N m s/rad", "viscous friction at the output") \
   X(INT, command_latency_ticks, 1, 1, 100, "steps", "a command acts this many steps after the step it is given in") \
+  X(DOUBLE, torque_scale, 1.0, 0.5, 2.0, "-", "the drive delivers this times the command (a torque constant off its datasheet)") \
   S("the full drive (docs/motor.md): the firmware's current loop around a motor, inverter and bus model") \
   X(INT, drive, 0, 0, 1, "-", "0: the torque-speed line above (the fast default for training); 1: field-oriented control at 20 kHz") \
   X(INT, drive_regen, 1, 0, 1, "-", "1: the drive's flux braking on; 0: off (regeneration charges the bus)") \

@@ -162,3 +162,45 @@ def test_save_without_storage_is_refused():
         assert "NO_SAMPLE" in refused("tare")
     finally:
         ctl.stop()
+
+
+def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
+    """pour-bench identify over the bus: refused with the e-stop asserted (its reason named), then run with
+    host_sim as the plant, whose policy has tilted the full bucket beyond the empty-bucket experiment's angle
+    range: it ends at its first tick with the bucket held, and pour-sysid says so of the log."""
+    policy_hash = weights_h.parse_weights_h(WEIGHTS).content_hash
+    ctl = Controller(*LOCKSTEP, io="can:vcan0")
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    plant = subprocess.Popen([str(BUILD_DIR / "bin" / "host_sim"), "--policy", str(WEIGHTS), "--lcm", URL,
+                              "--lcm-timeout-ms", "60000", "--set", "episode_s=300"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = tmp_path / "identify.log"
+    try:
+        with bn.Bench("vcan0") as b:
+            b.node(0).wait_mode({"RUN"}, timeout=20)  # the plant's samples flow
+        r = bench("identify", str(log))
+        assert r.returncode == 2 and "--expect-hash" in r.stderr, r.stderr
+        assert "mode ESTOP" in ok("estop")
+        err = refused("--expect-hash", f"0x{policy_hash:08x}", "--yes", "identify", str(log))
+        assert "refused the identify experiment: REFUSED_ESTOP" in err, err
+        assert not log.exists()
+        ok("estop", "--release")
+        ok("--expect-hash", f"0x{policy_hash:08x}", "--yes", "clear")
+        with bn.Bench("vcan0") as b:
+            b.node(0).wait_mode({"RUN"}, timeout=20)
+        # The guest makes ~300 samples/s, fewer on a loaded machine: minutes for the experiment's seconds.
+        r = bench("--expect-hash", f"0x{policy_hash:08x}", "--yes", "identify", str(log), "--seconds", "200",
+                  timeout=240)
+        assert r.returncode == 0, (r.stdout, r.stderr)
+        assert "the identify experiment ended: out of range (bucket held)" in r.stdout, r.stdout
+        lines = log.read_text().splitlines()
+        assert any(" 00F#01" in x for x in lines) and any(" 00C#0F0100" in x for x in lines)  # start, accepted
+        assert "mode IDLE" in ok("faults")
+        r = subprocess.run([sys.executable, "-m", "pour.sysid.cli", str(log), "--out", str(tmp_path / "rig.toml")],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 1 and "left its angle range" in r.stderr, r.stderr  # the policy had tilted it
+    finally:
+        stop(plant)
+        stop(bridge)
+        stop(ctl.proc)

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
 """pour-bench: bring a pour controller up on a CAN bus (scan, info, faults, e-stop, parameters, logs).
 
-Commands that can make the axis move (clear, which resumes a run, and reset) say so, check the node's
-policy hash against --expect-hash or --weights first, and ask for confirmation unless --yes.
+Commands that can make the axis move (clear, which resumes a run, reset, and identify, the controller's own
+identification experiment) say so, check the node's policy hash against --expect-hash or --weights first,
+and ask for confirmation unless --yes.
 """
 from __future__ import annotations
 
@@ -21,7 +22,7 @@ EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a fa
           "hash may be 0x hex.")
 
 
-MOTION = ("clear", "reset")  # commands after which the policy drives the axis again
+MOTION = ("clear", "reset", "identify")  # commands that can move the axis
 
 
 class UsageError(Exception):
@@ -104,6 +105,12 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--replay", type=Path, help="plot a candump -L log (pour-bench log) instead of the bus")
     p.add_argument("--fast", action="store_true", help="--replay as fast as it draws, not at the log's pace")
     p.add_argument("--no-window", action="store_true", help="draw off-screen (with --png)")
+    p = sub.add_parser("identify", help="the controller's identification experiment, logged (MOVES the axis)")
+    p.add_argument("output", type=Path, help="the candump -L log to write (pour-sysid reads it)")
+    p.add_argument("--kind", choices=["identify", "tilt"], default="identify",
+                   help="identify: bucket EMPTY, steps and a chirp about 20 deg within -3..43 deg; tilt: with "
+                        "water, to 90 deg at 0.1 rad/s and back (default %(default)s)")
+    p.add_argument("--seconds", type=_seconds, default=60.0, help="give up after this long (default %(default)s)")
     sub.add_parser("calibrate", help="drive calibration (needs the board's calibration messages)")
     return ap
 
@@ -199,7 +206,7 @@ def run(a: argparse.Namespace) -> int:
             _print_state(n.wait_mode({"FAULT"} if a.release else {"ESTOP"}, a.timeout))
         elif a.cmd == "stop":
             _print_state(n.stop(a.timeout))
-        elif a.cmd in MOTION:
+        elif a.cmd in ("clear", "reset"):
             assert want is not None
             _confirm_motion(a, n, want)
             n.clear(a.timeout) if a.cmd == "clear" else n.reset(a.timeout)
@@ -222,6 +229,11 @@ def run(a: argparse.Namespace) -> int:
         elif a.cmd == "zero":
             n.zero(a.timeout)
             print(f"node {n.id}: encoder zeroed")
+        elif a.cmd == "identify":
+            assert want is not None
+            _confirm_motion(a, n, want)
+            count, ended = n.identify(a.output, a.kind, a.seconds)
+            print(f"{a.output}: {count} frames; the {a.kind} experiment ended: {ended} (bucket held)")
         elif a.cmd == "log":
             count = n.record(a.output, a.seconds)
             print(f"{a.output}: {count} frames in {a.seconds:g} s")

@@ -25,6 +25,12 @@ from pour import atomic
 from pour.can import dbc
 
 DEFAULT_TIMEOUT_S = 1.0
+START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent again
+REST_S = 1.0  # identify: recorded after the end
+# pour/experiment.h's phases: Torque.Action while an experiment runs, and how it ended (8, 9) after it.
+EXPERIMENT_PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
+                     9: "out of range"}
+EXPERIMENT_ENDED = 8  # Action >= this outside RUN: the experiment is over
 HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
 TARE_ROTATING = 1
 TARE_TARGET = 2
@@ -355,6 +361,69 @@ class Node:
 
     def zero(self, timeout: float = DEFAULT_TIMEOUT_S) -> None:
         self._request("Zero", 0, timeout)
+
+    # -- identification ------------------------------------------------------------------------------------
+    def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
+        """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
+        writes the bus as a candump -L log (atomically, the start frames included) until the node reports how
+        it ended (Torque.Action outside RUN) and REST_S more (the held bucket at rest: the scale's noise), or
+        seconds pass. Returns (frames, how it ended).
+        A node in RUN gets a Stop just before the start: the two must land in one control tick, since the
+        next sample starts a new run; a start refused as REFUSED_RUNNING is tried again, START_TRIES times
+        in all. ParamRefused with the controller's reason; NodeTimeout if it never answers or never ends."""
+        atomic.check_output_path(path, "log")
+        kinds = {str(v): int(k) for k, v in self.bench.message("ExperimentStart").get_signal_by_name("Kind").choices.items()}
+        cmd = self.bench.message("ExperimentStart").frame_id
+        n, answered, ended, tail_end, tries = 0, False, None, None, 0
+        m = self.bench.message("ExperimentStart")
+        with atomic.atomic_path(path) as tmp:
+            writer = can.CanutilsLogWriter(str(tmp), channel=self.bench.channel)
+
+            def start() -> None:
+                if self.state is not None and self.state.mode == "RUN":
+                    self.bench.send(self.id, "Stop")
+                self.bench.send(self.id, "ExperimentStart", Kind=kinds[kind])
+                writer.on_message_received(can.Message(
+                    timestamp=time.time(), arbitration_id=dbc.can_id(self.id, m.frame_id), is_extended_id=False,
+                    data=m.encode({"Kind": kinds[kind]}, scaling=False, strict=True), channel=self.bench.channel))
+
+            try:
+                start()
+                tries = 1
+                for msg in self.bench.frames(seconds):
+                    writer.on_message_received(msg)
+                    n += 1
+                    d = self.bench.decode(msg)
+                    if d is None or d[0] != self.id:
+                        continue
+                    name, s = d[1], d[2]
+                    if name == "ParamAck" and s["Request"] == cmd:
+                        result = str(self.bench.message("ParamAck").get_signal_by_name("Result").choices[s["Result"]])
+                        if result == "REFUSED_RUNNING" and tries < START_TRIES:
+                            start()
+                            tries += 1
+                            continue
+                        answered = True
+                        if s["Result"] != 0:
+                            reason = {"REFUSED_RUNNING": "the controller runs: stop it first",
+                                      "REFUSED_ESTOP": "the e-stop is asserted",
+                                      "REFUSED_FAULT": "the controller is in FAULT: clear it first"}.get(result, "")
+                            raise ParamRefused(f"node {self.id} refused the {kind} experiment: {result} ({reason})",
+                                               "ExperimentStart", result)
+                    elif (name == "Torque" and answered and ended is None and s["Mode"] != 1
+                          and s["Action"] >= EXPERIMENT_ENDED):
+                        ended = EXPERIMENT_PHASES.get(s["Action"], str(s["Action"]))
+                        tail_end = time.monotonic() + REST_S
+                    if tail_end is not None and time.monotonic() >= tail_end:
+                        break
+            finally:
+                writer.stop()
+            if not answered:
+                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart: no log written", self.state)
+            if ended is None:
+                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s: no log "
+                                  "written", self.state)
+        return n, ended
 
     # -- telemetry -----------------------------------------------------------------------------------------
     def stream(self, seconds: float) -> Iterator[tuple[float, str, dict]]:

@@ -88,6 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     rb.add_argument("--build-dir", help="build directory holding bin/host_sim and lib/libpoursim.so")
     rb.add_argument("--workers", type=int, default=2, help="host_sim processes at once")
     rb.add_argument("--quiet", action="store_true", help="no progress bar on stderr")
+    rb.add_argument("--rig", type=Path, help="a rig file (pour-sysid): the nominal rig every scene starts from")
     args = ap.parse_args(argv)
     if args.cmd == "robust":
         return robust(args)
@@ -120,9 +121,15 @@ def robust(args: argparse.Namespace) -> int:
         weights_h.parse_weights_h(args.header)
         if not args.out.parent.is_dir():
             raise ValueError(f"--out: folder {args.out.parent} does not exist")
+        nominal, rig_sets = poursim.default_config(), []
+        if args.rig is not None:
+            from pour.sysid import rig as srig
+            rig = srig.load(args.rig)
+            nominal.update(rig.values)
+            rig_sets = srig.host_sim_sets(rig)
         rows = robustness.run(args.header, args.out, args.nominal_episodes, args.edge_episodes, args.seed,
-                              lambda a: run_host_sim(a, args.build_dir), poursim.default_config(), args.workers,
-                              args.quiet)
+                              lambda a: run_host_sim(a, args.build_dir), nominal, args.workers, args.quiet,
+                              rig_sets)
     except (OSError, RuntimeError, ValueError, weights_h.WeightsHError, poursim.SimError) as exc:
         print(f"pour-eval: error: {exc}", file=sys.stderr)
         return 2

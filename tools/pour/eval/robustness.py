@@ -132,8 +132,9 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
 
 def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed: int,
         run_host_sim: Callable[[Sequence[str]], Any], nominal_config: dict[str, float],
-        workers: int = 2, quiet: bool = False) -> list[dict[str, Any]]:
-    """Every scene's row (and the table, JSON and plot in out); progress on stderr by episodes unless quiet."""
+        workers: int = 2, quiet: bool = False, rig_sets: Sequence[str] = ()) -> list[dict[str, Any]]:
+    """Every scene's row (and the table, JSON and plot in out); progress on stderr by episodes unless quiet.
+    rig_sets: host_sim --set arguments of the nominal rig (a fitted rig file), before each scene's own."""
     out.mkdir(parents=True, exist_ok=True)
     todo = scenes()
     episodes = {sc.name: nominal_episodes if sc.nominal else edge_episodes for sc in todo}
@@ -142,7 +143,7 @@ def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed:
         def one(scene: Scene) -> dict[str, Any]:
             sets = scene_args(scene, nominal_config)
             s = run_host_sim(["--policy", header, "--episodes", str(episodes[scene.name]), "--seed", str(seed),
-                              "--quiet", *sets])
+                              "--quiet", *rig_sets, *sets])
             s["sets"] = sets[1::2]
             progress.update(episodes[scene.name])
             return judge(scene, s)
@@ -150,7 +151,7 @@ def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed:
         with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
             rows = list(ex.map(one, todo))
     doc = {"header": header, "seed": seed, "nominal_episodes": nominal_episodes, "edge_episodes": edge_episodes,
-           "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
+           "rig": list(rig_sets[1::2]), "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
     atomic.write_atomic(out / "robustness.json", json.dumps(doc, indent=1) + "\n")
     atomic.write_atomic(out / "robustness.md", table(rows, header, seed))
     plot(rows, out / "robustness.png")

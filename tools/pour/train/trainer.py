@@ -10,6 +10,7 @@ never from the worker that runs them, so the number of workers does not change t
 from __future__ import annotations
 
 import csv
+import dataclasses
 import importlib
 import io
 import json
@@ -25,6 +26,7 @@ import numpy as np
 from pour import cli
 from pour.policy import export, linear
 from pour.sim import envs
+from pour.sysid import rig as srig
 from pour.train import config as cfgmod
 from pour.train import executors, reinforce
 from pour.train.executors import Runner  # the local pool, the default executor (also as trainer.Runner)
@@ -372,6 +374,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--iterations", type=int, help="override the config's iterations")
     ap.add_argument("--workers", type=int, help="override the config's workers")
     ap.add_argument("--fresh", action="store_true", help="discard an existing checkpoint in --out")
+    ap.add_argument("--rig", type=Path, help="a rig file (pour-sysid): its values become the nominal rig, the "
+                                             "randomisation centred on it with widths from its uncertainties")
     ap.add_argument("--quiet", action="store_true", help="no progress lines (iteration, return, time left) on stderr")
     ap.add_argument("--executor", choices=("local", "ray"), default="local",
                     help="where episodes run: 'local' process pool (default) or Ray tasks (pip install './tools[ray]')")
@@ -384,9 +388,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         over = {k: getattr(args, k) for k in ("seed", "iterations", "workers") if getattr(args, k) is not None}
         if over:
             cfg = cfgmod.with_overrides(cfg, **over)
+        if args.rig is not None:
+            options = srig.centred(cfg.env.options, srig.load(args.rig))
+            cfg = cfgmod.validate(dataclasses.replace(cfg, env=dataclasses.replace(cfg.env, options=options)))
         res = train(cfg, args.out, resume=not args.fresh, quiet=args.quiet,
                     make_runner=executors.runner_factory("ray", args.ray_address) if args.executor == "ray" else Runner)
-    except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError, executors.ExecutorError) as exc:
+    except (cfgmod.ConfigError, envs.EnvError, TrainError, reinforce.GradientError, executors.ExecutorError,
+            srig.RigError) as exc:
         print(f"pour-train: error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps({"run_dir": str(res.run_dir), "iterations": res.iterations, "wall_s": round(res.wall_s, 1),

@@ -30,6 +30,7 @@
 #define POUR_CAN_CMD_PARAM_ACK 0x0Cu    /* controller -> host: the result of a parameter request */
 #define POUR_CAN_CMD_TARE 0x0Du         /* host -> controller: tare the scales at their latest reading */
 #define POUR_CAN_CMD_ZERO 0x0Eu         /* host -> controller: the encoder's latest count becomes upright */
+#define POUR_CAN_CMD_EXPERIMENT_START 0x0Fu /* host -> controller: run an identification experiment */
 #define POUR_CAN_CMD_SENSORS 0x10u      /* host -> controller: one raw sensor sample (encoder, scales) */
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
@@ -50,6 +51,7 @@
 #define POUR_CAN_DLC_PARAM_ACK 3u
 #define POUR_CAN_DLC_TARE 1u
 #define POUR_CAN_DLC_ZERO 0u
+#define POUR_CAN_DLC_EXPERIMENT_START 1u
 #define POUR_CAN_DLC_SENSORS 8u
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
@@ -90,7 +92,14 @@
 #define POUR_CAN_CAL_ABORTED 15u        /* a fault, the e-stop or a stop ended it, or a latched fault refused it */
 #define POUR_CAN_CAL_STATUS_MAX 15u
 #define POUR_CAN_CAL_STORED_MAX 5u
-#define POUR_CAN_PARAM_RESULT_MAX 6u    /* ParamAck.Result: a pour_param_result_t */
+#define POUR_CAN_PARAM_RESULT_MAX 9u    /* ParamAck.Result: a pour_param_result_t, or an ExperimentStart's refusal */
+/* ParamAck.Result for an ExperimentStart (beyond pour_param_result_t; OK: accepted, OUT_OF_RANGE: a kind
+ * that does not run). */
+#define POUR_CAN_ACK_REFUSED_RUNNING 7u /* asked for in RUN: Stop first */
+#define POUR_CAN_ACK_REFUSED_ESTOP 8u   /* asked for while the e-stop is asserted */
+#define POUR_CAN_ACK_REFUSED_FAULT 9u   /* asked for in FAULT: clear first */
+#define POUR_CAN_EXPERIMENT_KIND_MIN 1u /* ExperimentStart.Kind: pour_experiment_kind_t that run */
+#define POUR_CAN_EXPERIMENT_KIND_MAX 2u
 #define POUR_CAN_TARE_ROTATING 1u       /* Tare.Scales bits */
 #define POUR_CAN_TARE_TARGET 2u
 
@@ -182,6 +191,11 @@ typedef struct {
   uint8_t scales; /* POUR_CAN_TARE_* bits, 1 .. 3 */
 } pour_can_tare_t;
 
+/* ExperimentStart: which identification experiment (pour/experiment.h). */
+typedef struct {
+  uint8_t kind; /* pour_experiment_kind_t, POUR_CAN_EXPERIMENT_KIND_MIN .. _MAX */
+} pour_can_experiment_start_t;
+
 /* The fault bits the heartbeat carries: every POUR_FAULT_* of the core, the link (watchdog) fault included. */
 #define POUR_CAN_HEARTBEAT_FAULT_MASK POUR_FAULT_ALL
 
@@ -218,6 +232,8 @@ pour_status_t pour_can_pack_param_read(uint8_t node_id, const pour_can_param_rea
 pour_status_t pour_can_pack_param(uint8_t node_id, uint8_t cmd, const pour_can_param_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame);
+pour_status_t pour_can_pack_experiment_start(uint8_t node_id, const pour_can_experiment_start_t *msg,
+                                             pour_can_frame_t *frame);
 /* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET, _CALIBRATION_START, _PARAM_SAVE and
  * _ZERO (POUR_EINVAL
  * for another cmd). */
@@ -236,6 +252,7 @@ pour_can_rx_t pour_can_unpack_param_read(const pour_can_frame_t *frame, pour_can
 pour_can_rx_t pour_can_unpack_param(const pour_can_frame_t *frame, uint8_t cmd, pour_can_param_t *msg);
 pour_can_rx_t pour_can_unpack_param_ack(const pour_can_frame_t *frame, pour_can_param_ack_t *msg);
 pour_can_rx_t pour_can_unpack_tare(const pour_can_frame_t *frame, pour_can_tare_t *msg);
+pour_can_rx_t pour_can_unpack_experiment_start(const pour_can_frame_t *frame, pour_can_experiment_start_t *msg);
 /* The commands without signals: checks the id's cmd (as given) and the DLC. */
 pour_can_rx_t pour_can_unpack_command(const pour_can_frame_t *frame, uint8_t cmd);
 

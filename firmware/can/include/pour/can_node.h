@@ -63,6 +63,8 @@ typedef struct {
   bool calibration_start;                    /* one was accepted: the port has not taken it yet */
   bool calibration_report;                   /* the port's outcome waits to be sent */
   pour_can_calibration_result_t calibration; /* what the port says a start does and what is stored */
+  bool experiment_requested;                 /* an ExperimentStart arrived and waits for the port */
+  uint8_t experiment_kind;                   /* ... of this kind */
   bool have_drive;                           /* the port has a drive of its own: DriveTelemetry is sent */
   pour_can_drive_telemetry_t drive;          /* its latest state */
 } pour_can_node_t;
@@ -128,6 +130,15 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
 /* Takes the waiting parameter request, if any (one at a time: another that comes before is dropped and
  * counted as param_busy). */
 bool pour_can_node_take_param_request(pour_can_node_t *node, pour_can_param_request_t *request);
+
+/* Takes the waiting ExperimentStart, if any (the latest one): the port hands its kind to the core
+ * (pour_control_experiment) before the tick's update. */
+bool pour_can_node_take_experiment(pour_can_node_t *node, uint8_t *kind);
+
+/* The ParamAck (Request = ExperimentStart, ParamId = kind) that answers it, from the core's answer
+ * (pour_control_experiment_answer_t): OK when accepted, else the refusal's reason. */
+pour_status_t pour_can_node_experiment_ack(const pour_can_node_t *node, uint8_t kind, uint8_t answer,
+                                           pour_can_frame_t *frame);
 
 /* Total of the dropped-frame counters (what the heartbeat's RxDropped carries, mod 2^16). */
 uint32_t pour_can_node_dropped(const pour_can_node_t *node);

@@ -1,0 +1,198 @@
+# SPDX-License-Identifier: MIT
+"""System identification end to end: host_sim runs the controller's identify experiment on a rig with
+hidden parameters and logs the bus as candump -L; pour-sysid recovers them into a rig file (issue 20's
+bars: inertia, friction and torque scale within 5 %, latency exact, scale delay within 10 ms, on 5 seeded
+draws), and refuses every log or rig file it cannot use, saying why."""
+import json
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import BUILD_DIR
+
+HOST_SIM = BUILD_DIR / "bin" / "host_sim"
+SYSID = Path(sys.executable).parent / "pour-sysid"
+NOMINAL = {"torque_scale": 1.0, "motor_rotor_inertia": 2.4e-5, "friction_coulomb": 0.6, "friction_viscous": 0.02,
+           "command_latency_ticks": 1, "scale_delay_s": 0.05}
+# The empty bucket of the default rig (pour.sysid.fit.bucket_arm_and_inertia, checks.cpp's u_inertia).
+J_BUCKET = 0.0523058608
+GEAR = 20.0
+
+
+def hidden(seed: int) -> dict:
+    """Issue 20's draw: inertia, friction and torque scale each within ±30 %, latency 1..4 ticks, the scale's
+    delay ×0.5..×2."""
+    rng = np.random.default_rng(seed)
+    u = lambda: rng.uniform(0.7, 1.3)  # noqa: E731
+    return {"torque_scale": u(), "motor_rotor_inertia": NOMINAL["motor_rotor_inertia"] * u(),
+            "friction_coulomb": NOMINAL["friction_coulomb"] * u(), "friction_viscous": NOMINAL["friction_viscous"] * u(),
+            "command_latency_ticks": int(rng.integers(1, 5)), "scale_delay_s": NOMINAL["scale_delay_s"] * 2 ** rng.uniform(-1, 1)}
+
+
+def experiment(log: Path, kind: str = "identify", seed: int = 1, sets: dict | None = None, *extra) -> None:
+    argv = [HOST_SIM, "--experiment", kind, "--candump", log, "--seed", seed]
+    for k, v in (sets or {}).items():
+        argv += ["--set", f"{k}={v}"]
+    r = subprocess.run([str(a) for a in argv + list(extra)], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "ran to its end, bucket held" in r.stdout
+
+
+def sysid(log: Path, out: Path, *extra) -> subprocess.CompletedProcess:
+    return subprocess.run([str(a) for a in [SYSID, log, "--out", out, *extra]], capture_output=True, text=True,
+                          timeout=120)
+
+
+@pytest.fixture(scope="module")
+def nominal_log(tmp_path_factory) -> Path:
+    log = tmp_path_factory.mktemp("sysid") / "identify.log"
+    experiment(log)
+    return log
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4, 5])
+def test_recovers_the_hidden_rig(tmp_path, seed):
+    truth = hidden(seed)
+    log, rig = tmp_path / "run.log", tmp_path / "rig.toml"
+    experiment(log, seed=seed, sets=truth)
+    r = sysid(log, rig, "--json")
+    assert r.returncode == 0, r.stderr
+    got = {k: v["value"] for k, v in json.loads(r.stdout).items()}
+    j_true = J_BUCKET + truth["motor_rotor_inertia"] * GEAR ** 2
+    err = {k: got[k] / truth[k] - 1 for k in ("torque_scale", "motor_rotor_inertia", "friction_coulomb")}
+    err["inertia"] = got["inertia"] / j_true - 1
+    delay_ms = 1000 * (got["scale_delay_s"] - truth["scale_delay_s"])
+    print(f"draw {seed}: " + ", ".join(f"{k} {100 * v:+.2f} %" for k, v in err.items())
+          + f", latency {int(got['command_latency_ticks'])} (hidden {truth['command_latency_ticks']}), "
+            f"scale delay {delay_ms:+.1f} ms")
+    for k, e in err.items():
+        assert abs(e) < 0.05, (k, e)
+    assert int(got["command_latency_ticks"]) == truth["command_latency_ticks"]
+    assert abs(delay_ms) < 10.0
+    # The rig file is the simulator's: the same keys and values, as host_sim and the trainer read them.
+    doc = tomllib.loads(rig.read_text())
+    assert doc["command_latency_ticks"] == truth["command_latency_ticks"]
+    assert doc["torque_scale"] == pytest.approx(got["torque_scale"])
+    assert doc["sigma"]["torque_scale"] > 0
+
+
+def test_cfg_rig_file_runs_in_host_sim_and_the_png_is_written(tmp_path, nominal_log):
+    rig, png = tmp_path / "rig.cfg", tmp_path / "fit.png"
+    r = sysid(nominal_log, rig, "--png", png)
+    assert r.returncode == 0, r.stderr
+    assert png.stat().st_size > 10000 and png.read_bytes()[:4] == b"\x89PNG"
+    experiment(tmp_path / "again.log", "identify", 1, None, "--config", rig)
+
+
+def rewrite(src: Path, dst: Path, keep) -> None:
+    lines = src.read_text().splitlines(keepends=True)
+    dst.write_text("".join(line for i, line in enumerate(lines) if keep(i, line)))
+
+
+def test_truncated_log_is_refused(tmp_path, nominal_log):
+    lines = nominal_log.read_text().splitlines(keepends=True)
+    cut = tmp_path / "cut.log"
+    cut.write_text("".join(lines[:len(lines) // 2]))
+    r = sysid(cut, tmp_path / "rig.toml")
+    assert r.returncode == 1 and "truncated" in r.stderr and "before the experiment ended" in r.stderr, r.stderr
+    cut.write_text("".join(lines[:len(lines) // 2]) + lines[len(lines) // 2][:9])  # ends mid-line
+    r = sysid(cut, tmp_path / "rig.toml")
+    assert r.returncode == 1 and "truncated" in r.stderr, r.stderr
+    assert not (tmp_path / "rig.toml").exists()
+
+
+def test_log_of_another_node_is_refused(tmp_path, nominal_log):
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--node", "5")
+    assert r.returncode == 1 and "no frames of node 5" in r.stderr, r.stderr
+    assert "nodes in the log: 0" in r.stderr
+    other = tmp_path / "node3.log"
+    experiment(other, "identify", 1, None, "--node-id", "3")
+    assert sysid(other, tmp_path / "rig.toml", "--node", "3").returncode == 0
+
+
+def test_log_with_gaps_is_refused(tmp_path, nominal_log):
+    gappy = tmp_path / "gaps.log"
+    # Three ticks' frames lost in the middle of the chirp.
+    rewrite(nominal_log, gappy, lambda i, line: not line.startswith(("(8.001", "(8.002", "(8.003")))
+    r = sysid(gappy, tmp_path / "rig.toml")
+    assert r.returncode == 1 and "gaps" in r.stderr and "t = 8.0" in r.stderr, r.stderr
+
+
+def test_an_experiment_that_does_not_excite_is_refused_naming_what(tmp_path):
+    stuck = tmp_path / "stuck.log"
+    # Friction beyond every torque the experiment commands: the bucket never moves.
+    experiment(stuck, sets={"friction_coulomb": 8.0})
+    r = sysid(stuck, tmp_path / "rig.toml")
+    assert r.returncode == 1 and "cannot identify inertia, friction or torque scale" in r.stderr, r.stderr
+    assert "did not excite" in r.stderr
+
+
+def test_viscous_friction_is_named_as_not_identified(tmp_path, nominal_log):
+    r = sysid(nominal_log, tmp_path / "rig.toml")
+    assert r.returncode == 0
+    assert "friction_viscous" in r.stdout and "not identified" in r.stdout
+
+
+def test_tilt_log_is_not_fitted_as_the_identify_one(tmp_path):
+    log = tmp_path / "tilt.log"
+    experiment(log, "tilt")
+    r = sysid(log, tmp_path / "rig.toml")
+    assert r.returncode == 1 and "tilt experiment" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("text, why", [
+    ("gear_ratio = 20\nfriction_colomb = 0.5\n", "'friction_colomb' is no simulator key"),
+    ("bucket_mass = -1\n", "bucket_mass = -1 is out of range"),
+    ("torque_scale = 1.0\n[sigma]\ntorque_scale = -0.1\n", "not a standard deviation"),
+    ("torque_scale = \"big\"\n", "not a number"),
+])
+def test_bad_rig_files_are_refused(tmp_path, nominal_log, text, why):
+    base = tmp_path / "base.toml"
+    base.write_text(text)
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--base", base)
+    assert r.returncode == 2 and why in r.stderr, r.stderr
+    cfg = tmp_path / "base.cfg"
+    cfg.write_text("friction_colomb = 0.5\n")
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--base", cfg)
+    assert r.returncode == 2 and "friction_colomb" in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("argv, why", [
+    (["--experiment", "wobble", "--candump", "x.log"], "--experiment wants identify or tilt"),
+    (["--experiment", "identify"], "--experiment and --candump go together"),
+    (["--experiment", "identify", "--candump", "x.log", "--node-id", "64"], "--node-id wants an integer 0..63"),
+])
+def test_host_sim_experiment_usage_errors(tmp_path, argv, why):
+    r = subprocess.run([str(HOST_SIM)] + argv, capture_output=True, text=True, cwd=tmp_path, timeout=30)
+    assert r.returncode == 2 and why in r.stderr, r.stderr
+    assert not (tmp_path / "x.log").exists()
+
+
+def test_the_rig_centres_the_randomisation_with_its_uncertainties():
+    from pour.sysid import rig as srig
+    r = srig.Rig({"torque_scale": 0.8, "friction_coulomb": 0.5, "motor_rotor_inertia": 2e-5, "scale_delay_s": 0.04},
+                 {"friction_coulomb": 0.01, "motor_rotor_inertia": 1e-6, "scale_delay_s": 0.002})
+    opts = srig.centred({"rand_motor": 0.15, "rand_fill": 0.2, "friction_coulomb": 0.6}, r)
+    assert opts["torque_scale"] == 0.8 and opts["friction_coulomb"] == 0.5 and opts["rand_fill"] == 0.2
+    # The widest of the motor's figures: the rotor's 5 % -> a uniform ±√3·5 %.
+    assert opts["rand_motor"] == pytest.approx(3 ** 0.5 * 0.05)
+    assert opts["rand_sensor"] == pytest.approx(3 ** 0.5 * 0.05)
+    assert srig.host_sim_sets(srig.Rig({"command_latency_ticks": 3.0})) == ["--set", "command_latency_ticks=3"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["pour-train", "configs/train/toy.toml", "--out", "{tmp}/run", "--rig", "{rig}"],
+    ["pour-eval", "robust", "--header", "policy/weights.h", "--out", "{tmp}/rob", "--rig", "{rig}"],
+])
+def test_train_and_robust_refuse_a_bad_rig_file(tmp_path, argv):
+    from conftest import SOURCE_DIR
+    rig = tmp_path / "rig.toml"
+    rig.write_text("torque_scale = 7\n")  # outside [0.5, 2]
+    cmd = [str(Path(sys.executable).parent / argv[0])] + [a.format(tmp=tmp_path, rig=rig) for a in argv[1:]]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=SOURCE_DIR, timeout=120)
+    assert r.returncode == 2 and "torque_scale = 7 is out of range" in r.stderr, r.stderr
+    assert not (tmp_path / "run").exists() and not (tmp_path / "rob").exists()
