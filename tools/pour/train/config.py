@@ -60,7 +60,8 @@ class AlgoConfig:
 
 @dataclass(frozen=True)
 class ArsConfig:
-    """Augmented random search (Mania, Guy & Recht 2018, V1-t) over the policy's parameters (ars.py)."""
+    """Augmented random search (Mania, Guy & Recht 2018, V1-t, or V2-t with normalize_states) over the policy's
+    parameters (ars.py)."""
     directions: int = 8            # random directions per iteration, each rolled out at +noise and -noise
     top: int = 4                   # the directions with the best max(R+, R-) that make the step
     step_size: float = 0.02        # alpha at the first iteration (the step is alpha / (top * sigma_R) sum ...)
@@ -68,6 +69,9 @@ class ArsConfig:
     noise: float = 0.03            # nu: the perturbation's standard deviation per parameter
     noise_final: float = -1.0      # decayed geometrically to this at the last iteration (< 0: constant)
     episodes_per_direction: int = 1  # rigs per perturbed policy; the same rigs for +, - and every direction
+    normalize_states: bool = False  # V2-t: search in the coordinates of the states standardised by the running
+                                   # mean and std of every training rollout's features (ars.py)
+    state_std_min: float = 0.01    # floor of that std (a feature that barely moves, V_spill, is not blown up)
 
 
 @dataclass(frozen=True)
@@ -270,6 +274,9 @@ def _validate_search(cfg: TrainConfig) -> None:
            "constant noise")
     _check(1 <= r.episodes_per_direction <= 64,
            f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
+    _check(0.0 < r.state_std_min <= 1.0, f"ars.state_std_min = {r.state_std_min}: expected 0 < std <= 1")
+    _check(not r.normalize_states or a.kind == "ars",
+           f"ars.normalize_states = true: only for algo.kind = 'ars' (got {a.kind!r})")
     _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
     _check(1 <= c.elites < c.population,
            f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
