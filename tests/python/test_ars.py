@@ -108,6 +108,13 @@ def test_v2_normalised_search_learns_the_toy_and_resumes_bit_identically(tmp_pat
     assert not np.array_equal(v1.w, res.w)
 
 
+def test_features_limit_the_search_to_their_gains(tmp_path):
+    res = trainer.train(_cfg(ars={"features": ["theta", "bias"]}), tmp_path / "r", quiet=True)
+    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    assert not ck["history_w"][:, [1, 2, 3, 4]].any()        # omega and the volumes keep their 0 gains
+    assert ck["history_w"][:, 0].any() and ck["history_w"][:, 5].any() and res.w[[0, 5]].any()
+
+
 def test_random_init_is_seeded_and_scaled():
     a = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
     b = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
@@ -134,6 +141,9 @@ BAD = [
     ({"ars": {"state_std_min": float("nan")}}, "ars.state_std_min = nan: expected a finite number"),
     ({"algo": {"kind": "cem"}, "ars": {"normalize_states": True}},
      "ars.normalize_states = true: only for algo.kind = 'ars' \\(got 'cem'\\)"),
+    ({"ars": {"features": ["theta", "speed"]}}, r"ars.features = \['theta', 'speed'\]: expected distinct names out of"),
+    ({"ars": {"features": ["bias", "bias"]}}, r"ars.features = \['bias', 'bias'\]: expected distinct names"),
+    ({"algo": {"kind": "cem"}, "ars": {"features": ["bias"]}}, r"ars.features = \['bias'\]: only for algo.kind = 'ars'"),
     ({"eval": {"collapse": -1.0}}, "eval.collapse = -1.0"),
     ({"eval": {"collapse": 0.5, "collapse_patience": 0}}, "eval.collapse_patience = 0: expected >= 1"),
     ({"algo": {"kind": "pg"}, "eval": {"collapse": 0.5}}, "eval.collapse = 0.5: only for algo.kind 'ars' or 'cem'"),
@@ -163,6 +173,8 @@ def test_state_from_another_config_is_refused(tmp_path):
     trainer.train(_cfg(), tmp_path / "ars", quiet=True, stop_after=1)
     with pytest.raises(trainer.TrainError, match="different config"):
         trainer.train(_cfg(ars={"noise": 0.2}), tmp_path / "ars", quiet=True)
+    with pytest.raises(trainer.TrainError, match="different config"):   # V1-t's state under V2-t
+        trainer.train(_cfg(ars={"normalize_states": True}), tmp_path / "ars", quiet=True)
     pg = _cfg(algo={"kind": "pg", "entropy_coef": 0.0, "batch_episodes": 4})
     with pytest.raises(trainer.TrainError, match="different config"):
         trainer.train(pg, tmp_path / "ars", quiet=True)

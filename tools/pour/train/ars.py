@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from pour.policy import weights_h
 from pour.train import config as cfgmod
 from pour.train import reinforce, trainer
 
@@ -127,6 +128,9 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     params = trainer.initial_params(cfg)
     std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)
     stats = StateStats()                            # V2-t's state statistics (ars.normalize_states)
+    names = r.features or list(weights_h.FEATURE_NAMES)  # the rows ARS moves (ars.features)
+    searched = np.array([f in names for f in weights_h.FEATURE_NAMES], dtype=np.float64).reshape(
+        (6,) + (1,) * (params.ndim - 1))
 
     def to_w(p: np.ndarray) -> np.ndarray:
         if cfg.algo.kind == "ars" and r.normalize_states:
@@ -173,7 +177,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
             m = r.episodes_per_direction if is_ars else c.episodes_per_candidate
             seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, m)
             if is_ars:
-                deltas = draws(cfg, it, r.directions, params.shape)
+                deltas = draws(cfg, it, r.directions, params.shape) * searched
                 nu = noise(cfg, it)
                 cands = np.stack([params + sign * nu * d for d in deltas for sign in (1.0, -1.0)])
             else:

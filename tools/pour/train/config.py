@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pour.policy.weights_h import FEATURE_NAMES
+
 
 class ConfigError(ValueError):
     """A configuration file or value that cannot be used."""
@@ -72,6 +74,8 @@ class ArsConfig:
     normalize_states: bool = False  # V2-t: search in the coordinates of the states standardised by the running
                                    # mean and std of every training rollout's features (ars.py)
     state_std_min: float = 0.01    # floor of that std (a feature that barely moves, V_spill, is not blown up)
+    features: list = field(default_factory=list)  # the features whose gains the search moves (names of
+                                   # weights_h.FEATURE_NAMES); the others keep their initial gains. [] = all
 
 
 @dataclass(frozen=True)
@@ -277,6 +281,9 @@ def _validate_search(cfg: TrainConfig) -> None:
     _check(0.0 < r.state_std_min <= 1.0, f"ars.state_std_min = {r.state_std_min}: expected 0 < std <= 1")
     _check(not r.normalize_states or a.kind == "ars",
            f"ars.normalize_states = true: only for algo.kind = 'ars' (got {a.kind!r})")
+    _check(all(isinstance(f, str) and f in FEATURE_NAMES for f in r.features) and len(set(r.features)) == len(r.features),
+           f"ars.features = {r.features!r}: expected distinct names out of {list(FEATURE_NAMES)} ([] = all)")
+    _check(not r.features or a.kind == "ars", f"ars.features = {r.features!r}: only for algo.kind = 'ars' (got {a.kind!r})")
     _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
     _check(1 <= c.elites < c.population,
            f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
