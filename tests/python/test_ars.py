@@ -127,6 +127,9 @@ def test_configs_that_do_not_use_the_new_options_keep_their_digest():
     d = _cfg(algo={"kind": "pg", "entropy_coef": 0.01}).to_dict()
     assert "ars" not in d and "init_scale" not in d["policy"]
     assert "ars" in _cfg().to_dict()
+    assert not {"normalize_states", "state_std_min", "features"} & set(_cfg().to_dict()["ars"])
+    v2 = _cfg(ars={"normalize_states": True, "features": ["bias"]}).to_dict()["ars"]
+    assert v2["normalize_states"] and v2["state_std_min"] == 0.01 and v2["features"] == ["bias"]
 
 
 BAD = [

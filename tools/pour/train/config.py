@@ -119,7 +119,8 @@ class TrainConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Every value, except those of a method the run does not use ([ars] and [cem] unless algo.kind
-        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that
+        names them, policy.init_scale unless init = 'random', eval.collapse* while off, ars.normalize_states,
+        ars.state_std_min and ars.features while off): a config that
         does not use them keeps its digest, and the header it exports keeps its bytes."""
         d = dataclasses.asdict(self)
         for method in ("ars", "cem"):
@@ -129,6 +130,11 @@ class TrainConfig:
             del d["eval"]["collapse"], d["eval"]["collapse_patience"]
         if self.policy.init != "random":
             del d["policy"]["init_scale"]
+        if "ars" in d:
+            if not self.ars.normalize_states:
+                del d["ars"]["normalize_states"], d["ars"]["state_std_min"]
+            if not self.ars.features:
+                del d["ars"]["features"]
         return d
 
     def digest(self) -> str:
