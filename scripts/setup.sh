@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs everything pour needs on Debian 12 (bookworm): apt packages, a pinned Python venv in .venv,
-# the Unity test framework in .deps/unity, and ST's register description of the STM32G4 (the stm32g4 crate,
-# in cargo's home). Idempotent: a second run checks and changes nothing.
+# the Unity test framework in .deps/unity, and ST's register description of the STM32G4 (the stm32g4 and
+# stm32g4xx-hal crates, in cargo's home). Idempotent: a second run checks and changes nothing.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -87,35 +87,43 @@ if [ ! -f "$UNITY_DIR/unity.c" ]; then
 fi
 
 # ST's register description of the STM32G4 (the stm32g4 crate: stm32-rs's svd2rust output of ST's SVD
-# files), which tests/board/check_registers.py compares the port's register tables with. Fetched by cargo
-# into its home from the crate registry, pinned by version (scripts/stm32g4/Cargo.toml) and by the sha256
-# of the crate file, which cargo checks on download against the lock written here; never copied into
-# the repo. .deps/stm32g4/crate-dir names the unpacked sources.
-SVD_CRATE=stm32g4
-SVD_CRATE_VERSION=0.16.0
-SVD_CRATE_SHA256=97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d
+# files), which tests/board/check_registers.py compares the port's register tables with, and the
+# stm32g4xx-hal crate, whose pin maps (generated from ST's STM32CubeMX database) it checks the board's
+# alternate functions against. Fetched by cargo into its home from the crate registry, pinned by version
+# (scripts/stm32g4/Cargo.toml) and by the sha256 of each crate file, which cargo checks on download
+# against the lock written here; never copied into the repo. .deps/stm32g4/crate-dir and hal-dir name the
+# unpacked sources.
+SVD_CRATES=("stm32g4 0.16.0 97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d crate-dir src/stm32g431/mod.rs"
+            "stm32g4xx-hal 0.1.0 6402921e7994d834b5717593270b821dfb601d83ea7eeb4ebd6b2b3fe730f793 hal-dir src/pwm.rs")
 SVD_WORK=.deps/stm32g4
-svd_dir=$(cat "$SVD_WORK/crate-dir" 2>/dev/null || true)
-if [ -z "$svd_dir" ] || [ ! -f "$svd_dir/src/stm32g431/mod.rs" ] \
-   || ! cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"; then
-  log "stm32g4: fetching the $SVD_CRATE $SVD_CRATE_VERSION crate with cargo"
+svd_ok=1
+for entry in "${SVD_CRATES[@]}"; do
+  read -r _ _ _ marker probe <<<"$entry"
+  dir=$(cat "$SVD_WORK/$marker" 2>/dev/null || true)
+  [ -n "$dir" ] && [ -f "$dir/$probe" ] || svd_ok=0
+done
+cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml" || svd_ok=0
+if [ "$svd_ok" = 0 ]; then
+  log "stm32g4: fetching the stm32g4 and stm32g4xx-hal crates with cargo"
   mkdir -p "$SVD_WORK/src"
   cp scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"
   cp scripts/stm32g4/src/lib.rs "$SVD_WORK/src/lib.rs"
   (cd "$SVD_WORK" && cargo generate-lockfile -q && cargo fetch -q --locked)
-  got=$(awk -v name="$SVD_CRATE" -v ver="$SVD_CRATE_VERSION" '
-    /^\[\[package\]\]/ { n = ""; v = "" }
-    /^name = / { n = $3; gsub(/"/, "", n) }
-    /^version = / { v = $3; gsub(/"/, "", v) }
-    /^checksum = / { c = $3; gsub(/"/, "", c); if (n == name && v == ver) print c }' "$SVD_WORK/Cargo.lock")
-  [ "$got" = "$SVD_CRATE_SHA256" ] \
-    || { log "stm32g4: $SVD_CRATE $SVD_CRATE_VERSION has sha256 '$got', pinned $SVD_CRATE_SHA256"; exit 1; }
-  svd_dir=$(cd "$SVD_WORK" && cargo metadata -q --offline --locked --format-version 1 | "$PY" -c '
+  for entry in "${SVD_CRATES[@]}"; do
+    read -r name ver sha marker probe <<<"$entry"
+    got=$(awk -v name="$name" -v ver="$ver" '
+      /^\[\[package\]\]/ { n = ""; v = "" }
+      /^name = / { n = $3; gsub(/"/, "", n) }
+      /^version = / { v = $3; gsub(/"/, "", v) }
+      /^checksum = / { c = $3; gsub(/"/, "", c); if (n == name && v == ver) print c }' "$SVD_WORK/Cargo.lock")
+    [ "$got" = "$sha" ] || { log "stm32g4: $name $ver has sha256 '$got', pinned $sha"; exit 1; }
+    dir=$(cd "$SVD_WORK" && cargo metadata -q --offline --locked --format-version 1 | "$PY" -c '
 import json, os, sys
 meta = json.load(sys.stdin)
-print(next(os.path.dirname(p["manifest_path"]) for p in meta["packages"] if p["name"] == sys.argv[1]))' "$SVD_CRATE")
-  [ -f "$svd_dir/src/stm32g431/mod.rs" ] || { log "stm32g4: no src/stm32g431 under '$svd_dir'"; exit 1; }
-  echo "$svd_dir" > "$SVD_WORK/crate-dir"
+print(next(os.path.dirname(p["manifest_path"]) for p in meta["packages"] if p["name"] == sys.argv[1]))' "$name")
+    [ -f "$dir/$probe" ] || { log "stm32g4: no $probe under '$dir'"; exit 1; }
+    echo "$dir" > "$SVD_WORK/$marker"
+  done
 fi
 
 log "ok"

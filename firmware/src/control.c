@@ -106,6 +106,7 @@ static void start(pour_control_t *ctl, const pour_control_config_t *c, uint16_t 
   ctl->refused = 0u;
   ctl->check_restart = false;
   ctl->have_trusted = false;
+  ctl->drive_untrusted = false;
   start_afresh(ctl); /* the envelope at zero, as pour_safety_init left it: the motor has no current yet */
 }
 
@@ -204,7 +205,8 @@ static bool at_rest(const pour_stop_config_t *c, const pour_state_t *s) {
 static bool stop_active(pour_control_t *ctl) {
   const pour_stop_config_t *c = &ctl->config.stop;
   if (!ctl->stopped) {
-    const bool can_act = (ctl->faults & ~(uint16_t)POUR_FAULT_ACTIVE_STOP) == 0u &&
+    const uint16_t active = (uint16_t)(POUR_FAULT_ACTIVE_STOP | (ctl->drive_untrusted ? 0u : POUR_FAULT_DRIVE));
+    const bool can_act = (ctl->faults & (uint16_t)~active) == 0u &&
                          ctl->ms_since_fresh <= ctl->config.input_timeout_ms && ctl->stop_ms < c->timeout_ms;
     if (!can_act || at_rest(c, &ctl->state)) {
       ctl->stopped = true;
@@ -243,6 +245,12 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->mode = POUR_MODE_ESTOP;
     ctl->faults |= POUR_FAULT_ESTOP;
     ctl->stopped = true; /* after the release: brake and power cut until a clear */
+    if (in->stop) {
+      count_refused(ctl);
+    }
+    if (in->reset) {
+      count_refused(ctl);
+    }
     return false;
   }
   if (ctl->mode == POUR_MODE_ESTOP) {
@@ -254,7 +262,18 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->faults |= POUR_FAULT_LINK;
     ctl->mode = POUR_MODE_FAULT;
   }
-  if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
+  if (in->drive_faults != 0u) {
+    /* The drive's own fault, a level as the link's: its word names it on the bus (DriveTelemetry). */
+    ctl->faults |= POUR_FAULT_DRIVE;
+    ctl->drive_untrusted = ctl->drive_untrusted || !in->drive_trusted;
+    ctl->mode = POUR_MODE_FAULT;
+  }
+  /* A clear or a restart in the middle of the active stop would drop a torque that is braking the bucket
+   * and start the speed estimate from rest while it turns: both wait until the stop is over. */
+  const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+  if (in->clear_faults && stopping) {
+    count_refused(ctl);
+  } else if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
     expect_held_angle(ctl);
     /* Back to IDLE: RUN (and the timeout) start again only with the next fresh state, from the safe
      * torque the envelope holds now, through the slew limit. */
@@ -263,6 +282,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->ms_since_fresh = 0u;
     ctl->stop_ms = 0u;
     ctl->stopped = false;
+    ctl->drive_untrusted = false;
   }
   if (in->stop) {
     if (ctl->mode == POUR_MODE_RUN) {
@@ -272,12 +292,13 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
   }
   if (in->reset) {
-    /* A restart under a running policy, or in the middle of the active stop, would drop a torque that is
-     * holding or braking the bucket, and start the speed estimate from rest while it turns: refused. */
-    const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+    /* A restart under a running policy would drop the torque that holds the bucket: refused, as during the
+     * active stop. */
     if ((ctl->mode == POUR_MODE_IDLE || ctl->mode == POUR_MODE_FAULT) && !stopping) {
       expect_held_angle(ctl);
       start_afresh(ctl);
+      /* In FAULT the run's state restarts, but the brake keeps holding: only a clear releases it. */
+      ctl->stopped = ctl->mode == POUR_MODE_FAULT;
     } else {
       count_refused(ctl);
     }

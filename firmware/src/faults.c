@@ -6,7 +6,7 @@
 /* Indexed by bit position: the one spelling of each fault that every tool prints. */
 static const char *const fault_names[POUR_FAULT_COUNT] = {
     "STALE_INPUT", "ESTOP", "BAD_INPUT", "POSITION", "OVERSPEED", "TORQUE_SIGN",
-    "ENCODER",     "VOLUME", "LINK",     "SEQ",      "SCALE",
+    "ENCODER",     "VOLUME", "LINK",     "SEQ",      "SCALE",       "DRIVE",
 };
 
 static const char *const mode_names[POUR_MODE_COUNT] = {"IDLE", "RUN", "FAULT", "ESTOP"};

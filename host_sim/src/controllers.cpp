@@ -23,6 +23,8 @@ double CoreController::command(const poursim_obs_t &obs) {
   pour_control_input_t in{};
   in.sensors_fresh = true;
   in.sensors = to_sensor_sample(obs, seq_++);
+  in.drive_faults = static_cast<uint16_t>(obs.drive_faults); // the full drive's (drive = 1), as a board's reach its core
+  in.drive_trusted = obs.drive_trusted != 0;
   if (pour_control_update(&ctl_, &in)) decide(&ctl_, *pour_control_state(&ctl_));
   pour_control_shape(&ctl_, &out_);
   return out_.torque / 32768.0;

@@ -36,7 +36,20 @@ void FocDrive::reset(const poursim_config_t &c, uint32_t seed, uint32_t bandwidt
   params_ = motor_params(fw, c);
   gear_ = c.gear_ratio;
   eff_ = fw.gear_efficiency_q15 / 32768.0;
-  model_.reset(params_, seed, static_cast<MotorFault>(c.drive_fault));
+  fault_ = static_cast<MotorFault>(c.drive_fault);
+  model_.reset(params_, seed, fault_);
+  start_offsets();
+}
+
+void FocDrive::set_motor(const MotorParams &p, uint32_t seed) {
+  params_ = p;
+  model_.reset(params_, seed, fault_);
+  const pour_drive_config_t fw = drv_.config;
+  (void)pour_drive_init(&drv_, &fw); // the configuration in force: valid
+  start_offsets();
+}
+
+void FocDrive::start_offsets() {
   tel_ = FocTelemetry{};
   tel_.min_vbus = tel_.peak_vbus = model_.vbus();
   out_ = pour_drive_output_t{};

@@ -31,6 +31,15 @@ class FocDrive {
   // The firmware's default drive (its current loop tuned for bandwidth_rad_s if not 0), flux braking per
   // drive_regen, the model's fault; the start-up offset calibration runs here (the PWM off, 12.8 ms).
   void reset(const poursim_config_t &c, uint32_t seed, uint32_t bandwidth_rad_s = 0);
+  // A motor unlike the firmware's configuration (what calibration is for): the model restarts with p, the
+  // rig's fault kept, and the drive with its own configuration runs its start-up offsets again.
+  void set_motor(const MotorParams &p, uint32_t seed);
+  // Starts the drive's self-calibration (pour_drive_calibrate): POUR_OK, or POUR_EINVAL unless it runs.
+  pour_status_t calibrate() { return pour_drive_calibrate(&drv_); }
+  // Ends a running self-calibration as a stop or the e-stop does (pour_drive_calibrate_abort).
+  void abort_calibration() { pour_drive_calibrate_abort(&drv_); }
+  const pour_drive_t &drive() const { return drv_; }
+  pour_drive_t &drive() { return drv_; } // for a port's code around the drive (the calibration's flow)
   // One step of dt: the command [N·m at the output] to the 1 kHz tick, then the periods of the current
   // loop at output speed omega [rad/s]. Returns the mean torque at the output [N·m].
   double step(double tau_cmd, double omega, double dt);
@@ -39,6 +48,8 @@ class FocDrive {
   // One PWM period at output speed omega (the step above is made of these); the torque at the output.
   double period(double omega);
   bool brake_requested() const { return out_.brake != 0 && drv_.state != POUR_DRIVE_CALIBRATING; }
+  // The current loop runs (it follows the torque command): not calibrating, not faulted.
+  bool running() const { return drv_.state == POUR_DRIVE_RUN; }
   const FocTelemetry &telemetry() const { return tel_; }
   // The highest bus voltage of each step since the reset [V] (for plots).
   const std::vector<float> &vbus_trace() const { return vbus_trace_; }
@@ -57,7 +68,9 @@ class FocDrive {
   double gear_ = 20.0, eff_ = 0.9;
   double duty_[3] = {0.5, 0.5, 0.5}; // the compares loaded at the next period's start
   bool pwm_on_ = false;
+  MotorFault fault_ = MotorFault::None;
   std::vector<float> vbus_trace_;
+  void start_offsets();
 };
 
 // The model's parameters from the firmware's configuration (one source for the motor's numbers) and the

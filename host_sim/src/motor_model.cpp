@@ -48,9 +48,10 @@ MotorSample MotorModel::sample() {
   }
   const double v = std::round(vbus_ / p_.vbus_divider * 4096.0 / p_.adc_vref + p_.adc_noise * noise_(rng_));
   s.adc_vbus = static_cast<uint16_t>(std::clamp(v, 0.0, 4095.0));
-  const double turns = theta_m_ / kTwoPi;
+  const double turns = fault_ == MotorFault::EncoderMissing ? 0.0 : (theta_m_ - p_.encoder_zero) / kTwoPi;
   const int64_t count = static_cast<int64_t>(std::floor(turns * p_.encoder_cpr));
-  const int64_t signed_count = fault_ == MotorFault::EncoderReversed ? -count : count;
+  const int sign = fault_ == MotorFault::EncoderReversed ? -p_.encoder_sign : p_.encoder_sign;
+  const int64_t signed_count = sign * count;
   s.encoder = static_cast<uint16_t>(((signed_count % p_.encoder_cpr) + p_.encoder_cpr) % p_.encoder_cpr);
   return s;
 }

@@ -4,7 +4,8 @@
 // period from the duties and the bus (with the dead time's error), three low-side shunts through their
 // amplifiers into 12-bit converters (gain, offset, quantisation, seeded noise), the bus capacitor fed by a
 // supply with a source resistance that cannot sink current, and the motor encoder as TIM4 counts it.
-// Injected faults: a phase open, two phases shorted, an encoder wired backwards, a broken amplifier.
+// Injected faults: a phase open, two phases shorted, an encoder wired backwards, a broken amplifier, an
+// encoder unplugged (its count stays where it was).
 #ifndef POURSIM_MOTOR_MODEL_HPP
 #define POURSIM_MOTOR_MODEL_HPP
 
@@ -13,7 +14,7 @@
 
 namespace poursim {
 
-enum class MotorFault { None = 0, PhaseOpen = 1, PhaseShort = 2, EncoderReversed = 3, AmplifierOffset = 4 };
+enum class MotorFault { None = 0, PhaseOpen = 1, PhaseShort = 2, EncoderReversed = 3, AmplifierOffset = 4, EncoderMissing = 5 };
 
 struct MotorParams {
   // defaults: a placeholder; motor_params() fills every field from the firmware's configuration
@@ -29,6 +30,8 @@ struct MotorParams {
   double adc_noise = 1.0;         // RMS noise of a conversion [counts]
   double vbus_divider = 19.17;    // bus / ADC pin [-]
   int encoder_cpr = 4096;
+  double encoder_zero = 0.0;      // rotor angle at which the encoder reads 0 [rad]: electrical offset pp·zero
+  int encoder_sign = 1;           // +1: counts up as the rotor turns forward; -1: mounted the other way
   double short_r = 0.02;          // resistance of a phase-to-phase short, with the legs' on-resistance [Ω]
   double board_current = 0.05;    // the board's own draw on the bus (gate drivers, MCU, LDO) [A], assumed
 };

@@ -305,6 +305,9 @@ static void sense(poursim_world_t *w, bool initial) {
   }
   o.scale_rotating_g = w->scale_rotating.reading();
   o.scale_target_g = w->scale_target.reading();
+  const poursim::FocDrive *foc = w->drive.foc();
+  o.drive_faults = foc != nullptr ? foc->telemetry().faults : 0u;
+  o.drive_trusted = foc == nullptr || foc->running() ? 1 : 0;
 }
 
 // The drive's Coulomb friction (and the brake when engaged) as the joint's motor held at zero speed: it

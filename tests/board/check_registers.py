@@ -9,6 +9,11 @@ comments of the field readers and writers). Our side is the table that board_reg
 from the drivers' X-macro tables: lines "PERIPH <instance> <block> <base>", "REG <block> <reg> <offset>",
 "FIELD <block> <reg> <field> <bit> <width>".
 
+The board's alternate-function pins ("AF <owner> <signal> <pin> <af>", from board_af.h) are checked against
+the pin maps of the stm32g4xx-hal crate (--hal; generated from ST's STM32CubeMX database): the timers'
+channels in src/pwm.rs ("pins!" blocks: "TIM1: CH1(...): [gpio::PA8<AF6>, ...]") and FDCAN's in
+src/can.rs ("mod fdcan1 { ... tx: [PB9<AF9>, ...] rx: [...] }").
+
 Exit status 0 when every register and field we use matches, 1 with one line per mismatch, 2 on bad input.
 """
 from __future__ import annotations
@@ -123,10 +128,65 @@ def load_crate(crate_dir: Path) -> Crate:
     return Crate(bases, root)
 
 
-def parse_table(text: str) -> tuple[dict, dict, list]:
+_HAL_TIMER = re.compile(r"^\s*(TIM\d+):\s*$")
+_HAL_SIGNAL = re.compile(r"^\s*(CH\dN?|BRK2?)(?:\(\w+\))?:\s*\[")
+_HAL_PIN = re.compile(r"(P[A-G]\d+)<AF(\d+)>")
+_HAL_CAN_MOD = re.compile(r"^\s*mod (fdcan\d)\s*\{")
+_HAL_CAN_DIR = re.compile(r"^\s*(tx|rx):\s*\[")
+
+
+def load_hal_af(hal_dir: Path) -> dict[tuple[str, str, str], set[int]]:
+    """(owner, signal, pin) -> the alternate functions the HAL's pin maps give it."""
+    amap: dict[tuple[str, str, str], set[int]] = {}
+    owner = signal = None
+    for line in _read(hal_dir / "src" / "pwm.rs").splitlines():
+        m = _HAL_TIMER.match(line)
+        if m:
+            owner, signal = m.group(1), None
+            continue
+        m = _HAL_SIGNAL.match(line)
+        if m and owner:
+            signal = m.group(1)
+        if owner and signal:
+            for pin, af in _HAL_PIN.findall(line):
+                amap.setdefault((owner, signal, pin), set()).add(int(af))
+        if line.strip().startswith("]"):
+            signal = None
+    owner = signal = None
+    for line in _read(hal_dir / "src" / "can.rs").splitlines():
+        m = _HAL_CAN_MOD.match(line)
+        if m:
+            owner, signal = m.group(1).upper(), None
+            continue
+        m = _HAL_CAN_DIR.match(line)
+        if m and owner:
+            signal = m.group(1).upper()
+        if owner and signal:
+            for pin, af in _HAL_PIN.findall(line):
+                amap.setdefault((owner, signal, pin), set()).add(int(af))
+        if line.strip().startswith("]"):
+            signal = None
+    if not any(k[0].startswith("TIM") for k in amap) or not any(k[0].startswith("FDCAN") for k in amap):
+        raise InputError(f"{hal_dir}: no timer or FDCAN pin map found in src/pwm.rs, src/can.rs")
+    return amap
+
+
+def compare_af(amap: dict[tuple[str, str, str], set[int]], afs: list[tuple[str, str, str, int]]) -> list[str]:
+    problems = []
+    for owner, signal, pin, af in afs:
+        theirs = amap.get((owner, signal, pin))
+        if theirs is None:
+            problems.append(f"AF {owner}.{signal} on {pin}: the HAL has no such pin for it")
+        elif af not in theirs:
+            problems.append(f"AF {owner}.{signal} on {pin}: AF{af}, the HAL's AF{'/AF'.join(map(str, sorted(theirs)))}")
+    return problems
+
+
+def parse_table(text: str) -> tuple[dict, dict, list, list]:
     periphs: dict[str, tuple[str, int]] = {}
     regs: dict[tuple[str, str], int] = {}
     fields: list[tuple[str, str, str, int, int]] = []
+    afs: list[tuple[str, str, str, int]] = []
     for n, line in enumerate(text.splitlines(), 1):
         parts = line.split()
         try:
@@ -136,18 +196,22 @@ def parse_table(text: str) -> tuple[dict, dict, list]:
                 regs[(parts[1], parts[2])] = int(parts[3], 0)
             elif parts[:1] == ["FIELD"] and len(parts) == 6:
                 fields.append((parts[1], parts[2], parts[3], int(parts[4], 0), int(parts[5], 0)))
+            elif parts[:1] == ["AF"] and len(parts) == 5:
+                afs.append((parts[1], parts[2], parts[3], int(parts[4], 0)))
             elif parts:
                 raise ValueError
         except ValueError:
-            raise InputError(f"table line {n}: not PERIPH/REG/FIELD with numbers: {line!r}") from None
+            raise InputError(f"table line {n}: not PERIPH/REG/FIELD/AF with numbers: {line!r}") from None
     if not periphs:
         raise InputError("table: no PERIPH line")
-    return periphs, regs, fields
+    return periphs, regs, fields, afs
 
 
-def compare(crate: Crate, table: str) -> tuple[list[str], int]:
-    """Mismatches (one line each) and the number of items checked."""
-    periphs, regs, fields = parse_table(table)
+def compare(crate: Crate, table: str, amap: dict | None = None) -> tuple[list[str], int]:
+    """Mismatches (one line each) and the number of items checked (AF lines against amap, the HAL's pins)."""
+    periphs, regs, fields, afs = parse_table(table)
+    if afs and amap is None:
+        raise InputError("table: AF lines need the HAL's pin maps (--hal)")
     problems: list[str] = []
     checked = 0
     blocks_of: dict[str, list[str]] = {}
@@ -186,6 +250,9 @@ def compare(crate: Crate, table: str) -> tuple[list[str], int]:
                     f"{block}.{reg}.{name}: bits {bit}+{width}, ST's {got[0]}+{got[1]} ({module}.{reg.lower()})")
     for block in sorted({b for b, _ in regs} - set(blocks_of)):
         problems.append(f"{block}: registers listed but no PERIPH uses the block")
+    if afs:
+        problems += compare_af(amap, afs)
+        checked += len(afs)
     return problems, checked
 
 
@@ -193,10 +260,12 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--crate", type=Path, required=True, help="the stm32g4 crate's directory (Cargo.toml there)")
     ap.add_argument("--table", type=Path, required=True, help="our table, as board_regtable prints it")
+    ap.add_argument("--hal", type=Path, help="the stm32g4xx-hal crate's directory, for the AF lines")
     args = ap.parse_args(argv)
     try:
         crate = load_crate(args.crate)
-        problems, checked = compare(crate, _read(args.table))
+        amap = load_hal_af(args.hal) if args.hal is not None else None
+        problems, checked = compare(crate, _read(args.table), amap)
     except InputError as e:
         print(f"check_registers: {e}", file=sys.stderr)
         return 2

@@ -79,6 +79,28 @@ static void test_calibration_save_ReportsAFailedWrite(void) {
   TEST_ASSERT_EQUAL_INT(POUR_CAL_EMPTY, pour_calibration_load(&f, &got)); /* no valid block left behind */
 }
 
+static void test_calibration_can_result_CarriesTheStoredValuesRounded(void) {
+  pour_can_calibration_result_t r;
+  pour_calibration_can_result(POUR_CAL_OK, &good, POUR_CAN_CAL_MEASURING, &r);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, r.status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, r.stored);
+  TEST_ASSERT_EQUAL_UINT8(1u, r.encoder_reversed);
+  TEST_ASSERT_EQUAL_UINT8(8u, r.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(304u, r.resistance_mohm);
+  TEST_ASSERT_EQUAL_UINT16(232u, r.inductance_uh);   /* 231.5 µH, to nearest */
+  TEST_ASSERT_EQUAL_UINT8(48u, r.electrical_offset); /* 12345/256 = 48.2 */
+  pour_calibration_t top = good;
+  top.electrical_offset = 65500u; /* 255.9: to nearest wraps to 0 */
+  pour_calibration_can_result(POUR_CAL_OK, &top, POUR_CAN_CAL_OK, &r);
+  TEST_ASSERT_EQUAL_UINT8(0u, r.electrical_offset);
+  /* nothing valid stored: no values, whatever the struct holds */
+  pour_calibration_can_result(POUR_CAL_CORRUPT, &good, POUR_CAN_CAL_OK, &r);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_CORRUPT, r.stored);
+  TEST_ASSERT_EQUAL_UINT8(0u, r.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(0u, r.resistance_mohm);
+  TEST_ASSERT_EQUAL_UINT8(0u, r.encoder_reversed);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_calibration_SavesAndLoadsTheSameResults);
@@ -87,5 +109,6 @@ int main(void) {
   RUN_TEST(test_calibration_load_RefusesAnOlderFormat);
   RUN_TEST(test_calibration_RefusesResultsOutOfRange);
   RUN_TEST(test_calibration_save_ReportsAFailedWrite);
+  RUN_TEST(test_calibration_can_result_CarriesTheStoredValuesRounded);
   return UNITY_END();
 }

@@ -1,22 +1,31 @@
 /* SPDX-License-Identifier: MIT */
-/* Each board fault injected through the HAL into a closed loop, and the bucket ends held. The HAL
- * (hal_drive, hal_brake) is implemented here by a plant: the bucket of 10 L on its axis (inertia, gravity
- * torque m·g·r·sin θ), a motor through a 1:20 gearbox that gives the commanded torque while the gates
- * follow the loop and a damping torque b·ω while the phases are shorted (b = (Kt·N)²/R of the motor
- * library's EC 45 flat), nothing while the gates are off or the coupling has slipped, and a spring-applied
- * brake on the output shaft that holds 20 N·m once engaged for 20 ms. The board's supervisor
- * (board_guard.c + protect.c) runs at 1 kHz above a stand-in for the core: a PD that tilts the bucket at
- * 0.5 rad/s, and in an active stop holds it where the fault began. Injected: the comparators' break, a
- * sagging and a pumped-up bus, a hot power stage, a slipping coupling, a missing calibration. Checked: the
- * fault named, the brake engaged and holding at the end, within 10° of where the fault began, and no
- * tick between the fault and the brake's hold with the gates off and no torque (coasting). */
+/* Each board fault injected through the HAL into the closed loop the board runs, and the bucket ends held.
+ * The loop is the production code: the core (pour_control, its decisions a PD from outside, as host_sim's
+ * baselines give them), board_drive (the current loop's interrupt 20 times a tick over pour_drive_isr, the
+ * protection, the drive's faults into the core, the torque handed to the loop) and port_tick's outputs. The
+ * HAL (hal_drive, hal_brake, hal_power) is implemented here by a plant: the bucket of 10 L on its axis
+ * (inertia, gravity torque m·g·r·sin θ), a motor through a 1:20 gearbox whose currents follow the loop's
+ * references (tests/board/ideal_drive.h) while the gates follow the loop and the power stage is on, a
+ * damping torque b·ω while the phases are shorted (b = (Kt·N)²/R of the motor library's EC 45 flat),
+ * nothing while the gates are off or the coupling has slipped, and a spring-applied brake on the output
+ * shaft that holds 20 N·m once engaged for 20 ms. The core's sensors are the plant's: the output encoder
+ * (17 bits) and the two scales. Injected at 300 ms into a tilt at 0.5 rad/s: the comparators' break, a
+ * sagging and a pumped-up bus, a hot power stage, a slipping coupling; and a missing calibration at boot; a
+ * ClearErrors in the middle of an active stop, which releases nothing.
+ * Checked: the fault named in the drive's word and the core in FAULT with POUR_FAULT_DRIVE, an active stop
+ * (power on) where the drive is still trusted and the phases shorted where it is not, the brake engaged
+ * and holding at the end, within 10° of where the fault began, and no tick between the fault and the
+ * brake's hold with the bucket free (gates off, power off or nothing holding it: coasting). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
-#include "board_guard.h"
+#include "board_drive.h"
 #include "hal_brake.h"
 #include "hal_drive.h"
+#include "hal_power.h"
+#include "ideal_drive.h"
+#include "pour/control.h"
 #include "unity.h"
 
 #define DT 0.001
@@ -24,33 +33,35 @@
 #define ARM 0.12
 #define INERTIA 0.35
 #define G 9.81
-#define KT 0.0369
-#define GEAR 20.0
-#define R_TERMINAL 0.608
-#define B_SHORT (KT * GEAR * KT * GEAR / R_TERMINAL)
+#define B_SHORT (0.0404 * 20.0 * 0.0404 * 20.0 / 0.573) /* (Kt·N)²/R_terminal [N·m·s] */
 #define BRAKE_DELAY_S 0.020
 #define BRAKE_HOLD_NM 20.0
-#define CPR 4096.0
+#define TAU_MAX_NM 20.0
+#define PERIODS 20
+#define WARMUP_MS 20 /* the loop's offset calibration (12.8 ms) before the first sample reaches the core */
 #define PI 3.14159265358979
 
 typedef enum { GATES_OFF, GATES_ON, SHORTED } gates_t;
 
 static struct {
   double theta, omega, slip; /* slip: motor-side angle minus output angle, after the coupling slips [rad] */
-  double torque_cmd;         /* at the output [N·m] */
-  bool brake_cmd, brake_held, slipping, comparator_trip, breaked;
+  bool brake_cmd, brake_held, power, slipping, comparator_trip, breaked;
   double brake_since;
   gates_t gates;
   double vbus_v, temp_c;
   unsigned coasting_ticks;
 } plant;
 
-static pour_guard_t guard;
+static pour_control_t ctl;
+static pour_drive_config_t drive_config;
 
 /* --- the HAL, as the plant answers it ------------------------------------------------------------- */
 void pour_hal_brake_init(void) { plant.brake_cmd = true; }
 void pour_hal_brake_set(bool engage) { plant.brake_cmd = engage; }
 bool pour_hal_brake_engaged(void) { return plant.brake_cmd; }
+void pour_hal_power_init(void) { plant.power = false; }
+void pour_hal_power_set(bool on) { plant.power = on; }
+bool pour_hal_power_on(void) { return plant.power; }
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
 uint16_t pour_hal_drive_period(void) { return 4250u; }
 void pour_hal_drive_set_compares(const uint16_t compare[3]) { (void)compare; }
@@ -62,17 +73,23 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
 }
 bool pour_hal_drive_overcurrent_tripped(void) { return plant.breaked; }
 void pour_hal_drive_clear_overcurrent(void) { plant.breaked = plant.comparator_trip; }
+void pour_hal_drive_mask(bool masked) { (void)masked; }
 
-static uint16_t adc_counts(double pin_v) { return (uint16_t)lround(pin_v / 3.3 * 4096.0); }
+static uint16_t motor_count(void) {
+  const double motor_rad = (plant.theta + plant.slip) * 20.0;
+  return (uint16_t)((int64_t)floor(motor_rad / (2.0 * PI) * drive_config.encoder_cpr) & 0xFFFF); /* TIM4: 16 bits */
+}
+
+static gates_t gates(void) { return plant.breaked ? SHORTED : (plant.power ? plant.gates : GATES_OFF); }
 
 bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
-  for (unsigned i = 0; i < 3u; ++i) {
-    s->phase[i] = 2048u;
-  }
-  s->vbus = adc_counts(plant.vbus_v / 19.17);
-  s->ntc = adc_counts(1.055 + (plant.temp_c - 25.0) * 0.0227);
-  const double motor_rad = (plant.theta + plant.slip) * GEAR;
-  s->encoder = (uint16_t)((int64_t)floor(motor_rad / (2.0 * PI) * CPR) & 0xFFFF);
+  const pour_drive_output_t *o = pour_board_drive_output();
+  const bool on = gates() == GATES_ON;
+  pour_ideal_phase_counts(pour_board_drive_state(), on ? o->id_ref : 0, on ? o->iq_ref : 0, motor_count(),
+                          drive_config.offset_nominal, s->phase);
+  s->vbus = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(plant.vbus_v * 1e6 / drive_config.vbus_divider_milli));
+  s->ntc = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(1055.0 + (plant.temp_c - 25.0) * 22.7));
+  s->encoder = motor_count();
   return true;
 }
 
@@ -81,10 +98,12 @@ static void plant_step(double t) {
   if (plant.comparator_trip) {
     plant.breaked = true; /* TIM1's break: the hardware, no software in the path */
   }
-  gates_t gates = plant.breaked ? SHORTED : plant.gates;
   double motor = 0.0;
   if (!plant.slipping) {
-    motor = gates == GATES_ON ? plant.torque_cmd : (gates == SHORTED ? -B_SHORT * plant.omega : 0.0);
+    const q15_t iq = pour_board_drive_output()->iq_ref;
+    const bool motoring = (iq >= 0) == (plant.omega >= 0.0);
+    const double iq_nm = pour_ideal_torque_mnm(&drive_config, iq, motoring) * 1e-3;
+    motor = gates() == GATES_ON ? iq_nm : (gates() == SHORTED ? -B_SHORT * plant.omega : 0.0);
   }
   if (plant.brake_cmd && plant.brake_since < 0.0) {
     plant.brake_since = t;
@@ -102,7 +121,7 @@ static void plant_step(double t) {
     plant.omega = 0.0;
     return;
   }
-  if (gates != GATES_ON && gates != SHORTED && !plant.slipping) {
+  if (gates() == GATES_OFF && !plant.slipping) {
     plant.coasting_ticks++;
   }
   plant.omega += net / INERTIA * DT;
@@ -112,66 +131,86 @@ static void plant_step(double t) {
   }
 }
 
-typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION } fault_t;
+/* The core's sample of the plant: the 17-bit output encoder (0 = upright), 10 kg in the rotating bucket. */
+static pour_sensors_t sample_of(uint32_t seq) {
+  const int64_t c = (int64_t)llround(plant.theta / (2.0 * PI) * 131072.0);
+  const pour_sensors_t s = {seq, (uint32_t)((c % 131072 + 131072) % 131072), 10000, 0};
+  return s;
+}
+
+typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED } fault_t;
 
 typedef struct {
   double theta_fault, theta_end, theta_max_dev;
   int detected_ms, held_ms;
-  uint16_t faults;
+  uint16_t drive_faults, core_faults;
+  uint8_t mode;
   bool held, brake;
-  pour_protect_action_t first_action;
+  bool trusted_at_detection; /* the drive still followed a torque when the core learnt of the fault */
+  bool power_at_detection, shorted_at_detection, brake_at_detection;
 } result_t;
 
 static result_t pour_with(fault_t fault) {
   memset(&plant, 0, sizeof plant);
   plant.brake_since = -1.0;
+  plant.brake_cmd = true;
+  plant.brake_held = true; /* spring-applied: engaged from power-up */
   plant.theta = 40.0 * PI / 180.0;
   plant.vbus_v = 24.0;
   plant.temp_c = 40.0;
-  plant.gates = GATES_ON;
-  const pour_guard_config_t gc = pour_guard_default_config();
-  const pour_protect_config_t pc = pour_protect_default_config();
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_guard_init(&guard, &gc, &pc));
-  const bool calibrated = fault != F_CALIBRATION;
+  drive_config = pour_drive_default_config();
+  const pour_control_config_t cc = pour_control_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&drive_config, (int32_t)(TAU_MAX_NM * 1000), fault != F_CALIBRATION));
   const int fault_ms = fault == F_CALIBRATION ? 0 : 300;
   result_t r = {0};
   r.detected_ms = -1;
-  double hold = plant.theta;
   for (int ms = 0; ms < 1500; ++ms) {
     const double t = ms * DT;
     if (ms == fault_ms) {
       r.theta_fault = plant.theta;
-      hold = plant.theta;
     }
     if (ms >= fault_ms) {
       switch (fault) {
       case F_BREAK: plant.comparator_trip = ms < fault_ms + 5; break; /* a 5 ms current spike */
-      case F_UNDERVOLTAGE: plant.vbus_v = 24.0 - 0.5 * (ms - fault_ms); break; /* sags at 0.5 V/ms */
+      case F_UNDERVOLTAGE: plant.vbus_v = fmax(0.0, 24.0 - 0.5 * (ms - fault_ms)); break; /* sags at 0.5 V/ms */
+      case F_SAG_CLEARED: plant.vbus_v = r.detected_ms < 0 ? 24.0 - 0.5 * (ms - fault_ms) : 24.0; break;
       case F_OVERVOLTAGE: plant.vbus_v = 24.0 + 0.5 * (ms - fault_ms); break;
       case F_OVERTEMP: plant.temp_c = 40.0 + 2.0 * (ms - fault_ms); break;
       case F_SLIP: plant.slipping = true; break;
       case F_CALIBRATION: break;
       }
     }
-    const int32_t output_urad = (int32_t)lround(plant.theta * 1e6);
-    pour_protect_output_t out;
-    pour_guard_tick(&guard, output_urad, true, calibrated, false, &out);
-    if (out.faults != 0u && r.detected_ms < 0) {
-      r.detected_ms = ms - fault_ms;
-      r.first_action = out.action;
+    for (int k = 0; k < PERIODS; ++k) {
+      pour_board_drive_isr(); /* the ADC's end of sequence, every PWM period */
     }
-    /* The stand-in for the core: tilt at 0.5 rad/s with gravity feed-forward, or hold in an active stop. */
-    const double ref = out.action == POUR_PROTECT_RUN ? 40.0 * PI / 180.0 + 0.5 * t : hold;
+    pour_control_input_t in;
+    memset(&in, 0, sizeof in);
+    in.sensors_fresh = ms >= WARMUP_MS;
+    in.sensors = sample_of((uint32_t)ms);
+    /* A ClearErrors 3 ms into the active stop, the sag already over: the core refuses it, and so must the
+     * protection (else the brake would be released under a stop that returns the bucket upright). */
+    in.clear_faults = fault == F_SAG_CLEARED && r.detected_ms >= 0 && ms == fault_ms + r.detected_ms + 3;
+    /* The decisions: tilt at 0.5 rad/s with gravity feed-forward (the core's own stop takes over in FAULT). */
+    const double ref = 40.0 * PI / 180.0 + 0.5 * (t - WARMUP_MS * DT);
     const double ff = MASS * G * ARM * sin(plant.theta);
-    plant.torque_cmd = (ff + 200.0 * (ref - plant.theta) + 30.0 * ((out.action == POUR_PROTECT_RUN ? 0.5 : 0.0) - plant.omega)) *
-                       out.torque_scale / 32767.0;
-    if (out.action == POUR_PROTECT_RUN || out.action == POUR_PROTECT_ACTIVE_STOP) {
-      if (plant.gates != SHORTED) {
-        plant.gates = GATES_ON;
-      }
-      plant.brake_cmd = out.brake;
+    const double nm = ff + 200.0 * (ref - plant.theta) + 30.0 * (0.5 - plant.omega);
+    pour_control_request(&ctl, 0u, (q15_t)lround(fmax(-1.0, fmin(1.0, nm / TAU_MAX_NM)) * 32767.0));
+    pour_control_output_t out;
+    pour_board_drive_tick(&ctl, &in, &out);
+    if (in.drive_faults != 0u && r.detected_ms < 0) {
+      r.detected_ms = ms - fault_ms;
+      r.trusted_at_detection = in.drive_trusted;
+      r.power_at_detection = plant.power;
+      r.brake_at_detection = plant.brake_cmd;
+      r.shorted_at_detection = pour_board_drive_state()->state == POUR_DRIVE_FAULTED;
     }
-    r.faults = out.faults;
+    if (ms < fault_ms) {
+      TEST_ASSERT_EQUAL_HEX16(0u, out.faults); /* nothing before the injection */
+    }
+    r.drive_faults = in.drive_faults;
+    r.core_faults = out.faults;
+    r.mode = out.mode;
     plant_step(t);
     if (ms >= fault_ms && fabs(plant.theta - r.theta_fault) > r.theta_max_dev) {
       r.theta_max_dev = fabs(plant.theta - r.theta_fault);
@@ -187,16 +226,35 @@ static result_t pour_with(fault_t fault) {
 }
 
 static void assert_held(const result_t *r, uint16_t fault_bit, int max_detect_ms) {
-  printf("fault 0x%04x: detected after %d ms, brake holding %d ms after the fault began, moved at most %.2f deg, "
-         "ended %.2f deg from where it began\n",
-         (unsigned)fault_bit, r->detected_ms, r->held_ms, r->theta_max_dev * 180.0 / PI,
-         fabs(r->theta_end - r->theta_fault) * 180.0 / PI);
-  TEST_ASSERT_BITS_HIGH(fault_bit, r->faults);
+  printf("fault 0x%04x: detected after %d ms (drive trusted %d: power %d, phases shorted %d, brake %d), brake "
+         "holding %d ms after the fault began, moved at most %.2f deg, ended %.2f deg from where it began; core "
+         "faults 0x%04x, drive faults 0x%04x\n",
+         (unsigned)fault_bit, r->detected_ms, (int)r->trusted_at_detection, (int)r->power_at_detection,
+         (int)r->shorted_at_detection, (int)r->brake_at_detection, r->held_ms, r->theta_max_dev * 180.0 / PI,
+         fabs(r->theta_end - r->theta_fault) * 180.0 / PI, (unsigned)r->core_faults, (unsigned)r->drive_faults);
+  TEST_ASSERT_BITS_HIGH(fault_bit, r->drive_faults);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_DRIVE, r->core_faults);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, r->mode);
   TEST_ASSERT_TRUE(r->detected_ms >= 0 && r->detected_ms <= max_detect_ms);
+  TEST_ASSERT_TRUE(r->brake_at_detection); /* engaged at once, whichever way the bucket is held meanwhile */
   TEST_ASSERT_TRUE(r->brake);
   TEST_ASSERT_TRUE(r->held);
   TEST_ASSERT_DOUBLE_WITHIN(10.0 * PI / 180.0, r->theta_fault, r->theta_end);
   TEST_ASSERT_EQUAL_UINT(0u, plant.coasting_ticks);
+}
+
+/* The drive still trusted: the core's active stop drives the motor (power on, the loop running). */
+static void assert_active_stop(const result_t *r) {
+  TEST_ASSERT_TRUE(r->trusted_at_detection);
+  TEST_ASSERT_TRUE(r->power_at_detection);
+  TEST_ASSERT_FALSE(r->shorted_at_detection);
+}
+
+/* Not trusted: the loop shorts the phases (the power stage on for it) until the brake holds. */
+static void assert_shorted(const result_t *r) {
+  TEST_ASSERT_FALSE(r->trusted_at_detection);
+  TEST_ASSERT_TRUE(r->power_at_detection);
+  TEST_ASSERT_TRUE(r->shorted_at_detection);
 }
 
 void setUp(void) {}
@@ -205,37 +263,44 @@ void tearDown(void) {}
 static void test_faults_BreakShortsThePhasesAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_BREAK);
   assert_held(&r, POUR_DRIVE_FAULT_HW_OVERCURRENT, 1);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_SHORT, r.first_action);
+  assert_shorted(&r);
 }
 
 static void test_faults_UndervoltageStopsActivelyAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_UNDERVOLTAGE);
   assert_held(&r, POUR_DRIVE_FAULT_UNDERVOLTAGE, 20);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_ACTIVE_STOP, r.first_action);
+  assert_active_stop(&r);
+}
+
+static void test_faults_AClearDuringTheActiveStopReleasesNothing(void) {
+  const result_t r = pour_with(F_SAG_CLEARED);
+  assert_held(&r, POUR_DRIVE_FAULT_UNDERVOLTAGE, 20);
+  assert_active_stop(&r);
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.refused);
 }
 
 static void test_faults_OvervoltageShortsThePhasesAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_OVERVOLTAGE);
   assert_held(&r, POUR_DRIVE_FAULT_OVERVOLTAGE, 20);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_SHORT, r.first_action);
+  assert_shorted(&r);
 }
 
 static void test_faults_OvertemperatureStopsActivelyAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_OVERTEMP);
   assert_held(&r, POUR_DRIVE_FAULT_OVERTEMP, 40);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_ACTIVE_STOP, r.first_action);
+  assert_active_stop(&r);
 }
 
 static void test_faults_SlippingCouplingIsAMismatchAndTheBrakeHolds(void) {
   const result_t r = pour_with(F_SLIP);
   assert_held(&r, POUR_DRIVE_FAULT_ENCODER_MISMATCH, 15);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_SHORT, r.first_action);
+  assert_shorted(&r);
 }
 
 static void test_faults_WithoutCalibrationTheBucketNeverMoves(void) {
   const result_t r = pour_with(F_CALIBRATION);
   assert_held(&r, POUR_DRIVE_FAULT_CALIBRATION, 0);
-  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_HELD, r.first_action);
+  TEST_ASSERT_FALSE(r.trusted_at_detection);
   TEST_ASSERT_DOUBLE_WITHIN(0.5 * PI / 180.0, 40.0 * PI / 180.0, r.theta_end);
 }
 
@@ -243,6 +308,7 @@ int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_faults_BreakShortsThePhasesAndTheBrakeHolds);
   RUN_TEST(test_faults_UndervoltageStopsActivelyAndTheBrakeHolds);
+  RUN_TEST(test_faults_AClearDuringTheActiveStopReleasesNothing);
   RUN_TEST(test_faults_OvervoltageShortsThePhasesAndTheBrakeHolds);
   RUN_TEST(test_faults_OvertemperatureStopsActivelyAndTheBrakeHolds);
   RUN_TEST(test_faults_SlippingCouplingIsAMismatchAndTheBrakeHolds);

@@ -136,6 +136,14 @@ static void test_protect_init_RefusesThresholdsOutOfOrder(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_protect_init(&p, &c));
 }
 
+static void test_protect_AFaultTheLoopLatchedItselfShortsEvenATrustedOne(void) {
+  in.loop_faults = POUR_DRIVE_FAULT_UNDERVOLTAGE; /* the loop's own per-period trip: it shorts its phases */
+  step(1);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_UNDERVOLTAGE, out.faults);
+  TEST_ASSERT_EQUAL_INT(POUR_PROTECT_SHORT, out.action);
+  TEST_ASSERT_TRUE(out.brake);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_protect_DeratesBeforeItFaults);
@@ -145,6 +153,7 @@ int main(void) {
   RUN_TEST(test_protect_AnUntrustedFaultShortsTheRestOfTheStop);
   RUN_TEST(test_protect_SensorsDisagreeingBeyondTheBacklash);
   RUN_TEST(test_protect_WithoutCalibrationTheBrakeIsNeverReleased);
+  RUN_TEST(test_protect_AFaultTheLoopLatchedItselfShortsEvenATrustedOne);
   RUN_TEST(test_protect_init_RefusesThresholdsOutOfOrder);
   return UNITY_END();
 }

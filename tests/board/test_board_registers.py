@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """The port's register tables against ST's description of the STM32G431 (the stm32g4 crate, fetched by
-scripts/setup.sh into cargo's home), and the check's own refusal paths: a deliberately wrong offset in our
-table, a deliberately wrong field position in a copy of ST's sources, and bad input."""
+scripts/setup.sh into cargo's home) and the board's alternate-function pins against the stm32g4xx-hal
+crate's pin maps, and the check's own refusal paths: a deliberately wrong offset and a wrong alternate
+function in our table, a deliberately wrong field position in a copy of ST's sources, and bad input."""
 from __future__ import annotations
 
 import os
@@ -29,6 +30,15 @@ def crate() -> Path:
 
 
 @pytest.fixture(scope="module")
+def hal() -> Path:
+    marker = SOURCE / ".deps" / "stm32g4" / "hal-dir"
+    assert marker.is_file(), f"{marker} missing: run scripts/setup.sh (it fetches the stm32g4xx-hal crate)"
+    path = Path(marker.read_text().strip())
+    assert (path / "src" / "pwm.rs").is_file(), f"{path}: not the stm32g4xx-hal crate"
+    return path
+
+
+@pytest.fixture(scope="module")
 def table(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("regs") / "table.txt"
     text = subprocess.run([str(BUILD / "bin" / "board_regtable")], check=True, capture_output=True,
@@ -37,8 +47,17 @@ def table(tmp_path_factory) -> Path:
     return out
 
 
-def run(crate: Path, table: Path, capsys) -> tuple[int, str]:
-    status = check_registers.main(["--crate", str(crate), "--table", str(table)])
+HAL: Path | None = None
+
+
+@pytest.fixture(autouse=True)
+def _with_hal(hal):
+    global HAL
+    HAL = hal
+
+
+def run(crate: Path, table: Path, capsys, hal: Path | None = None) -> tuple[int, str]:
+    status = check_registers.main(["--crate", str(crate), "--table", str(table), "--hal", str(hal or HAL)])
     captured = capsys.readouterr()
     return status, captured.out + captured.err
 
@@ -47,7 +66,8 @@ def test_port_tables_match_st(crate, table, capsys):
     status, out = run(crate, table, capsys)
     assert status == 0, out
     lines = table.read_text().splitlines()
-    for needed in ("PERIPH RCC", "PERIPH FDCAN1", "REG FDCAN NBTP", "FIELD RCC PLLCFGR PLLN"):
+    for needed in ("PERIPH RCC", "PERIPH FDCAN1", "REG FDCAN NBTP", "FIELD RCC PLLCFGR PLLN", "AF TIM1 CH1N PC13 4",
+                   "AF FDCAN1 TX PB9 9"):
         assert any(line.startswith(needed) for line in lines), needed
     checked = int(out.split("check_registers: ")[1].split()[0])
     assert checked >= len(lines), out  # every line is checked once per instance of its block
@@ -61,6 +81,19 @@ def test_wrong_offset_in_our_table_fails(crate, table, tmp_path, capsys):
     status, out = run(crate, bad, capsys)
     assert status == 1
     assert "MISMATCH FDCAN.NBTP: offset 0x20, ST's 0x1c" in out
+
+
+def test_wrong_alternate_function_in_our_table_fails(crate, table, tmp_path, capsys):
+    text = table.read_text()
+    bad = tmp_path / "table.txt"
+    bad.write_text(text.replace("AF TIM1 CH1N PC13 4", "AF TIM1 CH1N PC13 6")
+                   .replace("AF FDCAN1 TX PB9 9", "AF FDCAN1 TX PB8 9"))
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert "AF TIM1.CH1N on PC13: AF6, the HAL's AF4" in out
+    assert "AF FDCAN1.TX on PB8: the HAL has no such pin for it" in out
+    status, out = run(crate, table, capsys, hal=tmp_path / "nowhere")
+    assert status == 2 and "cannot read" in out and "pwm.rs" in out
 
 
 def test_wrong_base_and_field_in_our_table_fail(crate, table, tmp_path, capsys):

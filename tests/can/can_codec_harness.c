@@ -4,7 +4,7 @@
  *   pack <msg> <node> <raw fields...>   -> "ok <id> <dlc> <hex>" | "einval"
  *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
  * msg: sensors (seq_low encoder scale_rotating scale_target), torque (seq torque action mode limits),
- * heartbeat (mode faults rx_dropped overruns counter), estop (assert), identity (hash tau_max fw init),
+ * heartbeat (mode faults rx_dropped overruns counter refused), estop (assert), identity (hash tau_max fw init),
  * param_read (id), param_value and param_write (id value), param_ack (request id result), tare (scales),
  * clear_errors, stop, reset, param_save and zero (no fields).
  *   param <id>                          -> "ok <name> <unit or -> <min> <max>" | "none" (pour/params.h's table)
@@ -90,8 +90,9 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "torque") == 0 && n == 6) {
     pour_can_torque_t m = {(uint16_t)v[1], (q15_t)v[2], (uint8_t)v[3], (uint8_t)v[4], (uint8_t)v[5]};
     print_frame(pour_can_pack_torque(node, &m, &f), &f);
-  } else if (strcmp(msg, "heartbeat") == 0 && n == 6) {
-    pour_can_heartbeat_t m = {(uint8_t)v[1], (uint16_t)v[2], (uint16_t)v[3], (uint16_t)v[4], (uint8_t)v[5]};
+  } else if (strcmp(msg, "heartbeat") == 0 && n == 7) {
+    pour_can_heartbeat_t m = {(uint8_t)v[1], (uint16_t)v[2], (uint16_t)v[3], (uint16_t)v[4], (uint8_t)v[5],
+                              (uint8_t)v[6]};
     print_frame(pour_can_pack_heartbeat(node, &m, &f), &f);
   } else if (strcmp(msg, "estop") == 0 && n == 2) {
     pour_can_estop_t m = {(uint8_t)v[1]};
@@ -176,8 +177,8 @@ static void do_unpack(const char *msg, char *rest) {
   } else if (strcmp(msg, "heartbeat") == 0) {
     pour_can_heartbeat_t m = {0};
     rc = pour_can_unpack_heartbeat(&f, &m);
-    snprintf(out, sizeof out, "%u %u %u %u %u", (unsigned)m.mode, (unsigned)m.faults, (unsigned)m.rx_dropped,
-             (unsigned)m.overruns, (unsigned)m.counter);
+    snprintf(out, sizeof out, "%u %u %u %u %u %u", (unsigned)m.mode, (unsigned)m.faults, (unsigned)m.rx_dropped,
+             (unsigned)m.overruns, (unsigned)m.counter, (unsigned)m.refused);
   } else if (strcmp(msg, "estop") == 0) {
     pour_can_estop_t m = {0};
     rc = pour_can_unpack_estop(&f, &m);

@@ -65,6 +65,9 @@ static void test_can_pack_RefusesOutOfRangeAndLeavesFrame(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_torque(0, &t, &f));
   pour_can_heartbeat_t hb = {.mode = 4};
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_heartbeat(0, &hb, &f));
+  hb.mode = 0;
+  hb.refused = 16; /* a count mod 16: the port reduces it, the codec does not */
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_heartbeat(0, &hb, &f));
   pour_can_estop_t e = {.assert_estop = 2};
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_estop(0, &e, &f));
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_command(64, POUR_CAN_CMD_CLEAR_ERRORS, &f));
@@ -107,16 +110,20 @@ static void test_can_torque_RoundTripsFullQ15Range(void) {
 
 static void test_can_heartbeat_CarriesOnlyNamedFaultBits(void) {
   pour_can_heartbeat_t hb = {.mode = 2, .faults = 0xFFFF, .rx_dropped = 0x1234, .overruns = 0xFFFF,
-                             .counter = 255};
+                             .counter = 255, .refused = 0xA};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_heartbeat(0, &hb, &f));
-  const uint8_t want[8] = {0x02, 0xFF, 0x07, 0x34, 0x12, 0xFF, 0xFF, 0xFF};
+  const uint8_t want[8] = {0xA2, 0xFF, 0x0F, 0x34, 0x12, 0xFF, 0xFF, 0xFF}; /* Refused in Mode's high nibble; 12 fault bits */
   TEST_ASSERT_EQUAL_HEX8_ARRAY(want, f.data, 8);
   pour_can_heartbeat_t back;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&f, &back));
   TEST_ASSERT_EQUAL_HEX16(POUR_CAN_HEARTBEAT_FAULT_MASK, back.faults);
   TEST_ASSERT_EQUAL_UINT16(0x1234, back.rx_dropped);
   TEST_ASSERT_EQUAL_UINT8(255, back.counter);
+  TEST_ASSERT_EQUAL_UINT8(2, back.mode);
+  TEST_ASSERT_EQUAL_UINT8(0xA, back.refused);
+  f.data[0] = 0xA4; /* mode 4 does not exist, whatever the count beside it */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_heartbeat(&f, &back));
 }
 
 static void test_can_unpack_RejectsWrongDlcAndWrongCmd(void) {

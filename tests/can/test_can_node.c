@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "pour/can_node.h"
+#include "pour/drive_faults.h"
 #include "pour/weights_compiled.h"
 #include "unity.h"
 
@@ -88,6 +89,36 @@ static void test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason(vo
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
 }
 
+static void test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows(void) {
+  cfg.can_calibrate = true;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_ESTOP, calibration_answer((uint8_t)POUR_MODE_ESTOP).status);
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node)); /* refused: nothing for the port */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, calibration_answer((uint8_t)POUR_MODE_IDLE).status);
+  TEST_ASSERT_TRUE(pour_can_node_take_calibration_start(&node));
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node)); /* once */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, calibration_answer((uint8_t)POUR_MODE_FAULT).status);
+  TEST_ASSERT_TRUE(pour_can_node_take_calibration_start(&node));
+  /* the outcome, unasked, once */
+  const pour_can_calibration_result_t done = {.status = POUR_CAN_CAL_NO_ENCODER, .stored = POUR_CAN_CAL_EMPTY};
+  pour_can_node_report_calibration(&node, &done);
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  int seen = 0;
+  for (int t = 0; t < 3; ++t) {
+    const uint8_t n = tick(0, &in, tx);
+    for (uint8_t i = 0; i < n; ++i) {
+      pour_can_calibration_result_t r;
+      if (tx[i].id != pour_can_id(cfg.node_id, POUR_CAN_CMD_CALIBRATION_RESULT)) continue;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&tx[i], &r));
+      TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_NO_ENCODER, r.status);
+      ++seen;
+    }
+  }
+  TEST_ASSERT_EQUAL_INT(1, seen);
+}
+
 static void test_can_node_init_RejectsBadConfig(void) {
   pour_can_node_config_t bad = cfg;
   bad.node_id = 64;
@@ -156,6 +187,50 @@ static void test_can_node_HeartbeatAtConfiguredPeriod(void) {
   }
   TEST_ASSERT_EQUAL_UINT(3, heartbeats);
   TEST_ASSERT_EQUAL_UINT8(2, last_counter);
+}
+
+static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  TEST_ASSERT_EQUAL_UINT8(3, tick(0, &in, tx)); /* no drive of its own: torque, heartbeat, identity */
+  const pour_can_drive_telemetry_t d = {-1234, 5678, 24000u,
+                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP};
+  pour_can_node_set_drive(&node, &d);
+  unsigned telemetry = 0;
+  for (unsigned t = 1; t < 12; ++t) {
+    const uint8_t n = tick(0, &in, tx);
+    if (t % 4u == 0u) {
+      TEST_ASSERT_EQUAL_UINT8(4, n);
+      pour_can_drive_telemetry_t back;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_drive_telemetry(&tx[3], &back));
+      TEST_ASSERT_EQUAL_INT16(-1234, back.id_2ma);
+      TEST_ASSERT_EQUAL_INT16(5678, back.iq_2ma);
+      TEST_ASSERT_EQUAL_UINT16(24000u, back.vbus_mv);
+      TEST_ASSERT_EQUAL_HEX16(d.drive_faults, back.drive_faults);
+      ++telemetry;
+    } else {
+      TEST_ASSERT_EQUAL_UINT8(1, n);
+    }
+  }
+  TEST_ASSERT_EQUAL_UINT(2, telemetry);
+}
+
+static void test_can_node_DriveFaultFaultsTheCoreAndTheHeartbeatNamesIt(void) {
+  pour_control_input_t in;
+  pour_can_node_begin_tick(&node, &in);
+  TEST_ASSERT_EQUAL_HEX16(0u, in.drive_faults); /* the bus carries no drive */
+  TEST_ASSERT_TRUE(in.drive_trusted);
+  in.drive_faults = POUR_DRIVE_FAULT_OVERTEMP; /* the port's drive, as board_drive fills it in */
+  pour_control_output_t out;
+  pour_control_step(&ctl, &in, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_TRUE(out.brake);
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  TEST_ASSERT_EQUAL_UINT8(3, pour_can_node_end_tick(&node, &out, 0, tx));
+  pour_can_heartbeat_t hb;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[1], &hb));
+  TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_DRIVE, hb.faults);
+  TEST_ASSERT_EQUAL_STRING("DRIVE", pour_fault_name(POUR_FAULT_DRIVE));
 }
 
 static void test_can_node_SilenceTripsWatchdogAfterTimeout(void) {
@@ -497,13 +572,90 @@ static void test_can_node_RefusedResetInRunChangesNothing(void) {
   TEST_ASSERT_EQUAL_UINT32(seq_before + 300u, node.sensors.seq);
 }
 
+/* The hardwired line, sampled before and after the tick's frames (main.c), joins the bus's e-stop: a clear that
+ * arrives while the line is held is dropped even if the line is released by the second sample, a bus release
+ * does not release a held line, and a clear with the line released at both samples counts. */
+static void test_can_node_HardwiredLineHeldDropsAClearAndOutranksTheBus(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(10u, &seq, &out);
+  pour_can_node_estop_line(&node, true);
+  run_ticks(3u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  receive_estop(false); /* the bus says released; the line is still held */
+  run_ticks(3u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  TEST_ASSERT_EQUAL_INT16(0, out.torque);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS); /* arrives with the line held */
+  pour_can_node_estop_line(&node, false);      /* the second sample of that tick finds it released */
+  run_ticks(20u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
+  TEST_ASSERT_TRUE(out.brake);
+  TEST_ASSERT_EQUAL_UINT32(1u, node.commands.clears_dropped);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  pour_can_node_estop_line(&node, false);
+  send_sample(seq++, 0);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT32(0u, out.faults);
+}
+
+/* The next heartbeat the node sends (the core behind it, samples flowing), decoded. */
+static pour_can_heartbeat_t next_heartbeat(uint32_t *seq) {
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  for (unsigned t = 0; t <= cfg.heartbeat_period_ms; ++t) {
+    send_sample((*seq)++, 0);
+    pour_control_input_t in;
+    pour_control_output_t out;
+    pour_can_node_begin_tick(&node, &in);
+    pour_control_step(&ctl, &in, &out);
+    const uint8_t n = pour_can_node_end_tick(&node, &out, 0, tx);
+    for (uint8_t i = 0; i < n; ++i) {
+      pour_can_heartbeat_t hb;
+      if (pour_can_unpack_heartbeat(&tx[i], &hb) == POUR_CAN_RX_OK) {
+        return hb;
+      }
+    }
+  }
+  TEST_FAIL_MESSAGE("no heartbeat within its period");
+  pour_can_heartbeat_t none = {0};
+  return none;
+}
+
+/* The heartbeat's Refused counts every command that changed nothing: a Reset the core refuses in RUN, a Stop
+ * outside RUN, a clear dropped with the e-stop held; mod 16. */
+static void test_can_node_HeartbeatCountsRefusedCommands(void) {
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(20u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_UINT8(0u, next_heartbeat(&seq).refused);
+  receive_command(POUR_CAN_CMD_RESET);
+  TEST_ASSERT_EQUAL_UINT8(1u, next_heartbeat(&seq).refused);
+  receive_estop(true);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  pour_can_heartbeat_t hb = next_heartbeat(&seq);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, hb.mode);
+  TEST_ASSERT_EQUAL_UINT8(2u, hb.refused);
+  for (unsigned k = 0; k < 15u; ++k) {
+    receive_command(POUR_CAN_CMD_STOP);
+    run_ticks(1u, &seq, &out);
+  }
+  hb = next_heartbeat(&seq);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, hb.mode); /* the mode is not disturbed by the count beside it */
+  TEST_ASSERT_EQUAL_UINT8((2u + 15u) % 16u, hb.refused);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_can_node_init_RejectsBadConfig);
   RUN_TEST(test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason);
+  RUN_TEST(test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows);
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);
+  RUN_TEST(test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet);
+  RUN_TEST(test_can_node_DriveFaultFaultsTheCoreAndTheHeartbeatNamesIt);
   RUN_TEST(test_can_node_SilenceTripsWatchdogAfterTimeout);
   RUN_TEST(test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew);
   RUN_TEST(test_can_node_EstopWinsOverWatchdogSafeTorque);
@@ -516,5 +668,7 @@ int main(void) {
   RUN_TEST(test_can_node_ClearCountsOnlyAfterTheReleaseAndWhileReleased);
   RUN_TEST(test_can_node_ClearStormWhileEstopHeldClearsNothing);
   RUN_TEST(test_can_node_RefusedResetInRunChangesNothing);
+  RUN_TEST(test_can_node_HardwiredLineHeldDropsAClearAndOutranksTheBus);
+  RUN_TEST(test_can_node_HeartbeatCountsRefusedCommands);
   return UNITY_END();
 }

@@ -43,30 +43,40 @@ class ControlModel {
       FUZZ_CHECK(out.torque == 0 && out.mode == POUR_MODE_ESTOP && out.brake && !out.power,
                  "e-stop: torque %d mode %u brake %d power %d", out.torque, out.mode, out.brake, out.power);
       FUZZ_CHECK((out.faults & (faults_ | POUR_FAULT_ESTOP)) == (faults_ | POUR_FAULT_ESTOP), "e-stop faults %x", out.faults);
+      FUZZ_CHECK(out.refused == refused_ + (in.stop ? 1u : 0u) + (in.reset ? 1u : 0u),
+                 "refused %u after %u in ESTOP (stop %d reset %d)", out.refused, refused_, in.stop, in.reset);
       end(out);
       return;
     }
-    // The mode the tick's requests leave before the state is looked at: a released e-stop and a link
-    // fault are FAULT; a clear takes FAULT to IDLE (all faults cleared); stop takes RUN to IDLE; a reset
-    // is taken in IDLE, or in FAULT once the active stop is over; a refused Stop or Reset is counted.
-    uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault ? static_cast<uint8_t>(POUR_MODE_FAULT) : mode_;
+    // The mode the tick's requests leave before the state is looked at: a released e-stop, a link fault
+    // and a drive fault are FAULT; a clear takes FAULT to IDLE (all faults cleared) once the active stop is over; stop
+    // takes RUN to IDLE; a reset is taken in IDLE, or in FAULT once the active stop is over; a refused
+    // Stop, Reset or clear is counted.
+    uint8_t mode = mode_ == POUR_MODE_ESTOP || in.link_fault || in.drive_faults != 0 ? static_cast<uint8_t>(POUR_MODE_FAULT)
+                                                                                   : mode_;
+    const bool stopping = mode_ == POUR_MODE_FAULT && power_; // the last tick ran the active stop
     uint16_t kept = faults_;
-    if (in.clear_faults && mode == POUR_MODE_FAULT) {
+    const bool clear_refused = in.clear_faults && mode == POUR_MODE_FAULT && stopping;
+    if (in.clear_faults && mode == POUR_MODE_FAULT && !clear_refused) {
       kept = 0;
       mode = POUR_MODE_IDLE;
     }
     const bool stop_refused = in.stop && mode != POUR_MODE_RUN;
     if (in.stop && mode == POUR_MODE_RUN) mode = POUR_MODE_IDLE;
-    const bool reset_refused = in.reset && (mode == POUR_MODE_RUN || (mode == POUR_MODE_FAULT && mode_ == POUR_MODE_FAULT && power_));
-    FUZZ_CHECK(out.refused == refused_ + (stop_refused ? 1u : 0u) + (reset_refused ? 1u : 0u),
-               "refused %u after %u (stop %d reset %d in mode %u)", out.refused, refused_, in.stop, in.reset, mode);
+    const bool reset_refused = in.reset && (mode == POUR_MODE_RUN || (mode == POUR_MODE_FAULT && stopping));
+    FUZZ_CHECK(out.refused == refused_ + (clear_refused ? 1u : 0u) + (stop_refused ? 1u : 0u) + (reset_refused ? 1u : 0u),
+               "refused %u after %u (clear %d stop %d reset %d in mode %u)", out.refused, refused_, in.clear_faults,
+               in.stop, in.reset, mode);
     stale_ = in.sensors_fresh ? 0u : stale_ + 1u;
     if (in.sensors_fresh && new_seq && !raw_plausible(in.sensors))
       FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible sample did not latch BAD_INPUT");
     if (in.link_fault && !in.clear_faults) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
+    if (in.drive_faults != 0 && !in.clear_faults)
+      FUZZ_CHECK(out.faults & POUR_FAULT_DRIVE, "a drive fault did not latch DRIVE");
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
     const uint16_t new_bits = static_cast<uint16_t>(out.faults & ~kept);
-    FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)),
+    FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)) &&
+                   (in.drive_faults != 0 || !(new_bits & POUR_FAULT_DRIVE)),
                "fault without a cause: %x (kept %x)", out.faults, kept);
     FUZZ_CHECK((out.faults != 0) == (out.mode == POUR_MODE_FAULT), "faults %x in mode %u", out.faults, out.mode);
     FUZZ_CHECK(out.brake == !out.power, "brake %d and power %d together", out.brake, out.power);
@@ -79,6 +89,8 @@ class ControlModel {
       FUZZ_CHECK(out.brake && on_the_way(out.torque, torque_), "torque %d in IDLE after %d", out.torque, torque_);
     } else {
       FUZZ_CHECK(out.mode == POUR_MODE_FAULT, "mode %u without e-stop", out.mode);
+      // Once a fault's stop is over the brake holds until a clear: no Reset, sample or storm releases it.
+      FUZZ_CHECK(!(held_ && mode == POUR_MODE_FAULT && out.power), "the brake released in FAULT after the stop ended");
     }
     // Continuity across every transition (power-on, stop, reset, clear, a fault, the stop's end): at most the
     // slew limit from the last command, or less torque toward zero, which never waits ...
@@ -110,6 +122,7 @@ class ControlModel {
     torque_ = out.torque;
     power_ = out.power;
     refused_ = out.refused;
+    held_ = (out.mode == POUR_MODE_FAULT || out.mode == POUR_MODE_ESTOP) && !out.power;
   }
 
   // Between the last command and the safe torque, or between it and zero (the safe torque cut at a limit).
@@ -125,6 +138,7 @@ class ControlModel {
   uint16_t faults_ = 0;
   q15_t torque_;
   bool power_ = false;  // the last tick drove the motor (RUN, the active stop)
+  bool held_ = false;   // the last tick was FAULT or ESTOP with the brake holding (the stop over, or none)
   uint32_t refused_ = 0;
 };
 

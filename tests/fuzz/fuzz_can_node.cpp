@@ -5,9 +5,11 @@
 // last Sensors frame the node accepted, reading for reading; on the bus, the torque frame decodes, carries
 // exactly the core's command and mode, stays within tau_limit, and is zero while the e-stop is asserted;
 // the heartbeat and identity frames decode. The order of the host's commands within a tick (docs/safety.md,
-// transitions): the core sees the e-stop if it was asserted at any frame since the last tick, and a clear
-// only if one arrived with the e-stop released and no assert came in the same tick; the 32-bit sample count
-// runs on by the frames' forward distance whatever commands came (a refused Reset changes nothing).
+// transitions): the e-stop is the bus's frames and the hardwired line (sampled before and after the frames);
+// the core sees it if either asserted it at any point since the last tick, and a clear only if one arrived
+// with both released and no assert came after it in the same tick; every clear not taken is counted, and the
+// heartbeat's Refused is the core's refusals plus those, mod 16; the 32-bit sample count runs on by the
+// frames' forward distance whatever commands came (a refused Reset changes nothing).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstring>
@@ -68,11 +70,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   FUZZ_CHECK(pour_can_node_init(&node, &ncfg) == POUR_OK, "a valid node config was refused");
   ControlModel model(cfg, pour_weights_compiled.n_actions);
   static const bool trace = std::getenv("POUR_FUZZ_TRACE") != nullptr; // replaying a crash: one line per tick
-  bool estop_level = false, have_count = false;
-  uint32_t count = 0;
+  // The e-stop's two sources as the frames and the line samples said them, and the model of pour_commands:
+  // a clear pending (it arrived released), the clears dropped so far.
+  bool bus_level = false, line_level = false, have_count = false;
+  uint32_t count = 0, dropped = 0;
   for (uint32_t tick = 0; tick < 4000 && fdp.remaining_bytes() > 0; ++tick) {
     bool sampled = false;
-    bool asserted = false, clear_released = false;
+    bool asserted = false, pending = false;
+    const auto asserts = [&] { // a source reports "asserted" (again or anew)
+      asserted = true;
+      if (pending) ++dropped; // an assert after a clear drops it
+      pending = false;
+    };
+    const auto sample_line = [&] { // the port's hardwired line, before and after the tick's frames (main.c)
+      line_level = fdp.ConsumeIntegralInRange<int>(0, 15) == 0 ? !line_level : line_level;
+      pour_can_node_estop_line(&node, line_level);
+      if (line_level) asserts();
+    };
+    sample_line();
     const auto counted = [&](const pour_can_sensors_t &m) { // the node's count after one more sample frame
       count = have_count ? count + static_cast<uint8_t>(m.seq_low - (count & 0xFFu)) : m.seq_low;
       have_count = true;
@@ -106,11 +121,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         last = m;
         counted(m);
       } else if (cmd == POUR_CAN_CMD_ESTOP && pour_can_unpack_estop(&f, &e) == POUR_CAN_RX_OK) {
-        estop_level = e.assert_estop != 0u;
-        asserted = asserted || estop_level;
-      } else if (cmd == POUR_CAN_CMD_CLEAR_ERRORS && !estop_level) {
-        clear_released = true;
+        bus_level = e.assert_estop != 0u;
+        if (bus_level) asserts();
+      } else if (cmd == POUR_CAN_CMD_CLEAR_ERRORS) {
+        if (bus_level || line_level) {
+          ++dropped; // held: dropped where it arrives
+        } else {
+          pending = true;
+        }
       }
+    }
+    sample_line();
+    if (pending && asserted) { // assert, release, clear within the tick: the core sees the assert
+      ++dropped;
+      pending = false;
     }
     pour_control_input_t in{};
     pour_can_node_begin_tick(&node, &in);
@@ -122,10 +146,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                  "the core got seq %u encoder %u scales %d/%d, the frame said %u %u %d/%d", in.sensors.seq,
                  in.sensors.encoder, in.sensors.scale_rotating_g, in.sensors.scale_target_g, last.seq_low, last.encoder,
                  last.scale_rotating_g, last.scale_target_g);
-    FUZZ_CHECK(in.estop == (estop_level || asserted), "e-stop %d, the frames said level %d, asserted %d", in.estop,
-               estop_level, asserted);
-    FUZZ_CHECK(in.clear_faults == (clear_released && !asserted), "clear %d, the frames said released %d, asserted %d",
-               in.clear_faults, clear_released, asserted);
+    FUZZ_CHECK(in.estop == (bus_level || line_level || asserted),
+               "e-stop %d, the frames said level %d, the line %d, asserted %d", in.estop, bus_level, line_level, asserted);
+    FUZZ_CHECK(in.clear_faults == pending, "clear %d, the frames and the line said %d", in.clear_faults, pending);
+    FUZZ_CHECK(node.commands.clears_dropped == dropped, "%u clears dropped, the frames and the line say %u",
+               node.commands.clears_dropped, dropped);
     if (sampled) {
       FUZZ_CHECK(in.sensors.seq == count, "sample count %u, expected %u", in.sensors.seq, count);
     }
@@ -152,6 +177,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                       (cmd == POUR_CAN_CMD_CALIBRATION_RESULT &&
                        pour_can_unpack_calibration_result(&tx[k], &cal) == POUR_CAN_RX_OK);
       FUZZ_CHECK(ok, "frame %u (cmd 0x%02x) does not decode", k, cmd);
+      if (cmd == POUR_CAN_CMD_HEARTBEAT)
+        FUZZ_CHECK(hb.mode == out.mode && hb.refused == ((out.refused + dropped) & POUR_CAN_REFUSED_MAX),
+                   "heartbeat mode %u refused %u; the core says %u, %u refused, %u clears dropped", hb.mode, hb.refused,
+                   out.mode, out.refused, dropped);
     }
     if (trace)
       std::fprintf(stderr, "tick %u: fresh %d estop %d clear %d | core mode %u faults %x torque %d | link fault %d since_valid %u | bus %d\n",

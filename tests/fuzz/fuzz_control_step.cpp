@@ -53,6 +53,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     in.link_fault = (more & 0x01) != 0;
     in.stop = (more & 0x02) != 0;
     in.reset = (more & 0x04) != 0;
+    in.drive_faults = (more & 0x08) != 0 ? static_cast<uint16_t>(1u << (more >> 5)) : 0; // a drive's fault bit
+    in.drive_trusted = (more & 0x10) != 0;
     // Repeat the input for a run of ticks (a stale link, a held e-stop) when asked.
     const int repeat = (flags & 0x0f) == 0 ? fdp.ConsumeIntegralInRange<int>(1, 40) : 1;
     if (in.sensors_fresh) in.sensors = fuzz_sample(fdp, tick + 1u, cfg, &count);

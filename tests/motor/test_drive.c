@@ -47,8 +47,8 @@ static void assert_held(uint16_t fault) {
 static void test_drive_DefaultConfigIsValid(void) { TEST_ASSERT_NULL(pour_drive_config_check(&cfg)); }
 
 static void test_drive_ConfigCheckNamesTheBadField(void) {
-  struct { const char *name; pour_drive_config_t c; } cases[8];
-  for (int k = 0; k < 8; ++k) cases[k].c = cfg;
+  struct { const char *name; pour_drive_config_t c; } cases[13];
+  for (int k = 0; k < 13; ++k) cases[k].c = cfg;
   cases[0].name = "bandwidth_rad_s"; cases[0].c.bandwidth_rad_s = 6284; /* above 2π·20 kHz/20 = 6283 */
   cases[1].name = "pwm_hz"; cases[1].c.pwm_hz = 10000;                 /* audible */
   cases[2].name = "r_phase_uohm"; cases[2].c.r_phase_uohm = 0;
@@ -57,7 +57,12 @@ static void test_drive_ConfigCheckNamesTheBadField(void) {
   cases[5].name = "overcurrent_ma"; cases[5].c.overcurrent_ma = cfg.current_limit_ma;
   cases[6].name = "encoder_cpr"; cases[6].c.encoder_cpr = 4000;
   cases[7].name = "regen_on_mv"; cases[7].c.regen_on_mv = cfg.vbus_ov_mv;
-  for (int k = 0; k < 8; ++k) {
+  cases[8].name = "encoder_reversed"; cases[8].c.encoder_reversed = 2;
+  cases[9].name = "cal_current_ma"; cases[9].c.cal_current_ma = cfg.current_limit_ma + 1u;
+  cases[10].name = "cal_l_test_mv"; cases[10].c.cal_l_test_mv = 99;
+  cases[11].name = "cal_motion_urad"; cases[11].c.cal_motion_urad = 9817; /* < 2π/(32·20): a turn would not fit */
+  cases[12].name = "cal_motion_urad"; cases[12].c.cal_motion_urad = 3141593 + 1;
+  for (int k = 0; k < 13; ++k) {
     TEST_ASSERT_EQUAL_STRING(cases[k].name, pour_drive_config_check(&cases[k].c));
     TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_drive_init(&drv, &cases[k].c));
   }

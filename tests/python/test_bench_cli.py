@@ -74,7 +74,7 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
         lines.append(f"({1700000000 + t:.6f}) vcan0 {dbc.can_id(node, m.frame_id):03X}#{data.hex().upper()}")
 
     faults = {f"Fault_{n}": 0 for n in ("StaleInput", "EStop", "BadInput", "Position", "Overspeed", "TorqueSign",
-                                         "Encoder", "Volume", "CanWatchdog", "Seq", "Scale")}
+                                         "Encoder", "Volume", "CanWatchdog", "Seq", "Scale", "Drive")}
     for k in range(samples):
         t = k * 0.001
         frame(t, "Sensors", Seq=k % 256, Encoder=k, ScaleRotating=10000 - k, ScaleTarget=k)
@@ -82,7 +82,7 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
         if k % 100 == 0:
             late = k >= 200
             frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
-                  Overruns=0, Counter=k // 100)
+                  Overruns=0, Counter=k // 100, Refused=0)
             frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
     path.write_text("\n".join(lines) + "\n")
 

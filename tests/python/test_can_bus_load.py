@@ -49,6 +49,9 @@ def test_protocol_load_at_1khz_is_under_half_the_bus():
     assert total == pytest.approx(((135 + 125) * 1000 + 135 * 10 * 3) / 1e6)
     assert total < 0.5
     assert "26.4 % worst case" in bl.report(list(rows.values()))
+    # The identity and drive-telemetry frames follow the heartbeat, whatever its period.
+    fast = {r.name: r.rate_hz for r in bl.cyclic_messages(heartbeat_ms=20)}
+    assert fast["Heartbeat"] == fast["Identity"] == fast["DriveTelemetry"] == 50.0
 
 
 def test_cli_reports_and_rejects_bad_input(tmp_path):

@@ -4,6 +4,7 @@ packed by both; random bytes, unpacked by both; the C range checks are the DBC's
 from __future__ import annotations
 
 import random
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -23,7 +24,7 @@ N_RANDOM = 400
 MESSAGES = {
     "sensors": ("Sensors", ["Seq", "Encoder", "ScaleRotating", "ScaleTarget"]),
     "torque": ("Torque", ["Seq", "Torque", "Action", "Mode", "Limits"]),
-    "heartbeat": ("Heartbeat", ["Mode", "Faults", "RxDropped", "Overruns", "Counter"]),
+    "heartbeat": ("Heartbeat", ["Mode", "Faults", "RxDropped", "Overruns", "Counter", "Refused"]),
     "estop": ("Estop", ["Assert"]),
     "identity": ("Identity", ["WeightsHash", "TauMax", "FwVersion", "InitStatus"]),
     "clear_errors": ("ClearErrors", []),
@@ -45,7 +46,7 @@ SIGNAL_FREE = ("clear_errors", "stop", "reset", "calibration_start", "param_save
 FAULT_BITS = {"Fault_StaleInput": 0x0001, "Fault_EStop": 0x0002, "Fault_BadInput": 0x0004,
               "Fault_Position": 0x0008, "Fault_Overspeed": 0x0010, "Fault_TorqueSign": 0x0020,
               "Fault_Encoder": 0x0040, "Fault_Volume": 0x0080, "Fault_CanWatchdog": 0x0100,
-              "Fault_Seq": 0x0200, "Fault_Scale": 0x0400}
+              "Fault_Seq": 0x0200, "Fault_Scale": 0x0400, "Fault_Drive": 0x0800}
 # The drive's fault word (pour/drive_faults.h) in DriveTelemetry, the same way.
 DRIVE_FAULT_BITS = {"DriveFault_Overcurrent": 0x0001, "DriveFault_HwOvercurrent": 0x0002,
                     "DriveFault_Overvoltage": 0x0004, "DriveFault_Undervoltage": 0x0008,
@@ -285,7 +286,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     """What a bench engineer runs: candump -L lines piped through cantools decode."""
     lines = []
     frames = [("sensors", [7, 131071, -5, 12345]),
-              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5]), ("estop", [1]),
+              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5, 2]), ("estop", [1]),
               ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", []),
               ("calibration_start", []), ("calibration_result", [7, 2, 0, 0, 0, 0, 0]),
               ("drive_telemetry", [-1500, 2500, 24100, 0x0102])]
@@ -308,6 +309,16 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "DriveFault_HwOvercurrent: 1" in text and "DriveFault_EncoderMismatch: 1" in text
     assert "ClearErrors(" in text
     assert "Stop(" in text and "Reset(" in text
+
+
+def test_calibration_status_names_are_the_codec_s(db):
+    """CalibrationResult.Status's choices are the codec's POUR_CAN_CAL_* values, name for name."""
+    header = (Path(SOURCE_DIR) / "firmware/can/include/pour/can_codec.h").read_text()
+    ours = {int(v): k for k, v in re.findall(r"#define POUR_CAN_CAL_(\w+) (\d+)u", header)
+            if not k.endswith("_MAX")}
+    choices = db.get_message_by_name("CalibrationResult").get_signal_by_name("Status").choices
+    assert {int(k): str(v) for k, v in choices.items()} == ours
+    assert len(ours) == 16 and "MEASURING" in ours.values()
 
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):

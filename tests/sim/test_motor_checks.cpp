@@ -3,8 +3,10 @@
 // switched off, and the injected faults: each latched, the bucket held by the brake, nothing non-finite.
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <string>
 
+#include "controllers.hpp"
 #include "motor_checks.hpp"
 #include "poursim/poursim.h"
 
@@ -120,8 +122,66 @@ static void test_motor_BrokenAmplifierLatchesTheOffsetFault(void) {
   assert_fault_held(4, POUR_DRIVE_FAULT_CURRENT_OFFSET);
 }
 
+// A tilt at 0.5 rad/s by the firmware's core (a baseline through its pipeline) with fault f injected in the
+// full drive: the drive's word as the core's input saw it, the core's faults and brake at the end, and how
+// far the bucket moved from where the drive's fault first showed [rad] (0 if none did).
+struct CoreFault {
+  uint32_t drive_faults = 0;
+  int trusted_at_fault = -1;
+  uint16_t core_faults = 0;
+  bool brake = false;
+  double moved = 0.0;
+};
+
+static CoreFault run_core_fault(int f) {
+  poursim_config_t c = full_drive();
+  c.drive_fault = f;
+  char err[POURSIM_ERR_LEN];
+  poursim_world_t *w = poursim_create(&c, err, sizeof err);
+  TEST_ASSERT_NOT_NULL_MESSAGE(w, err);
+  std::unique_ptr<poursim::Controller> ctl = poursim::make_rate_controller(0.5, c);
+  ctl->reset(1);
+  poursim_obs_t o;
+  poursim_observe(w, &o);
+  CoreFault r;
+  double theta_fault = 0.0;
+  for (int k = 0; k < 1500; ++k) {
+    const double a = ctl->command(o);
+    TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_set_brake(w, ctl->brake() ? 1 : 0));
+    if (r.trusted_at_fault < 0 && o.drive_faults != 0u) {
+      r.trusted_at_fault = o.drive_trusted;
+      theta_fault = o.theta;
+    }
+    TEST_ASSERT_EQUAL_INT(POURSIM_OK, poursim_step(w, a, &o));
+    r.drive_faults = o.drive_faults;
+  }
+  r.core_faults = ctl->faults();
+  r.brake = ctl->brake();
+  r.moved = r.trusted_at_fault < 0 ? 0.0 : std::fabs(o.theta - theta_fault);
+  poursim_destroy(w);
+  return r;
+}
+
+static void test_motor_DriveFaultsReachTheCoreWhichHoldsTheBucket(void) {
+  const struct {
+    int fault;
+    uint32_t bit;
+  } cases[] = {{1, POUR_DRIVE_FAULT_PHASE}, {2, POUR_DRIVE_FAULT_OVERCURRENT}, {3, POUR_DRIVE_FAULT_ENCODER_DIRECTION}};
+  for (const auto &k : cases) {
+    const CoreFault r = run_core_fault(k.fault);
+    TEST_ASSERT_EQUAL_HEX32(k.bit, r.drive_faults);
+    TEST_ASSERT_EQUAL_INT(0, r.trusted_at_fault); // the drive shorts its phases: not trusted to stop actively
+    TEST_ASSERT_TRUE((r.core_faults & POUR_FAULT_DRIVE) != 0u);
+    TEST_ASSERT_TRUE(r.brake);
+    TEST_ASSERT_TRUE(r.moved < 10.0 * M_PI / 180.0);
+  }
+  const CoreFault none = run_core_fault(0);
+  TEST_ASSERT_EQUAL_HEX32(0u, none.drive_faults);
+  TEST_ASSERT_EQUAL_HEX16(0u, none.core_faults & POUR_FAULT_DRIVE);
+}
+
 static void test_motor_ConfigRefusesDriveKeysOutOfRange(void) {
-  const char *bad[][2] = {{"drive", "2"}, {"drive_regen", "-1"}, {"drive_fault", "5"}, {"supply_voltage", "30"},
+  const char *bad[][2] = {{"drive", "2"}, {"drive_regen", "-1"}, {"drive_fault", "6"}, {"supply_voltage", "30"},
                           {"bus_capacitance", "0"}};
   for (const auto &kv : bad) {
     poursim_config_t c = poursim_default_config();
@@ -146,6 +206,7 @@ int main(void) {
   RUN_TEST(test_motor_ShortedPhasesLatchTheOvercurrent);
   RUN_TEST(test_motor_ReversedEncoderLatchesTheDirectionFault);
   RUN_TEST(test_motor_BrokenAmplifierLatchesTheOffsetFault);
+  RUN_TEST(test_motor_DriveFaultsReachTheCoreWhichHoldsTheBucket);
   RUN_TEST(test_motor_ConfigRefusesDriveKeysOutOfRange);
   return UNITY_END();
 }

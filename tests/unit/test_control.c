@@ -1,4 +1,6 @@
 /* SPDX-License-Identifier: MIT */
+#include <string.h>
+
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
 #include "unity.h"
@@ -43,6 +45,8 @@ void setUp(void) {
   sense(0, FULL_G, 0); /* upright, still, the liquid in the rotating bucket: the example policy pushes */
   in.estop = false;
   in.clear_faults = false;
+  in.stop = false;
+  in.reset = false;
 }
 
 void tearDown(void) {}
@@ -423,6 +427,7 @@ static void test_control_transitions_SafeTorqueIsReachedThroughTheSlew(void) {
  * FAULT with the active stop running. */
 static void run_into_the_active_stop(void) {
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &config, 1u));
+  memset(&out, 0, sizeof out); /* not the last test's output */
   int32_t theta = 0;
   for (unsigned t = 0; t < 2000u && out.mode != POUR_MODE_FAULT; ++t) {
     theta += 2000;
@@ -436,9 +441,10 @@ static void run_into_the_active_stop(void) {
   TEST_ASSERT_TRUE(out.power); /* the active stop */
 }
 
-/* A Reset in FAULT during the active stop is refused like one in RUN: the braking goes on, unchanged, and the
- * estimate does not restart from rest (it used to drop the stop's torque and restart the speed estimate). */
-static void test_control_transitions_ResetIsRefusedDuringTheActiveStop(void) {
+/* A request in FAULT during the active stop (*request: in.reset or in.clear_faults) is refused like a Reset in
+ * RUN: the braking goes on, unchanged, the faults stay latched and the estimate does not restart from rest (both
+ * used to drop the stop's torque and restart the speed estimate while the bucket turned). */
+static void assert_refused_during_the_active_stop(bool *request) {
   run_into_the_active_stop();
   pour_control_t without = ctl;
   pour_control_output_t out_without;
@@ -446,15 +452,55 @@ static void test_control_transitions_ResetIsRefusedDuringTheActiveStop(void) {
   in.sensors.seq++;
   pour_control_step(&without, &in, &out_without);
   const q15_t before = out.torque;
-  in.reset = true;
+  const uint16_t faults = out.faults;
+  *request = true;
   pour_control_step(&ctl, &in, &out);
-  in.reset = false;
+  *request = false;
   TEST_ASSERT_EQUAL_UINT32(1u, out.refused);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_EQUAL_HEX16(faults, out.faults);
   TEST_ASSERT_TRUE(out.power);
   assert_continuous(before, out.torque);
   TEST_ASSERT_EQUAL_INT16(out_without.torque, out.torque);
   TEST_ASSERT_EQUAL_INT32(without.state.omega_urad_s, ctl.state.omega_urad_s);
+}
+
+static void test_control_transitions_ResetIsRefusedDuringTheActiveStop(void) {
+  assert_refused_during_the_active_stop(&in.reset);
+}
+
+static void test_control_transitions_ClearIsRefusedDuringTheActiveStop(void) {
+  assert_refused_during_the_active_stop(&in.clear_faults);
+}
+
+/* A Reset accepted once the stop is over restarts the run's state, not the motion: with fresh samples coming,
+ * the brake keeps holding and the fault stays latched (it used to re-arm the active stop and release the
+ * brake) until a clear. A Reset and a Stop every tick for a second change nothing of that. */
+static void test_control_transitions_ResetOfAHeldAxisKeepsTheBrakeUntilAClear(void) {
+  run_into_the_active_stop();
+  const int32_t held = 2450000;
+  sense(held, FULL_G, 0);
+  for (unsigned t = 0; t < 6000u && out.power; ++t) {
+    step(true);
+  }
+  TEST_ASSERT_TRUE(out.brake);
+  for (unsigned t = 0; t < 1000u; ++t) {
+    in.reset = true;
+    in.stop = true;
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+    TEST_ASSERT_BITS_HIGH(POUR_FAULT_POSITION, out.faults);
+    TEST_ASSERT_TRUE(out.brake);
+    TEST_ASSERT_FALSE(out.power);
+  }
+  in.reset = false;
+  in.stop = false;
+  TEST_ASSERT_EQUAL_UINT32(1000u, out.refused); /* the Stops; each Reset was taken */
+  in.clear_faults = true;
+  step(false);
+  in.clear_faults = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_UINT16(0u, out.faults);
 }
 
 /* Once the stop is over and the brake holds the bucket, a Reset is accepted, and the restarted estimator checks
@@ -490,7 +536,9 @@ int main(void) {
   RUN_TEST(test_control_transitions_StopResetAndFirstSampleInOneTickKeepTheTorque);
   RUN_TEST(test_control_transitions_SafeTorqueIsReachedThroughTheSlew);
   RUN_TEST(test_control_transitions_ResetIsRefusedDuringTheActiveStop);
+  RUN_TEST(test_control_transitions_ClearIsRefusedDuringTheActiveStop);
   RUN_TEST(test_control_transitions_RestartOfAHeldAxisRefusesAJump);
+  RUN_TEST(test_control_transitions_ResetOfAHeldAxisKeepsTheBrakeUntilAClear);
   RUN_TEST(test_control_init_RefusesBadConfig);
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);

@@ -74,11 +74,12 @@ pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg
 
 pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
                                       pour_can_frame_t *frame) {
-  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->mode > POUR_CAN_MODE_MAX) {
+  if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->mode > POUR_CAN_MODE_MAX ||
+      msg->refused > POUR_CAN_REFUSED_MAX) {
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_HEARTBEAT, POUR_CAN_DLC_HEARTBEAT);
-  frame->data[0] = msg->mode;
+  frame->data[0] = (uint8_t)(msg->mode | (uint8_t)(msg->refused << 4));
   /* Faults occupy bits 8..23: the core's bits in byte 1, the CAN node's in byte 2. */
   uint16_t faults = (uint16_t)(msg->faults & POUR_CAN_HEARTBEAT_FAULT_MASK);
   put_u16(&frame->data[1], faults);
@@ -282,10 +283,11 @@ pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_
   if (rc != POUR_CAN_RX_OK) {
     return rc;
   }
-  if (frame->data[0] > POUR_CAN_MODE_MAX) {
+  if ((frame->data[0] & 0x0Fu) > POUR_CAN_MODE_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
-  msg->mode = frame->data[0];
+  msg->mode = (uint8_t)(frame->data[0] & 0x0Fu);
+  msg->refused = (uint8_t)(frame->data[0] >> 4);
   msg->faults = (uint16_t)(get_u16(&frame->data[1]) & POUR_CAN_HEARTBEAT_FAULT_MASK);
   msg->rx_dropped = get_u16(&frame->data[3]);
   msg->overruns = get_u16(&frame->data[5]);

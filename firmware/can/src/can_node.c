@@ -19,6 +19,7 @@ pour_can_node_config_t pour_can_node_default_config(void) {
   c.identity.tau_max_cnm = 0u;
   c.identity.fw_version = (uint8_t)POUR_FIRMWARE_VERSION;
   c.identity.init_status = (int8_t)POUR_OK;
+  c.can_calibrate = false;
   return c;
 }
 
@@ -142,7 +143,7 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       if (rc != POUR_CAN_RX_OK) {
         return drop(node, rc);
       }
-      pour_commands_estop(&node->commands, e.assert_estop != 0u);
+      pour_commands_estop(&node->commands, POUR_ESTOP_BUS, e.assert_estop != 0u);
       kick(node);
       break;
     }
@@ -171,11 +172,17 @@ static bool tripped(const pour_can_node_t *node) {
   return node->armed && node->ms_since_valid > node->config.watchdog_ms;
 }
 
+void pour_can_node_estop_line(pour_can_node_t *node, bool asserted) {
+  pour_commands_estop(&node->commands, POUR_ESTOP_LINE, asserted);
+}
+
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in) {
   in->sensors_fresh = node->sensors_fresh;
   in->sensors = node->sensors;
   pour_commands_take(&node->commands, in);
   in->link_fault = tripped(node);
+  in->drive_faults = 0u; /* the bus carries no drive: a port with one of its own fills these in */
+  in->drive_trusted = true;
   node->sensors_fresh = false;
 }
 
@@ -212,6 +219,7 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
   hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
   hb.overruns = (uint16_t)(overruns & 0xFFFFu);
   hb.counter = node->heartbeat_counter;
+  hb.refused = (uint8_t)((out->refused + node->commands.clears_dropped) & POUR_CAN_REFUSED_MAX);
   if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[0]) != POUR_OK ||
       pour_can_pack_identity(node->config.node_id, &node->config.identity, &tx[1]) != POUR_OK) {
     return 0u;
@@ -229,6 +237,9 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
   }
   if (node->ms_to_heartbeat == 0u) {
     n = (uint8_t)(n + pour_can_node_status_frames(node, out, overruns, &tx[n]));
+    if (node->have_drive && pour_can_pack_drive_telemetry(node->config.node_id, &node->drive, &tx[n]) == POUR_OK) {
+      ++n;
+    }
     node->ms_to_heartbeat = node->config.heartbeat_period_ms;
   }
   --node->ms_to_heartbeat;
@@ -238,13 +249,37 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
       r.status = POUR_CAN_CAL_REFUSED_RUNNING;
     } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
       r.status = POUR_CAN_CAL_REFUSED_ESTOP;
+    } else if (node->config.can_calibrate) {
+      r.status = POUR_CAN_CAL_MEASURING;
+      node->calibration_start = true;
     }
     if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
       ++n;
     }
     node->calibration_requested = false;
+  } else if (node->calibration_report) {
+    if (pour_can_pack_calibration_result(node->config.node_id, &node->calibration, &tx[n]) == POUR_OK) {
+      ++n;
+    }
+    node->calibration_report = false;
   }
   return n;
+}
+
+void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemetry_t *drive) {
+  node->drive = *drive;
+  node->have_drive = true;
+}
+
+void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
+  node->calibration = *result;
+  node->calibration_report = true;
+}
+
+bool pour_can_node_take_calibration_start(pour_can_node_t *node) {
+  const bool start = node->calibration_start;
+  node->calibration_start = false;
+  return start;
 }
 
 void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {

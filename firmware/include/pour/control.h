@@ -19,7 +19,7 @@
  * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity.
  * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp).
  * 4: parameters and calibration over CAN, the transitions of docs/safety.md (torque continuity, refusals). */
-#define POUR_FIRMWARE_VERSION 4u
+#define POUR_FIRMWARE_VERSION 5u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {
@@ -55,10 +55,14 @@ typedef struct {
   bool sensors_fresh;     /* a new sensor sample arrived since the last tick */
   pour_sensors_t sensors; /* that sample, raw */
   bool estop;        /* e-stop line/frame asserted (level) */
-  bool clear_faults; /* request to clear latched faults (acted on when e-stop is released) */
+  bool clear_faults; /* request to clear latched faults (acted on in FAULT once the active stop is over) */
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
   bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
   bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN and ESTOP */
+  uint16_t drive_faults; /* level: the drive's latched fault word (POUR_DRIVE_FAULT_*; 0: none, or no drive of
+                          * its own); any bit latches POUR_FAULT_DRIVE */
+  bool drive_trusted;    /* with drive_faults: the drive still follows a torque (the controlled stop runs); false:
+                          * it does not (its phases are shorted), the stop is over at once */
 } pour_control_input_t;
 
 /* Outputs of one tick. */
@@ -71,7 +75,7 @@ typedef struct {
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
   uint32_t tick;   /* ticks since init */
-  uint32_t refused; /* Reset and Stop requests refused so far (they changed nothing else) */
+  uint32_t refused; /* Stop, Reset and clear requests refused so far (they changed nothing else) */
   bool brake;      /* engage the holding brake (IDLE, ESTOP, and FAULT once the stop is done) */
   bool power;      /* motor power stage enabled (RUN and an active stop only) */
 } pour_control_output_t;
@@ -96,10 +100,12 @@ typedef struct {
   pour_supervisor_t supervisor;
   uint32_t stop_ms;       /* ticks of the active stop so far */
   bool stopped;           /* the stop is over: brake and power cut until a clear */
-  uint32_t refused;       /* Reset requests refused (RUN, ESTOP, an active stop) and Stops outside RUN */
+  uint32_t refused;       /* Resets refused (RUN, ESTOP, the active stop), clears during the active stop, Stops
+                           * outside RUN */
   bool have_trusted;      /* a fresh, plausible sample was taken since init */
   int32_t trusted_theta_urad; /* the angle of the latest one: a restart of a held axis must find it again [µrad] */
   bool check_restart;     /* the next fresh sample is the first after a restart of a held axis */
+  bool drive_untrusted;   /* a drive fault since the last clear came with a drive that no longer follows a torque */
 } pour_control_t;
 
 /* Defaults: docs/safety.md lists them with their reasons. */

@@ -26,10 +26,12 @@ typedef enum {
 #define POUR_FAULT_LINK 0x0100u        /* the transport's command watchdog tripped (the CAN node's) */
 #define POUR_FAULT_SEQ 0x0200u         /* supervisor: samples keep arriving but their seq does not advance */
 #define POUR_FAULT_SCALE 0x0400u       /* supervisor: the axis accelerates more than the command can (scale) */
-#define POUR_FAULT_ALL 0x07FFu
-#define POUR_FAULT_COUNT 11u           /* bits 0 .. POUR_FAULT_COUNT - 1 */
+#define POUR_FAULT_DRIVE 0x0800u       /* the drive latched a fault of its own (which: DriveTelemetry's word) */
+#define POUR_FAULT_ALL 0x0FFFu
+#define POUR_FAULT_COUNT 12u           /* bits 0 .. POUR_FAULT_COUNT - 1 */
 /* Faults the controlled stop answers actively (the sensors and the motor are still trusted): decelerate,
- * return toward upright at a bounded speed, then brake. Every other fault brakes at once. */
+ * return toward upright at a bounded speed, then brake. Every other fault brakes at once; POUR_FAULT_DRIVE
+ * is answered actively too while the drive says it still follows a torque (pour_control_input_t). */
 #define POUR_FAULT_ACTIVE_STOP (POUR_FAULT_POSITION | POUR_FAULT_OVERSPEED | POUR_FAULT_VOLUME)
 
 /* The name of one fault bit (a single POUR_FAULT_* value: "STALE_INPUT", ...), NULL for anything else. */

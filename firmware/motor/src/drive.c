@@ -47,6 +47,10 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.phase_sum_ma = 4000;
   c.phase_loss_ms = 20;
   c.encoder_check_urad = 3000;
+  c.encoder_reversed = 0;
+  c.cal_current_ma = 4000;    /* 1.2× the nominal current for 3.1 s: 0.16 N·m of hold at the motor */
+  c.cal_l_test_mv = 1000;     /* 0.33 A of ripple a period on the rig's 150 µH */
+  c.cal_motion_urad = 174533; /* 10° of output; an electrical turn of this motor is 2.25° through 1:20 */
   return c;
 }
 
@@ -58,11 +62,11 @@ const char *pour_drive_config_check(const pour_drive_config_t *c) {
   if (!in_range(c->timer_clock_hz, 1000000, 500000000) || c->timer_clock_hz / (2u * c->pwm_hz) > 65535u)
     return "timer_clock_hz";
   if ((uint64_t)c->deadtime_ns * c->pwm_hz * 20u > 1000000000ULL) return "deadtime_ns";
-  if (!in_range(c->r_phase_uohm, 10000, 10000000)) return "r_phase_uohm";
-  if (!in_range(c->ld_nh, 10000, 10000000)) return "ld_nh";
-  if (!in_range(c->lq_nh, 10000, 10000000)) return "lq_nh";
+  if (!in_range(c->r_phase_uohm, POUR_MOTOR_R_MIN_UOHM, POUR_MOTOR_R_MAX_UOHM)) return "r_phase_uohm";
+  if (!in_range(c->ld_nh, POUR_MOTOR_L_MIN_NH, POUR_MOTOR_L_MAX_NH)) return "ld_nh";
+  if (!in_range(c->lq_nh, POUR_MOTOR_L_MIN_NH, POUR_MOTOR_L_MAX_NH)) return "lq_nh";
   if (!in_range(c->kt_unm_per_a, 1, 1000000)) return "kt_unm_per_a";
-  if (!in_range(c->pole_pairs, 1, 32)) return "pole_pairs";
+  if (!in_range(c->pole_pairs, 1, POUR_MOTOR_POLE_PAIRS_MAX)) return "pole_pairs";
   if (!in_range(c->gear_ratio, 1, 1000)) return "gear_ratio";
   if (!in_range(c->gear_efficiency_q15, 16384, 32768)) return "gear_efficiency_q15";
   /* ωc·20 <= 2π·f: the loop's delay (1.5 periods) then costs at most 27° of phase margin */
@@ -89,6 +93,14 @@ const char *pour_drive_config_check(const pour_drive_config_t *c) {
   if (!in_range(c->phase_sum_ma, 100, 60000)) return "phase_sum_ma";
   if (!in_range(c->phase_loss_ms, 1, 1000)) return "phase_loss_ms";
   if (!in_range(c->encoder_check_urad, 1000, 1000000)) return "encoder_check_urad";
+  if (c->encoder_reversed > 1u) return "encoder_reversed";
+  if (!in_range(c->cal_current_ma, 100, c->current_limit_ma) || c->cal_current_ma > (uint32_t)I_BASE / 2u)
+    return "cal_current_ma";
+  if (!in_range(c->cal_l_test_mv, 100, 10000)) return "cal_l_test_mv";
+  /* an electrical turn of a 32-pole-pair motor at the output .. half a turn */
+  if ((uint64_t)c->cal_motion_urad * POUR_MOTOR_POLE_PAIRS_MAX * c->gear_ratio < TWO_PI_URAD ||
+      c->cal_motion_urad > TWO_PI_URAD / 2u)
+    return "cal_motion_urad";
   return NULL;
 }
 
@@ -147,6 +159,10 @@ pour_status_t pour_drive_init(pour_drive_t *drv, const pour_drive_config_t *conf
 }
 
 void pour_drive_trip(pour_drive_t *drv, uint16_t fault) {
+  if (drv->state == POUR_DRIVE_MEASURING) {
+    drv->cal_status = POUR_MOTOR_CAL_ABORTED;
+    fault |= POUR_DRIVE_FAULT_CALIBRATION;
+  }
   drv->faults = (uint16_t)(drv->faults | (fault & POUR_DRIVE_FAULT_ALL));
   drv->state = POUR_DRIVE_FAULTED;
   pour_current_pi_reset(&drv->pi_d);
@@ -173,6 +189,84 @@ static uint16_t compare_of(int32_t duty_q15, uint16_t period) {
   return (uint16_t)(((uint32_t)duty_q15 * period + (1u << 14)) >> 15);
 }
 
+static int32_t vmax_of(q15_t vbus) { return (int32_t)(((int64_t)vbus * VMAX_OF_BUS_Q15) >> 15); }
+
+pour_status_t pour_drive_calibrate(pour_drive_t *drv) {
+  const pour_drive_config_t *c = &drv->config;
+  /* a missing calibration is the one latched fault a calibration may start from (it clears it) */
+  const int uncalibrated = drv->state == POUR_DRIVE_FAULTED && drv->faults == POUR_DRIVE_FAULT_CALIBRATION &&
+                           drv->sense.calibrated;
+  if (drv->state != POUR_DRIVE_RUN && !uncalibrated) return POUR_EINVAL;
+  const pour_motor_cal_config_t mc = {
+      c->pwm_hz, I_BASE, V_BASE, c->cal_current_ma, c->cal_l_test_mv, c->encoder_cpr,
+      (uint32_t)((uint64_t)c->cal_motion_urad * c->gear_ratio * c->encoder_cpr / TWO_PI_URAD)};
+  if (pour_motor_cal_init(&drv->cal, &mc, drv->last_encoder) != POUR_OK) return POUR_EINVAL;
+  pour_current_pi_reset(&drv->pi_d);
+  pour_current_pi_reset(&drv->pi_q);
+  drv->iq_cmd_q15 = 0;
+  drv->cal_status = POUR_MOTOR_CAL_RUNNING;
+  drv->state = POUR_DRIVE_MEASURING;
+  return POUR_OK;
+}
+
+void pour_drive_calibrate_abort(pour_drive_t *drv) {
+  if (drv->state == POUR_DRIVE_MEASURING) pour_drive_trip(drv, POUR_DRIVE_FAULT_CALIBRATION);
+}
+
+pour_motor_cal_status_t pour_drive_calibration(const pour_drive_t *drv, pour_motor_cal_result_t *result) {
+  if (drv->cal_status == POUR_MOTOR_CAL_OK && result != NULL) *result = drv->cal_result;
+  return drv->cal_status;
+}
+
+/* A period of the self-calibration: its voltage vector through the same modulation as the current loop's;
+ * at its end, the results into the configuration and RUN, or the reason latched. */
+static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t alpha, q15_t beta,
+                    pour_drive_output_t *out) {
+  q15_t va, vb;
+  const pour_motor_cal_status_t st = pour_motor_cal_step(&drv->cal, alpha, beta, encoder, vmax_of(out->vbus), &va, &vb);
+  if (st == POUR_MOTOR_CAL_RUNNING) {
+    pour_foc_modulate_q15(va, vb, out->vbus, i, &drv->modulation, out->duty);
+    for (int k = 0; k < 3; ++k) out->compare[k] = compare_of(out->duty[k], drv->period);
+    out->pwm_enable = 1;
+    out->brake = 0;
+    out->faults = drv->faults;
+    return;
+  }
+  if (st == POUR_MOTOR_CAL_OK) {
+    const pour_motor_cal_result_t r = drv->cal.result;
+    pour_drive_config_t c = drv->config;
+    c.r_phase_uohm = r.r_phase_uohm;
+    c.ld_nh = c.lq_nh = r.l_phase_nh;
+    c.pole_pairs = r.pole_pairs;
+    c.encoder_reversed = r.encoder_direction < 0 ? 1u : 0u;
+    c.encoder_offset = r.electrical_offset;
+    /* Only the motor's numbers change: the current loop's gains from them, the rest (the offsets, the bases,
+     * the limits) stays, so this period costs two gain computations rather than a whole init. */
+    pour_current_pi_t pi_d, pi_q;
+    if (pour_drive_config_check(&c) == NULL &&
+        pour_current_pi_init(&pi_d, c.bandwidth_rad_s, c.ld_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK &&
+        pour_current_pi_init(&pi_q, c.bandwidth_rad_s, c.lq_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK) {
+      drv->config = c;
+      drv->pi_d = pi_d;
+      drv->pi_q = pi_q;
+      drv->cal_status = POUR_MOTOR_CAL_OK;
+      drv->cal_result = r;
+      drv->faults = 0; /* nothing else can be latched: a trip would have ended the sequence */
+      drv->iq_cmd_q15 = 0;
+      drv->motor_counts = drv->output_urad = 0;
+      drv->phase_loss_count = 0;
+      drv->last_encoder = encoder;
+      drv->state = POUR_DRIVE_RUN; /* at zero current from the next period */
+      hold(drv, out);
+      return;
+    }
+  }
+  pour_drive_trip(drv, POUR_DRIVE_FAULT_CALIBRATION);
+  /* R and L in range whose current-loop gains (Kp = ωc·L) do not fit Q16.16: L is what is implausible */
+  drv->cal_status = st == POUR_MOTOR_CAL_OK ? POUR_MOTOR_CAL_INDUCTANCE : st;
+  hold(drv, out);
+}
+
 void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive_output_t *out) {
   const pour_drive_config_t *c = &drv->config;
   out->id = out->iq = out->id_ref = out->iq_ref = 0;
@@ -192,7 +286,7 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   }
   q15_t i[3];
   pour_current_sense_convert(&drv->sense, in->adc_phase, i);
-  if (drv->state == POUR_DRIVE_RUN) {
+  if (drv->state == POUR_DRIVE_RUN || drv->state == POUR_DRIVE_MEASURING) {
     uint16_t f = 0;
     for (int k = 0; k < 3; ++k)
       if (abs_i32(i[k]) > drv->overcurrent_q15) f |= POUR_DRIVE_FAULT_OVERCURRENT;
@@ -205,13 +299,19 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   const int32_t cpr = (int32_t)c->encoder_cpr;
   int32_t step = ((int32_t)in->encoder - (int32_t)drv->last_encoder) & (cpr - 1);
   if (step >= cpr / 2) step -= cpr;
+  if (c->encoder_reversed) step = -step;
   drv->motor_counts += step;
   drv->last_encoder = in->encoder;
+  const uint32_t poles = (uint32_t)in->encoder * c->pole_pairs;
   const uint16_t angle =
-      (uint16_t)((((uint32_t)in->encoder * c->pole_pairs) << drv->elec_shift) + c->encoder_offset);
+      (uint16_t)((((c->encoder_reversed ? 0u - poles : poles)) << drv->elec_shift) + c->encoder_offset);
   q15_t s, co, alpha, beta, id, iq;
   pour_foc_sincos_q15(angle, &s, &co);
   pour_foc_clarke_q15(i[0], i[1], i[2], &alpha, &beta);
+  if (drv->state == POUR_DRIVE_MEASURING) {
+    measure(drv, in->encoder, i, alpha, beta, out);
+    return;
+  }
   pour_foc_park_q15(alpha, beta, s, co, &id, &iq);
   out->id = id;
   out->iq = iq;
@@ -235,7 +335,7 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   const int32_t iq_ref = clamp_i32(drv->iq_cmd_q15, -iq_max, iq_max);
   if (iq_ref != drv->iq_cmd_q15) limits |= POUR_DRIVE_LIMIT_CURRENT;
   /* the voltage vector within vmax, d first (flux braking keeps its current), q takes what is left */
-  const int32_t vmax = (int32_t)(((int64_t)out->vbus * VMAX_OF_BUS_Q15) >> 15);
+  const int32_t vmax = vmax_of(out->vbus);
   const int32_t ed = id_ref - id, eq = iq_ref - iq;
   const q15_t vd = pour_current_pi_step(&drv->pi_d, ed, vmax);
   const int32_t vq_max = (int32_t)pour_foc_isqrt_u32((uint32_t)(vmax * vmax - (int32_t)vd * vd));

@@ -58,6 +58,9 @@
 POUR_REGS_DECLARE(ADC);
 #define POUR_ADC_N_REGS (0x100 / 4)   /* one ADC's register file in a host test [words] */
 
+/* ADC1 and ADC2's interrupt line (the stm32g4 crate's Interrupt::ADC1_2): the current loop's. */
+#define POUR_ADC_IRQ 18u
+
 /* RM0440 (not in the SVD): injected trigger 8 of ADC1/ADC2 is TIM1's TRGO2; ADC12 clock HCLK / 4. */
 #define POUR_ADC_JEXTSEL_TIM1_TRGO2 8u
 #define POUR_ADC_CKMODE_HCLK_DIV4 3u

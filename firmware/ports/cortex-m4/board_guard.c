@@ -31,19 +31,19 @@ pour_status_t pour_guard_init(pour_guard_t *g, const pour_guard_config_t *config
   return pour_protect_init(&g->protect, protect);
 }
 
-void pour_guard_tick(pour_guard_t *g, int32_t output_urad, bool output_fresh, bool calibration_valid, bool clear,
-                     pour_protect_output_t *out) {
+void pour_guard_tick(pour_guard_t *g, const pour_hal_drive_sample_t *sample, uint16_t loop_faults, int32_t output_urad,
+                     bool output_fresh, bool calibration_valid, bool clear, pour_protect_output_t *out) {
   const pour_guard_config_t *c = &g->config;
-  pour_hal_drive_sample_t s;
-  if (pour_hal_drive_sample(&s)) {
-    const int64_t pin_mv = (int64_t)s.vbus * c->adc_vref_mv / 4096;
+  if (sample != NULL) {
+    const pour_hal_drive_sample_t *s = sample;
+    const int64_t pin_mv = (int64_t)s->vbus * c->adc_vref_mv / 4096;
     g->vbus_mv = (uint32_t)(pin_mv * c->vbus_divider_milli / 1000);
-    const int64_t ntc_mv = (int64_t)s.ntc * c->adc_vref_mv / 4096;
+    const int64_t ntc_mv = (int64_t)s->ntc * c->adc_vref_mv / 4096;
     g->temp_mdegc = (int32_t)(c->ntc_t0_mdegc + (ntc_mv - c->ntc_mv_at_t0) * 1000000 / c->ntc_uv_per_degc);
     if (g->sampled) {
-      g->motor_counts += (int16_t)(uint16_t)(s.encoder - g->last_count); /* one tick moves < 2^15 counts */
+      g->motor_counts += (int16_t)(uint16_t)(s->encoder - g->last_count); /* one tick moves < 2^15 counts */
     }
-    g->last_count = s.encoder;
+    g->last_count = s->encoder;
     g->sampled = true;
   }
   if (clear && pour_hal_drive_overcurrent_tripped()) {
@@ -57,6 +57,7 @@ void pour_guard_tick(pour_guard_t *g, int32_t output_urad, bool output_fresh, bo
   in.output_urad = output_urad;
   in.output_fresh = output_fresh && g->sampled;
   in.calibration_valid = calibration_valid;
+  in.loop_faults = loop_faults;
   in.clear = clear;
   pour_protect_step(&g->protect, &in, out);
   if (out->brake) {

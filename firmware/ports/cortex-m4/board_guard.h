@@ -1,14 +1,16 @@
 /* SPDX-License-Identifier: MIT */
-/* The board's protection wired to its HAL, once per 1 kHz tick: reads the bus voltage, the NTC and the
- * motor encoder (hal_drive), the hardware overcurrent cut, runs pour_protect_step, and acts: the brake
- * (hal_brake) and, unless the drive is still trusted to stop the bucket, the phases shorted (hal_drive).
- * The output angle and ClearErrors come from the bus; the calibration's validity from its storage. */
+/* The board's protection wired to its HAL, once per 1 kHz tick: the bus voltage, the NTC and the motor
+ * encoder of the current loop's latest sample (hal_drive's, which the loop's interrupt takes), the hardware
+ * overcurrent cut, pour_protect_step, and what it says: the brake (hal_brake) and, unless the drive is still
+ * trusted to stop the bucket, the phases shorted (hal_drive). The output angle and ClearErrors come from the
+ * bus; the calibration's validity from its storage. */
 #ifndef POUR_BOARD_GUARD_H
 #define POUR_BOARD_GUARD_H
 
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "hal_drive.h"
 #include "protect.h"
 
 typedef struct {
@@ -37,8 +39,10 @@ pour_guard_config_t pour_guard_default_config(void);
 
 pour_status_t pour_guard_init(pour_guard_t *g, const pour_guard_config_t *config, const pour_protect_config_t *protect);
 
-/* One tick; *out says what was done (and, in POUR_PROTECT_ACTIVE_STOP, that the caller's stop is to run). */
-void pour_guard_tick(pour_guard_t *g, int32_t output_urad, bool output_fresh, bool calibration_valid, bool clear,
-                     pour_protect_output_t *out);
+/* One tick on the loop's latest sample (NULL: none since the last tick; the previous readings stand) and
+ * the faults the loop latched itself (loop_faults, POUR_DRIVE_FAULT_*); *out says what was done (and, in
+ * POUR_PROTECT_ACTIVE_STOP, that the caller's stop is to run). */
+void pour_guard_tick(pour_guard_t *g, const pour_hal_drive_sample_t *sample, uint16_t loop_faults, int32_t output_urad,
+                     bool output_fresh, bool calibration_valid, bool clear, pour_protect_output_t *out);
 
 #endif /* POUR_BOARD_GUARD_H */

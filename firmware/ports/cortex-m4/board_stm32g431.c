@@ -9,17 +9,19 @@
  *         engaged through reset and while the MCU is unpowered
  *   PB8   power stage enable (J8's index pin, unused: the output encoder gives the absolute angle), high =
  *         on; external pull-down (it also holds BOOT0 low: boot from flash)
- *   PA11, PB9  FDCAN1 RX, TX (AF9); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
+ *   PA11, PB9  FDCAN1 RX, TX (board_af.h); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
  *   PC6   LED (red), high = on */
 #include <stddef.h>
 
 #include "adc_inj.h"
+#include "board_af.h"
 #include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
 #include "fdcan.h"
 #include "gpio.h"
 #include "hal_drive.h"
+#include "hal_drive_g4.h"
 #include "ocp.h"
 #include "opamp.h"
 #include "pwm_tim1.h"
@@ -40,7 +42,6 @@
 #define GPIOA_R POUR_PERIPH(GPIOA)
 #define GPIOB_R POUR_PERIPH(GPIOB)
 #define GPIOC_R POUR_PERIPH(GPIOC)
-#define AF_FDCAN1 9u
 #define CAN_TERMINATED true /* this node ends the bench's bus (the rig's sensor node is the other end) */
 #define WAIT_POLLS 100000u /* bound of every ready-flag wait: a flag that never comes is an error */
 
@@ -48,13 +49,20 @@ static const pour_gpio_t estop = {GPIOA_R, 15u};
 static const pour_gpio_t brake = {GPIOB_R, 12u};
 static const pour_gpio_t power = {GPIOB_R, 8u};
 static const pour_gpio_t led = {GPIOC_R, 6u};
-static const pour_gpio_t can_rx = {GPIOA_R, 11u};
-static const pour_gpio_t can_tx = {GPIOB_R, 9u};
+
+/* A pin and its alternate function, from board_af.h's table. */
+typedef struct {
+  pour_gpio_t pin;
+  uint8_t af;
+} af_pin_t;
+#define AF_PIN(owner, signal, port, pin, af) {{GPIO##port##_R, pin##u}, af##u},
+static const af_pin_t can_pins[] = {POUR_BOARD_AF_CAN(AF_PIN)};
+static const af_pin_t gates[] = {POUR_BOARD_AF_GATES(AF_PIN)};
+static const af_pin_t encoder_pins[] = {POUR_BOARD_AF_ENCODER(AF_PIN)};
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
 static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
 static const pour_gpio_t can_termination = {GPIOC_R, 14u};
 
-static pour_pwm_t pwm;
-static pour_adc_t adc;
 static pour_ocp_t ocp;
 
 static void clock_on(uint32_t enr, uint32_t mask) {
@@ -134,8 +142,9 @@ pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
   RCC_R[POUR_RCC_CCIPR] = (RCC_R[POUR_RCC_CCIPR] & ~POUR_MSK(RCC, CCIPR, FDCANSEL)) | POUR_VAL(RCC, CCIPR, FDCANSEL, 2u);
   clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, FDCANEN));
   ports_on();
-  pour_gpio_alternate(can_rx, AF_FDCAN1);
-  pour_gpio_alternate(can_tx, AF_FDCAN1);
+  for (unsigned i = 0; i < COUNT(can_pins); ++i) {
+    pour_gpio_alternate(can_pins[i].pin, can_pins[i].af);
+  }
   pour_gpio_output(can_termination, CAN_TERMINATED);
   pour_gpio_output(can_shutdown, false);
   pour_fdcan_config_t fc = pour_fdcan_default_config();
@@ -150,14 +159,7 @@ int pour_hal_can_receive(pour_can_frame_t *frame) { return pour_fdcan_receive(&f
 
 int pour_hal_can_transmit(const pour_can_frame_t *frame) { return pour_fdcan_transmit(&fdcan, frame); }
 
-/* The motor's power stage (hal_drive). Alternate functions from the STM32G431's datasheet (DS12589, table
- * "alternate functions"): TIM1 CH1..3 on PA8..PA10 AF6, CH1N on PC13 AF4, CH2N on PA12 AF6, CH3N on PB15
- * AF4; TIM4 CH1, CH2 on PB6, PB7 AF2. */
-static const struct {
-  pour_gpio_t pin;
-  uint8_t af;
-} gates[6] = {{{GPIOA_R, 8u}, 6u},  {{GPIOA_R, 9u}, 6u},  {{GPIOA_R, 10u}, 6u},
-              {{GPIOC_R, 13u}, 4u}, {{GPIOA_R, 12u}, 6u}, {{GPIOB_R, 15u}, 4u}};
+/* The motor's power stage (hal_drive): the gates, the encoder and the converters' pins. */
 /* OPAMP inputs and outputs, the bus divider, the NTC: PA0..PA3, PA5..PA7, PB0..PB2, PB14. */
 static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R, 2u}, {GPIOA_R, 3u},
                                           {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
@@ -167,60 +169,50 @@ static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R
 #define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
 
 
+/* The NVIC is the core's (ARMv7-M): the same addresses on every Cortex-M4. */
+#define NVIC_ISER0 (*(volatile uint32_t *)0xE000E100u)
+#define NVIC_ICER0 (*(volatile uint32_t *)0xE000E180u)
+
+void pour_hal_drive_mask(bool masked) {
+  if (masked) {
+    NVIC_ICER0 = 1u << POUR_ADC_IRQ;
+    __asm volatile("dsb\n isb" ::: "memory"); /* no interrupt of the loop's after this returns */
+  } else {
+    NVIC_ISER0 = 1u << POUR_ADC_IRQ;
+  }
+}
+
 pour_status_t pour_hal_drive_init(void) {
-  for (unsigned i = 0; i < 6u; ++i) {
+  for (unsigned i = 0; i < COUNT(gates); ++i) {
     pour_gpio_output(gates[i].pin, false); /* all six off while TIM1 is set up */
   }
   clock_on(POUR_RCC_APB2ENR, POUR_MSK(RCC, APB2ENR, TIM1EN) | POUR_MSK(RCC, APB2ENR, SYSCFGEN));
   clock_on(POUR_RCC_APB1ENR1, POUR_MSK(RCC, APB1ENR1, TIM4EN));
   clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, ADC12EN) | POUR_MSK(RCC, AHB2ENR, DAC3EN));
-  for (unsigned i = 0; i < sizeof analog_pins / sizeof analog_pins[0]; ++i) {
+  for (unsigned i = 0; i < COUNT(analog_pins); ++i) {
     pour_gpio_analog(analog_pins[i]);
   }
   const pour_pwm_config_t pc = pour_pwm_default_config();
+  pour_pwm_t pwm;
+  pour_adc_t adc;
   if (pour_pwm_init(&pwm, POUR_PERIPH(TIM1), &pc) != POUR_OK) {
     return POUR_EINVAL;
   }
-  for (unsigned i = 0; i < 6u; ++i) {
+  for (unsigned i = 0; i < COUNT(gates); ++i) {
     pour_gpio_alternate(gates[i].pin, gates[i].af); /* the timer, all six off, takes the pins */
   }
-  const pour_gpio_t enc_a = {GPIOB_R, 6u};
-  const pour_gpio_t enc_b = {GPIOB_R, 7u};
-  pour_gpio_alternate(enc_a, 2u);
-  pour_gpio_alternate(enc_b, 2u);
+  for (unsigned i = 0; i < COUNT(encoder_pins); ++i) {
+    pour_gpio_alternate(encoder_pins[i].pin, encoder_pins[i].af);
+  }
   if (pour_opamp_init(POUR_PERIPH(OPAMP), OPAMP_GAIN) != POUR_OK ||
       pour_encoder_init(POUR_PERIPH(TIM4), ENCODER_FILTER, 0) != POUR_OK ||
       pour_adc_init(&adc, POUR_PERIPH(ADC1), POUR_PERIPH(ADC2), POUR_PERIPH(ADC12_COMMON), WAIT_POLLS,
                     ADC_REGULATOR_WAIT) != POUR_OK) {
     return POUR_EINVAL;
   }
+  pour_hal_drive_attach(&pwm, &adc, POUR_PERIPH(TIM4));
+  pour_hal_drive_mask(false); /* the current loop runs from now on (ADC1's end of sequence: pour_adc_init) */
   return POUR_OK;
-}
-
-uint16_t pour_hal_drive_period(void) { return pwm.period; }
-
-bool pour_hal_drive_sample(pour_hal_drive_sample_t *sample) {
-  pour_adc_sample_t s;
-  if (adc.adc1 == NULL || !pour_adc_read(&adc, &s)) {
-    return false;
-  }
-  for (unsigned i = 0; i < 3u; ++i) {
-    sample->phase[i] = s.phase[i];
-  }
-  sample->vbus = s.vbus;
-  sample->ntc = s.ntc;
-  sample->encoder = pour_encoder_count(POUR_PERIPH(TIM4));
-  return true;
-}
-
-void pour_hal_drive_set_compares(const uint16_t compare[3]) { pour_pwm_set_compares(&pwm, compare); }
-
-void pour_hal_drive_enable(bool on) { pour_pwm_enable(&pwm, on); }
-
-void pour_hal_drive_short_low_sides(void) {
-  if (pwm.regs != NULL) {
-    pour_pwm_short_low_sides(&pwm);
-  }
 }
 
 pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
@@ -228,9 +220,6 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
   return pour_ocp_init(&ocp, POUR_PERIPH(COMP), POUR_PERIPH(DAC3), &oc, offset_counts);
 }
 
-bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
-
-void pour_hal_drive_clear_overcurrent(void) { pour_pwm_clear_break(&pwm); }
 
 /* The calibration: the block in the page the linker script leaves (hal_calibration). */
 static pour_calibration_t calibration;
@@ -246,12 +235,5 @@ pour_status_t pour_hal_calibration_load(void) {
 int pour_hal_calibration_reason(void) { return (int)calibration_status; }
 
 void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
-  const bool ok = calibration_status == POUR_CAL_OK;
-  r->status = POUR_CAN_CAL_UNAVAILABLE;
-  r->stored = (uint8_t)calibration_status; /* POUR_CAN_CAL_OK .. _WRITE_FAILED are pour_cal_status_t's values */
-  r->encoder_reversed = ok && calibration.encoder_direction < 0 ? 1u : 0u;
-  r->pole_pairs = ok ? (uint8_t)calibration.pole_pairs : 0u;
-  r->resistance_mohm = ok ? (uint16_t)(calibration.r_phase_uohm / 1000u) : 0u;
-  r->inductance_uh = ok ? (uint16_t)(calibration.l_phase_nh / 1000u) : 0u;
-  r->electrical_offset = ok ? (uint8_t)(calibration.electrical_offset >> 8) : 0u;
+  pour_calibration_can_result(calibration_status, &calibration, POUR_CAN_CAL_UNAVAILABLE, r);
 }

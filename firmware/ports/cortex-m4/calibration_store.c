@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "calibration_store.h"
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #define MAGIC 0x4C414350u /* "PCAL" */
@@ -72,6 +73,18 @@ pour_cal_status_t pour_calibration_load(const pour_flash_t *flash, pour_calibrat
   }
   *cal = c;
   return POUR_CAL_OK;
+}
+
+void pour_calibration_can_result(pour_cal_status_t stored, const pour_calibration_t *cal, uint8_t status,
+                                 pour_can_calibration_result_t *r) {
+  const bool ok = stored == POUR_CAL_OK && cal != NULL;
+  r->status = status;
+  r->stored = (uint8_t)stored; /* POUR_CAN_CAL_OK .. _WRITE_FAILED are pour_cal_status_t's values */
+  r->encoder_reversed = ok && cal->encoder_direction < 0 ? 1u : 0u;
+  r->pole_pairs = ok ? (uint8_t)cal->pole_pairs : 0u;
+  r->resistance_mohm = ok ? (uint16_t)((cal->r_phase_uohm + 500u) / 1000u) : 0u;
+  r->inductance_uh = ok ? (uint16_t)((cal->l_phase_nh + 500u) / 1000u) : 0u;
+  r->electrical_offset = ok ? (uint8_t)(((cal->electrical_offset + 128u) >> 8) & 0xFFu) : 0u;
 }
 
 pour_cal_status_t pour_calibration_save(const pour_flash_t *flash, const pour_calibration_t *cal) {

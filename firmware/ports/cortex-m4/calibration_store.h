@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "flash_g4.h"
+#include "pour/can_codec.h"
 
 #define POUR_CAL_FORMAT_VERSION 1u
 
@@ -42,6 +43,11 @@ pour_cal_status_t pour_calibration_load(const pour_flash_t *flash, pour_calibrat
 /* Checks, erases, programs, reads back: POUR_CAL_OK, POUR_CAL_OUT_OF_RANGE (nothing written) or
  * POUR_CAL_WRITE_FAILED. */
 pour_cal_status_t pour_calibration_save(const pour_flash_t *flash, const pour_calibration_t *cal);
+
+/* The CalibrationResult that says status (POUR_CAN_CAL_*) beside the stored block's state and, when it is
+ * POUR_CAL_OK, its values (R in mΩ, L in µH, the offset's top 8 bits). */
+void pour_calibration_can_result(pour_cal_status_t stored, const pour_calibration_t *cal, uint8_t status,
+                                 pour_can_calibration_result_t *result);
 
 /* CRC-32 (IEEE 802.3, reflected, initial and final 0xFFFFFFFF) of n little-endian words. */
 uint32_t pour_calibration_crc32(const uint32_t *words, uint32_t n);

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The motor driver of this port is reached over CAN (the torque goes out in the answer frame), so the
- * local "driver" only keeps the latest command; a board with a PWM stage would write its timer here. */
+/* The torque command as the 1 kHz tick leaves it: board_drive hands it to the current loop as its
+ * reference (pour_drive_tick), derated by the board's protection. */
 #include "hal_motor.h"
 
 static volatile q15_t command;

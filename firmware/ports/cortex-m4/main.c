@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: MIT */
-/* Cortex-M4 firmware: the 1 kHz loop around the control step. Inputs come from the bus through pour::can's
- * node (can/pour.dbc: states, e-stop, stop, clear-errors, reset) and from the hardwired e-stop line; the
- * torque, the brake and the power stage follow the core's output; torque, heartbeat and identity frames go
- * back on the bus. The same file runs in the STM32G431 image (board_stm32g431.c behind the hal_* calls)
+/* Cortex-M4 firmware: the 1 kHz loop around the control step, above the current loop's interrupt
+ * (board_drive). Inputs come from the bus through pour::can's node (can/pour.dbc: states, e-stop, stop,
+ * clear-errors, reset), from the hardwired e-stop line and from the drive (its faults); the torque (the
+ * current loop's reference), the brake and the power stage follow the core's output; torque, heartbeat,
+ * identity and drive-telemetry frames go back on the bus. The same file runs in the STM32G431 image (board_stm32g431.c behind the hal_* calls)
  * and in the QEMU smoke test (smoke_bench.c, a scripted bench behind the same calls). */
 #include <stdbool.h>
 
+#include "board_drive.h"
 #include "clock.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -73,6 +75,10 @@ int main(void) {
   if (status == POUR_OK) {
     status = pour_hal_calibration_load(); /* an uncalibrated drive could turn the bucket the wrong way */
   }
+  if (status == POUR_OK) {
+    const pour_drive_config_t drive = pour_drive_default_config();
+    status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, true);
+  }
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
@@ -95,17 +101,22 @@ int main(void) {
   for (;;) {
     const uint32_t missed = pour_hal_timer_wait_tick();
     overruns += missed;
+    /* The hardwired line around the tick's frames: a clear counts only if the line was released at both. */
+    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
     pour_hal_can_poll();
     pour_can_frame_t f;
     while (pour_hal_can_receive(&f) == 1) {
       (void)pour_can_node_receive(&can_node, &f);
     }
+    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
     pour_control_input_t in;
     pour_can_node_begin_tick(&can_node, &in);
-    in.estop = in.estop || pour_hal_estop_asserted(); /* the hardwired line, every tick, beside the frame */
     pour_control_output_t out;
-    pour_port_tick(&controller, &in, &out);
+    pour_board_drive_tick(&controller, &in, &out);
     pour_hal_led_show(out.mode, false);
+    pour_can_drive_telemetry_t drive;
+    pour_board_drive_telemetry(&drive);
+    pour_can_node_set_drive(&can_node, &drive);
     transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */

@@ -74,6 +74,7 @@ void pour_protect_step(pour_protect_t *p, const pour_protect_input_t *in, pour_p
   now |= in->hw_overcurrent ? POUR_DRIVE_FAULT_HW_OVERCURRENT : 0u;
   now |= p->mismatch_n >= c->mismatch_ticks ? POUR_DRIVE_FAULT_ENCODER_MISMATCH : 0u;
   now |= in->calibration_valid ? 0u : POUR_DRIVE_FAULT_CALIBRATION;
+  now |= in->loop_faults & POUR_DRIVE_FAULT_ALL;
 
   if (in->clear && now == 0u) {
     p->faults = 0u;
@@ -85,7 +86,7 @@ void pour_protect_step(pour_protect_t *p, const pour_protect_input_t *in, pour_p
     p->since_fault_ms = 0u;
   }
   p->faults |= now;
-  if ((p->faults & (uint16_t)~TRUSTED_FAULTS) != 0u) {
+  if ((p->faults & (uint16_t)~TRUSTED_FAULTS) != 0u || in->loop_faults != 0u) {
     p->trusted = false; /* once not trusted, for the rest of this stop */
   }
 

@@ -40,6 +40,7 @@ typedef struct {
   int32_t output_urad;       /* the output shaft's absolute encoder [µrad] */
   bool output_fresh;         /* output_urad is a new sample this tick */
   bool calibration_valid;    /* a valid calibration block was loaded */
+  uint16_t loop_faults;      /* POUR_DRIVE_FAULT_* the current loop latched itself: it shorts its phases */
   bool clear;                /* ClearErrors this tick */
 } pour_protect_input_t;
 

@@ -1,27 +1,35 @@
 /* SPDX-License-Identifier: MIT */
 /* The QEMU smoke test's bench (mps2-an386, semihosted): the hal_* calls of main.c answered by a scripted
- * host and a small plant instead of the STM32G431's pins and FDCAN, so that the production loop itself runs
- * under SysTick on an emulated Cortex-M4. The script, by tick:
+ * host and a small plant instead of the STM32G431's pins, FDCAN, TIM1 and ADCs, so that the production loop
+ * itself runs under SysTick on an emulated Cortex-M4, and the current loop's interrupt (board_drive) runs
+ * 20 times a tick, called by the script as the ADC would: its samples are those of a motor whose currents
+ * follow the drive's references (tests/board/ideal_drive.h), and the bucket moves with that motor's torque.
+ * The script, by tick:
  *     10..169  states of a bucket that moves with the torque (StateA + StateB frames, seq counting)
  *   100..119  the hardwired e-stop line asserted
  *        130  ClearErrors
  *      170..  no more states: the input times out
  *        205  the verdict (exit status 0 or 1), after the heartbeat of tick 201
- * Checked: RUN and torque before the e-stop; zero torque, brake engaged and power off in the e-stop's own
+ * Checked: the current loop's periods (20 a tick), its offsets measured with the gates off and the brake
+ * held meanwhile, then its compares written and its q current following the torque frame's sign;
+ * DriveTelemetry with every heartbeat, without a fault, its q current that of the loop; RUN and torque before the e-stop; zero torque, brake engaged and power off in the e-stop's own
  * tick; ESTOP latched until the clear, then RUN again through the slew limit; the stale-input fault and the
  * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
  * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "board_drive.h"
 #include "clock.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
+#include "hal_drive.h"
 #include "hal_estop.h"
 #include "hal_led.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
+#include "ideal_drive.h"
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
 
@@ -33,6 +41,9 @@
 #define ESTOP_TO 120u
 #define CLEAR_AT 130u
 #define STATES_TO 170u
+#define PERIODS_PER_TICK 20u /* 20 kHz PWM under the 1 kHz loop */
+#define VBUS_MV 24000u
+#define NTC_MV 1055u /* 25 °C */
 
 static uint32_t tick;
 static bool brake = true, power;
@@ -43,6 +54,8 @@ static unsigned rx_n, rx_i;
 
 static struct {
   uint32_t feeds, heartbeats, identities, bad_identity, slew_steps, led_shows, led_wrong;
+  uint32_t periods, gates_on_calibrating, released_calibrating, compares, iq_sign_wrong, iq_sign_checked;
+  uint32_t telemetry, telemetry_faulted, telemetry_iq_wrong;
   bool ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
   q15_t peak, last_torque;
   uint8_t last_mode;
@@ -81,11 +94,59 @@ pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
   return clock_hz == MPS2_AN386_CLOCK_HZ && node_id == 0u ? POUR_OK : POUR_EINVAL;
 }
 
-/* Once per loop tick: the plant moves under the last applied torque, and this tick's frames are queued. */
+/* --- the power stage: TIM1, the ADCs and the encoder as the current loop's interrupt sees them --------- */
+static bool gates_on;
+static uint16_t motor_counts; /* the motor encoder: θ through the gearbox */
+
+pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
+uint16_t pour_hal_drive_period(void) { return 4250u; }
+bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
+  const pour_drive_t *drv = pour_board_drive_state();
+  const pour_drive_output_t *o = pour_board_drive_output();
+  const q15_t id = gates_on ? o->id_ref : 0, iq = gates_on ? o->iq_ref : 0; /* last period's references */
+  pour_ideal_phase_counts(drv, id, iq, motor_counts, drv->config.offset_nominal, s->phase);
+  s->vbus = pour_ideal_adc_counts(&drv->config, VBUS_MV * 1000u / drv->config.vbus_divider_milli);
+  s->ntc = pour_ideal_adc_counts(&drv->config, NTC_MV);
+  s->encoder = motor_counts;
+  return true;
+}
+void pour_hal_drive_set_compares(const uint16_t compare[3]) {
+  seen.compares += (compare[0] | compare[1] | compare[2]) != 0u ? 1u : 0u;
+}
+void pour_hal_drive_enable(bool on) { gates_on = on; }
+void pour_hal_drive_short_low_sides(void) { gates_on = false; }
+pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
+  (void)offset_counts;
+  return POUR_OK;
+}
+bool pour_hal_drive_overcurrent_tripped(void) { return false; }
+void pour_hal_drive_clear_overcurrent(void) {}
+void pour_hal_drive_mask(bool masked) { (void)masked; }
+
+/* The PWM periods of one tick: the interrupt as the ADC's end of sequence would raise it. */
+static void run_periods(void) {
+  const pour_drive_t *drv = pour_board_drive_state();
+  for (unsigned k = 0; k < PERIODS_PER_TICK; ++k) {
+    pour_board_drive_isr();
+    seen.periods++;
+    if (drv->state == POUR_DRIVE_CALIBRATING) {
+      seen.gates_on_calibrating += gates_on ? 1u : 0u;
+      seen.released_calibrating += brake ? 0u : 1u;
+    }
+  }
+  const int32_t mnm = power && gates_on ? pour_ideal_torque_mnm(&drv->config, pour_board_drive_output()->iq_ref, true) : 0;
+  const int32_t q = mnm * 32768 / pour_weights_compiled.tau_max_mnm;
+  applied = (q15_t)(q > 32767 ? 32767 : (q < -32767 ? -32767 : q));
+}
+
+/* Once per loop tick: the plant moves under the motor's torque, and this tick's frames are queued. */
 void pour_hal_can_poll(void) {
   ++tick;
+  run_periods();
   omega_urad_s += (int32_t)applied * 6; /* ~200 rad/s² at full torque */
   theta_urad += omega_urad_s / 1000;
+  const pour_drive_config_t *dc = &pour_board_drive_state()->config;
+  motor_counts = (uint16_t)(((int64_t)theta_urad * dc->gear_ratio * dc->encoder_cpr / 6283185) & (dc->encoder_cpr - 1u));
   rx_n = 0u;
   rx_i = 0u;
   if (tick >= 10u && tick < STATES_TO) {
@@ -109,7 +170,12 @@ int pour_hal_can_receive(pour_can_frame_t *frame) {
 }
 
 static void on_torque(const pour_can_torque_t *t) {
-  applied = power ? t->torque : 0;
+  /* The loop's q current command follows the torque's sign (this tick's, handed over before the frame). */
+  const int32_t iq_ref = pour_board_drive_state()->iq_cmd_q15;
+  if (power && gates_on && (t->torque > 1000 || t->torque < -1000)) {
+    seen.iq_sign_checked++;
+    seen.iq_sign_wrong += (t->torque > 0) == (iq_ref > 0) ? 0u : 1u;
+  }
   /* Beyond the slew limit only toward zero (less torque never waits for the slew). */
   const int32_t step = (int32_t)t->torque - seen.last_torque;
   const bool toward_zero = (seen.last_torque >= 0 && t->torque >= 0 && t->torque <= seen.last_torque) ||
@@ -139,11 +205,17 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
   pour_can_torque_t t;
   pour_can_heartbeat_t hb;
   pour_can_identity_t id;
+  pour_can_drive_telemetry_t dt;
   if (pour_can_unpack_torque(frame, &t) == POUR_CAN_RX_OK) {
     on_torque(&t);
   } else if (pour_can_unpack_heartbeat(frame, &hb) == POUR_CAN_RX_OK) {
     seen.heartbeats++;
     seen.last_faults = hb.faults;
+  } else if (pour_can_unpack_drive_telemetry(frame, &dt) == POUR_CAN_RX_OK) {
+    seen.telemetry++;
+    seen.telemetry_faulted += dt.drive_faults != 0u ? 1u : 0u;
+    const int32_t iq_2ma = (int32_t)pour_board_drive_output()->iq * 1000 / 1024;
+    seen.telemetry_iq_wrong += dt.iq_2ma == iq_2ma ? 0u : 1u;
   } else if (pour_can_unpack_identity(frame, &id) == POUR_CAN_RX_OK) {
     seen.identities++;
     if (id.weights_hash != pour_weights_compiled.content_hash || id.init_status != 0 ||
@@ -164,7 +236,16 @@ void pour_hal_watchdog_feed(void) {
   const bool ok = seen.ran && seen.peak > 0 && seen.estop_same_tick && seen.estop_latched && seen.ran_again &&
                   seen.stale_at_end && (seen.last_faults & POUR_FAULT_STALE_INPUT) != 0u && seen.heartbeats >= 2u &&
                   seen.identities == seen.heartbeats && seen.bad_identity == 0u && seen.slew_steps == 0u &&
-                  seen.feeds + 5u >= tick && seen.led_shows + 5u >= tick && seen.led_wrong == 0u;
+                  seen.feeds + 5u >= tick && seen.led_shows + 5u >= tick && seen.led_wrong == 0u &&
+                  seen.periods == tick * PERIODS_PER_TICK && seen.gates_on_calibrating == 0u &&
+                  seen.released_calibrating == 0u && seen.compares > 0u && seen.iq_sign_checked > 0u &&
+                  seen.iq_sign_wrong == 0u && seen.telemetry == seen.heartbeats && seen.telemetry_faulted == 0u &&
+                  seen.telemetry_iq_wrong == 0u;
+  printf("smoke: current loop %u periods (gates on %u, brake released %u while measuring its offsets), %u with "
+         "compares, q current against the torque %u of %u; drive telemetry %u (%u faulted, %u not the loop's)\n",
+         (unsigned)seen.periods, (unsigned)seen.gates_on_calibrating, (unsigned)seen.released_calibrating,
+         (unsigned)seen.compares, (unsigned)seen.iq_sign_wrong, (unsigned)seen.iq_sign_checked,
+         (unsigned)seen.telemetry, (unsigned)seen.telemetry_faulted, (unsigned)seen.telemetry_iq_wrong);
   printf("smoke: %u ticks, watchdog fed %u; ran %d (peak torque %d); e-stop: zero torque, brake, power off in its "
          "tick %d, latched %d; after the clear ran %d; stale at the end %d (faults 0x%x); heartbeats %u, identities "
          "%u (%u wrong); slew-limit breaches %u; LED shown %u ticks, %u not the tick's mode: %s\n",

@@ -6,6 +6,10 @@
 
 #include "hal_timer.h"
 #include "safe_outputs.h"
+#ifndef POUR_SEMIHOSTED
+#include "adc_inj.h"
+#include "board_drive.h"
+#endif
 
 extern uint32_t __data_load__, __data_start__, __data_end__, __bss_start__, __bss_end__, __StackTop;
 extern int main(void);
@@ -45,13 +49,16 @@ void Reset_Handler(void) {
 }
 
 #ifndef POUR_SEMIHOSTED
-/* STM32G431 device interrupts (RM0440): IRQ 0..101 follow the 16 core entries. The loop polls every
- * peripheral, so none is enabled: each entry stops in Default_Handler (safe outputs first). */
+/* STM32G431 device interrupts (RM0440): IRQ 0..101 follow the 16 core entries. One is enabled: ADC1_2
+ * (POUR_ADC_IRQ), the end of each PWM period's conversions, runs the current loop. The 1 kHz loop polls
+ * every other peripheral: any other entry stops in Default_Handler (safe outputs first). */
 #define D1 Default_Handler
-#define D4 D1, D1, D1, D1
-#define D20 D4, D4, D4, D4, D4
-#define POUR_DEVICE_VECTORS D20, D20, D20, D20, D20, D1, D1 /* IRQ 0..101 */
+#define D3 D1, D1, D1
+#define D5 D1, D1, D1, D1, D1
+#define D20 D5, D5, D5, D5
+#define POUR_DEVICE_VECTORS D5, D5, D5, D3, pour_board_drive_isr, D20, D20, D20, D20, D3 /* IRQ 0..101 */
 #define POUR_N_DEVICE_VECTORS 102
+_Static_assert(POUR_ADC_IRQ == 18u, "the current loop's entry is the 19th device vector (5 + 5 + 5 + 3 before it)");
 #else
 /* QEMU mps2-an386 images (tests, benchmark) use no device interrupt. */
 #define POUR_DEVICE_VECTORS

@@ -48,4 +48,8 @@ bool pour_hal_drive_overcurrent_tripped(void);
 /* ClearErrors: re-arms the cut with all six switches off; a comparator still tripping fires it again. */
 void pour_hal_drive_clear_overcurrent(void);
 
+/* true: the current loop's interrupt is held off (the 1 kHz tick's short exchanges with the loop's state);
+ * false: it runs again (a period that ended meanwhile is taken at once). */
+void pour_hal_drive_mask(bool masked);
+
 #endif /* POUR_HAL_DRIVE_H */

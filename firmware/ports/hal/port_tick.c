@@ -9,7 +9,7 @@ void pour_port_outputs(const pour_control_output_t *out) {
   pour_hal_motor_set_torque(out->power ? out->torque : 0);
   if (out->brake) {
     pour_hal_brake_set(true);
-    pour_hal_power_set(false);
+    pour_hal_power_set(out->power); /* on only while a fault's stop or damping needs it, the brake engaging */
   } else {
     pour_hal_power_set(true);
     pour_hal_brake_set(false);

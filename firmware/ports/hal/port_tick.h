@@ -7,7 +7,8 @@
 #include "pour/control.h"
 
 /* The outputs, in order: the motor's torque (zero unless the power stage is to be on), then power on before
- * the brake releases, or the brake engaged before the power goes off. */
+ * the brake releases, or the brake engaged before the power goes off (or stays on, where out asks for both:
+ * a drive fault's stop while the brake engages). */
 void pour_port_outputs(const pour_control_output_t *out);
 
 /* pour_control_step, then pour_port_outputs. */

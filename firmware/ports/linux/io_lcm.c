@@ -60,7 +60,7 @@ static void on_command(const lcm_recv_buf_t *rbuf, const char *channel, void *us
   s->in->have_command = true;
   pour_commands_t *c = s->in->commands;
   if (c != NULL) { /* one message: its e-stop level first, then what it asks for under that level */
-    pour_commands_estop(c, msg.estop != 0);
+    pour_commands_estop(c, POUR_ESTOP_BUS, msg.estop != 0);
     if (msg.clear_faults != 0) {
       pour_commands_clear(c);
     }

@@ -57,7 +57,7 @@
   S("the full drive (docs/motor.md): the firmware's current loop around a motor, inverter and bus model") \
   X(INT, drive, 0, 0, 1, "-", "0: the torque-speed line above (the fast default for training); 1: field-oriented control at 20 kHz") \
   X(INT, drive_regen, 1, 0, 1, "-", "1: the drive's flux braking on; 0: off (regeneration charges the bus)") \
-  X(INT, drive_fault, 0, 0, 4, "-", "injected: 0 none, 1 phase open, 2 phases shorted, 3 encoder reversed, 4 a current amplifier's offset broken") \
+  X(INT, drive_fault, 0, 0, 5, "-", "injected: 0 none, 1 phase open, 2 phases shorted, 3 encoder reversed, 4 a current amplifier's offset broken, 5 motor encoder unplugged") \
   X(DOUBLE, supply_voltage, 24.0, 12.0, 26.0, "V", "bench supply of the drive's bus (it cannot sink current)") \
   X(DOUBLE, bus_capacitance, 200e-6, 1e-5, 0.1, "F", "the drive's bus capacitance") \
   S("the rig's sensors (poursim_obs_t.encoder, scale_rotating_g, scale_target_g)") \

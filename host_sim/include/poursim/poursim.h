@@ -58,6 +58,8 @@ typedef struct {
   uint32_t encoder;     /* output-shaft absolute encoder: round(θ·2^bits/2π) mod 2^bits (0 = upright) */
   int32_t scale_rotating_g; /* load cell carrying the rotating bucket, tared empty [g] */
   int32_t scale_target_g;   /* load cell under the target bucket, tared empty [g] */
+  uint32_t drive_faults;    /* the full drive's (drive = 1) latched faults, POUR_DRIVE_FAULT_*; 0 otherwise */
+  int drive_trusted;        /* 1 while the drive still follows a torque (no full drive, or its loop runs), else 0 */
 } poursim_obs_t;
 
 typedef struct poursim_world poursim_world_t;

@@ -71,6 +71,9 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
             assert e.value.result == "BUSY" and e.value.param == "omega_max"
         # The e-stop (a level): writes refused while it is asserted, accepted in FAULT after the release.
         assert "mode ESTOP" in ok("estop")
+        # Commands the controller refuses say so (the heartbeat's Refused count), and change nothing.
+        assert "refused Stop in ESTOP" in refused("stop")
+        assert "refused ClearErrors in ESTOP" in refused("--weights", str(WEIGHTS), "--yes", "clear")
         assert "BUSY" in refused("config", "set", "omega_max", "1500000")
         assert "mode FAULT" in ok("estop", "--release")
         assert ok("config", "set", "omega_max", "1500000") == "omega_max 1500000\n"

@@ -137,7 +137,7 @@ def _confirm_motion(a: argparse.Namespace, n: bn.Node, want: int) -> None:
 
 def _print_state(st: bn.NodeState) -> None:
     print(f"node {st.node_id}: mode {st.mode}, faults {', '.join(st.faults) or 'none'}, "
-          f"rx_dropped {st.rx_dropped}, overruns {st.overruns}")
+          f"rx_dropped {st.rx_dropped}, overruns {st.overruns}, refused {st.refused}")
 
 
 def _plot(a: argparse.Namespace) -> int:
@@ -198,12 +198,11 @@ def run(a: argparse.Namespace) -> int:
             n.estop(not a.release)
             _print_state(n.wait_mode({"FAULT"} if a.release else {"ESTOP"}, a.timeout))
         elif a.cmd == "stop":
-            n.stop()
-            _print_state(n.info(a.timeout))
+            _print_state(n.stop(a.timeout))
         elif a.cmd in MOTION:
             assert want is not None
             _confirm_motion(a, n, want)
-            n.clear() if a.cmd == "clear" else n.reset()
+            n.clear(a.timeout) if a.cmd == "clear" else n.reset(a.timeout)
             st = n.wait_mode({"IDLE", "RUN"} if a.cmd == "clear" else {"IDLE", "RUN", "FAULT"}, a.timeout)
             _print_state(st)
         elif a.cmd == "config":

@@ -48,6 +48,10 @@ class NodeTimeout(BenchError):
         self.last = last
 
 
+class CommandRefused(BenchError):
+    """The node counted the command as refused (the heartbeat's Refused moved): it changed nothing."""
+
+
 class ParamRefused(BenchError):
     def __init__(self, message: str, param: str, result: str) -> None:
         super().__init__(message)
@@ -71,6 +75,7 @@ class NodeState:
     faults: list[str] = field(default_factory=list)
     rx_dropped: int = 0
     overruns: int = 0
+    refused: int = 0  # commands refused or dropped by the node, mod 16 (Heartbeat.Refused)
     counter: int | None = None
     identity: Identity | None = None
     t_heartbeat: float | None = None
@@ -182,7 +187,7 @@ class Bench:
             st.mode = self.message("Heartbeat").get_signal_by_name("Mode").choices.get(sig["Mode"], str(sig["Mode"]))
             st.mode = str(st.mode)
             st.faults = [f.removeprefix("Fault_") for f in self._faults if sig[f]]
-            st.rx_dropped, st.overruns = sig["RxDropped"], sig["Overruns"]
+            st.rx_dropped, st.overruns, st.refused = sig["RxDropped"], sig["Overruns"], sig["Refused"]
             st.t_heartbeat = now
             st.heartbeats += 1
         elif name == "Identity":
@@ -260,14 +265,30 @@ class Node:
     def estop(self, asserted: bool = True) -> None:
         self.bench.send(self.id, "Estop", Assert=1 if asserted else 0)
 
-    def clear(self) -> None:
-        self.bench.send(self.id, "ClearErrors")
+    def _command(self, message: str, timeout: float) -> NodeState:
+        """Sends a command the node may refuse, and waits for the second heartbeat after it (the first may
+        have been packed before the tick that took it). CommandRefused if its Refused count moved."""
+        before = self.info(timeout)
+        refused, counter = before.refused, before.counter
+        assert counter is not None
+        self.bench.send(self.id, message)
+        self.bench.wait_for(self.id, lambda n, s: n == "Heartbeat" and 2 <= (s["Counter"] - counter) % 256 < 128,
+                            timeout, f"with two heartbeats after {message}")
+        assert self.state is not None
+        if self.state.refused != refused:
+            raise CommandRefused(f"node {self.id} refused {message} in {self.state.mode} (a Stop outside RUN, a "
+                                 "Reset in RUN or during the active stop, a ClearErrors with the e-stop held or "
+                                 f"during the active stop): nothing changed ({self.state.describe()})")
+        return self.state
 
-    def stop(self) -> None:
-        self.bench.send(self.id, "Stop")
+    def clear(self, timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        return self._command("ClearErrors", timeout)
 
-    def reset(self) -> None:
-        self.bench.send(self.id, "Reset")
+    def stop(self, timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        return self._command("Stop", timeout)
+
+    def reset(self, timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        return self._command("Reset", timeout)
 
     def wait_mode(self, modes: set[str], timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
         """Waits for a heartbeat whose mode is one of modes."""

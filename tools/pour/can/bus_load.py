@@ -91,13 +91,13 @@ class Row:
 
 
 def cyclic_messages(dbc: Path | None = None, heartbeat_ms: float | None = None) -> list[Row]:
-    """One row per message with a cycle time in the DBC (heartbeat_ms overrides the heartbeat's, and the
-    identity frame's, which goes out with every heartbeat)."""
+    """One row per message with a cycle time in the DBC (heartbeat_ms overrides the heartbeat's, and those of
+    the identity and drive-telemetry frames, which go out with every heartbeat)."""
     db = cantools.database.load_file(str(dbc or default_dbc()))
     rows = []
     for m in db.messages:
         cycle = m.cycle_time
-        if m.name in ("Heartbeat", "Identity") and heartbeat_ms is not None:
+        if m.name in ("Heartbeat", "Identity", "DriveTelemetry") and heartbeat_ms is not None:
             cycle = heartbeat_ms
         if not cycle:
             continue  # event messages (e-stop, clear-errors) add nothing steady

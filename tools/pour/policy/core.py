@@ -62,7 +62,8 @@ class PlantState(_Record):
 class ControlInput(_Record):
     """pour_control_input_t: one tick's inputs."""
     _fields_ = [("sensors_fresh", C.c_bool), ("sensors", SensorSample), ("estop", C.c_bool),
-                ("clear_faults", C.c_bool), ("link_fault", C.c_bool), ("stop", C.c_bool), ("reset", C.c_bool)]
+                ("clear_faults", C.c_bool), ("link_fault", C.c_bool), ("stop", C.c_bool), ("reset", C.c_bool),
+                ("drive_faults", C.c_uint16), ("drive_trusted", C.c_bool)]
 
 
 class ControlOutput(_Record):

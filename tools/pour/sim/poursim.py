@@ -43,7 +43,7 @@ class ObsStruct(C.Structure):
         ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
         ("torque", C.c_double), ("done", C.c_int),
         ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
-        ("scale_target_g", C.c_int32),
+        ("scale_target_g", C.c_int32), ("drive_faults", C.c_uint32), ("drive_trusted", C.c_int),
     ]
 
 
@@ -347,12 +347,15 @@ class Obs:
     encoder: int = 0           # output-shaft absolute encoder count
     scale_rotating_g: int = 0  # load cell carrying the rotating bucket [g]
     scale_target_g: int = 0    # load cell under the target [g]
+    drive_faults: int = 0      # the full drive's latched faults (POUR_DRIVE_FAULT_*), drive = 1
+    drive_trusted: bool = True  # the drive still follows a torque
 
     @staticmethod
     def from_struct(o: ObsStruct) -> "Obs":
         return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
                    o.torque, bool(o.done), o.motor_torque,
-                   int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g))
+                   int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g), int(o.drive_faults),
+                   bool(o.drive_trusted))
 
 
 @dataclass(frozen=True)

@@ -61,6 +61,7 @@
 #define POUR_CAN_SCALE_MAX_G 32767     /* |scale| <= 32.767 kg [g]; -32768 is the load cell amplifier's
                                          * overload code, out of range */
 #define POUR_CAN_MODE_MAX (POUR_MODE_COUNT - 1u) /* pour_mode_t */
+#define POUR_CAN_REFUSED_MAX 0x0Fu                /* Heartbeat.Refused: a count mod 16 */
 #define POUR_CAN_ACTION_MAX 15u
 #define POUR_CAN_LIMITS_MAX 63u /* POUR_LIMIT_* bits 0..5, the motion envelope's speed and acceleration included */
 #define POUR_CAN_INIT_STATUS_MIN (-128) /* Identity.InitStatus: a pour_status_t, 0 = OK */
@@ -69,7 +70,8 @@
 #define POUR_CAN_DRIVE_FAULT_MASK 0x07FFu /* the 11 bits of pour/drive_faults.h, in their order */
 
 /* CalibrationResult.Status: 0 .. 5 the stored block's state (as calibration_store.h's pour_cal_status_t),
- * then the refusals of a CalibrationStart, each with its reason. */
+ * then the refusals of a CalibrationStart, each with its reason, then the measurement's progress and why it
+ * stopped (the drive's pour_motor_cal_status_t, pour/motor_cal.h). */
 #define POUR_CAN_CAL_OK 0u
 #define POUR_CAN_CAL_EMPTY 1u
 #define POUR_CAN_CAL_CORRUPT 2u
@@ -78,8 +80,15 @@
 #define POUR_CAN_CAL_WRITE_FAILED 5u
 #define POUR_CAN_CAL_REFUSED_RUNNING 6u /* asked for in RUN: Stop first */
 #define POUR_CAN_CAL_REFUSED_ESTOP 7u   /* asked for while the e-stop is asserted */
-#define POUR_CAN_CAL_UNAVAILABLE 8u     /* this firmware cannot measure (the drive's calibration routine is not in it) */
-#define POUR_CAN_CAL_STATUS_MAX 8u
+#define POUR_CAN_CAL_UNAVAILABLE 8u     /* this controller cannot measure (no drive of its own) */
+#define POUR_CAN_CAL_MEASURING 9u       /* started: the outcome follows, unasked, when it ends */
+#define POUR_CAN_CAL_BAD_RESISTANCE 10u /* R out of range, or unequal on the two axes (an open phase) */
+#define POUR_CAN_CAL_BAD_INDUCTANCE 11u /* L out of range */
+#define POUR_CAN_CAL_NO_ENCODER 12u     /* the motor encoder did not count over an electrical turn */
+#define POUR_CAN_CAL_BAD_POLE_PAIRS 13u /* the counts of an electrical turn fit no pole-pair count 1 .. 32 */
+#define POUR_CAN_CAL_MOTION_RANGE 14u   /* the output moved beyond the sequence's range: stopped there */
+#define POUR_CAN_CAL_ABORTED 15u        /* a fault, the e-stop or a stop ended it, or a latched fault refused it */
+#define POUR_CAN_CAL_STATUS_MAX 15u
 #define POUR_CAN_CAL_STORED_MAX 5u
 #define POUR_CAN_PARAM_RESULT_MAX 6u    /* ParamAck.Result: a pour_param_result_t */
 #define POUR_CAN_TARE_ROTATING 1u       /* Tare.Scales bits */
@@ -113,11 +122,12 @@ typedef struct {
 } pour_can_torque_t;
 
 typedef struct {
-  uint8_t mode;        /* pour_mode_t, 0 .. 3 */
+  uint8_t mode;        /* pour_mode_t, 0 .. 3 (bits 0..3) */
   uint16_t faults;     /* POUR_FAULT_* | POUR_CAN_FAULT_*; only the bits the DBC names are carried */
   uint16_t rx_dropped; /* malformed frames dropped, wraps */
   uint16_t overruns;   /* missed control deadlines, wraps */
   uint8_t counter;     /* +1 per heartbeat, wraps */
+  uint8_t refused;     /* commands refused or dropped (Stop, Reset, ClearErrors), mod 16 (bits 4..7) */
 } pour_can_heartbeat_t;
 
 typedef struct {

@@ -15,13 +15,16 @@
 #include "pour/fixed.h"
 #include "pour/sensors.h"
 
-#define POUR_CAN_NODE_MAX_TX 4u /* frames one tick can produce: torque, heartbeat, identity, calibration result */
+#define POUR_CAN_NODE_MAX_TX 5u /* frames one tick can produce: torque, heartbeat, identity, drive telemetry,
+                                 * calibration result */
 
 typedef struct {
   uint8_t node_id;              /* 0 .. 63 */
   uint16_t watchdog_ms;         /* >= 1: no valid sample or command for longer trips the watchdog [ms] */
   uint16_t heartbeat_period_ms; /* >= 1: a heartbeat and an identity frame every this many ticks [ms] */
   pour_can_identity_t identity; /* what the identity frame says (policy hash, tau_max, version, init) */
+  bool can_calibrate;           /* the port measures: a CalibrationStart not refused is answered MEASURING and
+                                   handed to it (pour_can_node_take_calibration_start) */
 } pour_can_node_config_t;
 
 /* Receive counters; they saturate at UINT32_MAX. */
@@ -57,7 +60,11 @@ typedef struct {
   uint8_t heartbeat_counter;
   pour_can_node_counters_t counters;
   bool calibration_requested;                /* a CalibrationStart arrived since the last tick */
+  bool calibration_start;                    /* one was accepted: the port has not taken it yet */
+  bool calibration_report;                   /* the port's outcome waits to be sent */
   pour_can_calibration_result_t calibration; /* what the port says a start does and what is stored */
+  bool have_drive;                           /* the port has a drive of its own: DriveTelemetry is sent */
+  pour_can_drive_telemetry_t drive;          /* its latest state */
 } pour_can_node_t;
 
 /* Node 0, watchdog 50 ms (above the core's input timeout, so the core trips first), heartbeat 100 ms,
@@ -71,19 +78,38 @@ pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_conf
  * stored calibration. Until set: UNAVAILABLE and nothing stored (EMPTY). */
 void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result);
 
+/* The drive's state for the next DriveTelemetry (a port with a drive of its own calls it every tick; from
+ * the first call on, a DriveTelemetry frame follows every heartbeat). */
+void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemetry_t *drive);
+
+/* The measurement's outcome (status POUR_CAN_CAL_*, the calibration stored), sent unasked as a
+ * CalibrationResult at the end of a tick (after a pending request's answer, if any: one a tick). */
+void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result);
+
+/* Takes an accepted CalibrationStart (config.can_calibrate), once: true if one waits. */
+bool pour_can_node_take_calibration_start(pour_can_node_t *node);
+
 /* Feeds one received frame. Malformed frames are dropped and counted, never acted on. */
 pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_t *frame);
 
+/* A sample of the port's hardwired e-stop input, taken before the tick's frames are fed and again after
+ * them: the e-stop is asserted while the line or the bus asserts it, and a ClearErrors counts only if both
+ * were released when it arrived and stayed released until the tick. */
+void pour_can_node_estop_line(pour_can_node_t *node, bool asserted);
+
 /* Start of a 1 ms tick, once per tick: the control input from what arrived since the last tick (the
- * latest Sensors sample, as the sensors read it), the watchdog's state as in->link_fault. The frame's
+ * latest Sensors sample, as the sensors read it), the watchdog's state as in->link_fault, no drive fault. The frame's
  * 8-bit seq reaches the core extended to 32 bits by its forward distance (it wraps every 256 ms at 1 kHz;
  * a wrap is just the next sample). A Reset does not restart the count: the core, when it accepts the
  * Reset, takes the new run's first sample whatever its seq, and a refused Reset changes nothing here. */
 void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 
 /* End of a tick: advances the watchdog by 1 ms, then writes the torque frame, when due the heartbeat and
- * the identity frame, and after a CalibrationStart its CalibrationResult into tx: refused in RUN
- * (REFUSED_RUNNING) and in ESTOP (REFUSED_ESTOP), else the port's answer (pour_can_node_set_calibration). overruns: the port's missed deadlines. Returns the count. */
+ * the identity frame (and DriveTelemetry, once pour_can_node_set_drive was called), and after a
+ * CalibrationStart its CalibrationResult into tx: refused in RUN (REFUSED_RUNNING) and in ESTOP
+ * (REFUSED_ESTOP), else MEASURING if the port measures (config.can_calibrate), else the port's answer
+ * (pour_can_node_set_calibration); or else a reported outcome. overruns: the port's missed deadlines.
+ * Returns the count. */
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
 
@@ -94,7 +120,8 @@ bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms);
 /* The frames end_tick is made of, for a port that schedules them itself (the Linux one, by wall clock). */
 pour_status_t pour_can_node_torque_frame(const pour_can_node_t *node, const pour_control_output_t *out,
                                          pour_can_frame_t *frame);
-/* Heartbeat (counter advanced) then identity: 2 frames, or 0 if the output cannot be packed. */
+/* Heartbeat (counter advanced; Refused = the core's refused Stops, Resets and clears plus the clears dropped
+ * here, mod 16) then identity: 2 frames, or 0 if the output cannot be packed. */
 uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                     pour_can_frame_t tx[2]);
 

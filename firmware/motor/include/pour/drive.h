@@ -15,6 +15,7 @@
 #include "pour/drive_faults.h"
 #include "pour/fixed.h"
 #include "pour/foc.h"
+#include "pour/motor_cal.h"
 
 #define POUR_DRIVE_I_BASE_MA 64000 /* current of Q15 1.0 [mA]: one LSB = 1.95 mA, ±64 A */
 #define POUR_DRIVE_V_BASE_MV 64000 /* voltage of Q15 1.0 [mV]: one LSB = 1.95 mV, ±64 V */
@@ -29,7 +30,8 @@
 typedef enum {
   POUR_DRIVE_CALIBRATING = 0, /* PWM off, measuring the current offsets */
   POUR_DRIVE_RUN = 1,         /* the current loop runs */
-  POUR_DRIVE_FAULTED = 2      /* latched: phases shorted (low sides on), brake engaged */
+  POUR_DRIVE_FAULTED = 2,     /* latched: phases shorted (low sides on), brake engaged */
+  POUR_DRIVE_MEASURING = 3    /* the self-calibration (pour/motor_cal.h) drives the bridge, brake released */
 } pour_drive_state_t;
 
 typedef struct {
@@ -67,11 +69,17 @@ typedef struct {
   uint32_t vbus_divider_milli; /* bus voltage / ADC pin voltage [1/1000] */
   uint32_t encoder_cpr;        /* motor encoder counts a turn, a power of two, 256..65536 */
   uint16_t encoder_offset;     /* electrical angle at count 0 (alignment), 65536 = 2π */
+  uint32_t encoder_reversed;   /* 1: the count falls as the electrical angle rises; 0: it rises */
   uint32_t phase_sum_ma;       /* |ia + ib + ic| above this: a phase shorted to a rail or a bad shunt [mA] */
   uint32_t phase_loss_ms;      /* the loop saturated and its error above 1/4 of a reference above 1/10 of the
                                   limit this long: a phase open [ms] */
   uint32_t encoder_check_urad; /* output motion over which the motor encoder's direction is compared [µrad]:
                                   small, because a reversed encoder stalls the motor within a pole pitch */
+  /* self-calibration (pour_drive_calibrate) */
+  uint32_t cal_current_ma;     /* test current [mA], 100 .. current_limit_ma */
+  uint32_t cal_l_test_mv;      /* square-wave amplitude of the inductance stage [mV], 100 .. 10,000 */
+  uint32_t cal_motion_urad;    /* largest output motion the sequence may make [µrad], beyond it it stops;
+                                  at least an electrical turn of a 32-pole-pair motor through the gear */
 } pour_drive_config_t;
 
 /* One sample, taken at the PWM's centre (counter underflow). */
@@ -116,6 +124,9 @@ typedef struct {
   int64_t heat_q30ms;         /* ∫(i² − i_cont²)dt, per-unit Q30 · ms */
   int64_t i2t_budget_q30ms, i_cont2_q30;
   uint32_t phase_loss_count, phase_loss_limit; /* periods of lost current control, and the trip count */
+  pour_motor_cal_t cal;               /* the self-calibration's state while MEASURING */
+  pour_motor_cal_status_t cal_status; /* how the last one went (NONE since init, until one is started) */
+  pour_motor_cal_result_t cal_result; /* its results, when cal_status is OK */
 } pour_drive_t;
 
 /* The B-G431B-ESC1 (3 mΩ shunts, 20 kHz) with a maxon EC 45 flat 70 W 24 V on the rig's 1:20 planetary
@@ -136,6 +147,21 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
  * efficiency: τ/(N·η·Kt) motoring, τ·η/(N·Kt) braking, as the output's motion says), clamped to the current limit; the I²t budget; the motor encoder's direction against the
  * output's motion since the last tick output_delta_urad [µrad]. */
 void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta_urad);
+
+/* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: from RUN, or FAULTED with
+ * POUR_DRIVE_FAULT_CALIBRATION alone (no valid calibration, or the last one failed) once the current offsets
+ * are measured; else POUR_EINVAL. The brake is released while it runs (3.1 s). Success applies the results to
+ * the configuration (R, L, pole pairs, encoder direction and offset; the current loop's gains from R and L),
+ * the brake requested for that period, then RUN at zero current; a failure or a fault latches
+ * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. */
+pour_status_t pour_drive_calibrate(pour_drive_t *drv);
+
+/* Ends a running self-calibration (a stop, the e-stop): cal_status ABORTED, POUR_DRIVE_FAULT_CALIBRATION
+ * latched, the bucket held. Nothing if none runs. */
+void pour_drive_calibrate_abort(pour_drive_t *drv);
+
+/* How the last self-calibration went; *result (may be NULL) is written when OK. */
+pour_motor_cal_status_t pour_drive_calibration(const pour_drive_t *drv, pour_motor_cal_result_t *result);
 
 /* Latches a fault from outside the loop (the comparators' break input, an over-temperature). */
 void pour_drive_trip(pour_drive_t *drv, uint16_t fault);

@@ -1,0 +1,141 @@
+/* SPDX-License-Identifier: MIT */
+/* The current loop's interrupt against register files in plain memory: board_drive over hal_drive_g4 over
+ * the TIM1, ADC1/ADC2 and TIM4 drivers, as on the chip. Each period's end of sequence (ADC1 JEOS) has the
+ * interrupt read the injected data registers (JDR1..4 of ADC1, JDR1 of ADC2) and TIM4's count, acknowledge
+ * the flags and write the drive's compares into CCR1..3; no sample, no write; the gates stay off while the
+ * offsets are measured; a tripped loop leaves the compares at 0 with the bridge on (the low sides short the
+ * phases). The board's own parts (the NVIC, the comparators' thresholds, the brake and power lines) are
+ * answered here. */
+#include <string.h>
+
+#include "board_drive.h"
+#include "encoder_tim4.h"
+#include "hal_brake.h"
+#include "hal_drive.h"
+#include "hal_drive_g4.h"
+#include "hal_power.h"
+#include "unity.h"
+
+static uint32_t tim1[POUR_TIM1_N_REGS], tim4[POUR_TIM4_N_REGS], adc1[POUR_ADC_N_REGS], adc2[POUR_ADC_N_REGS];
+static bool brake = true, power;
+
+pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
+pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
+  (void)offset_counts;
+  return POUR_OK;
+}
+void pour_hal_drive_mask(bool masked) { (void)masked; }
+void pour_hal_brake_init(void) { brake = true; }
+void pour_hal_brake_set(bool engage) { brake = engage; }
+bool pour_hal_brake_engaged(void) { return brake; }
+void pour_hal_power_init(void) { power = false; }
+void pour_hal_power_set(bool on) { power = on; }
+bool pour_hal_power_on(void) { return power; }
+
+#define CCER_BRIDGE 0x555u /* CC1E/NE, CC2E/NE, CC3E/NE */
+#define JEOC_JEOS ((1u << 5) | (1u << 6))
+
+void setUp(void) {
+  memset(tim1, 0, sizeof tim1);
+  memset(tim4, 0, sizeof tim4);
+  memset(adc1, 0, sizeof adc1);
+  memset(adc2, 0, sizeof adc2);
+  pour_pwm_t pwm;
+  const pour_pwm_config_t pc = pour_pwm_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_pwm_init(&pwm, tim1, &pc));
+  const pour_adc_t adc = {adc1, adc2, NULL, 10u};
+  pour_hal_drive_attach(&pwm, &adc, tim4);
+  const pour_drive_config_t dc = pour_drive_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, 20000, true));
+}
+
+void tearDown(void) {}
+
+/* One period's conversions done: U, V, W, the bus, the NTC in their data registers; the encoder's count. */
+static void convert(uint16_t u, uint16_t v, uint16_t w, uint16_t count) {
+  adc1[POUR_ADC_JDR1] = u;
+  adc2[POUR_ADC_JDR1] = v;
+  adc1[POUR_ADC_JDR2] = w;
+  adc1[POUR_ADC_JDR3] = 1554u; /* 24 V through the 19.17 divider */
+  adc1[POUR_ADC_JDR4] = 1309u; /* 25 °C */
+  tim4[POUR_TIM4_CNT] = count;
+  adc1[POUR_ADC_ISR] = JEOC_JEOS;
+}
+
+/* The interrupt; the flags' acknowledgement (rc_w1) is read back and the flags cleared as the hardware would. */
+static void isr_acknowledged(void) {
+  adc1[POUR_ADC_ISR] |= 1u << 0; /* ADRDY stays: the acknowledgement writes only JEOC and JEOS */
+  pour_board_drive_isr();
+  TEST_ASSERT_EQUAL_HEX32(JEOC_JEOS, adc1[POUR_ADC_ISR]);
+  TEST_ASSERT_EQUAL_HEX32(JEOC_JEOS, adc2[POUR_ADC_ISR]);
+  adc1[POUR_ADC_ISR] = 0u;
+  adc2[POUR_ADC_ISR] = 0u;
+}
+
+static void calibrate(void) {
+  for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES; ++k) {
+    convert(2048u, 2050u, 2046u, 0u);
+    isr_acknowledged();
+    TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCER]); /* the gates off while the offsets are measured */
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, pour_board_drive_state()->state);
+}
+
+static void test_drive_isr_WithoutTheEndOfSequenceNothingIsRead(void) {
+  tim1[POUR_TIM1_CCR1] = 1234u;
+  pour_board_drive_isr();
+  TEST_ASSERT_EQUAL_HEX32(1234u, tim1[POUR_TIM1_CCR1]);
+  TEST_ASSERT_EQUAL_HEX32(0u, adc1[POUR_ADC_ISR]);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, pour_board_drive_state()->state);
+}
+
+static void test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares(void) {
+  calibrate();
+  const uint16_t offsets[3] = {2048u, 2050u, 2046u};
+  TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, pour_board_drive_state()->sense.offset, 3);
+  /* At zero current and no reference the bridge runs at half duty: each compare mid-period. */
+  convert(2048u, 2050u, 2046u, 100u);
+  isr_acknowledged();
+  const pour_drive_output_t *o = pour_board_drive_output();
+  TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]);
+  for (int k = 0; k < 3; ++k) {
+    TEST_ASSERT_EQUAL_UINT32(o->compare[k], tim1[POUR_TIM1_CCR1 + k]);
+    TEST_ASSERT_UINT32_WITHIN(50u, 2125u, tim1[POUR_TIM1_CCR1 + k]);
+  }
+  TEST_ASSERT_EQUAL_UINT16(100u, pour_board_drive_state()->last_encoder); /* TIM4's count reached the loop */
+  /* U 200 counts above its offset, V and W sharing the return: the loop answers, its compares follow. */
+  for (int n = 0; n < 5; ++n) {
+    convert(2248u, 1950u, 1946u, 100u);
+    isr_acknowledged();
+  }
+  TEST_ASSERT_TRUE(o->id != 0 || o->iq != 0);
+  for (int k = 0; k < 3; ++k) {
+    TEST_ASSERT_EQUAL_UINT32(o->compare[k], tim1[POUR_TIM1_CCR1 + k]);
+  }
+  TEST_ASSERT_TRUE(tim1[POUR_TIM1_CCR1] != tim1[POUR_TIM1_CCR2]);
+}
+
+static void test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares(void) {
+  calibrate();
+  convert(4095u, 2050u, 0u, 0u); /* beyond the 45 A software limit on U and W */
+  tim1[POUR_TIM1_EGR] = 0u;
+  isr_acknowledged();
+  TEST_ASSERT_BITS_HIGH(POUR_DRIVE_FAULT_OVERCURRENT, pour_board_drive_state()->faults);
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR2]);
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR3]);
+  TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* the low sides on, all period */
+  TEST_ASSERT_EQUAL_HEX32(1u, tim1[POUR_TIM1_EGR]);           /* now, not at the next update */
+  convert(2048u, 2050u, 2046u, 0u); /* the current gone: still shorted, latched */
+  isr_acknowledged();
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
+}
+
+int main(void) {
+  UNITY_BEGIN();
+  RUN_TEST(test_drive_isr_WithoutTheEndOfSequenceNothingIsRead);
+  RUN_TEST(test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares);
+  RUN_TEST(test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares);
+  return UNITY_END();
+}
