@@ -8,7 +8,7 @@ import pytest
 
 from pour.policy import export
 from pour.sim import envs
-from pour.train import ars, trainer
+from pour.train import ars, reinforce, trainer
 from pour.train import config as cfgmod
 
 TOY = {"seed": 3, "iterations": 6, "workers": 1,
@@ -68,6 +68,53 @@ def test_step_keeps_the_top_directions_and_scales_by_their_spread():
     assert sigma == 0.0 and not step.any()   # no information, no step
 
 
+def test_state_stats_merge_batches_to_the_pooled_mean_and_std():
+    rng = np.random.default_rng(5)
+    xs = [rng.normal(size=(n, 6)) * [0.3, 0.05, 0.4, 0.4, 0.001, 0.0] + [0.5, 0.5, 0.5, 0.4, 0.0, 1.0]
+          for n in (7, 1, 30)]
+    st = ars.StateStats()
+    np.testing.assert_array_equal(st.std(0.01), np.ones(5))   # nothing seen: the raw coordinates
+    for x in xs:
+        st.add(x)
+    pooled = np.concatenate(xs)[:, :5]
+    np.testing.assert_allclose(st.mean, pooled.mean(axis=0), rtol=1e-12)
+    np.testing.assert_allclose(st.std(0.0), pooled.std(axis=0), rtol=1e-10)
+    assert st.std(0.01)[4] == 0.01 and st.n == 38   # V_spill barely moves: floored
+
+
+@pytest.mark.parametrize("param", ["full", "feedback"])
+def test_state_coords_run_the_standardised_policy_on_raw_features(param):
+    rng = np.random.default_rng(6)
+    mean, std = rng.uniform(0.2, 0.8, 5), rng.uniform(0.01, 0.5, 5)
+    p = rng.normal(size=(6, 11) if param == "full" else (6,))
+    x = np.column_stack([rng.uniform(0, 1, (20, 5)), np.ones(20)])
+    xs = np.column_stack([(x[:, :5] - mean) / std, np.ones(20)])
+    w_raw = reinforce.w_from_params(param, ars.state_coords(p, mean, std), 11, 50.0)
+    w_std = reinforce.w_from_params(param, p, 11, 50.0)
+    np.testing.assert_allclose(x @ w_raw, xs @ w_std, rtol=1e-9, atol=1e-9)
+
+
+def test_v2_normalised_search_learns_the_toy_and_resumes_bit_identically(tmp_path):
+    v2 = _cfg(iterations=20, ars={"normalize_states": True, "state_std_min": 0.02})
+    res = trainer.train(v2, tmp_path / "a", quiet=True)
+    assert _v_target(res.best_w) > 0.15
+    ck = trainer.load_checkpoint(tmp_path / "a" / "checkpoint.npz")
+    assert ck["state_n"] > 0 and np.all(ck["state_m2"] >= 0)
+    trainer.train(v2, tmp_path / "b", quiet=True, stop_after=7)
+    b = trainer.train(v2, tmp_path / "b", quiet=True)
+    np.testing.assert_array_equal(res.w, b.w)
+    np.testing.assert_array_equal(res.best_w, b.best_w)
+    v1 = trainer.train(_cfg(iterations=20), tmp_path / "c", quiet=True)
+    assert not np.array_equal(v1.w, res.w)
+
+
+def test_features_limit_the_search_to_their_gains(tmp_path):
+    res = trainer.train(_cfg(ars={"features": ["theta", "bias"]}), tmp_path / "r", quiet=True)
+    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    assert not ck["history_w"][:, [1, 2, 3, 4]].any()        # omega and the volumes keep their 0 gains
+    assert ck["history_w"][:, 0].any() and ck["history_w"][:, 5].any() and res.w[[0, 5]].any()
+
+
 def test_random_init_is_seeded_and_scaled():
     a = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
     b = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
@@ -80,6 +127,9 @@ def test_configs_that_do_not_use_the_new_options_keep_their_digest():
     d = _cfg(algo={"kind": "pg", "entropy_coef": 0.01}).to_dict()
     assert "ars" not in d and "init_scale" not in d["policy"]
     assert "ars" in _cfg().to_dict()
+    assert not {"normalize_states", "state_std_min", "features"} & set(_cfg().to_dict()["ars"])
+    v2 = _cfg(ars={"normalize_states": True, "features": ["bias"]}).to_dict()["ars"]
+    assert v2["normalize_states"] and v2["state_std_min"] == 0.01 and v2["features"] == ["bias"]
 
 
 BAD = [
@@ -90,6 +140,13 @@ BAD = [
     ({"ars": {"step_size": float("nan")}}, "ars.step_size = nan: expected a finite number"),
     ({"ars": {"step_size": 0.1, "step_size_final": 0.2}}, "ars.step_size_final = 0.2: expected <= ars.step_size"),
     ({"ars": {"episodes_per_direction": 0}}, "ars.episodes_per_direction = 0: expected 1..64"),
+    ({"ars": {"state_std_min": 0.0}}, "ars.state_std_min = 0.0: expected 0 < std <= 1"),
+    ({"ars": {"state_std_min": float("nan")}}, "ars.state_std_min = nan: expected a finite number"),
+    ({"algo": {"kind": "cem"}, "ars": {"normalize_states": True}},
+     "ars.normalize_states = true: only for algo.kind = 'ars' \\(got 'cem'\\)"),
+    ({"ars": {"features": ["theta", "speed"]}}, r"ars.features = \['theta', 'speed'\]: expected distinct names out of"),
+    ({"ars": {"features": ["bias", "bias"]}}, r"ars.features = \['bias', 'bias'\]: expected distinct names"),
+    ({"algo": {"kind": "cem"}, "ars": {"features": ["bias"]}}, r"ars.features = \['bias'\]: only for algo.kind = 'ars'"),
     ({"eval": {"collapse": -1.0}}, "eval.collapse = -1.0"),
     ({"eval": {"collapse": 0.5, "collapse_patience": 0}}, "eval.collapse_patience = 0: expected >= 1"),
     ({"algo": {"kind": "pg"}, "eval": {"collapse": 0.5}}, "eval.collapse = 0.5: only for algo.kind 'ars' or 'cem'"),
@@ -119,6 +176,8 @@ def test_state_from_another_config_is_refused(tmp_path):
     trainer.train(_cfg(), tmp_path / "ars", quiet=True, stop_after=1)
     with pytest.raises(trainer.TrainError, match="different config"):
         trainer.train(_cfg(ars={"noise": 0.2}), tmp_path / "ars", quiet=True)
+    with pytest.raises(trainer.TrainError, match="different config"):   # V1-t's state under V2-t
+        trainer.train(_cfg(ars={"normalize_states": True}), tmp_path / "ars", quiet=True)
     pg = _cfg(algo={"kind": "pg", "entropy_coef": 0.0, "batch_episodes": 4})
     with pytest.raises(trainer.TrainError, match="different config"):
         trainer.train(pg, tmp_path / "ars", quiet=True)

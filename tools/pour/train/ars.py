@@ -8,7 +8,11 @@ theta + nu d_k and theta - nu d_k, keeps the `top` directions with the largest m
 
     theta <- theta + alpha / (top * sigma_R) * sum_k (R+_k - R-_k) d_k
 
-where sigma_R is the standard deviation of the 2 * top returns kept.
+where sigma_R is the standard deviation of the 2 * top returns kept. V2-t (ars.normalize_states) searches in
+the coordinates of the standardised state (x_i - mu_i) / sigma_i, with mu and sigma the running mean and std
+of every training rollout's features so far: a gain on a feature that moves little (the speed) is explored
+as widely as one on a feature that sweeps [0, 1] (the angle), and a gain no longer drags the bias with it.
+The policy it runs is still softmax(x W) on the raw features (state_coords folds mu and sigma into W).
 
 CEM (Rubinstein; in control, e.g. Szita & Lorincz 2006): each iteration draws `population` candidates
 from normal(mean, diag(std^2)), rolls them out, and refits mean and std to the `elites` best ones (std
@@ -35,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from pour.policy import weights_h
 from pour.train import config as cfgmod
 from pour.train import reinforce, trainer
 
@@ -53,6 +58,43 @@ def step_size(cfg: cfgmod.TrainConfig, it: int) -> float:
 
 def noise(cfg: cfgmod.TrainConfig, it: int) -> float:
     return trainer.geometric_schedule(cfg.ars.noise, cfg.ars.noise_final, it, cfg.iterations)
+
+
+class StateStats:
+    """The running mean and variance of the five state features (not the bias) over every decision row seen."""
+
+    def __init__(self, n: float = 0.0, mean: np.ndarray | None = None, m2: np.ndarray | None = None):
+        self.n, self.mean = n, np.zeros(5) if mean is None else np.array(mean, dtype=np.float64)
+        self.m2 = np.zeros(5) if m2 is None else np.array(m2, dtype=np.float64)
+
+    def add(self, x: np.ndarray) -> None:
+        """Merges the rows of x [T][6] (Chan et al.'s pairwise update: exact, order-independent to rounding)."""
+        x = np.asarray(x, dtype=np.float64)[:, :5]
+        nb = float(len(x))
+        if nb == 0:
+            return
+        mb, m2b = x.mean(axis=0), ((x - x.mean(axis=0)) ** 2).sum(axis=0)
+        n = self.n + nb
+        d = mb - self.mean
+        self.mean = self.mean + d * nb / n
+        self.m2 = self.m2 + m2b + d ** 2 * self.n * nb / n
+        self.n = n
+
+    def std(self, floor: float) -> np.ndarray:
+        """The std of each feature, floored; 1 (the raw coordinates) before any row was seen."""
+        if self.n < 2:
+            return np.ones(5)
+        return np.maximum(np.sqrt(self.m2 / self.n), floor)
+
+
+def state_coords(p: np.ndarray, mean: np.ndarray, std: np.ndarray) -> np.ndarray:
+    """The raw-feature parameters (rows: theta, omega, V_rot, V_tgt, V_spill, bias) equivalent to parameters p
+    over the standardised features: p_i / std_i, and the bias less sum_i p_i mean_i / std_i."""
+    scale = (1.0 / std).reshape((5,) + (1,) * (p.ndim - 1))
+    raw = np.array(p, dtype=np.float64)
+    raw[:5] = p[:5] * scale
+    raw[5] = p[5] - np.tensordot(mean, raw[:5], axes=1)
+    return raw
 
 
 def ars_step(deltas: np.ndarray, r_plus: np.ndarray, r_minus: np.ndarray, top: int, alpha: float
@@ -85,7 +127,17 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
     params = trainer.initial_params(cfg)
     std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)
-    w = trainer.weights(cfg, params)
+    stats = StateStats()                            # V2-t's state statistics (ars.normalize_states)
+    names = r.features or list(weights_h.FEATURE_NAMES)  # the rows ARS moves (ars.features)
+    searched = np.array([f in names for f in weights_h.FEATURE_NAMES], dtype=np.float64).reshape(
+        (6,) + (1,) * (params.ndim - 1))
+
+    def to_w(p: np.ndarray) -> np.ndarray:
+        if cfg.algo.kind == "ars" and r.normalize_states:
+            p = state_coords(p, stats.mean, stats.std(r.state_std_min))
+        return trainer.weights(cfg, p)
+
+    w = to_w(params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
     best_ep: dict[str, np.ndarray] = {}
     history: list[np.ndarray] = []
@@ -100,7 +152,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                 "state); "
                 "use a new run directory or --fresh")
         params, best_w, best_score = np.array(st["params"]), np.array(st["best_w"]), float(st["best_score"])
-        w = trainer.weights(cfg, params)
+        stats = StateStats(float(st.get("state_n", 0.0)), st.get("state_mean"), st.get("state_m2"))
+        w = to_w(params)
         start, wall_prev, n_low = int(st["iteration"]), float(st["wall_s"]), int(st["n_low"])
         history = list(np.array(st["history_w"]))
         std = np.array(st["cem_std"])
@@ -124,12 +177,12 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
             m = r.episodes_per_direction if is_ars else c.episodes_per_candidate
             seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, m)
             if is_ars:
-                deltas = draws(cfg, it, r.directions, params.shape)
+                deltas = draws(cfg, it, r.directions, params.shape) * searched
                 nu = noise(cfg, it)
                 cands = np.stack([params + sign * nu * d for d in deltas for sign in (1.0, -1.0)])
             else:
                 cands = params + std * draws(cfg, it, c.population, params.shape)
-            ws = [trainer.weights(cfg, p) for p in cands]
+            ws = [to_w(p) for p in cands]
             eps = runner.run_each([wk for wk in ws for _ in seeds], seeds * len(ws), greedy=True)
             rets = np.array([trainer.episode_return(e, gamma_d) for e in eps]) * cfg.algo.reward_scale
             per_cand = rets.reshape(len(ws), m).mean(axis=1)
@@ -148,7 +201,9 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                     f"{sigma:g}); stopped. The best validated weights (score {best_score:.6g}) "
                     "are kept in checkpoint.npz and policy.json: pour-export exports them; lower ars.step_size")
             params = new_params
-            w = trainer.weights(cfg, params)
+            for e in eps:
+                stats.add(e.x)
+            w = to_w(params)
             history.append(w.copy())
             ib = int(np.argmax(rets))
             if not best_ep or rets[ib] > float(best_ep["best_ep_return"]):
@@ -183,7 +238,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
             rows.append({k: trainer._fmt(v) for k, v in row.items()})
             state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1,
                      "wall_s": wall, "config_digest": digest, "history_w": np.array(history), "n_low": n_low,
-                     "cem_std": std,
+                     "cem_std": std, "state_n": stats.n, "state_mean": stats.mean, "state_m2": stats.m2,
                      **best_ep}
             trainer.write_log(log_path, rows)
             trainer.write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)

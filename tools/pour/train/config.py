@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from pour.policy.weights_h import FEATURE_NAMES
+
 
 class ConfigError(ValueError):
     """A configuration file or value that cannot be used."""
@@ -60,7 +62,8 @@ class AlgoConfig:
 
 @dataclass(frozen=True)
 class ArsConfig:
-    """Augmented random search (Mania, Guy & Recht 2018, V1-t) over the policy's parameters (ars.py)."""
+    """Augmented random search (Mania, Guy & Recht 2018, V1-t, or V2-t with normalize_states) over the policy's
+    parameters (ars.py)."""
     directions: int = 8            # random directions per iteration, each rolled out at +noise and -noise
     top: int = 4                   # the directions with the best max(R+, R-) that make the step
     step_size: float = 0.02        # alpha at the first iteration (the step is alpha / (top * sigma_R) sum ...)
@@ -68,6 +71,11 @@ class ArsConfig:
     noise: float = 0.03            # nu: the perturbation's standard deviation per parameter
     noise_final: float = -1.0      # decayed geometrically to this at the last iteration (< 0: constant)
     episodes_per_direction: int = 1  # rigs per perturbed policy; the same rigs for +, - and every direction
+    normalize_states: bool = False  # V2-t: search in the coordinates of the states standardised by the running
+                                   # mean and std of every training rollout's features (ars.py)
+    state_std_min: float = 0.01    # floor of that std (a feature that barely moves, V_spill, is not blown up)
+    features: list = field(default_factory=list)  # the features whose gains the search moves (names of
+                                   # weights_h.FEATURE_NAMES); the others keep their initial gains. [] = all
 
 
 @dataclass(frozen=True)
@@ -111,7 +119,8 @@ class TrainConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Every value, except those of a method the run does not use ([ars] and [cem] unless algo.kind
-        names them, policy.init_scale unless init = 'random', eval.collapse* while off): a config that
+        names them, policy.init_scale unless init = 'random', eval.collapse* while off, ars.normalize_states,
+        ars.state_std_min and ars.features while off): a config that
         does not use them keeps its digest, and the header it exports keeps its bytes."""
         d = dataclasses.asdict(self)
         for method in ("ars", "cem"):
@@ -121,6 +130,11 @@ class TrainConfig:
             del d["eval"]["collapse"], d["eval"]["collapse_patience"]
         if self.policy.init != "random":
             del d["policy"]["init_scale"]
+        if "ars" in d:
+            if not self.ars.normalize_states:
+                del d["ars"]["normalize_states"], d["ars"]["state_std_min"]
+            if not self.ars.features:
+                del d["ars"]["features"]
         return d
 
     def digest(self) -> str:
@@ -270,6 +284,12 @@ def _validate_search(cfg: TrainConfig) -> None:
            "constant noise")
     _check(1 <= r.episodes_per_direction <= 64,
            f"ars.episodes_per_direction = {r.episodes_per_direction}: expected 1..64")
+    _check(0.0 < r.state_std_min <= 1.0, f"ars.state_std_min = {r.state_std_min}: expected 0 < std <= 1")
+    _check(not r.normalize_states or a.kind == "ars",
+           f"ars.normalize_states = true: only for algo.kind = 'ars' (got {a.kind!r})")
+    _check(all(isinstance(f, str) and f in FEATURE_NAMES for f in r.features) and len(set(r.features)) == len(r.features),
+           f"ars.features = {r.features!r}: expected distinct names out of {list(FEATURE_NAMES)} ([] = all)")
+    _check(not r.features or a.kind == "ars", f"ars.features = {r.features!r}: only for algo.kind = 'ars' (got {a.kind!r})")
     _check(2 <= c.population <= 1024, f"cem.population = {c.population}: expected 2..1024")
     _check(1 <= c.elites < c.population,
            f"cem.elites = {c.elites}: expected 1..cem.population - 1 ({c.population - 1})")
