@@ -23,6 +23,7 @@ static struct {
   bool have_theta;                 /* last_theta_urad is a trusted angle */
   bool clear;                      /* the core accepted a ClearErrors last tick: the protection clears now */
   uint16_t faults;                 /* the loop's and the protection's, as the core and the bus see them */
+  pour_board_calibration_fn calibration; /* the port's calibration flow, or NULL */
 } bd;
 
 pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t tau_max_mnm, bool calibration_valid) {
@@ -37,6 +38,7 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   bd.clear = false;
   bd.tau_max_mnm = tau_max_mnm;
   bd.calibration_valid = calibration_valid;
+  bd.calibration = NULL;
   if (config == NULL || tau_max_mnm <= 0 || pour_drive_init(&bd.drive, config) != POUR_OK) {
     return POUR_EINVAL;
   }
@@ -50,10 +52,18 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   if (pour_guard_init(&bd.guard, &gc, &pc) != POUR_OK) {
     return POUR_EINVAL;
   }
-  if (!calibration_valid) {
-    pour_drive_trip(&bd.drive, POUR_DRIVE_FAULT_CALIBRATION); /* never runs: the brake is never released */
-  }
   return pour_hal_drive_init(); /* last: its interrupt finds the drive ready */
+}
+
+void pour_board_drive_set_calibration(pour_board_calibration_fn flow) { bd.calibration = flow; }
+
+void pour_board_drive_calibrated(void) {
+  if (!bd.calibration_valid) {
+    bd.calibration_valid = true;
+    const pour_guard_config_t gc = bd.guard.config;
+    const pour_protect_config_t pc = bd.guard.protect.config;
+    (void)pour_guard_init(&bd.guard, &gc, &pc); /* both checked at init */
+  }
 }
 
 void pour_board_drive_isr(void) {
@@ -62,7 +72,13 @@ void pour_board_drive_isr(void) {
     return;
   }
   const pour_drive_sample_t in = {{s.phase[0], s.phase[1], s.phase[2]}, s.vbus, s.encoder};
+  const bool offsets = bd.drive.state == POUR_DRIVE_CALIBRATING;
   pour_drive_isr(&bd.drive, &in, &bd.out);
+  if (offsets && bd.drive.state == POUR_DRIVE_RUN && !bd.calibration_valid) {
+    /* Uncalibrated, the drive never follows a torque: it waits, faulted, for a self-calibration (which needs
+     * the offsets just measured), the brake engaged. */
+    pour_drive_trip(&bd.drive, POUR_DRIVE_FAULT_CALIBRATION);
+  }
   if (bd.drive.state == POUR_DRIVE_FAULTED) {
     pour_hal_drive_short_low_sides(); /* damping, never coasting, until the brake holds */
   } else {
@@ -102,7 +118,13 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
                   bd.clear, &p);
 
   pour_hal_drive_mask(true);
-  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && bd.drive.state != POUR_DRIVE_FAULTED) {
+  /* A missing calibration alone does not trip a drive that measures its offsets (the interrupt trips it
+   * then), measures the motor, or has just measured it (the flow stores it this tick). */
+  const pour_motor_cal_status_t cal = pour_drive_calibration(&bd.drive, NULL);
+  const bool measures = bd.drive.state == POUR_DRIVE_CALIBRATING || cal == POUR_MOTOR_CAL_RUNNING ||
+                        (cal == POUR_MOTOR_CAL_OK && bd.drive.state == POUR_DRIVE_RUN);
+  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && bd.drive.state != POUR_DRIVE_FAULTED &&
+      !(measures && p.faults == POUR_DRIVE_FAULT_CALIBRATION)) {
     pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
   }
   bd.faults = (uint16_t)(bd.drive.faults | p.faults);
@@ -113,7 +135,16 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
 
   pour_control_step(ctl, in, out);
   bd.clear = in->clear_faults && out->faults == 0u;
-  if (p.brake) {
+  bool measuring = false;
+  if (bd.calibration != NULL) {
+    pour_hal_drive_mask(true);
+    measuring = bd.calibration(&bd.drive, out->mode);
+    pour_hal_drive_mask(false);
+  }
+  if (measuring) {
+    out->brake = bd.out.brake != 0u; /* the sequence releases it while it drives the motor */
+    out->power = true;
+  } else if (p.brake) {
     /* A drive fault: the brake engages at once; until it holds, the power stage stays on for the active
      * stop (a trusted drive) or the shorted phases (one that is not). */
     out->brake = true;

@@ -22,9 +22,19 @@
 
 /* The drive with its configuration, the board's protection with its defaults; tau_max_mnm: the torque of the
  * core's Q15 1.0 [mN·m], > 0; calibration_valid: a valid calibration block was loaded (else the drive is
- * faulted with POUR_DRIVE_FAULT_CALIBRATION and the brake never releases). Starts the current-offset
- * calibration (the gates off). POUR_EINVAL for a bad configuration. */
+ * faulted with POUR_DRIVE_FAULT_CALIBRATION the period its current offsets are measured, and the brake
+ * never releases outside a self-calibration). Starts the current-offset calibration (the gates off). POUR_EINVAL for a bad configuration. */
 pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t tau_max_mnm, bool calibration_valid);
+
+/* The drive's self-calibration as the board runs it (the port's calibration flow), called by the tick after the
+ * core's step with the drive (masked from the interrupt) and the core's mode; returns true while the sequence
+ * runs: the power stage then stays on and the drive's own brake request stands. NULL: none. */
+typedef bool (*pour_board_calibration_fn)(pour_drive_t *drv, uint8_t mode);
+void pour_board_drive_set_calibration(pour_board_calibration_fn flow);
+
+/* A valid calibration is stored now (one measured in this power cycle): the protection starts afresh, as at
+ * boot, and a ClearErrors lets the core run. Nothing if it already was. */
+void pour_board_drive_calibrated(void);
 
 /* One PWM period (the ADC's end-of-sequence interrupt); nothing if the period's sample is not complete. */
 void pour_board_drive_isr(void);

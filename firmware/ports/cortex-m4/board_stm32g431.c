@@ -225,14 +225,22 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
 static pour_calibration_t calibration;
 static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
 
+static const pour_flash_t calibration_flash = {
+    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS};
+
 pour_status_t pour_hal_calibration_load(void) {
-  const pour_flash_t f = {POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE,
-                          WAIT_POLLS};
-  calibration_status = pour_calibration_load(&f, &calibration);
+  calibration_status = pour_calibration_load(&calibration_flash, &calibration);
   return calibration_status == POUR_CAL_OK ? POUR_OK : POUR_ECALIBRATION;
 }
 
 int pour_hal_calibration_reason(void) { return (int)calibration_status; }
+
+pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
+  *cal = calibration;
+  return calibration_status;
+}
+
+const pour_flash_t *pour_hal_calibration_flash(void) { return &calibration_flash; }
 
 void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
   pour_calibration_can_result(calibration_status, &calibration, POUR_CAN_CAL_UNAVAILABLE, r);

@@ -4,6 +4,7 @@
 #ifndef POUR_HAL_CALIBRATION_H
 #define POUR_HAL_CALIBRATION_H
 
+#include "calibration_store.h"
 #include "pour/can_codec.h"
 #include "pour/fixed.h"
 
@@ -11,9 +12,15 @@
  * pour_hal_calibration_reason). */
 pour_status_t pour_hal_calibration_load(void);
 
-/* What a CalibrationStart is answered with (the stored calibration as loaded, and whether this board can
- * measure one: POUR_CAN_CAL_UNAVAILABLE while the drive's calibration routine is not in the firmware). */
+/* The stored calibration as loaded (the CalibrationResult beside the status the CAN node answers a
+ * CalibrationStart with). */
 void pour_hal_calibration_result(pour_can_calibration_result_t *result);
+
+/* The block's state as loaded, and its values into *cal when POUR_CAL_OK. */
+pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal);
+
+/* The flash that a measured calibration is saved to. */
+const pour_flash_t *pour_hal_calibration_flash(void);
 
 /* Why the last load failed, a pour_cal_status_t (0: it did not). */
 int pour_hal_calibration_reason(void);

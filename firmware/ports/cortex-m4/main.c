@@ -1,13 +1,16 @@
 /* SPDX-License-Identifier: MIT */
-/* Cortex-M4 firmware: the 1 kHz loop around the control step, above the current loop's interrupt
- * (board_drive). Inputs come from the bus through pour::can's node (can/pour.dbc: states, e-stop, stop,
- * clear-errors, reset), from the hardwired e-stop line and from the drive (its faults); the torque (the
- * current loop's reference), the brake and the power stage follow the core's output; torque, heartbeat,
- * identity and drive-telemetry frames go back on the bus. The same file runs in the STM32G431 image (board_stm32g431.c behind the hal_* calls)
- * and in the QEMU smoke test (smoke_bench.c, a scripted bench behind the same calls). */
+/* Cortex-M4 firmware: start-up, then the 1 kHz loop (board_loop: the bus, the core's step, the drive and its
+ * calibration) above the current loop's interrupt (board_drive). Inputs come from the bus through pour::can's
+ * node (can/pour.dbc: states, e-stop, stop, clear-errors, reset, CalibrationStart), from the hardwired e-stop
+ * line and from the drive (its faults); the torque (the current loop's reference), the brake and the power
+ * stage follow the core's output; torque, heartbeat, identity, drive-telemetry and calibration frames go
+ * back on the bus. An uncalibrated drive runs the same loop with RUN refused, so that a CalibrationStart can
+ * calibrate it. The same file runs in the STM32G431 image (board_stm32g431.c behind the hal_* calls) and in
+ * the QEMU smoke test (smoke_bench.c, a scripted bench behind the same calls). */
 #include <stdbool.h>
 
 #include "board_drive.h"
+#include "board_loop.h"
 #include "clock.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -28,12 +31,6 @@
 static pour_control_t controller;
 static pour_can_node_t can_node;
 
-static void transmit(const pour_can_frame_t *tx, uint8_t n) {
-  for (uint8_t i = 0; i < n; ++i) {
-    (void)pour_hal_can_transmit(&tx[i]);
-  }
-}
-
 /* A controller that cannot run says why, forever: brake engaged, power off, heartbeat and identity frames
  * with the start-up status (Identity.InitStatus), and no motion whatever arrives. */
 static void report_forever(void) {
@@ -51,7 +48,7 @@ static void report_forever(void) {
     pour_port_outputs(&out);
     pour_hal_led_show(out.mode, true);
     /* The torque frame says IDLE and 0; the heartbeat and identity frames carry the reason. */
-    transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
+    pour_board_transmit(tx, pour_can_node_end_tick(&can_node, &out, 0u, tx));
     pour_hal_watchdog_feed();
   }
 }
@@ -73,18 +70,21 @@ int main(void) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
   }
   if (status == POUR_OK) {
-    status = pour_hal_calibration_load(); /* an uncalibrated drive could turn the bucket the wrong way */
-  }
-  if (status == POUR_OK) {
+    /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
+    const bool calibrated = pour_hal_calibration_load() == POUR_OK;
     const pour_drive_config_t drive = pour_drive_default_config();
-    status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, true);
+    status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, calibrated);
+    if (status == POUR_OK && !calibrated) {
+      status = POUR_ECALIBRATION; /* what Identity says until then */
+    }
   }
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
   nc.identity.init_status = (int8_t)status;
+  nc.can_calibrate = true;
   pour_can_calibration_result_t calibration;
-  pour_hal_calibration_result(&calibration); /* what a CalibrationStart is answered with */
+  pour_hal_calibration_result(&calibration); /* the stored calibration a CalibrationStart is answered with */
   if (pour_can_node_init(&can_node, &nc) != POUR_OK || pour_hal_can_init(clock_hz, nc.node_id) != POUR_OK) {
     /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
      * watchdog resets the MCU, which tries again. */
@@ -92,43 +92,16 @@ int main(void) {
     }
   }
   pour_can_node_set_calibration(&can_node, &calibration);
-  if (status != POUR_OK) {
+  if (status != POUR_OK && status != POUR_ECALIBRATION) {
     report_forever();
   }
+  pour_board_loop_init(&can_node);
 
   uint32_t overruns = 0u;
-  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   for (;;) {
     const uint32_t missed = pour_hal_timer_wait_tick();
     overruns += missed;
-    /* The hardwired line around the tick's frames: a clear counts only if the line was released at both. */
-    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
-    pour_hal_can_poll();
-    pour_can_frame_t f;
-    while (pour_hal_can_receive(&f) == 1) {
-      (void)pour_can_node_receive(&can_node, &f);
-    }
-    pour_can_node_estop_line(&can_node, pour_hal_estop_asserted());
-    pour_control_input_t in;
-    pour_can_node_begin_tick(&can_node, &in);
-    /* An ExperimentStart goes to the core before the tick; this tick's update answers it. */
-    uint8_t kind = 0u;
-    const bool asked = pour_can_node_take_experiment(&can_node, &kind);
-    if (asked) {
-      pour_control_experiment(&controller, kind);
-    }
-    pour_control_output_t out;
-    pour_board_drive_tick(&controller, &in, &out);
-    pour_hal_led_show(out.mode, false);
-    pour_can_drive_telemetry_t drive;
-    pour_board_drive_telemetry(&drive);
-    pour_can_node_set_drive(&can_node, &drive);
-    transmit(tx, pour_can_node_end_tick(&can_node, &out, overruns, tx));
-    pour_can_frame_t ack;
-    if (asked && pour_can_node_experiment_ack(&can_node, kind, pour_control_experiment_answer(&controller), &ack) ==
-                     POUR_OK) {
-      transmit(&ack, 1u);
-    }
+    pour_board_loop_tick(&controller, &can_node, overruns);
     if (missed == 0u) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */
     }

@@ -70,9 +70,23 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
 /* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
 pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
 int pour_hal_calibration_reason(void) { return 0; }
+/* The block as the drive's default configuration would have measured it. */
+pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
+  const pour_drive_config_t c = pour_drive_default_config();
+  const pour_calibration_t stored = {c.r_phase_uohm, c.lq_nh, c.encoder_reversed != 0u ? -1 : 1, c.pole_pairs,
+                                     c.encoder_offset};
+  *cal = stored;
+  return POUR_CAL_OK;
+}
 void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
-  const pour_can_calibration_result_t none = {POUR_CAN_CAL_UNAVAILABLE, POUR_CAN_CAL_EMPTY, 0u, 0u, 0u, 0u, 0u};
-  *r = none;
+  pour_calibration_t cal;
+  pour_calibration_can_result(pour_hal_calibration_stored(&cal), &cal, POUR_CAN_CAL_UNAVAILABLE, r);
+}
+/* A page and the flash interface's registers in RAM (mps2-an386 has no flash controller). */
+static uint32_t flash_regs[POUR_FLASH_N_REGS], flash_page[POUR_FLASH_PAGE_BYTES / 4u];
+const pour_flash_t *pour_hal_calibration_flash(void) {
+  static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u};
+  return &f;
 }
 
 void pour_hal_brake_init(void) { brake = true; }
