@@ -138,7 +138,24 @@ static pour_sensors_t sample_of(uint32_t seq) {
   return s;
 }
 
-typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED } fault_t;
+typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED, F_SELF_CAL } fault_t;
+
+/* F_SELF_CAL: an uncalibrated board whose calibration flow (the hook board_loop installs on the board) starts
+ * the drive's self-calibration at SELF_CAL_MS; what the tick did while it ran. */
+#define SELF_CAL_MS 50
+static struct {
+  int ms;
+  pour_status_t started;
+  int measuring_ticks, power_off_ticks, released_ticks, brake_not_drives_ticks;
+} self_cal;
+
+static bool self_cal_flow(pour_drive_t *drv, uint8_t mode) {
+  (void)mode;
+  if (self_cal.ms == SELF_CAL_MS) {
+    self_cal.started = pour_drive_calibrate(drv);
+  }
+  return drv->state == POUR_DRIVE_MEASURING;
+}
 
 typedef struct {
   double theta_fault, theta_end, theta_max_dev;
@@ -155,14 +172,17 @@ static result_t pour_with(fault_t fault) {
   plant.brake_since = -1.0;
   plant.brake_cmd = true;
   plant.brake_held = true; /* spring-applied: engaged from power-up */
-  plant.theta = 40.0 * PI / 180.0;
+  plant.theta = fault == F_SELF_CAL ? 0.0 : 40.0 * PI / 180.0; /* calibrated where gravity has no torque */
   plant.vbus_v = 24.0;
   plant.temp_c = 40.0;
   drive_config = pour_drive_default_config();
   const pour_control_config_t cc = pour_control_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&drive_config, (int32_t)(TAU_MAX_NM * 1000), fault != F_CALIBRATION));
-  const int fault_ms = fault == F_CALIBRATION ? 0 : 300;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&drive_config, (int32_t)(TAU_MAX_NM * 1000), fault != F_CALIBRATION && fault != F_SELF_CAL));
+  memset(&self_cal, 0, sizeof self_cal);
+  self_cal.started = POUR_EINVAL;
+  pour_board_drive_set_calibration(fault == F_SELF_CAL ? self_cal_flow : NULL);
+  const int fault_ms = fault == F_CALIBRATION || fault == F_SELF_CAL ? 0 : 300;
   result_t r = {0};
   r.detected_ms = -1;
   for (int ms = 0; ms < 1500; ++ms) {
@@ -179,6 +199,7 @@ static result_t pour_with(fault_t fault) {
       case F_OVERTEMP: plant.temp_c = 40.0 + 2.0 * (ms - fault_ms); break;
       case F_SLIP: plant.slipping = true; break;
       case F_CALIBRATION: break;
+      case F_SELF_CAL: break;
       }
     }
     for (int k = 0; k < PERIODS; ++k) {
@@ -197,7 +218,14 @@ static result_t pour_with(fault_t fault) {
     const double nm = ff + 200.0 * (ref - plant.theta) + 30.0 * (0.5 - plant.omega);
     pour_control_request(&ctl, 0u, (q15_t)lround(fmax(-1.0, fmin(1.0, nm / TAU_MAX_NM)) * 32767.0));
     pour_control_output_t out;
+    self_cal.ms = ms;
     pour_board_drive_tick(&ctl, &in, &out);
+    if (pour_board_drive_state()->state == POUR_DRIVE_MEASURING) {
+      self_cal.measuring_ticks++;
+      self_cal.power_off_ticks += plant.power ? 0 : 1;
+      self_cal.released_ticks += plant.brake_cmd ? 0 : 1;
+      self_cal.brake_not_drives_ticks += plant.brake_cmd == (pour_board_drive_output()->brake != 0u) ? 0 : 1;
+    }
     if (in.drive_faults != 0u && r.detected_ms < 0) {
       r.detected_ms = ms - fault_ms;
       r.trusted_at_detection = in.drive_trusted;
@@ -304,6 +332,25 @@ static void test_faults_WithoutCalibrationTheBucketNeverMoves(void) {
   TEST_ASSERT_DOUBLE_WITHIN(0.5 * PI / 180.0, 40.0 * PI / 180.0, r.theta_end);
 }
 
+/* The self-calibration on an uncalibrated board runs to its own end: the protection's missing calibration
+ * does not re-trip the measuring drive, the power stays on and the brake is the drive's. The motor here
+ * draws no current from the sequence's voltages (the ideal drive follows current references only), so the
+ * sequence ends on the resistance stage, with the brake engaged and holding. */
+static void test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd(void) {
+  const result_t r = pour_with(F_SELF_CAL);
+  printf("self-calibration: %d ms measuring (power off %d, brake released %d, brake not the drive's %d)\n",
+         self_cal.measuring_ticks, self_cal.power_off_ticks, self_cal.released_ticks,
+         self_cal.brake_not_drives_ticks);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, self_cal.started);
+  TEST_ASSERT_TRUE(self_cal.measuring_ticks > 10);
+  TEST_ASSERT_EQUAL_INT(0, self_cal.power_off_ticks);
+  TEST_ASSERT_EQUAL_INT(0, self_cal.brake_not_drives_ticks);
+  TEST_ASSERT_TRUE(self_cal.released_ticks > 0);
+  TEST_ASSERT_EQUAL_INT(POUR_MOTOR_CAL_RESISTANCE, pour_drive_calibration(pour_board_drive_state(), NULL));
+  assert_held(&r, POUR_DRIVE_FAULT_CALIBRATION, 0);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_faults_BreakShortsThePhasesAndTheBrakeHolds);
@@ -313,5 +360,6 @@ int main(void) {
   RUN_TEST(test_faults_OvertemperatureStopsActivelyAndTheBrakeHolds);
   RUN_TEST(test_faults_SlippingCouplingIsAMismatchAndTheBrakeHolds);
   RUN_TEST(test_faults_WithoutCalibrationTheBucketNeverMoves);
+  RUN_TEST(test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd);
   return UNITY_END();
 }

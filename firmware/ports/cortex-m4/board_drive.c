@@ -24,6 +24,7 @@ static struct {
   bool clear;                      /* the core accepted a ClearErrors last tick: the protection clears now */
   uint16_t faults;                 /* the loop's and the protection's, as the core and the bus see them */
   pour_board_calibration_fn calibration; /* the port's calibration flow, or NULL */
+  uint16_t settle_ms;              /* after a self-calibration: the brake engaging, the power kept on */
 } bd;
 
 pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t tau_max_mnm, bool calibration_valid) {
@@ -39,6 +40,7 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   bd.tau_max_mnm = tau_max_mnm;
   bd.calibration_valid = calibration_valid;
   bd.calibration = NULL;
+  bd.settle_ms = 0u;
   if (config == NULL || tau_max_mnm <= 0 || pour_drive_init(&bd.drive, config) != POUR_OK) {
     return POUR_EINVAL;
   }
@@ -143,6 +145,13 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   }
   if (measuring) {
     out->brake = bd.out.brake != 0u; /* the sequence releases it while it drives the motor */
+    out->power = true;
+    bd.settle_ms = bd.guard.protect.config.brake_engage_ms;
+  } else if (bd.settle_ms > 0u) {
+    /* The sequence has ended with the brake released: until it holds, the power stays on for the shorted
+     * phases (a fault) or the held position (a result), never coasting. */
+    bd.settle_ms--;
+    out->brake = true;
     out->power = true;
   } else if (p.brake) {
     /* A drive fault: the brake engages at once; until it holds, the power stage stays on for the active
