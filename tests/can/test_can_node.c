@@ -484,6 +484,14 @@ static void run_ticks(unsigned n, uint32_t *seq, pour_control_output_t *out) {
   }
 }
 
+/* After a clear that did not count (dropped clears so far): FAULT, the e-stop fault latched, the brake on. */
+static void assert_estop_still_latched(const pour_control_output_t *out, uint32_t dropped) {
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out->mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out->faults);
+  TEST_ASSERT_TRUE(out->brake);
+  TEST_ASSERT_EQUAL_UINT32(dropped, node.commands.clears_dropped);
+}
+
 /* docs/safety.md, transitions: a ClearErrors that arrives while the e-stop is held is dropped where it arrives,
  * even when the release follows it before the next tick; the e-stop fault stays latched and no torque comes. */
 static void test_can_node_ClearBeforeTheReleaseInOneTickIsDropped(void) {
@@ -497,10 +505,7 @@ static void test_can_node_ClearBeforeTheReleaseInOneTickIsDropped(void) {
   receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
   receive_estop(false);
   run_ticks(50u, &seq, &out);
-  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
-  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
-  TEST_ASSERT_TRUE(out.brake);
-  TEST_ASSERT_EQUAL_UINT32(1u, node.commands.clears_dropped);
+  assert_estop_still_latched(&out, 1u);
   /* The deliberate second step: a clear after the release counts. */
   receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
   send_sample(seq++, 0);
@@ -647,10 +652,7 @@ static void test_can_node_HardwiredLineHeldDropsAClearAndOutranksTheBus(void) {
   receive_command(POUR_CAN_CMD_CLEAR_ERRORS); /* arrives with the line held */
   pour_can_node_estop_line(&node, false);      /* the second sample of that tick finds it released */
   run_ticks(20u, &seq, &out);
-  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
-  TEST_ASSERT_BITS_HIGH(POUR_FAULT_ESTOP, out.faults);
-  TEST_ASSERT_TRUE(out.brake);
-  TEST_ASSERT_EQUAL_UINT32(1u, node.commands.clears_dropped);
+  assert_estop_still_latched(&out, 1u);
   receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
   pour_can_node_estop_line(&node, false);
   send_sample(seq++, 0);
