@@ -241,12 +241,9 @@ static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_ou
   out->power = ctl->mode == POUR_MODE_RUN;
 }
 
-/* The request of pour_control_experiment, after this tick's Stop and Reset (so that a Stop and a start
+/* The request of pour_control_experiment (one is pending), after this tick's Stop and Reset (so that a Stop and a start
  * in one tick start the experiment). */
 static void take_experiment_request(pour_control_t *ctl) {
-  if (!ctl->experiment_asked) {
-    return;
-  }
   ctl->experiment_asked = false;
   uint8_t answer = (uint8_t)POUR_CONTROL_EXPERIMENT_ACCEPTED;
   if (ctl->experiment_kind == (uint8_t)POUR_EXPERIMENT_NONE || ctl->experiment_kind > POUR_EXPERIMENT_KIND_MAX) {
@@ -263,13 +260,10 @@ static void take_experiment_request(pour_control_t *ctl) {
   ctl->experiment_answer = answer;
 }
 
-/* An armed experiment runs in RUN: its request every tick, in place of any decision; its end (or a Stop)
+/* An armed experiment (kind not NONE) runs in RUN: its request every tick, in place of any decision; its end (or a Stop)
  * leaves the axis held in IDLE; a fault ends it as it ends any run. */
 static void experiment_tick(pour_control_t *ctl) {
   pour_experiment_t *e = &ctl->experiment;
-  if (e->kind == (uint8_t)POUR_EXPERIMENT_NONE) {
-    return;
-  }
   if (ctl->mode != POUR_MODE_RUN) {
     if (ctl->mode == POUR_MODE_FAULT || e->started) {
       ctl->held = ctl->mode == POUR_MODE_IDLE;
@@ -369,7 +363,10 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
   }
 
-  take_experiment_request(ctl);
+  /* The experiment's two hooks are tested here, not in them: the policy's tick pays no calls for them. */
+  if (ctl->experiment_asked) {
+    take_experiment_request(ctl);
+  }
 
   bool fresh = false;
   if (in->sensors_fresh && ctl->mode == POUR_MODE_IDLE) {
@@ -428,7 +425,9 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     }
     ctl->ms_to_decision--;
   }
-  experiment_tick(ctl);
+  if (ctl->experiment.kind != (uint8_t)POUR_EXPERIMENT_NONE) {
+    experiment_tick(ctl);
+  }
   return ctl->decision_due;
 }
 
