@@ -240,6 +240,100 @@ static void test_drive_TripFromOutsideLatches(void) {
   assert_held(POUR_DRIVE_FAULT_HW_OVERCURRENT);
 }
 
+static const pour_drive_sample_t *quiet(void) {
+  static pour_drive_sample_t s;
+  s = sample(0, 0, 0, 24000, 0);
+  return &s;
+}
+
+/* Trips fault from RUN, a quiet period, then a clear: RUN at zero current, or the fault kept. */
+static void assert_clear(uint16_t fault, int clears) {
+  setUp();
+  run_calibration();
+  pour_drive_tick(&drv, 20000, 0);
+  pour_drive_trip(&drv, fault);
+  pour_drive_isr(&drv, quiet(), &out);
+  assert_held(fault);
+  TEST_ASSERT_EQUAL_HEX16(clears ? 0u : fault, pour_drive_clear_faults(&drv));
+  TEST_ASSERT_EQUAL_INT(clears ? POUR_DRIVE_RUN : POUR_DRIVE_FAULTED, drv.state);
+  TEST_ASSERT_EQUAL_HEX16(clears ? 0u : fault, drv.faults);
+  pour_drive_isr(&drv, quiet(), &out);
+  TEST_ASSERT_EQUAL_UINT8(clears ? 0u : 1u, out.brake);
+  TEST_ASSERT_EQUAL_INT16(0, out.iq_ref); /* the torque before the fault is gone */
+}
+
+static void test_drive_ClearErrorsClearsWhatItCanJudgeAndKeepsTheRest(void) {
+  assert_clear(POUR_DRIVE_FAULT_OVERCURRENT, 1);
+  assert_clear(POUR_DRIVE_FAULT_HW_OVERCURRENT, 1);
+  assert_clear(POUR_DRIVE_FAULT_OVERVOLTAGE, 1);
+  assert_clear(POUR_DRIVE_FAULT_UNDERVOLTAGE, 1);
+  assert_clear(POUR_DRIVE_FAULT_OVERTEMP, 1);
+  assert_clear(POUR_DRIVE_FAULT_PHASE, 1);
+  assert_clear(POUR_DRIVE_FAULT_I2T, 1); /* cold: no heat accrued */
+  assert_clear(POUR_DRIVE_FAULT_CURRENT_OFFSET, 0);
+  assert_clear(POUR_DRIVE_FAULT_ENCODER_DIRECTION, 0);
+  assert_clear(POUR_DRIVE_FAULT_ENCODER_MISMATCH, 0);
+  assert_clear(POUR_DRIVE_FAULT_CALIBRATION, 0);
+  for (uint16_t bit = 1u; bit <= POUR_DRIVE_FAULT_ALL; bit = (uint16_t)(bit << 1))
+    assert_clear(bit, (bit & POUR_DRIVE_FAULT_CLEARABLE) != 0u);
+}
+
+static void test_drive_ClearKeepsTheKeptBitAndClearsTheOthers(void) {
+  run_calibration();
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_OVERCURRENT | POUR_DRIVE_FAULT_ENCODER_DIRECTION);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_ENCODER_DIRECTION, pour_drive_clear_faults(&drv));
+  pour_drive_isr(&drv, quiet(), &out);
+  assert_held(POUR_DRIVE_FAULT_ENCODER_DIRECTION);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_ENCODER_DIRECTION, out.faults);
+}
+
+static void test_drive_ClearKeepsTheBusFaultWhileTheBusIsOut(void) {
+  run_calibration();
+  pour_drive_sample_t s = sample(0, 0, 0, 30500, 0);
+  pour_drive_isr(&drv, &s, &out);
+  pour_drive_isr(&drv, &s, &out);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_OVERVOLTAGE, pour_drive_clear_faults(&drv));
+  s = sample(0, 0, 0, 9000, 0);
+  pour_drive_isr(&drv, &s, &out);
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_UNDERVOLTAGE);
+  /* the bus no longer over: that one clears, the one still out stays */
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_UNDERVOLTAGE, pour_drive_clear_faults(&drv));
+  pour_drive_isr(&drv, quiet(), &out); /* back in range */
+  TEST_ASSERT_EQUAL_HEX16(0u, pour_drive_clear_faults(&drv));
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+static void test_drive_ClearKeepsTheI2tFaultUntilTheMotorCools(void) {
+  run_calibration();
+  const int32_t ib = 30000 * 866 / 1000;
+  const pour_drive_sample_t hot = sample(0, ib, -ib, 24000, 0);
+  while (drv.state == POUR_DRIVE_RUN) {
+    for (int p = 0; p < 20; ++p) pour_drive_isr(&drv, &hot, &out);
+    pour_drive_tick(&drv, 20000, 0);
+  }
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_I2T, pour_drive_clear_faults(&drv));
+  /* held at zero current it cools at i_cont²: half the 466 A²·s budget in 21.5 s */
+  int ms = 0;
+  while (pour_drive_clear_faults(&drv) != 0u && ms < 60000) {
+    for (int p = 0; p < 20; ++p) pour_drive_isr(&drv, quiet(), &out);
+    pour_drive_tick(&drv, 0, 0);
+    ++ms;
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+  TEST_ASSERT_INT_WITHIN(100, 21500, ms);
+}
+
+static void test_drive_ClearDoesNothingOutsideFaulted(void) {
+  TEST_ASSERT_EQUAL_HEX16(0u, pour_drive_clear_faults(&drv));
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv.state); /* the offsets are still being measured */
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_OVERTEMP);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_OVERTEMP, pour_drive_clear_faults(&drv)); /* never measured */
+  setUp();
+  run_calibration();
+  TEST_ASSERT_EQUAL_HEX16(0u, pour_drive_clear_faults(&drv));
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_drive_DefaultConfigIsValid);
@@ -257,5 +351,10 @@ int main(void) {
   RUN_TEST(test_drive_I2tBudgetTripsAtItsIntegral);
   RUN_TEST(test_drive_AnyInputGivesDutiesInRange);
   RUN_TEST(test_drive_TripFromOutsideLatches);
+  RUN_TEST(test_drive_ClearErrorsClearsWhatItCanJudgeAndKeepsTheRest);
+  RUN_TEST(test_drive_ClearKeepsTheKeptBitAndClearsTheOthers);
+  RUN_TEST(test_drive_ClearKeepsTheBusFaultWhileTheBusIsOut);
+  RUN_TEST(test_drive_ClearKeepsTheI2tFaultUntilTheMotorCools);
+  RUN_TEST(test_drive_ClearDoesNothingOutsideFaulted);
   return UNITY_END();
 }

@@ -170,6 +170,23 @@ void pour_drive_trip(pour_drive_t *drv, uint16_t fault) {
   drv->iq_cmd_q15 = 0;
 }
 
+uint16_t pour_drive_clear_faults(pour_drive_t *drv) {
+  if (drv->state != POUR_DRIVE_FAULTED || !drv->sense.calibrated) return drv->faults;
+  uint16_t keep = (uint16_t)(drv->faults & ~POUR_DRIVE_FAULT_CLEARABLE);
+  if (drv->vbus_q15 > drv->ov_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_OVERVOLTAGE);
+  if (drv->vbus_q15 < drv->uv_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_UNDERVOLTAGE);
+  if (drv->heat_q30ms > drv->i2t_budget_q30ms / 2) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_I2T);
+  drv->faults = keep;
+  if (keep != 0u) return keep;
+  pour_current_pi_reset(&drv->pi_d);
+  pour_current_pi_reset(&drv->pi_q);
+  drv->iq_cmd_q15 = 0;
+  drv->phase_loss_count = 0;
+  drv->motor_counts = drv->output_urad = 0;
+  drv->state = POUR_DRIVE_RUN;
+  return 0u;
+}
+
 static int32_t abs_i32(int32_t x) { return x < 0 ? -x : x; }
 static int32_t clamp_i32(int32_t x, int32_t lo, int32_t hi) { return x < lo ? lo : (x > hi ? hi : x); }
 
@@ -272,6 +289,7 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   out->id = out->iq = out->id_ref = out->iq_ref = 0;
   out->limits = 0;
   out->vbus = pour_sat_q15((int32_t)(((int64_t)in->adc_vbus * drv->vbus_gain_q16 + (1 << 15)) >> 16)); /* < 2^47 >> 16 */
+  drv->vbus_q15 = out->vbus;
   if (drv->state == POUR_DRIVE_CALIBRATING) {
     const int r = pour_current_sense_calibrate(&drv->sense, in->adc_phase);
     if (r < 0) {
@@ -365,8 +383,23 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   out->faults = drv->faults;
 }
 
+/* I²t: the mean i² of this millisecond above the continuous current's, accrued; cooling below it. Returns
+ * whether periods ran this millisecond. */
+static int accrue_i2t(pour_drive_t *drv) {
+  if (drv->i2_n == 0u) return 0;
+  drv->heat_q30ms += drv->i2_sum_q30 / drv->i2_n - drv->i_cont2_q30;
+  if (drv->heat_q30ms < 0) drv->heat_q30ms = 0;
+  drv->i2_sum_q30 = 0;
+  drv->i2_n = 0;
+  return 1;
+}
+
 void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta_urad) {
   const pour_drive_config_t *c = &drv->config;
+  if (drv->state == POUR_DRIVE_FAULTED) {
+    accrue_i2t(drv); /* the motor cools while held: a clear waits for it */
+    return;
+  }
   if (drv->state != POUR_DRIVE_RUN) {
     drv->i2_sum_q30 = 0;
     drv->i2_n = 0;
@@ -381,16 +414,9 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
   }
   const int64_t iq = ((int64_t)torque_mnm * gain + (1 << 15)) >> 16;
   drv->iq_cmd_q15 = (int32_t)(iq > drv->limit_q15 ? drv->limit_q15 : (iq < -drv->limit_q15 ? -drv->limit_q15 : iq));
-  /* I²t: the mean i² of this millisecond above the continuous current's, accrued; cooling below it */
-  if (drv->i2_n > 0u) {
-    drv->heat_q30ms += drv->i2_sum_q30 / drv->i2_n - drv->i_cont2_q30;
-    if (drv->heat_q30ms < 0) drv->heat_q30ms = 0;
-    drv->i2_sum_q30 = 0;
-    drv->i2_n = 0;
-    if (drv->heat_q30ms > drv->i2t_budget_q30ms) {
-      pour_drive_trip(drv, POUR_DRIVE_FAULT_I2T);
-      return;
-    }
+  if (accrue_i2t(drv) && drv->heat_q30ms > drv->i2t_budget_q30ms) {
+    pour_drive_trip(drv, POUR_DRIVE_FAULT_I2T);
+    return;
   }
   /* the motor encoder against the output's motion: counts expected = Δθ·N·cpr/2π */
   drv->output_urad += output_delta_urad;

@@ -115,6 +115,7 @@ typedef struct {
   int32_t limit_q15, overcurrent_q15, phase_sum_q15, flux_brake_q15;
   int32_t regen_on_q15, regen_span_q15, ov_q15, uv_q15;
   int32_t iq_cmd_q15;         /* from the last tick */
+  q15_t vbus_q15;             /* the last period's bus voltage, per-unit */
   uint8_t elec_shift;         /* 16 − log2(encoder_cpr) */
   uint16_t last_encoder;
   int32_t motor_counts;       /* motor encoder motion since the direction window opened [counts] */
@@ -165,5 +166,11 @@ pour_motor_cal_status_t pour_drive_calibration(const pour_drive_t *drv, pour_mot
 
 /* Latches a fault from outside the loop (the comparators' break input, an over-temperature). */
 void pour_drive_trip(pour_drive_t *drv, uint16_t fault);
+
+/* ClearErrors: clears the latched faults whose cause is judged gone (POUR_DRIVE_FAULT_CLEARABLE, with the
+ * bus and I²t conditions there); with none left, FAULTED becomes RUN at zero current, the PI loops reset.
+ * Returns the faults still latched (0: cleared). Nothing changes outside FAULTED, nor before the current
+ * offsets were measured (a reset measures them). */
+uint16_t pour_drive_clear_faults(pour_drive_t *drv);
 
 #endif /* POUR_DRIVE_H */

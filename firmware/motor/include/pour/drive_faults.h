@@ -18,4 +18,16 @@
 #define POUR_DRIVE_FAULT_I2T 0x0400u              /* the motor's thermal (I²t) budget is spent */
 #define POUR_DRIVE_FAULT_ALL 0x07FFu
 
+/* What ClearErrors may clear (pour_drive_clear_faults): a fault whose cause the drive or the board judges
+ * afresh once cleared. OVERCURRENT and PHASE: the loop checks every period again. HW_OVERCURRENT: the board
+ * re-arms the break, which fires again while a comparator still trips. OVERVOLTAGE, UNDERVOLTAGE: only with
+ * the last bus sample in range. OVERTEMP: the board's protection reads the NTC again. I2T: only once the
+ * motor has cooled to half its budget.
+ * Kept until a reset: CURRENT_OFFSET (a broken amplifier or an unarmed cut), ENCODER_DIRECTION (wiring or
+ * a wrong calibration: the motor would run away), ENCODER_MISMATCH (a slipped coupling would look fine
+ * once re-anchored). Kept until a self-calibration succeeds: CALIBRATION. */
+#define POUR_DRIVE_FAULT_CLEARABLE                                                                            \
+  (POUR_DRIVE_FAULT_OVERCURRENT | POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERVOLTAGE |            \
+   POUR_DRIVE_FAULT_UNDERVOLTAGE | POUR_DRIVE_FAULT_OVERTEMP | POUR_DRIVE_FAULT_PHASE | POUR_DRIVE_FAULT_I2T)
+
 #endif /* POUR_DRIVE_FAULTS_H */
