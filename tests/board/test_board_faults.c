@@ -138,7 +138,19 @@ static pour_sensors_t sample_of(uint32_t seq) {
   return s;
 }
 
-typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED, F_SELF_CAL } fault_t;
+typedef enum { F_BREAK, F_UNDERVOLTAGE, F_OVERVOLTAGE, F_OVERTEMP, F_SLIP, F_CALIBRATION, F_SAG_CLEARED, F_SELF_CAL, F_BREAK_CLEARED,
+               F_BREAK_PERSISTS } fault_t;
+
+/* F_BREAK_CLEARED, F_BREAK_PERSISTS: the comparators' break for 5 ms, or for good, then a ClearErrors at
+ * CLEAR_MS with the bucket held; from then on the decisions tilt it on at 0.5 rad/s from where it was
+ * held. What the ticks after the clear did. */
+#define CLEAR_MS 900
+static struct {
+  double theta;
+  int brake_not_core_ticks; /* the brake other than the core commands it, from the tick after the clear */
+  int released_ticks;
+  int32_t torque_step_max; /* the largest change of the core's torque between two ticks in RUN [Q15] */
+} after_clear;
 
 /* F_SELF_CAL: an uncalibrated board whose calibration flow (the hook board_loop installs on the board) starts
  * the drive's self-calibration at SELF_CAL_MS; what the tick did while it ran. */
@@ -167,12 +179,18 @@ typedef struct {
   bool power_at_detection, shorted_at_detection, brake_at_detection;
 } result_t;
 
+/* Where the decisions after the clear take the bucket: on at 0.5 rad/s. */
+static double resumed_theta(double t) { return after_clear.theta + 0.5 * (t - CLEAR_MS * DT); }
+
 static result_t pour_with(fault_t fault) {
   memset(&plant, 0, sizeof plant);
   plant.brake_since = -1.0;
   plant.brake_cmd = true;
   plant.brake_held = true; /* spring-applied: engaged from power-up */
-  plant.theta = fault == F_SELF_CAL ? 0.0 : 40.0 * PI / 180.0; /* calibrated where gravity has no torque */
+  const bool clearing = fault == F_BREAK_CLEARED || fault == F_BREAK_PERSISTS;
+  /* calibrated where gravity has no torque; cleared where the envelope's torque from rest still lifts it */
+  const double start = fault == F_SELF_CAL ? 0.0 : (clearing ? 15.0 : 40.0) * PI / 180.0;
+  plant.theta = start;
   plant.vbus_v = 24.0;
   plant.temp_c = 40.0;
   drive_config = pour_drive_default_config();
@@ -180,6 +198,9 @@ static result_t pour_with(fault_t fault) {
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&drive_config, (int32_t)(TAU_MAX_NM * 1000), fault != F_CALIBRATION && fault != F_SELF_CAL));
   memset(&self_cal, 0, sizeof self_cal);
+  memset(&after_clear, 0, sizeof after_clear);
+  q15_t last_torque = 0;
+  uint8_t last_mode = POUR_MODE_IDLE;
   self_cal.started = POUR_EINVAL;
   pour_board_drive_set_calibration(fault == F_SELF_CAL ? self_cal_flow : NULL);
   const int fault_ms = fault == F_CALIBRATION || fault == F_SELF_CAL ? 0 : 300;
@@ -192,7 +213,9 @@ static result_t pour_with(fault_t fault) {
     }
     if (ms >= fault_ms) {
       switch (fault) {
-      case F_BREAK: plant.comparator_trip = ms < fault_ms + 5; break; /* a 5 ms current spike */
+      case F_BREAK:
+      case F_BREAK_CLEARED: plant.comparator_trip = ms < fault_ms + 5; break; /* a 5 ms current spike */
+      case F_BREAK_PERSISTS: plant.comparator_trip = true; break;
       case F_UNDERVOLTAGE: plant.vbus_v = fmax(0.0, 24.0 - 0.5 * (ms - fault_ms)); break; /* sags at 0.5 V/ms */
       case F_SAG_CLEARED: plant.vbus_v = r.detected_ms < 0 ? 24.0 - 0.5 * (ms - fault_ms) : 24.0; break;
       case F_OVERVOLTAGE: plant.vbus_v = 24.0 + 0.5 * (ms - fault_ms); break;
@@ -212,14 +235,29 @@ static result_t pour_with(fault_t fault) {
     /* A ClearErrors 3 ms into the active stop, the sag already over: the core refuses it, and so must the
      * protection (else the brake would be released under a stop that returns the bucket upright). */
     in.clear_faults = fault == F_SAG_CLEARED && r.detected_ms >= 0 && ms == fault_ms + r.detected_ms + 3;
+    if (clearing && ms == CLEAR_MS) {
+      in.clear_faults = true;
+      after_clear.theta = plant.theta;
+    }
     /* The decisions: tilt at 0.5 rad/s with gravity feed-forward (the core's own stop takes over in FAULT). */
-    const double ref = 40.0 * PI / 180.0 + 0.5 * (t - WARMUP_MS * DT);
+    const bool resumed = clearing && ms >= CLEAR_MS;
+    const double ref = resumed ? resumed_theta(t) : start + 0.5 * (t - WARMUP_MS * DT);
     const double ff = MASS * G * ARM * sin(plant.theta);
     const double nm = ff + 200.0 * (ref - plant.theta) + 30.0 * (0.5 - plant.omega);
     pour_control_request(&ctl, 0u, (q15_t)lround(fmax(-1.0, fmin(1.0, nm / TAU_MAX_NM)) * 32767.0));
     pour_control_output_t out;
     self_cal.ms = ms;
     pour_board_drive_tick(&ctl, &in, &out);
+    if (clearing && ms > CLEAR_MS && out.mode == POUR_MODE_RUN && last_mode == POUR_MODE_RUN) {
+      const int32_t step = out.torque > last_torque ? out.torque - last_torque : last_torque - out.torque;
+      after_clear.torque_step_max = step > after_clear.torque_step_max ? step : after_clear.torque_step_max;
+    }
+    if (clearing && ms > CLEAR_MS) {
+      after_clear.brake_not_core_ticks += plant.brake_cmd == out.brake ? 0 : 1;
+      after_clear.released_ticks += plant.brake_cmd ? 0 : 1;
+    }
+    last_torque = out.torque;
+    last_mode = out.mode;
     if (pour_board_drive_state()->state == POUR_DRIVE_MEASURING) {
       self_cal.measuring_ticks++;
       self_cal.power_off_ticks += plant.power ? 0 : 1;
@@ -351,6 +389,37 @@ static void test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd(void
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
 }
 
+/* The cause gone, a ClearErrors re-arms the break and clears the drive: the core back to RUN, the brake
+ * released by the core alone, the torque within the slew limit, the bucket following the decisions. */
+static void test_faults_AClearAfterTheBreakRunsAgainThroughTheCore(void) {
+  const result_t r = pour_with(F_BREAK_CLEARED);
+  printf("break cleared: brake released %d ticks, brake not the core's %d ticks, largest torque step %d (Q15), "
+         "ended %.2f deg from where the decisions took it\n",
+         after_clear.released_ticks, after_clear.brake_not_core_ticks, (int)after_clear.torque_step_max,
+         fabs(r.theta_end - resumed_theta(1499 * DT)) * 180.0 / PI);
+  TEST_ASSERT_EQUAL_HEX16(0u, r.drive_faults);
+  TEST_ASSERT_EQUAL_HEX16(0u, r.core_faults);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, r.mode);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, pour_board_drive_state()->state);
+  TEST_ASSERT_FALSE(plant.breaked);
+  TEST_ASSERT_FALSE(r.brake);
+  TEST_ASSERT_TRUE(after_clear.released_ticks > 0);
+  TEST_ASSERT_EQUAL_INT(0, after_clear.brake_not_core_ticks);
+  TEST_ASSERT_TRUE(after_clear.torque_step_max <= pour_control_default_config().safety.slew_per_tick);
+  TEST_ASSERT_DOUBLE_WITHIN(3.0 * PI / 180.0, resumed_theta(1499 * DT), r.theta_end);
+  TEST_ASSERT_EQUAL_UINT(0u, plant.coasting_ticks);
+}
+
+/* The comparator still tripping: the break fires again at the re-arm, and everything stays latched. */
+static void test_faults_AClearWhileTheBreakPersistsKeepsItLatched(void) {
+  const result_t r = pour_with(F_BREAK_PERSISTS);
+  assert_held(&r, POUR_DRIVE_FAULT_HW_OVERCURRENT, 1);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
+  TEST_ASSERT_TRUE(plant.breaked);
+  TEST_ASSERT_EQUAL_INT(0, after_clear.released_ticks);
+  TEST_ASSERT_DOUBLE_WITHIN(0.5 * PI / 180.0, after_clear.theta, r.theta_end);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_faults_BreakShortsThePhasesAndTheBrakeHolds);
@@ -361,5 +430,7 @@ int main(void) {
   RUN_TEST(test_faults_SlippingCouplingIsAMismatchAndTheBrakeHolds);
   RUN_TEST(test_faults_WithoutCalibrationTheBucketNeverMoves);
   RUN_TEST(test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd);
+  RUN_TEST(test_faults_AClearAfterTheBreakRunsAgainThroughTheCore);
+  RUN_TEST(test_faults_AClearWhileTheBreakPersistsKeepsItLatched);
   return UNITY_END();
 }

@@ -102,7 +102,11 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   const bool sampled = bd.periods != bd.periods_seen;
   bd.periods_seen = bd.periods;
   const pour_hal_drive_sample_t s = bd.latest;
-  const uint16_t loop_faults = bd.drive.faults;
+  /* After a clear the core accepted, the protection judges the board's sensors afresh without the loop's
+   * faults a clear may fix; the loop clears only if the protection did, so it never runs while the
+   * protection still holds. */
+  const uint16_t loop_faults =
+      bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
   if (!bd.armed && bd.drive.state == POUR_DRIVE_RUN) {
     bd.armed = true; /* the thresholds sit above the offsets the loop has just measured */
     if (pour_hal_drive_arm_overcurrent(bd.drive.sense.offset) != POUR_OK) {
@@ -120,6 +124,9 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
                   bd.clear, &p);
 
   pour_hal_drive_mask(true);
+  if (bd.clear && p.faults == 0u) {
+    (void)pour_drive_clear_faults(&bd.drive); /* what it keeps stays in bd.faults: the core latches it again */
+  }
   /* A missing calibration alone does not trip a drive that measures its offsets (the interrupt trips it
    * then), measures the motor, or has just measured it (the flow stores it this tick). */
   const pour_motor_cal_status_t cal = pour_drive_calibration(&bd.drive, NULL);
