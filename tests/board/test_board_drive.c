@@ -17,6 +17,8 @@
 #include "unity.h"
 
 static uint32_t tim1[POUR_TIM1_N_REGS], tim4[POUR_TIM4_N_REGS], adc1[POUR_ADC_N_REGS], adc2[POUR_ADC_N_REGS];
+static uint32_t comp[POUR_OCP_COMP_N_REGS];
+static pour_ocp_t ocp;
 static bool brake = true, power;
 
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
@@ -40,11 +42,13 @@ void setUp(void) {
   memset(tim4, 0, sizeof tim4);
   memset(adc1, 0, sizeof adc1);
   memset(adc2, 0, sizeof adc2);
+  memset(comp, 0, sizeof comp);
+  ocp.comp = comp;
   pour_pwm_t pwm;
   const pour_pwm_config_t pc = pour_pwm_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_pwm_init(&pwm, tim1, &pc));
   const pour_adc_t adc = {adc1, adc2, NULL, 10u};
-  pour_hal_drive_attach(&pwm, &adc, tim4);
+  pour_hal_drive_attach(&pwm, &adc, tim4, &ocp);
   const pour_drive_config_t dc = pour_drive_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, 20000, true));
 }
@@ -132,10 +136,29 @@ static void test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares(void) {
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
 }
 
+/* The comparators' break (SR.BIF, MOE cleared by the hardware): a clear while a comparator's output is high
+ * leaves it fired; once every output is low, the flag clears and MOE is set with all six switches off. */
+static void test_drive_isr_TheBreakClearsOnlyOnceTheComparatorsAreLow(void) {
+  calibrate();
+  tim1[POUR_TIM1_SR] |= 1u << 7;           /* BIF */
+  tim1[POUR_TIM1_BDTR] &= ~(1u << 15);     /* MOE */
+  comp[POUR_COMP_C4CSR] |= 1u << 30;       /* phase W still above its threshold */
+  TEST_ASSERT_TRUE(pour_hal_drive_overcurrent_tripped());
+  pour_hal_drive_clear_overcurrent();
+  TEST_ASSERT_TRUE(pour_hal_drive_overcurrent_tripped());
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_BDTR] & (1u << 15));
+  comp[POUR_COMP_C4CSR] &= ~(1u << 30);
+  pour_hal_drive_clear_overcurrent();
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_SR] & (1u << 7));
+  TEST_ASSERT_EQUAL_HEX32(1u << 15, tim1[POUR_TIM1_BDTR] & (1u << 15));
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCER]); /* all six off until the loop drives them again */
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_drive_isr_WithoutTheEndOfSequenceNothingIsRead);
   RUN_TEST(test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares);
   RUN_TEST(test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares);
+  RUN_TEST(test_drive_isr_TheBreakClearsOnlyOnceTheComparatorsAreLow);
   return UNITY_END();
 }

@@ -210,7 +210,7 @@ pour_status_t pour_hal_drive_init(void) {
                     ADC_REGULATOR_WAIT) != POUR_OK) {
     return POUR_EINVAL;
   }
-  pour_hal_drive_attach(&pwm, &adc, POUR_PERIPH(TIM4));
+  pour_hal_drive_attach(&pwm, &adc, POUR_PERIPH(TIM4), &ocp);
   pour_hal_drive_mask(false); /* the current loop runs from now on (ADC1's end of sequence: pour_adc_init) */
   return POUR_OK;
 }

@@ -9,11 +9,13 @@
 static pour_pwm_t pwm;
 static pour_adc_t adc;
 static volatile uint32_t *tim4;
+static const pour_ocp_t *ocp;
 
-void pour_hal_drive_attach(const pour_pwm_t *p, const pour_adc_t *a, volatile uint32_t *t) {
+void pour_hal_drive_attach(const pour_pwm_t *p, const pour_adc_t *a, volatile uint32_t *t, const pour_ocp_t *o) {
   pwm = *p;
   adc = *a;
   tim4 = t;
+  ocp = o;
 }
 
 uint16_t pour_hal_drive_period(void) { return pwm.period; }
@@ -53,7 +55,9 @@ void pour_hal_drive_short_low_sides(void) {
 bool pour_hal_drive_overcurrent_tripped(void) { return pwm.regs != NULL && pour_pwm_break_fired(&pwm); }
 
 void pour_hal_drive_clear_overcurrent(void) {
-  if (pwm.regs != NULL) {
+  /* MOE only once every comparator's output is low again: the break's cause gone, not merely masked */
+  const bool tripping = ocp != NULL && ocp->comp != NULL && pour_ocp_tripping(ocp);
+  if (pwm.regs != NULL && !tripping) {
     pour_pwm_clear_break(&pwm);
   }
 }

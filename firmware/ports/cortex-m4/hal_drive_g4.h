@@ -9,10 +9,14 @@
 #include <stdint.h>
 
 #include "adc_inj.h"
+#include "ocp.h"
 #include "pwm_tim1.h"
 
 /* The drivers' instances behind hal_drive (copied; their registers stay where they are); tim4: the encoder
- * timer's registers. Until attached, hal_drive has no sample and every output call does nothing. */
-void pour_hal_drive_attach(const pour_pwm_t *pwm, const pour_adc_t *adc, volatile uint32_t *tim4);
+ * timer's registers; ocp: the comparators (kept by pointer: armed later, pour_hal_drive_arm_overcurrent),
+ * read before a break is cleared, or NULL for none. Until attached, hal_drive has no sample and every
+ * output call does nothing. */
+void pour_hal_drive_attach(const pour_pwm_t *pwm, const pour_adc_t *adc, volatile uint32_t *tim4,
+                           const pour_ocp_t *ocp);
 
 #endif /* POUR_HAL_DRIVE_G4_H */

@@ -45,7 +45,8 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]);
 /* true once the hardware cut has fired (latched: the phases stay shorted) until cleared. */
 bool pour_hal_drive_overcurrent_tripped(void);
 
-/* ClearErrors: re-arms the cut with all six switches off; a comparator still tripping fires it again. */
+/* ClearErrors: re-arms the cut with all six switches off once no comparator trips; while one does, the cut
+ * stays fired. */
 void pour_hal_drive_clear_overcurrent(void);
 
 /* true: the current loop's interrupt is held off (the 1 kHz tick's short exchanges with the loop's state);

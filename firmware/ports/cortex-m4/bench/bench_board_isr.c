@@ -55,7 +55,7 @@ int main(void) {
     printf("pour_pwm_init failed\n");
     return 1;
   }
-  pour_hal_drive_attach(&pwm, &adc, tim4);
+  pour_hal_drive_attach(&pwm, &adc, tim4, NULL);
   if (pour_board_drive_init(&dc, 20000, true) != POUR_OK) {
     printf("pour_board_drive_init failed\n");
     return 1;
