@@ -11,7 +11,9 @@
  * shaft that holds 20 N·m once engaged for 20 ms. The core's sensors are the plant's: the output encoder
  * (17 bits) and the two scales. Injected at 300 ms into a tilt at 0.5 rad/s: the comparators' break, a
  * sagging and a pumped-up bus, a hot power stage, a slipping coupling; and a missing calibration at boot; a
- * ClearErrors in the middle of an active stop, which releases nothing.
+ * ClearErrors in the middle of an active stop, which releases nothing; a ClearErrors after a break whose cause
+ * is gone (the core back to RUN, the brake released by the core alone, the torque within the slew limit)
+ * and one while the comparator still trips (everything kept).
  * Checked: the fault named in the drive's word and the core in FAULT with POUR_FAULT_DRIVE, an active stop
  * (power on) where the drive is still trusted and the phases shorted where it is not, the brake engaged
  * and holding at the end, within 10° of where the fault began, and no tick between the fault and the
