@@ -115,8 +115,9 @@ static int32_t identify(pour_experiment_t *e, const pour_state_t *s) {
     e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_STEPS;
     excite = (((t - RAMP_MS) / STEP_HALF_MS) & 1u) == 0u ? c->step_torque : -c->step_torque;
     if ((t - RAMP_MS) % c->prbs_bit_ms == 0u) {
-      const uint16_t bit = (uint16_t)(((e->lfsr >> 0) ^ (e->lfsr >> 2) ^ (e->lfsr >> 3) ^ (e->lfsr >> 5)) & 1u);
-      e->lfsr = (uint16_t)((e->lfsr >> 1) | (bit << 15));
+      const uint32_t r = e->lfsr;
+      const uint32_t bit = (r ^ (r >> 2) ^ (r >> 3) ^ (r >> 5)) & 1u;
+      e->lfsr = (uint16_t)((r >> 1) | (bit << 15));
     }
     excite += (e->lfsr & 1u) != 0u ? c->prbs_torque : -c->prbs_torque;
   } else if (t < RAMP_MS + STEPS_MS + CHIRP_MS) {

@@ -51,7 +51,8 @@ double com_across(poursim_world_t *w, const poursim_config_t &c, std::vector<flo
   int k = 0;
   for (int i = 0; i < n; ++i) {
     if (reg[static_cast<size_t>(i)] != 0) continue;
-    double dx = xy[static_cast<size_t>(2 * i)], dy = static_cast<double>(xy[static_cast<size_t>(2 * i + 1)]) - c.pivot_height;
+    const double dx = static_cast<double>(xy[static_cast<size_t>(2 * i)]);
+    const double dy = static_cast<double>(xy[static_cast<size_t>(2 * i + 1)]) - c.pivot_height;
     sum += dx * cs - dy * sn;
     ++k;
   }
