@@ -289,7 +289,6 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   out->id = out->iq = out->id_ref = out->iq_ref = 0;
   out->limits = 0;
   out->vbus = pour_sat_q15((int32_t)(((int64_t)in->adc_vbus * drv->vbus_gain_q16 + (1 << 15)) >> 16)); /* < 2^47 >> 16 */
-  drv->vbus_q15 = out->vbus;
   if (drv->state == POUR_DRIVE_CALIBRATING) {
     const int r = pour_current_sense_calibrate(&drv->sense, in->adc_phase);
     if (r < 0) {
@@ -336,6 +335,7 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   drv->i2_sum_q30 += (int64_t)id * id + (int64_t)iq * iq;
   drv->i2_n++;
   if (drv->state != POUR_DRIVE_RUN) {
+    drv->vbus_q15 = out->vbus; /* for a clear; kept off the running path, the interrupt's longest */
     hold(drv, out);
     return;
   }

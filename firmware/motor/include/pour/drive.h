@@ -115,7 +115,7 @@ typedef struct {
   int32_t limit_q15, overcurrent_q15, phase_sum_q15, flux_brake_q15;
   int32_t regen_on_q15, regen_span_q15, ov_q15, uv_q15;
   int32_t iq_cmd_q15;         /* from the last tick */
-  q15_t vbus_q15;             /* the last period's bus voltage, per-unit */
+  q15_t vbus_q15;             /* the bus voltage of the last period held FAULTED, per-unit (for a clear) */
   uint8_t elec_shift;         /* 16 − log2(encoder_cpr) */
   uint16_t last_encoder;
   int32_t motor_counts;       /* motor encoder motion since the direction window opened [counts] */
