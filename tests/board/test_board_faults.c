@@ -415,6 +415,8 @@ static void test_faults_AClearAfterTheBreakRunsAgainThroughTheCore(void) {
 /* The comparator still tripping: the break fires again at the re-arm, and everything stays latched. */
 static void test_faults_AClearWhileTheBreakPersistsKeepsItLatched(void) {
   const result_t r = pour_with(F_BREAK_PERSISTS);
+  printf("break persisting: brake released %d ticks after the clear, ended %.2f deg from where it was held\n",
+         after_clear.released_ticks, fabs(r.theta_end - after_clear.theta) * 180.0 / PI);
   assert_held(&r, POUR_DRIVE_FAULT_HW_OVERCURRENT, 1);
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
   TEST_ASSERT_TRUE(plant.breaked);
