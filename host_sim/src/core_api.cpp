@@ -55,6 +55,14 @@ const Field kFields[] = {
     POURSIM_FW_FIELD(stop.return_speed_urad_s), POURSIM_FW_FIELD(stop.return_gain_per_s),
     POURSIM_FW_FIELD(stop.torque_per_rad_s), POURSIM_FW_FIELD(stop.rest_theta_urad),
     POURSIM_FW_FIELD(stop.rest_omega_urad_s), POURSIM_FW_FIELD(stop.timeout_ms),
+    POURSIM_FW_FIELD(restart_jump_max_urad), POURSIM_FW_FIELD(experiment.hold_theta_urad),
+    POURSIM_FW_FIELD(experiment.range_urad), POURSIM_FW_FIELD(experiment.kp_per_rad),
+    POURSIM_FW_FIELD(experiment.kd_per_rad_s), POURSIM_FW_FIELD(experiment.step_torque),
+    POURSIM_FW_FIELD(experiment.chirp_torque), POURSIM_FW_FIELD(experiment.prbs_torque),
+    POURSIM_FW_FIELD(experiment.prbs_bit_ms), POURSIM_FW_FIELD(experiment.chirp_f0_mhz),
+    POURSIM_FW_FIELD(experiment.chirp_f1_mhz), POURSIM_FW_FIELD(experiment.tilt_theta_urad),
+    POURSIM_FW_FIELD(experiment.tilt_speed_urad_s), POURSIM_FW_FIELD(experiment.tilt_margin_urad),
+    POURSIM_FW_FIELD(experiment.tilt_kp_per_rad), POURSIM_FW_FIELD(experiment.tilt_kd_per_rad_s),
 };
 #undef POURSIM_FW_FIELD
 

@@ -43,6 +43,11 @@ def test_the_records_that_cross_the_c_api_have_c_sizes():
 def test_the_core_config_is_read_and_set_by_name():
     cfg = core.control_config()
     assert "safety.tau_limit" in cfg.fields() and "stop.timeout_ms" in cfg.fields()
+    assert "restart_jump_max_urad" in cfg.fields() and "experiment.tilt_kd_per_rad_s" in cfg.fields()
+    cfg.experiment.prbs_bit_ms = 255  # a uint8_t field: its whole range, and no more
+    assert cfg.get("experiment.prbs_bit_ms") == 255
+    with pytest.raises(core.CoreError):
+        cfg.set("experiment.prbs_bit_ms", 256)
     cfg.safety.tau_limit = 12345
     assert cfg.get("safety.tau_limit") == cfg.safety.tau_limit == 12345
     cfg.safety.theta_min_urad = -87266

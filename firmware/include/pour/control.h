@@ -70,7 +70,7 @@ typedef struct {
   bool clear_faults; /* request to clear latched faults (acted on in FAULT once the active stop is over) */
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
   bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
-  bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN and ESTOP */
+  bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN, ESTOP, active stop */
   uint16_t drive_faults; /* level: the drive's latched fault word (POUR_DRIVE_FAULT_*; 0: none, or no drive of
                           * its own); any bit latches POUR_FAULT_DRIVE */
   bool drive_trusted;    /* with drive_faults: the drive still follows a torque (the controlled stop runs); false:
