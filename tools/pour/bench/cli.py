@@ -111,7 +111,7 @@ def parser() -> argparse.ArgumentParser:
                    help="identify: bucket EMPTY, steps and a chirp about 20 deg within -3..43 deg; tilt: with "
                         "water, to 90 deg at 0.1 rad/s and back (default %(default)s)")
     p.add_argument("--seconds", type=_seconds, default=60.0, help="give up after this long (default %(default)s)")
-    sub.add_parser("calibrate", help="drive calibration (needs the board's calibration messages)")
+    sub.add_parser("calibrate", help="drive calibration (not in this tool yet: docs/bringup.md)")
     return ap
 
 
@@ -174,8 +174,9 @@ def _plot(a: argparse.Namespace) -> int:
 
 def run(a: argparse.Namespace) -> int:
     if a.cmd == "calibrate":
-        raise bn.BenchError("calibrate is not available over this firmware: its CAN protocol has no calibration "
-                            "messages (can/pour.dbc)")
+        raise bn.BenchError("calibrate is not available over this firmware's bench tool yet: send CalibrationStart "
+                            "(can/pour.dbc, 0x05) and read the CalibrationResult frames (docs/bringup.md, "
+                            "'Calibration')")
     if a.cmd == "config" and a.config_cmd == "list":
         for pid, name in bn.param_names(bn.load_dbc()).items():
             print(f"{pid:3d} {name}")
