@@ -270,6 +270,13 @@ def test_pour_results_reach_finds_the_first_confirmed_iteration(tmp_path, monkey
     assert got["iteration"] == first and got["episodes"] == int(log[first]["episodes"]) == (first + 1) * 8
     row = results.reach_row("toy", [tmp_path / "r", tmp_path / "r"], 4)
     assert row["reached"] == 2 and row["episodes_median"] == got["episodes"] and row["budget_episodes"] == 160
+    last = [env.rollout(hist[-1], s, True).metrics for s in range(results.FIRST_SEED, results.FIRST_SEED + 4)]
+    assert row["final"]["poured_pct"] == pytest.approx(100 * np.mean([m["v_target"] for m in last]))
+    assert row["final"]["episodes"] == 8   # the final weights of both runs, 4 held-out episodes each
+    from pour.eval import plots
+    png = tmp_path / "curves.png"
+    plots.validation_curves({"toy": [tmp_path / "r", tmp_path / "r"]}, png)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     monkeypatch.setattr(results, "BAR_POURED_PCT", 101.0)  # never reached: no number, said so
     never = results.reach_row("toy", [tmp_path / "r"], 4)
     assert never["reached"] == 0 and never["episodes_median"] is None

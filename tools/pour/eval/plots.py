@@ -180,26 +180,33 @@ def _liquid(out_dir: Path, prefix: str, poursim: Any, progress: Any) -> list[Pat
     return paths
 
 
-def validation_curves(groups: dict[str, Sequence[Path]], out: Path) -> None:
-    """The greedy validation score (mean per-tick reward, log.csv's eval_score) of each group against
-    training episodes and against wall time: mean over the group's runs, shaded min to max."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), dpi=120, sharey=True)
+def validation_curves(groups: dict[str, Sequence[Path]], out: Path,
+                      bars: tuple[float, float] = (0.98, 0.01)) -> None:
+    """The greedy validation pour (log.csv's eval_v_target, top) and spill (eval_v_spill, bottom) of each group
+    against training episodes (left) and against wall time (right): mean over the group's runs, shaded min to
+    max, the bars (poured, spilled fractions) dashed. The volumes, not eval_score: the methods' rewards differ
+    (a reversal cost or none), the liquid does not."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), dpi=120, sharex="col", sharey="row")
     for label, dirs in groups.items():
         logs = [_log(Path(d)) for d in dirs]
-        n = min(len(lg["eval_score"]) for lg in logs)
-        keep = np.all(np.stack([np.isfinite(lg["eval_score"][:n]) for lg in logs]), axis=0)
-        y = np.stack([lg["eval_score"][:n][keep] for lg in logs])
-        for ax, x in ((axes[0], logs[0]["episodes"][:n][keep]),
-                      (axes[1], np.mean([lg["wall_s"][:n][keep] for lg in logs], axis=0))):
-            line, = ax.plot(x, y.mean(axis=0), label=f"{label} ({len(dirs)} runs)")
-            ax.fill_between(x, y.min(axis=0), y.max(axis=0), color=line.get_color(), alpha=0.2)
-    axes[0].set_xlabel("training episodes")
-    axes[1].set_xlabel("wall time [s] (mean over runs)")
-    axes[0].set_ylabel("greedy validation score (mean reward per tick)")
-    axes[0].legend(fontsize=7)
-    for ax in axes:
-        ax.grid(alpha=0.3)
-    fig.suptitle("Learning curves: mean over training seeds, shaded min to max")
+        n = min(len(lg["eval_v_target"]) for lg in logs)
+        keep = np.all(np.stack([np.isfinite(lg["eval_v_target"][:n]) for lg in logs]), axis=0)
+        xs = (logs[0]["episodes"][:n][keep], np.mean([lg["wall_s"][:n][keep] for lg in logs], axis=0))
+        for row, column in enumerate(("eval_v_target", "eval_v_spill")):
+            y = 100 * np.stack([lg[column][:n][keep] for lg in logs])
+            for ax, x in zip(axes[row], xs):
+                line, = ax.plot(x, y.mean(axis=0), label=f"{label} ({len(dirs)} runs)")
+                ax.fill_between(x, y.min(axis=0), y.max(axis=0), color=line.get_color(), alpha=0.2)
+    for row, bar in enumerate(bars):
+        for ax in axes[row]:
+            ax.axhline(100 * bar, color="k", ls="--", lw=0.8)
+            ax.grid(alpha=0.3)
+    axes[1][0].set_xlabel("training episodes")
+    axes[1][1].set_xlabel("wall time [s] (mean over runs)")
+    axes[0][0].set_ylabel("validation poured [%]")
+    axes[1][0].set_ylabel("validation spilled [%]")
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle("Learning curves, greedy validation: mean over training seeds, shaded min to max, bars dashed")
     fig.tight_layout()
     _save(fig, out)
 

@@ -59,18 +59,22 @@ def _greedy_metrics(job: tuple) -> dict[str, float]:
     return dict(_SIMS[(kind, n_actions, period_ms)].rollout(w, seed, True).metrics)
 
 
-def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> dict[str, Any]:
-    """The output policies of several runs (which 'best': policy.json's best_w, the best greedy-validated
-    weights, or the last ones for configs with eval.select_best = false; 'last': the final weights),
-    greedy, n held-out episodes each, pooled."""
+def _jobs(runs: Sequence[Path], n: int, which: str) -> list[tuple]:
+    """The held-out episodes of several runs' policies (export.weights_of's which), as _greedy_metrics jobs."""
     jobs = []
     for run in runs:
         doc = export.load_policy(run)
         w = export.weights_of(doc, which)
         jobs += [(doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]), w, seed)
                  for seed in range(FIRST_SEED, FIRST_SEED + n)]
-    # Episodes are independent and seeded: run them on every core, results in job order.
-    ms = _held_out(jobs)
+    return jobs
+
+
+def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> dict[str, Any]:
+    """The output policies of several runs (which 'best': policy.json's best_w, the best greedy-validated
+    weights, or the last ones for configs with eval.select_best = false; 'last': the final weights),
+    greedy, n held-out episodes each, pooled."""
+    ms = _held_out(_jobs(runs, n, which))
     p = [100 * m["v_target"] for m in ms]
     s = [100 * m["v_spill"] for m in ms]
     f = [m["finish_s"] for m in ms]
@@ -88,6 +92,7 @@ MAX_CHECKS = 12            # held-out confirmations per run at most (each costs 
 
 
 def _held_out(jobs: list[tuple]) -> list[dict[str, float]]:
+    # Episodes are independent and seeded: run them on every core, results in job order.
     with mp.get_context("fork").Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
         return pool.map(_greedy_metrics, jobs, chunksize=1)
 
@@ -120,8 +125,19 @@ def reach(run: Path, n: int) -> dict[str, Any]:
     return {"run": str(run), "episodes": None, "wall_s": None, "iteration": None, "checks": checks}
 
 
+def _final_figures(runs: Sequence[Path], n: int) -> dict[str, float]:
+    """Poured and spilled of the runs' last weights, greedy, n held-out episodes each, pooled."""
+    ms = _held_out(_jobs(runs, n, "last"))
+    spilled = [100 * m["v_spill"] for m in ms]
+    return {"episodes": len(ms), "poured_pct": 100 * float(np.mean([m["v_target"] for m in ms])),
+            "spilled_pct": float(np.mean(spilled)), "spilled_pct_max": float(np.max(spilled))}
+
+
 def reach_row(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
+    """reach over a group's runs: how many reached, the median episodes and wall time, and the figures of the
+    runs' final weights (the last iteration's, not the best validated) on the held-out seeds."""
     per = [reach(r, n) for r in runs]
+    final = _final_figures(runs, n)
     got = [p for p in per if p["episodes"] is not None]
     budget = [int(_last_log_row(r)["episodes"]) for r in runs]
     # A run that never reached the bars counts as its whole budget and more: the median is then a lower bound.
@@ -131,7 +147,8 @@ def reach_row(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
         return float(v) if np.isfinite(v) else None
     return {"name": name, "runs": len(runs), "reached": len(got), "budget_episodes": max(budget),
             "episodes_median": finite(np.median(eps)), "episodes_min": finite(eps[0]),
-            "episodes_max": finite(eps[-1]), "wall_s_median": finite(np.median(wall)), "per_run": per}
+            "episodes_max": finite(eps[-1]), "wall_s_median": finite(np.median(wall)), "per_run": per,
+            "final": final}
 
 
 def _last_log_row(run: Path) -> dict[str, str]:
@@ -146,11 +163,12 @@ def reach_markdown(reach_rows: list[dict[str, Any]], rows: dict[str, dict[str, A
         return "not reached" if v is None else format(v, fmt)
     lines = ["", f"Learning from zero: training episodes and wall time until the greedy policy first pours >= "
              f"{BAR_POURED_PCT:g} % and spills <= {BAR_SPILLED_PCT:g} % on average over {n} held-out episodes "
-             "(median over the runs; a run that never did counts as not reached), and the output policies' "
-             "figures on the held-out seeds.", "",
+             "(median over the runs; a run that never did counts as not reached), the output policies' "
+             "(best validated weights) figures on the held-out seeds, and the final weights' (last iteration).", "",
              "| method | runs reaching 98 % / 1 % | episodes to reach (median; min–max) | wall s to reach (median) | "
-             "budget (episodes) | poured % | spilled % (max) | reversals per 10 s (max) | finish s |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "budget (episodes) | poured % | spilled % (max) | reversals per 10 s (max) | finish s | "
+             "final weights: poured % / spilled % (max) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in reach_rows:
         f = rows[r["name"]]
         spread = "" if r["episodes_min"] is None else \
@@ -158,7 +176,8 @@ def reach_markdown(reach_rows: list[dict[str, Any]], rows: dict[str, dict[str, A
         lines.append(f"| {r['name']} | {r['reached']}/{r['runs']} | {num(r['episodes_median'], '.0f')}{spread} | "
                      f"{num(r['wall_s_median'], '.0f')} | {r['budget_episodes']} | {f['poured_pct']:.1f} | "
                      f"{f['spilled_pct']:.2f} ({f['spilled_pct_max']:.1f}) | {f['reversals']:.1f} "
-                     f"({f['reversals_max']:.0f}) | {f['finish_s']:.2f} |")
+                     f"({f['reversals_max']:.0f}) | {f['finish_s']:.2f} | {r['final']['poured_pct']:.1f} / "
+                     f"{r['final']['spilled_pct']:.2f} ({r['final']['spilled_pct_max']:.1f}) |")
     return "\n".join(lines) + "\n"
 
 
@@ -247,7 +266,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     text = markdown(rows, n)
     if reach_rows:
         text += reach_markdown(reach_rows, {r["name"]: r for r in rows}, n)
-        plots.validation_curves({g[0]: [Path(d) for d in g[1:]] for g in args.group}, args.out / "reach_curves.png")
+        plots.validation_curves({g[0]: [Path(d) for d in g[1:]] for g in args.group}, args.out / "reach_curves.png",
+                                (BAR_POURED_PCT / 100, BAR_SPILLED_PCT / 100))
     atomic.write_atomic(args.out / "results.json",
                         json.dumps({"header_hash": f"0x{hdr.content_hash:08x}", "rows": rows, "reach": reach_rows},
                                    indent=1, default=_json_number) + "\n")
