@@ -129,3 +129,88 @@ def test_set_and_read_linear_weights_round_trip():
     np.testing.assert_allclose(sb3_ppo.linear_weights(model), w, rtol=1e-6)  # float32
     with pytest.raises(sb3_ppo.ExampleError, match="6 x 11"):
         sb3_ppo.set_linear_weights(model, w[:, :5])
+
+
+LIKE = """seed = 1
+iterations = 2
+workers = 1
+[policy]
+n_actions = 11
+decision_period_ms = 10
+[algo]
+kind = "pg"
+[eval]
+every = 1
+episodes = 2
+[env]
+kind = "toy"
+episode_s = 1.0
+"""
+
+
+@pytest.fixture(scope="module")
+def like_run(tmp_path_factory):
+    """--like: PPO on a training config's rig and validation, 6 episodes of 1 s, validated every 2."""
+    d = tmp_path_factory.mktemp("like")
+    (d / "toy.toml").write_text(LIKE)
+    w = sb3_ppo.train_run(d / "toy.toml", d / "run", episodes=6, every=2, seed=4, n_steps=128, batch_size=64)
+    return d / "run", w
+
+
+def test_a_run_like_a_training_config_is_read_as_the_trainers_are(like_run):
+    from pour.eval import plots, results
+    from pour.sim import envs
+    from pour.train import trainer
+
+    run, w = like_run
+    log = trainer.read_log(run / "log.csv")
+    hist = trainer.load_checkpoint(run / "checkpoint.npz")["history_w"]
+    assert [int(r["episodes"]) for r in log] == [2, 4, 6] and hist.shape == (3, 6, 11)
+    doc = json.loads((run / "policy.json").read_text())
+    assert np.array_equal(np.array(doc["w"]), hist[-1]) and np.array_equal(hist[-1], w)
+    assert not np.array_equal(hist[0], hist[-1])   # PPO updated the actor (128 decisions an update)
+    # Each row is the trainer's validation of that W: the same seeds (seed 4's), the same C rollouts.
+    env = envs.ToyEnv(11, 10, 1.0)
+    seeds = trainer.episode_seeds(4, trainer.STREAM_VALID, 0, 2)
+    for row, wi in zip(log, hist):
+        ms = [env.rollout(wi, s, True).metrics for s in seeds]
+        assert float(row["eval_v_target"]) == pytest.approx(np.mean([m["v_target"] for m in ms]))
+    best = int(np.argmax([float(r["eval_score"]) for r in log]))
+    assert np.array_equal(np.array(doc["best_w"]), hist[best])
+    assert results.reach(run, 2)["run"] == str(run)   # pour-results --reach reads it
+    plots.validation_curves({"PPO": [run]}, run / "curves.png")
+
+
+def test_a_diverging_ppo_run_stops_and_keeps_its_best(tmp_path, monkeypatch):
+    (tmp_path / "toy.toml").write_text(LIKE)
+    real, calls = sb3_ppo.linear_weights, []
+
+    def nan_from_the_second(model):
+        calls.append(1)
+        return real(model) * (np.nan if len(calls) >= 2 else 1.0)
+
+    monkeypatch.setattr(sb3_ppo, "linear_weights", nan_from_the_second)
+    with pytest.raises(sb3_ppo.ExampleError, match="diverged after 4 episodes.*keeps the best validated weights"):
+        sb3_ppo.train_run(tmp_path / "toy.toml", tmp_path / "run", episodes=6, every=2, seed=4)
+    doc = json.loads((tmp_path / "run" / "policy.json").read_text())
+    assert np.all(np.isfinite(doc["best_w"])) and doc["episodes"] == 2
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--episodes", "0"], "episodes = 0"),
+    (["--episodes", "4", "--validate-every", "5"], "expected 1 <= every <= episodes"),
+])
+def test_bad_like_options_are_a_clear_error(tmp_path, argv, message):
+    (tmp_path / "toy.toml").write_text(LIKE)
+    r = subprocess.run([sys.executable, "-m", "pour.examples.sb3_ppo", "--like", str(tmp_path / "toy.toml"),
+                        "--out", str(tmp_path / "run"), *argv], capture_output=True, text=True, timeout=300)
+    assert r.returncode != 0 and "Traceback" not in r.stderr and message in r.stderr, r.stderr
+
+
+def test_a_missing_or_bad_like_config_is_a_clear_error(tmp_path):
+    (tmp_path / "bad.toml").write_text(LIKE.replace("episodes = 2", "episodes = 0"))
+    for cfg, message in ((tmp_path / "nope.toml", "nope.toml"), (tmp_path / "bad.toml", "eval.episodes = 0")):
+        r = subprocess.run([sys.executable, "-m", "pour.examples.sb3_ppo", "--like", str(cfg), "--episodes", "2",
+                            "--validate-every", "1", "--out", str(tmp_path / "run")],
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode != 0 and "Traceback" not in r.stderr and message in r.stderr, r.stderr

@@ -130,6 +130,93 @@ def train_linear(steps: int, seed: int = 1, env_id: str = ENV_ID, **kwargs: Any)
     return train(steps, seed, env_id, **kwargs)[1]
 
 
+def _validation_callback(cfg: Any, run_dir: Path, episodes: int, every: int, seed: int, runner: Any,
+                         quiet: bool) -> Any:
+    """Every `every` finished training episodes (and at the budget), the actor's W greedy on the validation
+    seeds a pour-train run of cfg with this seed uses, through the same C rollouts; each validation is a
+    row of run_dir/log.csv (the trainer's columns) and a W of checkpoint.npz's history_w, so that
+    pour-results --reach reads the run as it reads the trainer's. Stops the learning at the budget, and
+    with an ExampleError when W stops being finite (policy.json keeps the best validated W)."""
+    import time
+
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from pour.train import trainer
+
+    valid_seeds = trainer.episode_seeds(seed, trainer.STREAM_VALID, 0, cfg.eval.episodes)
+    config = cfg.to_dict()
+    del config["workers"]
+
+    class Validation(BaseCallback):
+        def _on_training_start(self) -> None:
+            self.t0, self.done, self.due = time.monotonic(), 0, min(every, episodes)
+            self.rows: list[dict[str, str]] = []
+            self.history: list[np.ndarray] = []
+            self.best_w, self.best_score = None, -np.inf
+            self.bar = cli.bar(episodes, desc="PPO", quiet=quiet, unit="episode")
+
+        def _on_step(self) -> bool:
+            finished = int(np.sum(self.locals["dones"]))
+            self.done += finished
+            self.bar.update(finished)
+            if self.done < self.due:
+                return True
+            w = linear_weights(self.model)
+            if not np.all(np.isfinite(w)):
+                raise ExampleError(f"PPO diverged after {self.done} episodes: the actor's W is not finite; "
+                                   f"{run_dir / 'policy.json'} keeps the best validated weights")
+            ev, _ = trainer.greedy_validation(cfg, runner, w, valid_seeds)
+            if ev["eval_score"] > self.best_score or self.best_w is None:
+                self.best_w, self.best_score = w.copy(), float(ev["eval_score"])
+            row = dict.fromkeys(trainer.LOG_FIELDS, np.nan)
+            row.update(ev, iteration=len(self.rows), episodes=self.done, wall_s=time.monotonic() - self.t0,
+                       best_score=self.best_score)
+            self.rows.append({k: trainer._fmt(v) for k, v in row.items()})
+            self.history.append(w)
+            trainer.write_log(run_dir / "log.csv", self.rows)
+            export.write_policy(run_dir / "policy.json", cfg.policy.n_actions, cfg.policy.decision_period_ms,
+                                runner.tau_max_nm, episode.NORM, w, self.best_w, learner="stable-baselines3 PPO",
+                                config=config, seed=int(seed), episodes=self.done, ppo=dict(PPO_DEFAULTS),
+                                critic=list(CRITIC), best_score=self.best_score)
+            trainer.save_checkpoint(run_dir / "checkpoint.npz",
+                                    {"history_w": np.array(self.history), "episodes": self.done,
+                                     "wall_s": row["wall_s"], "best_w": self.best_w})
+            self.due = min(self.due + every, episodes)
+            return self.done < episodes
+
+        def _on_training_end(self) -> None:
+            self.bar.close()
+
+    return Validation()
+
+
+def train_run(config_path: str | Path, run_dir: str | Path, episodes: int, every: int, seed: int = 1,
+              quiet: bool = True, **ppo_kwargs: Any) -> np.ndarray:
+    """PPO with the softmax-linear actor on the rig, episode length and validation of a training config
+    (its env and eval; not its method), for `episodes` training episodes, validated every `every`: a run
+    directory pour-results --reach reads (log.csv, checkpoint.npz's history_w, policy.json). Returns the
+    final W [6][n_actions]."""
+    from pour.train import config as cfgmod
+    from pour.train import trainer
+
+    if episodes < 1 or not 1 <= every <= episodes:
+        raise ExampleError(f"episodes = {episodes}, validate every {every}: expected 1 <= every <= episodes")
+    cfg = cfgmod.load(config_path)
+    if cfg.eval.episodes < 1:
+        raise ExampleError(f"{config_path}: eval.episodes = 0: the run needs validation episodes")
+    run_dir = _make_dir(run_dir)
+    with trainer.Runner(cfg) as runner:   # its workers fork before torch starts
+        env = gym_env.PourEnv(cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
+                              cfg.env.episode_s, cfg.env.options)
+        model = make_model(env, seed, **ppo_kwargs)
+        cb = _validation_callback(cfg, run_dir, episodes, every, seed, runner, quiet)
+        # The callback stops the learning at the budget; the step count only has to be large enough.
+        model.learn(total_timesteps=(episodes + 1) * env.max_decisions + model.n_steps, callback=cb)
+        runner.close()
+    model.save(run_dir / "sb3_model.zip")
+    return linear_weights(model)
+
+
 def _make_dir(path: str | Path) -> Path:
     path = Path(path)
     try:
@@ -163,22 +250,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--init-header", type=Path, help="start the actor from this weights.h's W (e.g. policy/weights.h)")
     ap.add_argument("-o", "--out", required=True, type=Path, help="run directory: policy.json, sb3_model.zip")
     ap.add_argument("--header", type=Path, help="also export weights.h here (as pour-export RUN --out HEADER)")
+    ap.add_argument("--like", metavar="CONFIG", type=Path,
+                    help="train on this training config's rig, episode length and validation (e.g. "
+                         "configs/train/ars11.toml) for --episodes episodes, logging as pour-train does, so "
+                         "that pour-results --reach reads the run (instead of --steps and --env)")
+    ap.add_argument("--episodes", type=int, default=960, help="--like: training episodes (the budget)")
+    ap.add_argument("--validate-every", type=int, default=32, help="--like: training episodes between validations")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
     try:
         _make_dir(args.out)
         if args.header is not None:
             atomic.check_output_path(args.header, "--header")
-        init_w = header_weights(args.init_header) if args.init_header is not None else None
-        model, w = train(args.steps, args.seed, args.env, quiet=args.quiet, init_w=init_w)
-        path = write_run(args.out, model, w, args.steps, args.seed, args.env,
-                         init_header=None if args.init_header is None else str(args.init_header))
-        print(f"{path}: W [6][{w.shape[1]}] of PPO, {args.steps} steps, seed {args.seed}")
+        if args.like is not None:
+            w = train_run(args.like, args.out, args.episodes, args.validate_every, args.seed, args.quiet)
+            path = args.out / "policy.json"
+            print(f"{path}: W [6][{w.shape[1]}] of PPO, {args.episodes} episodes like {args.like}, seed {args.seed}")
+        else:
+            init_w = header_weights(args.init_header) if args.init_header is not None else None
+            model, w = train(args.steps, args.seed, args.env, quiet=args.quiet, init_w=init_w)
+            path = write_run(args.out, model, w, args.steps, args.seed, args.env,
+                             init_header=None if args.init_header is None else str(args.init_header))
+            print(f"{path}: W [6][{w.shape[1]}] of PPO, {args.steps} steps, seed {args.seed}")
         if args.header is not None:
             export.export(path, args.header)
             print(f"{args.header}: exported")
     except (ExampleError, export.ExportError, weights_h.WeightsHError, episode.EnvError, gym.error.Error,
-            ValueError) as exc:
+            ValueError, OSError) as exc:
         print(f"sb3_ppo: {exc}", file=sys.stderr)
         return 1
     return 0

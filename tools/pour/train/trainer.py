@@ -230,9 +230,15 @@ def validate(cfg: cfgmod.TrainConfig, runner: Any, w: np.ndarray, seeds: Sequenc
              ) -> tuple[dict[str, float], float]:
     """The greedy validation of W when iteration it is due one (every eval.every and the last): the log's
     eval_* columns (NaN when not due) and the score's standard error."""
-    ev = {"eval_score": np.nan, "eval_v_target": np.nan, "eval_v_spill": np.nan, "eval_finish_s": np.nan}
     if not cfg.eval.episodes or ((it + 1) % cfg.eval.every != 0 and it != cfg.iterations - 1):
-        return ev, np.nan
+        return dict.fromkeys(("eval_score", "eval_v_target", "eval_v_spill", "eval_finish_s"), np.nan), np.nan
+    return greedy_validation(cfg, runner, w, seeds)
+
+
+def greedy_validation(cfg: cfgmod.TrainConfig, runner: Any, w: np.ndarray, seeds: Sequence[int]
+                      ) -> tuple[dict[str, float], float]:
+    """W greedy on the validation seeds, now: the log's eval_* columns and the score's standard error (also
+    for other learners' run directories, pour.examples.sb3_ppo)."""
     steps = int(round(cfg.env.episode_s * 1000))
     veps = runner.run(w, seeds, greedy=True)
     ev = {"eval_score": score(veps, steps),
