@@ -208,12 +208,16 @@ static uint16_t compare_of(int32_t duty_q15, uint16_t period) {
 
 static int32_t vmax_of(q15_t vbus) { return (int32_t)(((int64_t)vbus * VMAX_OF_BUS_Q15) >> 15); }
 
+bool pour_drive_can_calibrate(const pour_drive_t *drv) {
+  /* the latched faults a calibration may start from are those its success clears */
+  return drv->state == POUR_DRIVE_RUN ||
+         (drv->state == POUR_DRIVE_FAULTED && drv->sense.calibrated &&
+          (drv->faults & (uint16_t)~POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION) == 0u);
+}
+
 pour_status_t pour_drive_calibrate(pour_drive_t *drv) {
   const pour_drive_config_t *c = &drv->config;
-  /* a missing calibration is the one latched fault a calibration may start from (it clears it) */
-  const int uncalibrated = drv->state == POUR_DRIVE_FAULTED && drv->faults == POUR_DRIVE_FAULT_CALIBRATION &&
-                           drv->sense.calibrated;
-  if (drv->state != POUR_DRIVE_RUN && !uncalibrated) return POUR_EINVAL;
+  if (!pour_drive_can_calibrate(drv)) return POUR_EINVAL;
   const pour_motor_cal_config_t mc = {
       c->pwm_hz, I_BASE, V_BASE, c->cal_current_ma, c->cal_l_test_mv, c->encoder_cpr,
       (uint32_t)((uint64_t)c->cal_motion_urad * c->gear_ratio * c->encoder_cpr / TWO_PI_URAD)};
@@ -268,7 +272,7 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
       drv->pi_q = pi_q;
       drv->cal_status = POUR_MOTOR_CAL_OK;
       drv->cal_result = r;
-      drv->faults = 0; /* nothing else can be latched: a trip would have ended the sequence */
+      drv->faults = 0; /* what it started from (POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION): a trip would end it */
       drv->iq_cmd_q15 = 0;
       drv->motor_counts = drv->output_urad = 0;
       drv->phase_loss_count = 0;
