@@ -135,9 +135,12 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   const bool measures = bd.drive.state == POUR_DRIVE_CALIBRATING || cal == POUR_MOTOR_CAL_RUNNING ||
                         (cal == POUR_MOTOR_CAL_OK && bd.cal_seen == POUR_MOTOR_CAL_RUNNING);
   bd.cal_seen = cal;
-  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && bd.drive.state != POUR_DRIVE_FAULTED &&
+  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) &&
       !(measures && (p.faults & (uint16_t)~POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION) == 0u)) {
-    pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
+    pour_hal_drive_short_low_sides(); /* now, not at the next period: the loop may not be tripped yet */
+    if (bd.drive.state != POUR_DRIVE_FAULTED) {
+      pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
+    }
   }
   bd.faults = (uint16_t)(bd.drive.faults | p.faults);
   const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
