@@ -330,6 +330,8 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   pour_foc_sincos_q15(angle, &s, &co);
   pour_foc_clarke_q15(i[0], i[1], i[2], &alpha, &beta);
   if (drv->state == POUR_DRIVE_MEASURING) {
+    drv->i2_sum_q30 += (int64_t)alpha * alpha + (int64_t)beta * beta; /* |i|², as id² + iq² (Park rotates) */
+    drv->i2_n++;
     measure(drv, in->encoder, i, alpha, beta, out);
     return;
   }
@@ -402,6 +404,11 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
   const pour_drive_config_t *c = &drv->config;
   if (drv->state == POUR_DRIVE_FAULTED) {
     accrue_i2t(drv); /* the motor cools while held: a clear waits for it */
+    return;
+  }
+  if (drv->state == POUR_DRIVE_MEASURING) {
+    /* the sequence's test current heats the motor as a torque would: a hot start ends in the I²t fault */
+    if (accrue_i2t(drv) && drv->heat_q30ms > drv->i2t_budget_q30ms) pour_drive_trip(drv, POUR_DRIVE_FAULT_I2T);
     return;
   }
   if (drv->state != POUR_DRIVE_RUN) {

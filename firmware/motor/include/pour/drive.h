@@ -155,7 +155,9 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
  * fault) once the current offsets are measured; else POUR_EINVAL. The brake is released while it runs (3.1 s). Success applies the results to
  * the configuration (R, L, pole pairs, encoder direction and offset; the current loop's gains from R and L),
  * the brake requested for that period, then RUN at zero current; a failure or a fault latches
- * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. */
+ * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. Its current
+ * accrues to the I²t budget as a torque's does (pour_drive_tick): spent, the sequence ends ABORTED with
+ * POUR_DRIVE_FAULT_I2T. */
 pour_status_t pour_drive_calibrate(pour_drive_t *drv);
 
 /* Whether pour_drive_calibrate would start the sequence now. */
