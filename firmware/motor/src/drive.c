@@ -170,19 +170,33 @@ void pour_drive_trip(pour_drive_t *drv, uint16_t fault) {
   drv->iq_cmd_q15 = 0;
 }
 
+/* Back to zero current: the PI loops, the command and the supervision windows start afresh. */
+static void restart(pour_drive_t *drv) {
+  pour_current_pi_reset(&drv->pi_d);
+  pour_current_pi_reset(&drv->pi_q);
+  drv->iq_cmd_q15 = 0;
+  drv->phase_loss_count = 0;
+  drv->motor_counts = drv->output_urad = 0;
+}
+
 uint16_t pour_drive_clear_faults(pour_drive_t *drv) {
-  if (drv->state != POUR_DRIVE_FAULTED || !drv->sense.calibrated) return drv->faults;
+  if (drv->state != POUR_DRIVE_FAULTED) return drv->faults;
+  if (drv->faults & POUR_DRIVE_FAULT_CURRENT_OFFSET) {
+    /* Measured again with the gates off (CALIBRATING); the fault stays latched until they are in range. */
+    const pour_current_sense_config_t sc = drv->sense.config;
+    (void)pour_current_sense_init(&drv->sense, &sc); /* valid: checked at init */
+    restart(drv);
+    drv->state = POUR_DRIVE_CALIBRATING;
+    return drv->faults;
+  }
+  if (!drv->sense.calibrated) return drv->faults;
   uint16_t keep = (uint16_t)(drv->faults & ~POUR_DRIVE_FAULT_CLEARABLE);
   if (drv->vbus_q15 > drv->ov_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_OVERVOLTAGE);
   if (drv->vbus_q15 < drv->uv_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_UNDERVOLTAGE);
   if (drv->heat_q30ms > drv->i2t_budget_q30ms / 2) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_I2T);
   drv->faults = keep;
   if (keep != 0u) return keep;
-  pour_current_pi_reset(&drv->pi_d);
-  pour_current_pi_reset(&drv->pi_q);
-  drv->iq_cmd_q15 = 0;
-  drv->phase_loss_count = 0;
-  drv->motor_counts = drv->output_urad = 0;
+  restart(drv);
   drv->state = POUR_DRIVE_RUN;
   return 0u;
 }
@@ -273,9 +287,7 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
       drv->cal_status = POUR_MOTOR_CAL_OK;
       drv->cal_result = r;
       drv->faults = 0; /* what it started from (POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION): a trip would end it */
-      drv->iq_cmd_q15 = 0;
-      drv->motor_counts = drv->output_urad = 0;
-      drv->phase_loss_count = 0;
+      restart(drv);
       drv->last_encoder = encoder;
       drv->state = POUR_DRIVE_RUN; /* at zero current from the next period */
       hold(drv, out);
@@ -298,7 +310,8 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
     if (r < 0) {
       pour_drive_trip(drv, POUR_DRIVE_FAULT_CURRENT_OFFSET);
     } else if (r > 0) {
-      drv->state = POUR_DRIVE_RUN;
+      drv->faults = (uint16_t)(drv->faults & ~POUR_DRIVE_FAULT_CURRENT_OFFSET); /* a clear's re-measure passed */
+      drv->state = drv->faults != 0u ? POUR_DRIVE_FAULTED : POUR_DRIVE_RUN;
       drv->last_encoder = in->encoder;
     }
     hold(drv, out);

@@ -107,8 +107,14 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   /* After a clear the core accepted, the protection judges the board's sensors afresh without the loop's
    * faults a clear may fix; the loop clears only if the protection did, so it never runs while the
    * protection still holds. */
-  const uint16_t loop_faults =
-      bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
+  uint16_t loop_faults = bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
+  const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
+  if (calibrating) {
+    /* The offsets measured (again, after a clear of CURRENT_OFFSET): the gates off and the brake engaged
+     * below; the cut is armed on the new ones once they pass. */
+    loop_faults = (uint16_t)(loop_faults & ~POUR_DRIVE_FAULT_CURRENT_OFFSET);
+    bd.armed = false;
+  }
   if (!bd.armed && bd.drive.state == POUR_DRIVE_RUN) {
     bd.armed = true; /* the thresholds sit above the offsets the loop has just measured */
     if (pour_hal_drive_arm_overcurrent(bd.drive.sense.offset) != POUR_OK) {
@@ -143,7 +149,6 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
     }
   }
   bd.faults = (uint16_t)(bd.drive.faults | p.faults);
-  const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
   in->drive_faults = bd.faults;
   in->drive_trusted = bd.drive.state == POUR_DRIVE_RUN;
   pour_hal_drive_mask(false);

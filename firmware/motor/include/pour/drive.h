@@ -175,8 +175,10 @@ void pour_drive_trip(pour_drive_t *drv, uint16_t fault);
 
 /* ClearErrors: clears the latched faults whose cause is judged gone (POUR_DRIVE_FAULT_CLEARABLE, with the
  * bus and I²t conditions there); with none left, FAULTED becomes RUN at zero current, the PI loops reset.
- * Returns the faults still latched (0: cleared). Nothing changes outside FAULTED, nor before the current
- * offsets were measured (a reset measures them). */
+ * With POUR_DRIVE_FAULT_CURRENT_OFFSET latched it clears nothing yet: the offsets are measured again with the
+ * gates off (CALIBRATING, 256 periods), and the fault clears there only if they are in range (then RUN, or
+ * FAULTED while others stay latched); out of range it stays. Returns the faults still latched (0: cleared).
+ * Nothing changes outside FAULTED. */
 uint16_t pour_drive_clear_faults(pour_drive_t *drv);
 
 #endif /* POUR_DRIVE_H */
