@@ -24,6 +24,7 @@ extern "C" {
 #include "board_drive.h"
 #include "board_loop.h"
 #include "calibration_flow.h"
+#include "clock.h"
 #include "flash_page_file.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -106,6 +107,7 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   return true;
 }
 
+uint32_t pour_clock_crystal(void) { return 0u; } // the clock is no part of this plant: HSI16, as without a crystal
 void pour_hal_estop_init(void) {}
 bool pour_hal_estop_asserted(void) { return false; }
 void pour_hal_led_show(uint8_t mode, bool refused) {
