@@ -103,23 +103,23 @@ static void test_calibration_flow_TheEstopEndsIt(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[1].status);
 }
 
+/* A CalibrationStart the drive cannot start: the n-th answer ABORTED, at once, the drive left in state. */
+static void assert_aborted_at_once(int n, pour_drive_state_t state) {
+  start();
+  tick(POUR_MODE_IDLE);
+  tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_INT(n, n_sent);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[n - 1].status);
+  TEST_ASSERT_EQUAL_INT(state, drv.state);
+}
+
 static void test_calibration_flow_AStartTheDriveRefusesIsAborted(void) {
   /* before the current offsets are measured, and with a power-stage fault latched: refused at once */
   tick(POUR_MODE_IDLE);
-  start();
-  tick(POUR_MODE_IDLE);
-  tick(POUR_MODE_IDLE);
-  TEST_ASSERT_EQUAL_INT(1, n_sent);
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[0].status);
-  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv.state);
+  assert_aborted_at_once(1, POUR_DRIVE_CALIBRATING);
   for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE);
   pour_drive_trip(&drv, POUR_DRIVE_FAULT_OVERTEMP);
-  start();
-  tick(POUR_MODE_IDLE);
-  tick(POUR_MODE_IDLE);
-  TEST_ASSERT_EQUAL_INT(2, n_sent);
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[1].status);
-  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv.state);
+  assert_aborted_at_once(2, POUR_DRIVE_FAULTED);
 }
 
 /* One CalibrationStart answered after the offsets, with the rig as set: the answer's status, and the drive
