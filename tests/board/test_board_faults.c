@@ -375,7 +375,8 @@ static void test_faults_WithoutCalibrationTheBucketNeverMoves(void) {
 /* The self-calibration on an uncalibrated board runs to its own end: the protection's missing calibration
  * does not re-trip the measuring drive, the power stays on and the brake is the drive's. The motor here
  * draws no current from the sequence's voltages (the ideal drive follows current references only), so the
- * sequence ends on the resistance stage, with the brake engaged and holding. */
+ * sequence ends on the resistance stage, with the brake engaged and holding (the OK path through this wiring,
+ * against host_sim's motor model, is test_board_calibration_run). */
 static void test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd(void) {
   const result_t r = pour_with(F_SELF_CAL);
   printf("self-calibration: %d ms measuring (power off %d, brake released %d, brake not the drive's %d)\n",
