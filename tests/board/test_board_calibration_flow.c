@@ -3,7 +3,8 @@
  * drive fed scripted samples (no motor: the closed loop with one is tests/sim/test_calibration.cpp): an open
  * circuit named on the bus with nothing stored, the e-stop ending it, a start the drive refuses, what a
  * controller that cannot measure answers, the brake-release interlock's refusals (tilted, not empty, no or
- * stale sensors) and its limits, a second start while one runs, and a start from a latched encoder fault. Runs on the host and on the emulated Cortex-M4. */
+ * stale sensors) and its limits, a second start while one runs, and a start from a latched encoder fault.
+ * Runs on the host and on the emulated Cortex-M4. */
 #include <string.h>
 
 #include "calibration_flow.h"

@@ -245,7 +245,8 @@ void tick(uint32_t ms, double ref) {
   for (int k = 0; k < kPeriods; ++k) period();
   plant.rx.push_back(sensors_frame(ms));
   const double nm = 40.0 * (ref - plant.theta) - 1.0 * plant.omega;
-  pour_control_request(&ctl, 0u, static_cast<q15_t>(std::lround(std::fmax(-1.0, std::fmin(1.0, nm / kTauMax)) * 32767.0)));
+  const double q = std::fmax(-1.0, std::fmin(1.0, nm / kTauMax));
+  pour_control_request(&ctl, 0u, static_cast<q15_t>(std::lround(q * 32767.0)));
   pour_board_loop_tick(&ctl, &node, 0u);
 }
 

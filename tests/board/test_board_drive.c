@@ -5,8 +5,8 @@
  * the flags and write the drive's compares into CCR1..3; no sample, no write; the gates stay off while the
  * offsets are measured; a tripped loop leaves the compares at 0 with the bridge on (the low sides short the
  * phases); a ClearErrors of a broken amplifier measures the offsets again with the gates off, and clears
- * the fault only if they pass. The board's own parts (the NVIC, the comparators' thresholds, the brake and power lines) are
- * answered here. */
+ * the fault only if they pass. The board's own parts (the NVIC, the comparators' thresholds, the brake and
+ * power lines) are answered here. */
 #include <string.h>
 
 #include "board_drive.h"

@@ -135,14 +135,16 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   if (bd.clear && p.faults == 0u) {
     (void)pour_drive_clear_faults(&bd.drive); /* what it keeps stays in bd.faults: the core latches it again */
   }
-  /* What a calibration clears does not trip a drive that measures its offsets (the interrupt trips it then),
-   * measures the motor, or has just measured it (the flow stores it this tick). */
+  /* What a calibration clears does not trip (nor short) a drive that measures the motor or has just measured
+   * it (the flow stores it this tick); a missing calibration alone not one that measures its offsets with the
+   * gates off (the interrupt trips it then). */
   const pour_motor_cal_status_t cal = pour_drive_calibration(&bd.drive, NULL);
-  const bool measures = bd.drive.state == POUR_DRIVE_CALIBRATING || cal == POUR_MOTOR_CAL_RUNNING ||
-                        (cal == POUR_MOTOR_CAL_OK && bd.cal_seen == POUR_MOTOR_CAL_RUNNING);
+  const bool measures =
+      cal == POUR_MOTOR_CAL_RUNNING || (cal == POUR_MOTOR_CAL_OK && bd.cal_seen == POUR_MOTOR_CAL_RUNNING);
   bd.cal_seen = cal;
-  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) &&
-      !(measures && (p.faults & (uint16_t)~POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION) == 0u)) {
+  const uint16_t exempt = measures ? POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION
+                                   : (calibrating ? POUR_DRIVE_FAULT_CALIBRATION : 0u);
+  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && (p.faults & (uint16_t)~exempt) != 0u) {
     pour_hal_drive_short_low_sides(); /* now, not at the next period: the loop may not be tripped yet */
     if (bd.drive.state != POUR_DRIVE_FAULTED) {
       pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
