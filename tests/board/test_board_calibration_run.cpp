@@ -22,17 +22,16 @@
 
 extern "C" {
 #include "board_drive.h"
+#include "brake_power_lines.h"
 #include "board_loop.h"
 #include "calibration_flow.h"
 #include "clock.h"
 #include "flash_page_file.h"
-#include "hal_brake.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_drive.h"
 #include "hal_estop.h"
 #include "hal_led.h"
-#include "hal_power.h"
 #include "ideal_drive.h"
 #include "pour/can_node.h"
 #include "pour/control.h"
@@ -59,7 +58,7 @@ struct Plant {
   double duty[3] = {0, 0, 0};
   uint16_t compare[3] = {0, 0, 0};
   Gates gates = Gates::Off;
-  bool power = false, brake_cmd = true, held = true;
+  bool held = true;
   bool slipping = false; // the coupling slips: the motor turns on at 2 rad/s of output, its torque lost
   double brake_since = 0.0, t = 0.0, theta = 0.0, omega = 0.0;
   std::vector<pour_can_frame_t> rx;         // what the host and the rig send this tick
@@ -73,19 +72,13 @@ struct Plant {
 
 bool drive_powers() {
   const pour_drive_state_t st = pour_board_drive_state()->state;
-  return plant.power && plant.gates == Gates::On && (st == POUR_DRIVE_RUN || st == POUR_DRIVE_MEASURING);
+  return power_line && plant.gates == Gates::On && (st == POUR_DRIVE_RUN || st == POUR_DRIVE_MEASURING);
 }
 
 } // namespace
 
 // --- the HAL, as the plant answers it ------------------------------------------------------------------
 extern "C" {
-void pour_hal_brake_init(void) { plant.brake_cmd = true; }
-void pour_hal_brake_set(bool engage) { plant.brake_cmd = engage; }
-bool pour_hal_brake_engaged(void) { return plant.brake_cmd; }
-void pour_hal_power_init(void) { plant.power = false; }
-void pour_hal_power_set(bool on) { plant.power = on; }
-bool pour_hal_power_on(void) { return plant.power; }
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
 uint16_t pour_hal_drive_period(void) { return kPeriod; }
 void pour_hal_drive_set_compares(const uint16_t c[3]) { std::memcpy(plant.compare, c, sizeof plant.compare); }
@@ -184,8 +177,8 @@ void plant_reset() {
   plant.rx.clear();
   plant.results.clear();
   plant.gates = Gates::Off;
-  plant.power = false;
-  plant.brake_cmd = plant.held = true;
+  power_line = false;
+  brake_line = plant.held = true;
   plant.t = plant.theta = plant.omega = plant.theta_max = 0.0;
   plant.slipping = false;
   plant.unpowered_released = 0;
@@ -197,7 +190,7 @@ void plant_reset() {
 void period() {
   const double ts = 1.0 / plant.params.pwm_hz;
   plant.sample = plant.model.sample();
-  const bool on = plant.power && plant.gates != Gates::Off;
+  const bool on = power_line && plant.gates != Gates::Off;
   for (int k = 0; k < 3; ++k) plant.duty[k] = plant.gates == Gates::On ? plant.compare[k] / double(kPeriod) : 0.0;
   const double omega_m = (plant.omega + (plant.slipping ? 2.0 : 0.0)) * plant.gear;
   const double tau_m = plant.model.period(plant.duty, on, omega_m);
@@ -205,14 +198,14 @@ void period() {
   // the gearbox loses (1 − η) of the power that crosses it, whichever way it flows (as FocDrive's)
   double tau = tau_m * plant.omega >= 0.0 ? tau_m * plant.gear * plant.eff : tau_m * plant.gear / plant.eff;
   if (plant.slipping) tau = 0.0;
-  if (!plant.brake_cmd) {
+  if (!brake_line) {
     plant.held = false;
     plant.brake_since = -1.0;
   } else if (plant.brake_since < 0.0) {
     plant.brake_since = plant.t;
   }
-  if (plant.brake_cmd && plant.t - plant.brake_since >= kBrakeDelay && std::fabs(tau) < kBrakeHold) plant.held = true;
-  if (!plant.brake_cmd && !drive_powers()) plant.unpowered_released++;
+  if (brake_line && plant.t - plant.brake_since >= kBrakeDelay && std::fabs(tau) < kBrakeHold) plant.held = true;
+  if (!brake_line && !drive_powers()) plant.unpowered_released++;
   if (plant.held) {
     plant.omega = 0.0;
   } else {
@@ -322,7 +315,7 @@ static void test_board_calibration_run_UncalibratedToRunWithoutAReset(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, plant.last_mode);
   TEST_ASSERT_EQUAL_HEX16(0u, pour_board_drive_faults());
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv->state);
-  TEST_ASSERT_FALSE(plant.brake_cmd);
+  TEST_ASSERT_FALSE(brake_line);
   // the drive follows the core's torque with the measured commutation: the bucket where the decisions took it
   TEST_ASSERT_DOUBLE_WITHIN(1.0 * kPi / 180, kTilt, plant.theta);
   // held throughout: never released unless the drive powered the motor, never beyond 10°
@@ -380,7 +373,7 @@ static void test_board_calibration_run_ASlippedCouplingIsClearedOnlyByACalibrati
   send(POUR_CAN_CMD_CLEAR_ERRORS);
   run_for(100);
   const uint16_t after_clear = pour_board_drive_faults();
-  const bool held_after_clear = plant.brake_cmd && plant.held;
+  const bool held_after_clear = brake_line && plant.held;
   // Plain memory neither answers the unlock keys nor erases: the interface and the page as the chip leaves
   // them for a second write (the first block's read-back is the first test's).
   flash_page_file_reset();

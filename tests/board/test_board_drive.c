@@ -10,18 +10,16 @@
 #include <string.h>
 
 #include "board_drive.h"
+#include "brake_power_lines.h"
 #include "encoder_tim4.h"
-#include "hal_brake.h"
 #include "hal_drive.h"
 #include "hal_drive_g4.h"
-#include "hal_power.h"
 #include "pour/control.h"
 #include "unity.h"
 
 static uint32_t tim1[POUR_TIM1_N_REGS], tim4[POUR_TIM4_N_REGS], adc1[POUR_ADC_N_REGS], adc2[POUR_ADC_N_REGS];
 static uint32_t comp[POUR_OCP_COMP_N_REGS];
 static pour_ocp_t ocp;
-static bool brake = true, power;
 
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
 static int armed; /* the cut armed on these offsets, this many times */
@@ -32,12 +30,6 @@ pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
   return POUR_OK;
 }
 void pour_hal_drive_mask(bool masked) { (void)masked; }
-void pour_hal_brake_init(void) { brake = true; }
-void pour_hal_brake_set(bool engage) { brake = engage; }
-bool pour_hal_brake_engaged(void) { return brake; }
-void pour_hal_power_init(void) { power = false; }
-void pour_hal_power_set(bool on) { power = on; }
-bool pour_hal_power_on(void) { return power; }
 
 #define CCER_BRIDGE 0x555u /* CC1E/NE, CC2E/NE, CC3E/NE */
 #define JEOC_JEOS ((1u << 5) | (1u << 6))
@@ -183,7 +175,7 @@ static void run_ms(int ms, uint16_t u, bool clear_first) {
       gates_on_measuring += measuring && tim1[POUR_TIM1_CCER] != 0u ? 1 : 0;
     }
     board_tick(clear_first && t == 0);
-    released += brake ? 0 : 1;
+    released += brake_line ? 0 : 1;
   }
 }
 
