@@ -8,6 +8,7 @@ from __future__ import annotations
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -204,3 +205,48 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
         stop(plant)
         stop(bridge)
         stop(ctl.proc)
+
+
+def test_calibrate_with_the_simulated_drive(tmp_path):
+    """pour-bench calibrate against pour_controller --io can:vcan0,drive=sim (the firmware's drive and the
+    board's calibration flow on host_sim's motor model): refused for another policy, then measured and
+    stored, the stored values read back in the result; refused by name with the e-stop asserted, the stored
+    block shown; a node that stops answering mid-way times out with its last state; a controller without a
+    drive refuses by name."""
+    policy = f"0x{weights_h.parse_weights_h(WEIGHTS).content_hash:08x}"
+    ctl = Controller(io="can:vcan0,heartbeat-ms=10,drive=sim")
+    try:
+        assert "runs policy" in refused("--expect-hash", "0x1", "--yes", "calibrate")
+        r = bench("--expect-hash", policy, "--yes", "calibrate", "--seconds", "120", timeout=180)
+        assert r.returncode == 0, (r.stdout, r.stderr)
+        out = r.stdout
+        assert "node 0: calibrated: resistance " in out and "pole pairs 8, encoder direction normal" in out, out
+        assert "(stored OK)" in out, out
+        ohm = float(out.split("resistance ")[1].split()[0])
+        mh = float(out.split("inductance ")[1].split()[0])
+        assert abs(ohm / 0.2865 - 1) <= 0.05 and abs(mh / 0.1505 - 1) <= 0.05, out  # the model's motor
+        print(out)
+        ok("estop")
+        err = refused("--expect-hash", policy, "--yes", "calibrate")
+        assert "refused the calibration: REFUSED_ESTOP (the e-stop is asserted" in err, err
+        assert f"resistance {ohm:.3f} Ohm" in err and "(stored OK)" in err, err  # what is stored, read back
+        ok("estop", "--release")
+        with bn.Bench("vcan0") as b:
+            n = b.node(0)
+            assert n.info().mode == "FAULT"  # after the release; calibration is not refused there
+            threading.Timer(0.05, ctl.proc.send_signal, [signal.SIGSTOP]).start()
+            with pytest.raises(bn.NodeTimeout) as e:
+                n.calibrate(seconds=2.0)
+        msg = str(e.value)
+        assert "node 0 did not answer" in msg and "(node 0: mode FAULT" in msg and "last heartbeat" in msg, msg
+        assert e.value.last is not None and e.value.last.mode == "FAULT"
+    finally:
+        ctl.proc.send_signal(signal.SIGCONT)
+        ctl.stop()
+    ctl = Controller()
+    try:
+        err = refused("--expect-hash", policy, "--yes", "calibrate")
+        assert "refused the calibration: UNAVAILABLE (this controller has no drive of its own" in err, err
+        assert "stored calibration: EMPTY" in err, err
+    finally:
+        ctl.stop()
