@@ -29,7 +29,7 @@ START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent ag
 REST_S = 1.0  # identify: recorded after the end
 # pour/experiment.h's phases: Torque.Action while an experiment runs, and how it ended (8, 9) after it.
 EXPERIMENT_PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
-                     9: "out of range"}
+                     9: "out of range", 10: "sweep"}
 EXPERIMENT_ENDED = 8  # Action >= this outside RUN: the experiment is over
 HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
 CALIBRATION_S = 30.0  # calibrate: the outcome's wait (the board's sequence takes 3.1 s)
