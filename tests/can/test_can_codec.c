@@ -188,7 +188,8 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
 }
 
 static void test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults(void) {
-  const pour_can_drive_telemetry_t t = {.id_2ma = -32767, .iq_2ma = 2500, .vbus_mv = 24100u, .drive_faults = 0xF902u};
+  const pour_can_drive_telemetry_t t = {
+      .id_2ma = -32767, .iq_2ma = 2500, .vbus_mv = 24100u, .drive_faults = 0xF902u, .crystal_4mhz = 6u};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_drive_telemetry(0, &t, &f));
   pour_can_drive_telemetry_t got;
@@ -197,9 +198,15 @@ static void test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults(void) {
   TEST_ASSERT_EQUAL_INT16(2500, got.iq_2ma);
   TEST_ASSERT_EQUAL_UINT16(24100u, got.vbus_mv);
   TEST_ASSERT_EQUAL_HEX16(0x0102u, got.drive_faults); /* bits beyond the 11 named ones are not carried */
+  TEST_ASSERT_EQUAL_UINT8(6u, got.crystal_4mhz);        /* 24 MHz, beside them */
   pour_can_drive_telemetry_t bad = t;
   bad.iq_2ma = INT16_MIN;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_drive_telemetry(0, &bad, &f));
+  bad = t;
+  bad.crystal_4mhz = POUR_CAN_CRYSTAL_MAX + 1u; /* 52 MHz: no crystal the clock set-up takes */
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_drive_telemetry(0, &bad, &f));
+  f.data[7] = (uint8_t)((f.data[7] & ~0x78u) | 0x68u); /* Crystal (bits 59..62) raw 13 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_drive_telemetry(&f, &got));
 }
 
 static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {

@@ -195,7 +195,7 @@ static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   TEST_ASSERT_EQUAL_UINT8(3, tick(0, &in, tx)); /* no drive of its own: torque, heartbeat, identity */
   const pour_can_drive_telemetry_t d = {-1234, 5678, 24000u,
-                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP};
+                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP, 2u};
   pour_can_node_set_drive(&node, &d);
   unsigned telemetry = 0;
   for (unsigned t = 1; t < 12; ++t) {
@@ -208,6 +208,7 @@ static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
       TEST_ASSERT_EQUAL_INT16(5678, back.iq_2ma);
       TEST_ASSERT_EQUAL_UINT16(24000u, back.vbus_mv);
       TEST_ASSERT_EQUAL_HEX16(d.drive_faults, back.drive_faults);
+      TEST_ASSERT_EQUAL_UINT8(2u, back.crystal_4mhz);
       ++telemetry;
     } else {
       TEST_ASSERT_EQUAL_UINT8(1, n);

@@ -132,17 +132,20 @@ pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_c
 
 static int current_ok(int16_t i) { return i >= -POUR_CAN_CURRENT_MAX; }
 
+#define DRIVE_CRYSTAL_SHIFT 11u /* DriveTelemetry.Crystal above the 11 fault bits in bytes 6..7 */
+
 pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_drive_telemetry_t *msg,
                                             pour_can_frame_t *frame) {
   if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !current_ok(msg->id_2ma) ||
-      !current_ok(msg->iq_2ma)) {
+      !current_ok(msg->iq_2ma) || msg->crystal_4mhz > POUR_CAN_CRYSTAL_MAX) {
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_DRIVE_TELEMETRY, POUR_CAN_DLC_DRIVE_TELEMETRY);
   put_u16(&frame->data[0], i16_bits(msg->id_2ma));
   put_u16(&frame->data[2], i16_bits(msg->iq_2ma));
   put_u16(&frame->data[4], msg->vbus_mv);
-  put_u16(&frame->data[6], (uint16_t)(msg->drive_faults & POUR_CAN_DRIVE_FAULT_MASK));
+  put_u16(&frame->data[6], (uint16_t)((msg->drive_faults & POUR_CAN_DRIVE_FAULT_MASK) |
+                                      ((uint32_t)msg->crystal_4mhz << DRIVE_CRYSTAL_SHIFT)));
   return POUR_OK;
 }
 
@@ -444,12 +447,15 @@ pour_can_rx_t pour_can_unpack_drive_telemetry(const pour_can_frame_t *frame, pou
   }
   const int16_t id = as_i16(get_u16(&frame->data[0]));
   const int16_t iq = as_i16(get_u16(&frame->data[2]));
-  if (!current_ok(id) || !current_ok(iq)) {
+  const uint16_t word = get_u16(&frame->data[6]);
+  const uint8_t crystal = (uint8_t)((word >> DRIVE_CRYSTAL_SHIFT) & 0xFu);
+  if (!current_ok(id) || !current_ok(iq) || crystal > POUR_CAN_CRYSTAL_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
   msg->id_2ma = id;
   msg->iq_2ma = iq;
   msg->vbus_mv = get_u16(&frame->data[4]);
-  msg->drive_faults = (uint16_t)(get_u16(&frame->data[6]) & POUR_CAN_DRIVE_FAULT_MASK);
+  msg->drive_faults = (uint16_t)(word & POUR_CAN_DRIVE_FAULT_MASK);
+  msg->crystal_4mhz = crystal;
   return POUR_CAN_RX_OK;
 }

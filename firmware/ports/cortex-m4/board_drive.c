@@ -2,6 +2,7 @@
 #include "board_drive.h"
 
 #include <stddef.h>
+#include <string.h>
 
 #include "board_guard.h"
 #include "hal_drive.h"
@@ -28,8 +29,7 @@ static struct {
 } bd;
 
 pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t tau_max_mnm, bool calibration_valid) {
-  static const pour_drive_t no_drive;
-  bd.drive = no_drive;
+  memset(&bd.drive, 0, sizeof bd.drive); /* not a copy of a const zero: that would be 512 B of flash */
   bd.periods = bd.periods_seen = 0u;
   bd.armed = false;
   bd.faults = 0u;

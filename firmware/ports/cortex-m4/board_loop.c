@@ -5,6 +5,7 @@
 
 #include "board_drive.h"
 #include "calibration_flow.h"
+#include "clock.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
@@ -58,6 +59,7 @@ void pour_board_loop_tick(pour_control_t *ctl, pour_can_node_t *node, uint32_t o
   pour_hal_led_show(out.mode, false);
   pour_can_drive_telemetry_t drive;
   pour_board_drive_telemetry(&drive);
+  drive.crystal_4mhz = (uint8_t)(pour_clock_crystal() / 4000000u);
   pour_can_node_set_drive(node, &drive);
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   pour_board_transmit(tx, pour_can_node_end_tick(node, &out, overruns, tx));

@@ -70,6 +70,7 @@
 #define POUR_CAN_POLE_PAIRS_MAX 32u
 #define POUR_CAN_CURRENT_MAX 32767 /* |Id|, |Iq| [2 mA]; -32768 is out of range */
 #define POUR_CAN_DRIVE_FAULT_MASK 0x07FFu /* the 11 bits of pour/drive_faults.h, in their order */
+#define POUR_CAN_CRYSTAL_MAX 12u /* DriveTelemetry.Crystal [4 MHz]: 4 .. 48 MHz; 0 = no crystal, HSI16 */
 
 /* CalibrationResult.Status: 0 .. 5 the stored block's state (as calibration_store.h's pour_cal_status_t),
  * then the refusals of a CalibrationStart, each with its reason, then the measurement's progress and why it
@@ -168,6 +169,7 @@ typedef struct {
   int16_t iq_2ma;        /* q current [2 mA], |.| <= POUR_CAN_CURRENT_MAX */
   uint16_t vbus_mv;      /* bus voltage [mV] */
   uint16_t drive_faults; /* POUR_DRIVE_FAULT_* (pour/drive_faults.h); only POUR_CAN_DRIVE_FAULT_MASK is carried */
+  uint8_t crystal_4mhz;  /* the crystal the core clock runs from [4 MHz], <= POUR_CAN_CRYSTAL_MAX; 0: HSI16 */
 } pour_can_drive_telemetry_t;
 /* ParamRead: which parameter. */
 typedef struct {
