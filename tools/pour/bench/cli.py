@@ -2,8 +2,8 @@
 """pour-bench: bring a pour controller up on a CAN bus (scan, info, faults, e-stop, parameters, logs).
 
 Commands that can make the axis move (clear, which resumes a run, reset, identify, the controller's own
-identification experiment, and calibrate, the drive's) say so, check the node's policy hash against --expect-hash or --weights first,
-and ask for confirmation unless --yes.
+identification experiment, and calibrate, the drive's) say so, check the node's policy hash against
+--expect-hash or --weights first, and ask for confirmation unless --yes.
 """
 from __future__ import annotations
 

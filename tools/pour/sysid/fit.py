@@ -136,7 +136,7 @@ def fit_identify(run: Run, rig: dict) -> Fit:
     use = edge & win & np.isin(run.action, FIT_PHASES)
     if use.sum() < 200:
         raise LogError("cannot identify inertia, friction or torque scale: the bucket hardly moved "
-                       f"({int(use.sum())} usable ticks of steps and chirp): the experiment did not excite them")
+                       f"({int(use.sum())} usable ticks of steps, chirp and sweep): the experiment did not excite them")
     fit = Fit()
     md, j_bucket = bucket_arm_and_inertia(rig)
     g_known = md * G0
