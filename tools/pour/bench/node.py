@@ -496,11 +496,13 @@ class Node:
                         break
             finally:
                 writer.stop()
+            last = self.state.describe() if self.state else f"node {self.id}: never heard on {self.bench.channel}"
             if not answered:
-                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart: no log written", self.state)
+                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart within {seconds:g} s ({last}): "
+                                  "no log written", self.state)
             if ended is None:
-                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s: no log "
-                                  "written", self.state)
+                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s ({last}): no "
+                                  "log written", self.state)
         return n, ended
 
     # -- telemetry -----------------------------------------------------------------------------------------
