@@ -168,7 +168,7 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
   TEST_ASSERT_EQUAL_HEX16(pour_can_id(2, POUR_CAN_CMD_CALIBRATION_RESULT), f.id);
-  TEST_ASSERT_EQUAL_HEX8(0x06u, f.data[0]); /* status 6 in the low nibble, stored 0 in the high one */
+  TEST_ASSERT_EQUAL_HEX8(0x06u, f.data[0]); /* status 6 in bits 0..4, stored 0 in bits 5..7 */
   pour_can_calibration_result_t got;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
   TEST_ASSERT_EQUAL_UINT8(r.status, got.status);
@@ -178,6 +178,16 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
   TEST_ASSERT_EQUAL_UINT16(304u, got.resistance_mohm);
   TEST_ASSERT_EQUAL_UINT16(231u, got.inductance_uh);
   TEST_ASSERT_EQUAL_UINT8(200u, got.electrical_offset);
+  /* the interlock's refusals need Status's fifth bit; Stored sits above it */
+  const pour_can_calibration_result_t hi = {.status = POUR_CAN_CAL_REFUSED_NO_SENSORS, .stored = POUR_CAN_CAL_WRITE_FAILED};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &hi, &f));
+  TEST_ASSERT_EQUAL_HEX8(0xB2u, f.data[0]); /* 18 | 5 << 5 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, got.status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_WRITE_FAILED, got.stored);
+  f.data[0] = 19u; /* a status beyond the last */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
   pour_can_calibration_result_t bad = r;
   bad.status = POUR_CAN_CAL_STATUS_MAX + 1u;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_calibration_result(2, &bad, &f));

@@ -319,7 +319,7 @@ def test_calibration_status_names_are_the_codec_s(db):
             if not k.endswith("_MAX")}
     choices = db.get_message_by_name("CalibrationResult").get_signal_by_name("Status").choices
     assert {int(k): str(v) for k, v in choices.items()} == ours
-    assert len(ours) == 16 and "MEASURING" in ours.values()
+    assert len(ours) == 19 and "MEASURING" in ours.values() and "REFUSED_NO_SENSORS" in ours.values()
 
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):

@@ -121,7 +121,7 @@ pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_c
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_CALIBRATION_RESULT, POUR_CAN_DLC_CALIBRATION_RESULT);
-  frame->data[0] = (uint8_t)(msg->status | (uint8_t)(msg->stored << 4));
+  frame->data[0] = (uint8_t)(msg->status | (uint8_t)(msg->stored << 5));
   frame->data[1] = msg->encoder_reversed;
   frame->data[2] = msg->pole_pairs;
   put_u16(&frame->data[3], msg->resistance_mohm);
@@ -426,8 +426,8 @@ pour_can_rx_t pour_can_unpack_calibration_result(const pour_can_frame_t *frame, 
     return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
   }
   pour_can_calibration_result_t m;
-  m.status = (uint8_t)(frame->data[0] & 0x0Fu);
-  m.stored = (uint8_t)(frame->data[0] >> 4);
+  m.status = (uint8_t)(frame->data[0] & 0x1Fu);
+  m.stored = (uint8_t)(frame->data[0] >> 5);
   m.encoder_reversed = (uint8_t)(frame->data[1] & 1u); /* bits 9..15 are not signals */
   m.pole_pairs = frame->data[2];
   m.resistance_mohm = get_u16(&frame->data[3]);

@@ -3,7 +3,9 @@
  * firmware's drive (pour::motor) and the board's calibration flow (calibration_flow.c, its block stored by
  * calibration_store.c in a flash page held in memory) run against host_sim's motor model, the default motor
  * with the empty bucket on its bearing. It serves CalibrationStart only: the torque the core commands still
- * goes to the bus (the plant, host_sim through can_bridge, has its own drive), and RUN does not wait for it. */
+ * goes to the bus (the plant, host_sim through can_bridge, has its own drive), and RUN does not wait for it.
+ * It has no sensors of its own: the board's interlock (pour_calibration_flow_sense: a recent sample, upright,
+ * empty) is not applied, a start is refused only in RUN and ESTOP. */
 #ifndef POUR_LINUX_SIM_DRIVE_H
 #define POUR_LINUX_SIM_DRIVE_H
 

@@ -47,6 +47,9 @@ CALIBRATION_REASONS = {
     "MOTION_RANGE": "the output moved beyond the sequence's range: stopped there",
     "ABORTED": "a fault, the e-stop or a stop ended it, or a latched drive fault refused it",
     "WRITE_FAILED": "measured, but the flash refused it: no valid calibration stored",
+    "REFUSED_NOT_UPRIGHT": "the output is not within 5 deg of upright: bring the bucket upright first",
+    "REFUSED_NOT_EMPTY": "the rotating scale reads more than 200 g beyond its tare: empty the bucket first",
+    "REFUSED_NO_SENSORS": "no sensor sample in the last 20 ms: start the rig's sensor node first",
 }
 TARE_ROTATING = 1
 TARE_TARGET = 2

@@ -91,7 +91,11 @@
 #define POUR_CAN_CAL_BAD_POLE_PAIRS 13u /* the counts of an electrical turn fit no pole-pair count 1 .. 32 */
 #define POUR_CAN_CAL_MOTION_RANGE 14u   /* the output moved beyond the sequence's range: stopped there */
 #define POUR_CAN_CAL_ABORTED 15u        /* a fault, the e-stop or a stop ended it, or a latched fault refused it */
-#define POUR_CAN_CAL_STATUS_MAX 15u
+/* The interlock of the brake's release (calibration_flow.h): the bucket must be upright and empty. */
+#define POUR_CAN_CAL_REFUSED_NOT_UPRIGHT 16u /* the output is more than 5° from upright */
+#define POUR_CAN_CAL_REFUSED_NOT_EMPTY 17u   /* the rotating scale reads more than 200 g (or below -200 g) */
+#define POUR_CAN_CAL_REFUSED_NO_SENSORS 18u  /* no sensor sample within 20 ms: no data is not "empty" */
+#define POUR_CAN_CAL_STATUS_MAX 18u
 #define POUR_CAN_CAL_STORED_MAX 5u
 #define POUR_CAN_PARAM_RESULT_MAX 9u    /* ParamAck.Result: a pour_param_result_t, or an ExperimentStart's refusal */
 /* ParamAck.Result for an ExperimentStart (beyond pour_param_result_t; OK: accepted, OUT_OF_RANGE: a kind
