@@ -26,7 +26,7 @@ from pathlib import Path
 
 # Instances whose crate name differs from ours: the SVD calls FDCAN's message RAM "FDCAN"; the flash
 # driver's table names the flash interface FLASH_IF (the board's table already declares FLASH's base).
-CRATE_NAME = {"SRAMCAN": "FDCAN", "FLASH_IF": "FLASH"}
+CRATE_NAME = {"SRAMCAN": "FDCAN", "FLASH_IF": "FLASH", "LPTIM1": "LPTIMER1"}
 
 _PERIPH = re.compile(r"pub type (\w+) = crate::Periph<(\w+)::RegisterBlock, (0x[0-9a-f_]+)>;")
 _REG_DOC = re.compile(r"^\s*///(0x[0-9a-f]+) - ")

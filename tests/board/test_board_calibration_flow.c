@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /* The board's calibration flow (calibration_flow.c) with the real CAN node, drive and flash block, the
  * drive fed scripted samples (no motor: the closed loop with one is tests/sim/test_calibration.cpp): an open
- * circuit named on the bus with nothing stored, the e-stop ending it, a start the drive refuses, and what a
- * controller that cannot measure answers. Runs on the host and on the emulated Cortex-M4. */
+ * circuit named on the bus with nothing stored, the e-stop ending it, a start the drive refuses, what a
+ * controller that cannot measure answers, the brake-release interlock's refusals (tilted, not empty, no or
+ * stale sensors) and its limits, a second start while one runs, and a start from a latched encoder fault.
+ * Runs on the host and on the emulated Cortex-M4. */
 #include <string.h>
 
 #include "calibration_flow.h"
@@ -16,6 +18,17 @@ static pour_can_calibration_result_t sent[4];
 static int n_sent;
 static int released_outside;
 
+/* The rig's sensor node: the output encoder (17 bits, 0 = upright) and the rotating scale; sending false: it
+ * has gone quiet. */
+static struct {
+  bool sending;
+  uint32_t encoder;
+  int32_t scale_rotating_g;
+} rig;
+
+#define ENCODER_BITS 17u
+#define DEG10_COUNTS(d10) ((uint32_t)(d10) * 131072u / 3600u) /* an angle in 0.1° as a count, rounded down */
+
 void setUp(void) {
   flash_page_file_reset();
   pour_can_node_config_t nc = pour_can_node_default_config();
@@ -27,6 +40,9 @@ void setUp(void) {
   pour_calibration_flow_init(&flow, POUR_CAL_EMPTY, NULL);
   n_sent = 0;
   released_outside = 0;
+  rig.sending = true; /* upright, empty */
+  rig.encoder = 0u;
+  rig.scale_rotating_g = 0;
 }
 
 void tearDown(void) {}
@@ -35,7 +51,9 @@ void tearDown(void) {}
 static void tick(pour_mode_t mode) {
   pour_control_input_t in;
   pour_can_node_begin_tick(&node, &in);
+  const pour_sensors_t sample = {0u, rig.encoder, rig.scale_rotating_g, 0};
   const bool measuring = pour_calibration_flow_tick(&flow, &node, &drv, (uint8_t)mode, &f);
+  pour_calibration_flow_sense(&flow, &node, &drv, &sample, rig.sending, ENCODER_BITS);
   pour_control_output_t out;
   memset(&out, 0, sizeof out);
   out.mode = (uint8_t)mode;
@@ -86,15 +104,115 @@ static void test_calibration_flow_TheEstopEndsIt(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[1].status);
 }
 
+/* A CalibrationStart the drive cannot start: the n-th answer ABORTED, at once, the drive left in state. */
+static void assert_aborted_at_once(int n, pour_drive_state_t state) {
+  start();
+  tick(POUR_MODE_IDLE);
+  tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_INT(n, n_sent);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[n - 1].status);
+  TEST_ASSERT_EQUAL_INT(state, drv.state);
+}
+
 static void test_calibration_flow_AStartTheDriveRefusesIsAborted(void) {
-  /* before the current offsets are measured (and likewise with a power-stage fault latched) */
+  /* before the current offsets are measured, and with a power-stage fault latched: refused at once */
+  tick(POUR_MODE_IDLE);
+  assert_aborted_at_once(1, POUR_DRIVE_CALIBRATING);
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE);
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_OVERTEMP);
+  assert_aborted_at_once(2, POUR_DRIVE_FAULTED);
+}
+
+/* One CalibrationStart answered after the offsets, with the rig as set: the answer's status, and the drive
+ * not started by a refusal. */
+static uint8_t answer_with_rig(void) {
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE);
+  start();
+  tick(POUR_MODE_IDLE);
+  tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_INT(1, n_sent);
+  return sent[0].status;
+}
+
+static void test_calibration_flow_TiltedIsRefusedNotUpright(void) {
+  rig.encoder = DEG10_COUNTS(55); /* beyond the 5° of upright */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NOT_UPRIGHT, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+  TEST_ASSERT_FALSE(released_outside);
+}
+
+static void test_calibration_flow_TiltedBackIsRefusedNotUpright(void) {
+  rig.encoder = (1u << ENCODER_BITS) - DEG10_COUNTS(55); /* below upright: the count wraps */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NOT_UPRIGHT, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+static void test_calibration_flow_LiquidInTheBucketIsRefusedNotEmpty(void) {
+  rig.scale_rotating_g = 201;
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NOT_EMPTY, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+static void test_calibration_flow_AScaleFarBelowItsTareIsNotEmpty(void) {
+  rig.scale_rotating_g = -201;
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NOT_EMPTY, answer_with_rig());
+}
+
+static void test_calibration_flow_NoSampleSinceBootIsRefused(void) {
+  rig.sending = false; /* no data is not "empty" */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+}
+
+static void test_calibration_flow_AStaleSampleIsRefused(void) {
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE); /* upright and empty ... */
+  rig.sending = false;                                  /* ... then the sensor node goes quiet */
+  for (int ms = 0; ms < (int)POUR_CALIBRATION_SAMPLE_MS - 1; ++ms) tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, answer_with_rig()); /* 21 ms and more */
+  /* a sample out of the encoder's range is no sample either */
+  rig.sending = true;
+  rig.encoder = 1u << ENCODER_BITS;
+  for (int ms = 0; ms < (int)POUR_CALIBRATION_SAMPLE_MS; ++ms) tick(POUR_MODE_IDLE);
+  n_sent = 0;
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, answer_with_rig());
+}
+
+static void test_calibration_flow_UprightAndEmptyWithinTheLimitsStarts(void) {
+  rig.encoder = (1u << ENCODER_BITS) - DEG10_COUNTS(49);
+  rig.scale_rotating_g = -200;
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_MEASURING, drv.state);
+}
+
+/* A second CalibrationStart while the sequence runs: answered MEASURING again, nothing restarts, and the
+ * one running ends with its own outcome (here the open circuit's). */
+static void test_calibration_flow_ASecondStartWhileMeasuringIsAnsweredMeasuring(void) {
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, answer_with_rig());
+  for (int ms = 0; ms < 50; ++ms) tick(POUR_MODE_IDLE);
+  const uint32_t n_before = drv.cal.n;
+  rig.encoder = DEG10_COUNTS(80); /* the sequence may move it: the interlock judges a start, not a run */
   start();
   tick(POUR_MODE_IDLE);
   tick(POUR_MODE_IDLE);
   TEST_ASSERT_EQUAL_INT(2, n_sent);
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, sent[0].status);
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_ABORTED, sent[1].status);
-  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv.state);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, sent[1].status);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_MEASURING, drv.state);
+  TEST_ASSERT_TRUE(drv.cal.n > n_before); /* the same stage's count runs on: not restarted */
+  for (int ms = 0; ms < 600; ++ms) tick(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_INT(3, n_sent);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_BAD_RESISTANCE, sent[2].status);
+}
+
+/* An encoder fault latched (a slipped coupling, a reversed encoder) is cleared by a self-calibration only:
+ * the start is accepted from it. */
+static void test_calibration_flow_AnEncoderFaultMayBeCalibratedAway(void) {
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE);
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_ENCODER_MISMATCH | POUR_DRIVE_FAULT_ENCODER_DIRECTION);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_ENCODER_MISMATCH | POUR_DRIVE_FAULT_ENCODER_DIRECTION,
+                          pour_drive_clear_faults(&drv)); /* a ClearErrors keeps both */
+  n_sent = 0;
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, answer_with_rig());
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_MEASURING, drv.state);
 }
 
 static void test_calibration_flow_AControllerThatCannotMeasureSaysSo(void) {
@@ -114,5 +232,14 @@ int main(void) {
   RUN_TEST(test_calibration_flow_TheEstopEndsIt);
   RUN_TEST(test_calibration_flow_AStartTheDriveRefusesIsAborted);
   RUN_TEST(test_calibration_flow_AControllerThatCannotMeasureSaysSo);
+  RUN_TEST(test_calibration_flow_TiltedIsRefusedNotUpright);
+  RUN_TEST(test_calibration_flow_TiltedBackIsRefusedNotUpright);
+  RUN_TEST(test_calibration_flow_LiquidInTheBucketIsRefusedNotEmpty);
+  RUN_TEST(test_calibration_flow_AScaleFarBelowItsTareIsNotEmpty);
+  RUN_TEST(test_calibration_flow_NoSampleSinceBootIsRefused);
+  RUN_TEST(test_calibration_flow_AStaleSampleIsRefused);
+  RUN_TEST(test_calibration_flow_UprightAndEmptyWithinTheLimitsStarts);
+  RUN_TEST(test_calibration_flow_ASecondStartWhileMeasuringIsAnsweredMeasuring);
+  RUN_TEST(test_calibration_flow_AnEncoderFaultMayBeCalibratedAway);
   return UNITY_END();
 }

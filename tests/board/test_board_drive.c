@@ -4,35 +4,32 @@
  * interrupt read the injected data registers (JDR1..4 of ADC1, JDR1 of ADC2) and TIM4's count, acknowledge
  * the flags and write the drive's compares into CCR1..3; no sample, no write; the gates stay off while the
  * offsets are measured; a tripped loop leaves the compares at 0 with the bridge on (the low sides short the
- * phases). The board's own parts (the NVIC, the comparators' thresholds, the brake and power lines) are
- * answered here. */
+ * phases); a ClearErrors of a broken amplifier measures the offsets again with the gates off, and clears
+ * the fault only if they pass. The board's own parts (the NVIC, the comparators' thresholds, the brake and
+ * power lines) are answered here. */
 #include <string.h>
 
 #include "board_drive.h"
+#include "brake_power_lines.h"
 #include "encoder_tim4.h"
-#include "hal_brake.h"
 #include "hal_drive.h"
 #include "hal_drive_g4.h"
-#include "hal_power.h"
+#include "pour/control.h"
 #include "unity.h"
 
 static uint32_t tim1[POUR_TIM1_N_REGS], tim4[POUR_TIM4_N_REGS], adc1[POUR_ADC_N_REGS], adc2[POUR_ADC_N_REGS];
 static uint32_t comp[POUR_OCP_COMP_N_REGS];
 static pour_ocp_t ocp;
-static bool brake = true, power;
 
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
+static int armed; /* the cut armed on these offsets, this many times */
+static uint16_t armed_on[3];
 pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
-  (void)offset_counts;
+  memcpy(armed_on, offset_counts, sizeof armed_on);
+  armed++;
   return POUR_OK;
 }
 void pour_hal_drive_mask(bool masked) { (void)masked; }
-void pour_hal_brake_init(void) { brake = true; }
-void pour_hal_brake_set(bool engage) { brake = engage; }
-bool pour_hal_brake_engaged(void) { return brake; }
-void pour_hal_power_init(void) { power = false; }
-void pour_hal_power_set(bool on) { power = on; }
-bool pour_hal_power_on(void) { return power; }
 
 #define CCER_BRIDGE 0x555u /* CC1E/NE, CC2E/NE, CC3E/NE */
 #define JEOC_JEOS ((1u << 5) | (1u << 6))
@@ -51,6 +48,7 @@ void setUp(void) {
   pour_hal_drive_attach(&pwm, &adc, tim4, &ocp);
   const pour_drive_config_t dc = pour_drive_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, 20000, true));
+  armed = 0;
 }
 
 void tearDown(void) {}
@@ -154,11 +152,86 @@ static void test_drive_isr_TheBreakClearsOnlyOnceTheComparatorsAreLow(void) {
   TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCER]); /* all six off until the loop drives them again */
 }
 
+/* The board's 1 kHz tick around the core (no sensor samples: nothing to run), with a ClearErrors if asked. */
+static pour_control_t ctl;
+static void board_tick(bool clear) {
+  pour_control_input_t in;
+  memset(&in, 0, sizeof in);
+  in.clear_faults = clear;
+  pour_control_output_t out;
+  pour_board_drive_tick(&ctl, &in, &out);
+}
+
+/* ms milliseconds of 20 periods, phase U's amplifier at u counts (2048: its nominal bias), a tick after each
+ * with a ClearErrors at the first if asked; counts the periods with the gates on while the drive measured
+ * its offsets, and the ticks with the brake released. */
+static int gates_on_measuring, released;
+static void run_ms(int ms, uint16_t u, bool clear_first) {
+  for (int t = 0; t < ms; ++t) {
+    for (int k = 0; k < 20; ++k) {
+      convert(u, 2050u, 2046u, 0u);
+      isr_acknowledged();
+      const bool measuring = pour_board_drive_state()->state == POUR_DRIVE_CALIBRATING;
+      gates_on_measuring += measuring && tim1[POUR_TIM1_CCER] != 0u ? 1 : 0;
+    }
+    board_tick(clear_first && t == 0);
+    released += brake_line ? 0 : 1;
+  }
+}
+
+/* A broken amplifier at start-up (U 400 counts off its bias, beyond the 160 accepted): CURRENT_OFFSET, the
+ * phases shorted. A ClearErrors measures the offsets again with the gates off and the brake engaged. */
+static void broken_amplifier_cleared(void) {
+  const pour_control_config_t cc = pour_control_default_config();
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
+  gates_on_measuring = released = 0;
+  run_ms(20, 2448u, false);
+  const pour_drive_t *drv = pour_board_drive_state();
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv->state);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, pour_board_drive_faults());
+  TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* shorted */
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
+  TEST_ASSERT_EQUAL_INT(0, armed);
+  run_ms(2, 2448u, true); /* the core takes the clear, the board's next tick hands it to the drive */
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv->state);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, drv->faults); /* latched until they pass */
+}
+
+static void test_drive_isr_AClearMeasuresTheOffsetsAgainAndClearsThemInRange(void) {
+  broken_amplifier_cleared();
+  run_ms(20, 2048u, false); /* the amplifier reads its bias again: 256 periods, 12.8 ms */
+  const pour_drive_t *drv = pour_board_drive_state();
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv->state);
+  TEST_ASSERT_EQUAL_HEX16(0u, pour_board_drive_faults());
+  const uint16_t offsets[3] = {2048u, 2050u, 2046u};
+  TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, drv->sense.offset, 3);
+  TEST_ASSERT_EQUAL_INT(1, armed); /* the cut armed on the new offsets */
+  TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, armed_on, 3);
+  TEST_ASSERT_EQUAL_INT(0, gates_on_measuring);
+  TEST_ASSERT_EQUAL_INT(0, released);                       /* the core, latched, keeps the brake until a clear */
+  TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* the loop runs at zero current */
+}
+
+static void test_drive_isr_AClearWithTheAmplifierStillBrokenKeepsItLatched(void) {
+  broken_amplifier_cleared();
+  run_ms(20, 2448u, false);
+  const pour_drive_t *drv = pour_board_drive_state();
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv->state);
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, pour_board_drive_faults());
+  TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* shorted again */
+  TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
+  TEST_ASSERT_EQUAL_INT(0, armed);
+  TEST_ASSERT_EQUAL_INT(0, gates_on_measuring);
+  TEST_ASSERT_EQUAL_INT(0, released);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_drive_isr_WithoutTheEndOfSequenceNothingIsRead);
   RUN_TEST(test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares);
   RUN_TEST(test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares);
   RUN_TEST(test_drive_isr_TheBreakClearsOnlyOnceTheComparatorsAreLow);
+  RUN_TEST(test_drive_isr_AClearMeasuresTheOffsetsAgainAndClearsThemInRange);
+  RUN_TEST(test_drive_isr_AClearWithTheAmplifierStillBrokenKeepsItLatched);
   return UNITY_END();
 }

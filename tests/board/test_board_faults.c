@@ -23,9 +23,8 @@
 #include <string.h>
 
 #include "board_drive.h"
-#include "hal_brake.h"
+#include "brake_power_lines.h"
 #include "hal_drive.h"
-#include "hal_power.h"
 #include "ideal_drive.h"
 #include "pour/control.h"
 #include "unity.h"
@@ -47,7 +46,7 @@ typedef enum { GATES_OFF, GATES_ON, SHORTED } gates_t;
 
 static struct {
   double theta, omega, slip; /* slip: motor-side angle minus output angle, after the coupling slips [rad] */
-  bool brake_cmd, brake_held, power, slipping, comparator_trip, breaked;
+  bool brake_held, slipping, comparator_trip, breaked;
   double brake_since;
   gates_t gates;
   double vbus_v, temp_c;
@@ -58,12 +57,6 @@ static pour_control_t ctl;
 static pour_drive_config_t drive_config;
 
 /* --- the HAL, as the plant answers it ------------------------------------------------------------- */
-void pour_hal_brake_init(void) { plant.brake_cmd = true; }
-void pour_hal_brake_set(bool engage) { plant.brake_cmd = engage; }
-bool pour_hal_brake_engaged(void) { return plant.brake_cmd; }
-void pour_hal_power_init(void) { plant.power = false; }
-void pour_hal_power_set(bool on) { plant.power = on; }
-bool pour_hal_power_on(void) { return plant.power; }
 pour_status_t pour_hal_drive_init(void) { return POUR_OK; }
 uint16_t pour_hal_drive_period(void) { return 4250u; }
 void pour_hal_drive_set_compares(const uint16_t compare[3]) { (void)compare; }
@@ -82,7 +75,7 @@ static uint16_t motor_count(void) {
   return (uint16_t)((int64_t)floor(motor_rad / (2.0 * PI) * drive_config.encoder_cpr) & 0xFFFF); /* TIM4: 16 bits */
 }
 
-static gates_t gates(void) { return plant.breaked ? SHORTED : (plant.power ? plant.gates : GATES_OFF); }
+static gates_t gates(void) { return plant.breaked ? SHORTED : (power_line ? plant.gates : GATES_OFF); }
 
 bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_output_t *o = pour_board_drive_output();
@@ -107,10 +100,10 @@ static void plant_step(double t) {
     const double iq_nm = pour_ideal_torque_mnm(&drive_config, iq, motoring) * 1e-3;
     motor = gates() == GATES_ON ? iq_nm : (gates() == SHORTED ? -B_SHORT * plant.omega : 0.0);
   }
-  if (plant.brake_cmd && plant.brake_since < 0.0) {
+  if (brake_line && plant.brake_since < 0.0) {
     plant.brake_since = t;
   }
-  if (!plant.brake_cmd) {
+  if (!brake_line) {
     plant.brake_since = -1.0;
     plant.brake_held = false;
   }
@@ -187,7 +180,8 @@ static double resumed_theta(double t) { return after_clear.theta + 0.5 * (t - CL
 static result_t pour_with(fault_t fault) {
   memset(&plant, 0, sizeof plant);
   plant.brake_since = -1.0;
-  plant.brake_cmd = true;
+  brake_line = true;
+  power_line = false;
   plant.brake_held = true; /* spring-applied: engaged from power-up */
   const bool clearing = fault == F_BREAK_CLEARED || fault == F_BREAK_PERSISTS;
   /* calibrated where gravity has no torque; cleared where the envelope's torque from rest still lifts it */
@@ -255,22 +249,22 @@ static result_t pour_with(fault_t fault) {
       after_clear.torque_step_max = step > after_clear.torque_step_max ? step : after_clear.torque_step_max;
     }
     if (clearing && ms > CLEAR_MS) {
-      after_clear.brake_not_core_ticks += plant.brake_cmd == out.brake ? 0 : 1;
-      after_clear.released_ticks += plant.brake_cmd ? 0 : 1;
+      after_clear.brake_not_core_ticks += brake_line == out.brake ? 0 : 1;
+      after_clear.released_ticks += brake_line ? 0 : 1;
     }
     last_torque = out.torque;
     last_mode = out.mode;
     if (pour_board_drive_state()->state == POUR_DRIVE_MEASURING) {
       self_cal.measuring_ticks++;
-      self_cal.power_off_ticks += plant.power ? 0 : 1;
-      self_cal.released_ticks += plant.brake_cmd ? 0 : 1;
-      self_cal.brake_not_drives_ticks += plant.brake_cmd == (pour_board_drive_output()->brake != 0u) ? 0 : 1;
+      self_cal.power_off_ticks += power_line ? 0 : 1;
+      self_cal.released_ticks += brake_line ? 0 : 1;
+      self_cal.brake_not_drives_ticks += brake_line == (pour_board_drive_output()->brake != 0u) ? 0 : 1;
     }
     if (in.drive_faults != 0u && r.detected_ms < 0) {
       r.detected_ms = ms - fault_ms;
       r.trusted_at_detection = in.drive_trusted;
-      r.power_at_detection = plant.power;
-      r.brake_at_detection = plant.brake_cmd;
+      r.power_at_detection = power_line;
+      r.brake_at_detection = brake_line;
       r.shorted_at_detection = pour_board_drive_state()->state == POUR_DRIVE_FAULTED;
     }
     if (ms < fault_ms) {
@@ -289,7 +283,7 @@ static result_t pour_with(fault_t fault) {
   }
   r.theta_end = plant.theta;
   r.held = plant.brake_held;
-  r.brake = plant.brake_cmd;
+  r.brake = brake_line;
   return r;
 }
 
@@ -375,7 +369,8 @@ static void test_faults_WithoutCalibrationTheBucketNeverMoves(void) {
 /* The self-calibration on an uncalibrated board runs to its own end: the protection's missing calibration
  * does not re-trip the measuring drive, the power stays on and the brake is the drive's. The motor here
  * draws no current from the sequence's voltages (the ideal drive follows current references only), so the
- * sequence ends on the resistance stage, with the brake engaged and holding. */
+ * sequence ends on the resistance stage, with the brake engaged and holding (the OK path through this wiring,
+ * against host_sim's motor model, is test_board_calibration_run). */
 static void test_faults_TheSelfCalibrationOfAnUncalibratedBoardRunsToItsEnd(void) {
   const result_t r = pour_with(F_SELF_CAL);
   printf("self-calibration: %d ms measuring (power off %d, brake released %d, brake not the drive's %d)\n",

@@ -105,8 +105,8 @@ static void do_pack(const char *msg, long *v, int n) {
     pour_can_calibration_result_t m = {(uint8_t)v[1], (uint8_t)v[2], (uint8_t)v[3], (uint8_t)v[4],
                                        (uint16_t)v[5], (uint16_t)v[6], (uint8_t)v[7]};
     print_frame(pour_can_pack_calibration_result(node, &m, &f), &f);
-  } else if (strcmp(msg, "drive_telemetry") == 0 && n == 5) {
-    pour_can_drive_telemetry_t m = {(int16_t)v[1], (int16_t)v[2], (uint16_t)v[3], (uint16_t)v[4]};
+  } else if (strcmp(msg, "drive_telemetry") == 0 && n == 6) {
+    pour_can_drive_telemetry_t m = {(int16_t)v[1], (int16_t)v[2], (uint16_t)v[3], (uint16_t)v[4], (uint8_t)v[5]};
     print_frame(pour_can_pack_drive_telemetry(node, &m, &f), &f);
   } else if (strcmp(msg, "param_read") == 0 && n == 2) {
     pour_can_param_read_t m = {(uint8_t)v[1]};
@@ -201,7 +201,8 @@ static void do_unpack(const char *msg, char *rest) {
   } else if (strcmp(msg, "drive_telemetry") == 0) {
     pour_can_drive_telemetry_t m = {0};
     rc = pour_can_unpack_drive_telemetry(&f, &m);
-    snprintf(out, sizeof out, "%d %d %u %u", m.id_2ma, m.iq_2ma, (unsigned)m.vbus_mv, (unsigned)m.drive_faults);
+    snprintf(out, sizeof out, "%d %d %u %u %u", m.id_2ma, m.iq_2ma, (unsigned)m.vbus_mv, (unsigned)m.drive_faults,
+             (unsigned)m.crystal_4mhz);
   } else if (strcmp(msg, "param_read") == 0) {
     pour_can_param_read_t m = {0};
     rc = pour_can_unpack_param_read(&f, &m);

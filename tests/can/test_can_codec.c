@@ -168,7 +168,7 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
   TEST_ASSERT_EQUAL_HEX16(pour_can_id(2, POUR_CAN_CMD_CALIBRATION_RESULT), f.id);
-  TEST_ASSERT_EQUAL_HEX8(0x06u, f.data[0]); /* status 6 in the low nibble, stored 0 in the high one */
+  TEST_ASSERT_EQUAL_HEX8(0x06u, f.data[0]); /* status 6 in bits 0..4, stored 0 in bits 5..7 */
   pour_can_calibration_result_t got;
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
   TEST_ASSERT_EQUAL_UINT8(r.status, got.status);
@@ -178,6 +178,16 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
   TEST_ASSERT_EQUAL_UINT16(304u, got.resistance_mohm);
   TEST_ASSERT_EQUAL_UINT16(231u, got.inductance_uh);
   TEST_ASSERT_EQUAL_UINT8(200u, got.electrical_offset);
+  /* the interlock's refusals need Status's fifth bit; Stored sits above it */
+  const pour_can_calibration_result_t hi = {.status = POUR_CAN_CAL_REFUSED_NO_SENSORS, .stored = POUR_CAN_CAL_WRITE_FAILED};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &hi, &f));
+  TEST_ASSERT_EQUAL_HEX8(0xB2u, f.data[0]); /* 18 | 5 << 5 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, got.status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_WRITE_FAILED, got.stored);
+  f.data[0] = 19u; /* a status beyond the last */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
   pour_can_calibration_result_t bad = r;
   bad.status = POUR_CAN_CAL_STATUS_MAX + 1u;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_calibration_result(2, &bad, &f));
@@ -188,7 +198,8 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
 }
 
 static void test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults(void) {
-  const pour_can_drive_telemetry_t t = {.id_2ma = -32767, .iq_2ma = 2500, .vbus_mv = 24100u, .drive_faults = 0xF902u};
+  const pour_can_drive_telemetry_t t = {
+      .id_2ma = -32767, .iq_2ma = 2500, .vbus_mv = 24100u, .drive_faults = 0xF902u, .crystal_4mhz = 6u};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_drive_telemetry(0, &t, &f));
   pour_can_drive_telemetry_t got;
@@ -197,9 +208,15 @@ static void test_can_drive_telemetry_CarriesOnlyTheNamedDriveFaults(void) {
   TEST_ASSERT_EQUAL_INT16(2500, got.iq_2ma);
   TEST_ASSERT_EQUAL_UINT16(24100u, got.vbus_mv);
   TEST_ASSERT_EQUAL_HEX16(0x0102u, got.drive_faults); /* bits beyond the 11 named ones are not carried */
+  TEST_ASSERT_EQUAL_UINT8(6u, got.crystal_4mhz);        /* 24 MHz, beside them */
   pour_can_drive_telemetry_t bad = t;
   bad.iq_2ma = INT16_MIN;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_drive_telemetry(0, &bad, &f));
+  bad = t;
+  bad.crystal_4mhz = POUR_CAN_CRYSTAL_MAX + 1u; /* 52 MHz: no crystal the clock set-up takes */
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_pack_drive_telemetry(0, &bad, &f));
+  f.data[7] = (uint8_t)((f.data[7] & ~0x78u) | 0x68u); /* Crystal (bits 59..62) raw 13 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_drive_telemetry(&f, &got));
 }
 
 static void test_can_classify_SeparatesNodesCmdsAndDlcs(void) {

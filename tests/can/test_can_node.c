@@ -120,6 +120,21 @@ static void test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFo
   TEST_ASSERT_EQUAL_INT(1, seen);
 }
 
+/* The port's interlock: a refusal is answered with its reason and never handed to the port; RUN and the
+ * e-stop still come first; MEASURING again hands the next one over. */
+static void test_can_node_CalibrationStartFollowsThePortsGate(void) {
+  cfg.can_calibrate = true;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
+  pour_can_node_gate_calibration(&node, POUR_CAN_CAL_REFUSED_NOT_EMPTY);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NOT_EMPTY, calibration_answer((uint8_t)POUR_MODE_IDLE).status);
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, calibration_answer((uint8_t)POUR_MODE_RUN).status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_ESTOP, calibration_answer((uint8_t)POUR_MODE_ESTOP).status);
+  pour_can_node_gate_calibration(&node, POUR_CAN_CAL_MEASURING);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, calibration_answer((uint8_t)POUR_MODE_IDLE).status);
+  TEST_ASSERT_TRUE(pour_can_node_take_calibration_start(&node));
+}
+
 static void test_can_node_init_RejectsBadConfig(void) {
   pour_can_node_config_t bad = cfg;
   bad.node_id = 64;
@@ -195,7 +210,7 @@ static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   TEST_ASSERT_EQUAL_UINT8(3, tick(0, &in, tx)); /* no drive of its own: torque, heartbeat, identity */
   const pour_can_drive_telemetry_t d = {-1234, 5678, 24000u,
-                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP};
+                                        POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERTEMP, 2u};
   pour_can_node_set_drive(&node, &d);
   unsigned telemetry = 0;
   for (unsigned t = 1; t < 12; ++t) {
@@ -208,6 +223,7 @@ static void test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet(void) {
       TEST_ASSERT_EQUAL_INT16(5678, back.iq_2ma);
       TEST_ASSERT_EQUAL_UINT16(24000u, back.vbus_mv);
       TEST_ASSERT_EQUAL_HEX16(d.drive_faults, back.drive_faults);
+      TEST_ASSERT_EQUAL_UINT8(2u, back.crystal_4mhz);
       ++telemetry;
     } else {
       TEST_ASSERT_EQUAL_UINT8(1, n);
@@ -711,6 +727,7 @@ int main(void) {
   RUN_TEST(test_can_node_init_RejectsBadConfig);
   RUN_TEST(test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason);
   RUN_TEST(test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows);
+  RUN_TEST(test_can_node_CalibrationStartFollowsThePortsGate);
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);

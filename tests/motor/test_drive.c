@@ -270,12 +270,38 @@ static void test_drive_ClearErrorsClearsWhatItCanJudgeAndKeepsTheRest(void) {
   assert_clear(POUR_DRIVE_FAULT_OVERTEMP, 1);
   assert_clear(POUR_DRIVE_FAULT_PHASE, 1);
   assert_clear(POUR_DRIVE_FAULT_I2T, 1); /* cold: no heat accrued */
-  assert_clear(POUR_DRIVE_FAULT_CURRENT_OFFSET, 0);
   assert_clear(POUR_DRIVE_FAULT_ENCODER_DIRECTION, 0);
   assert_clear(POUR_DRIVE_FAULT_ENCODER_MISMATCH, 0);
   assert_clear(POUR_DRIVE_FAULT_CALIBRATION, 0);
   for (uint16_t bit = 1u; bit <= POUR_DRIVE_FAULT_ALL; bit = (uint16_t)(bit << 1))
-    assert_clear(bit, (bit & POUR_DRIVE_FAULT_CLEARABLE) != 0u);
+    if (bit != POUR_DRIVE_FAULT_CURRENT_OFFSET) assert_clear(bit, (bit & POUR_DRIVE_FAULT_CLEARABLE) != 0u);
+}
+
+/* CURRENT_OFFSET: a clear measures the offsets again with the bridge off, the fault latched meanwhile; in
+ * range it clears (RUN at zero current), out of range it stays. */
+static void test_drive_ClearOfACurrentOffsetMeasuresTheOffsetsAgain(void) {
+  for (int bad = 0; bad <= 1; ++bad) {
+    setUp();
+    run_calibration();
+    pour_drive_trip(&drv, POUR_DRIVE_FAULT_CURRENT_OFFSET);
+    pour_drive_isr(&drv, quiet(), &out);
+    TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, pour_drive_clear_faults(&drv));
+    TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv.state);
+    pour_drive_sample_t s = *quiet();
+    if (bad) s.adc_phase[1] = (uint16_t)(s.adc_phase[1] + 400u); /* the amplifier still 400 counts off */
+    for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES; ++k) {
+      TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv.state);
+      TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, drv.faults);
+      pour_drive_isr(&drv, &s, &out);
+      TEST_ASSERT_EQUAL_UINT8(0u, out.pwm_enable); /* all six switches off while it measures */
+      TEST_ASSERT_EQUAL_UINT8(1u, out.brake);
+    }
+    TEST_ASSERT_EQUAL_INT(bad ? POUR_DRIVE_FAULTED : POUR_DRIVE_RUN, drv.state);
+    TEST_ASSERT_EQUAL_HEX16(bad ? POUR_DRIVE_FAULT_CURRENT_OFFSET : 0u, drv.faults);
+    pour_drive_isr(&drv, quiet(), &out);
+    TEST_ASSERT_EQUAL_UINT8(bad ? 1u : 0u, out.brake);
+    TEST_ASSERT_EQUAL_INT16(0, out.iq_ref);
+  }
 }
 
 static void test_drive_ClearKeepsTheKeptBitAndClearsTheOthers(void) {
@@ -353,6 +379,7 @@ int main(void) {
   RUN_TEST(test_drive_TripFromOutsideLatches);
   RUN_TEST(test_drive_ClearErrorsClearsWhatItCanJudgeAndKeepsTheRest);
   RUN_TEST(test_drive_ClearKeepsTheKeptBitAndClearsTheOthers);
+  RUN_TEST(test_drive_ClearOfACurrentOffsetMeasuresTheOffsetsAgain);
   RUN_TEST(test_drive_ClearKeepsTheBusFaultWhileTheBusIsOut);
   RUN_TEST(test_drive_ClearKeepsTheI2tFaultUntilTheMotorCools);
   RUN_TEST(test_drive_ClearDoesNothingOutsideFaulted);

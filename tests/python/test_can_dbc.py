@@ -33,7 +33,7 @@ MESSAGES = {
     "calibration_start": ("CalibrationStart", []),
     "calibration_result": ("CalibrationResult", ["Status", "Stored", "EncoderReversed", "PolePairs", "Resistance",
                                                  "Inductance", "ElectricalOffset"]),
-    "drive_telemetry": ("DriveTelemetry", ["Id", "Iq", "Vbus", "DriveFaults"]),
+    "drive_telemetry": ("DriveTelemetry", ["Id", "Iq", "Vbus", "DriveFaults", "Crystal"]),
     "param_read": ("ParamRead", ["ParamId"]),
     "param_value": ("ParamValue", ["ParamId", "Value"]),
     "param_write": ("ParamWrite", ["ParamId", "Value"]),
@@ -290,7 +290,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
               ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5, 2]), ("estop", [1]),
               ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", []),
               ("calibration_start", []), ("calibration_result", [7, 2, 0, 0, 0, 0, 0]),
-              ("drive_telemetry", [-1500, 2500, 24100, 0x0102])]
+              ("drive_telemetry", [-1500, 2500, 24100, 0x0102, 6])]
     for cname, values in frames:
         frame_id, _, data = c_pack(harness, cname, 0, values)
         lines.append(f"(1700000000.{len(lines):06d}) vcan0 {frame_id:03X}#{data.hex().upper()}")
@@ -306,7 +306,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "TauMax: 20.0 N.m" in text
     assert "Assert: ASSERT" in text
     assert "Status: REFUSED_ESTOP" in text and "Stored: CORRUPT" in text  # a refusal's reason, by name
-    assert "Iq: 5.0 A" in text and "Vbus: 24.1 V" in text
+    assert "Iq: 5.0 A" in text and "Vbus: 24.1 V" in text and "Crystal: 24 MHz" in text
     assert "DriveFault_HwOvercurrent: 1" in text and "DriveFault_EncoderMismatch: 1" in text
     assert "ClearErrors(" in text
     assert "Stop(" in text and "Reset(" in text
@@ -319,7 +319,7 @@ def test_calibration_status_names_are_the_codec_s(db):
             if not k.endswith("_MAX")}
     choices = db.get_message_by_name("CalibrationResult").get_signal_by_name("Status").choices
     assert {int(k): str(v) for k, v in choices.items()} == ours
-    assert len(ours) == 16 and "MEASURING" in ours.values()
+    assert len(ours) == 19 and "MEASURING" in ours.values() and "REFUSED_NO_SENSORS" in ours.values()
 
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):

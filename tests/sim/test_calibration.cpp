@@ -59,6 +59,7 @@ Run run(poursim::FocDrive &foc, long abort_at = 0) {
   double omega = 0, theta = 0;
   for (long n = 0; n < 5L * 20000; ++n) {
     if (abort_at > 0 && n == abort_at) foc.abort_calibration();
+    if (n % 20 == 0) foc.command(0.0, omega, 1e-3); // the 1 kHz tick: the I²t budget
     const double tau = foc.period(omega);
     const bool brake = foc.output().brake != 0;
     if (foc.drive().state != POUR_DRIVE_MEASURING) {
@@ -156,6 +157,35 @@ static void test_motor_cal_TheDefaultMotorMeasuresAsConfigured(void) {
          r.result.r_phase_uohm * 1e-6, r.result.l_phase_nh * 1e-3, (unsigned)r.result.pole_pairs,
          offset_error_deg(r.result.electrical_offset, 0.0), r.peak_motion * 180 / kPi);
   TEST_ASSERT_TRUE(r.peak_motion <= 5.0 * kPi / 180);
+}
+
+// The drive's heat [A²·s] from its per-unit Q30·ms (pour_drive_init's scale).
+double heat_a2s(const pour_drive_t &d) {
+  return static_cast<double>(d.heat_q30ms) * (POUR_DRIVE_I_BASE_MA / 1000.0) * (POUR_DRIVE_I_BASE_MA / 1000.0) /
+         (1000.0 * 1073741824.0);
+}
+
+// The sequence's 4 A for 3.1 s heats the motor as a torque would; started with less of the I²t budget left
+// than a run takes, it ends in the I²t fault, held.
+static void test_motor_cal_TheSequenceSpendsTheI2tBudgetAndAHotStartEndsInTheFault(void) {
+  poursim::FocDrive cold = drive_with(nullptr, 0);
+  const Run c = run(cold);
+  TEST_ASSERT_EQUAL_INT(POUR_MOTOR_CAL_OK, c.status);
+  const double spent = heat_a2s(cold.drive());
+  const double budget = cold.firmware_config().i2t_budget_a2s;
+  poursim::FocDrive hot = drive_with(nullptr, 0);
+  const int64_t five_a2s = hot.drive().i2t_budget_q30ms * 5 / static_cast<int64_t>(budget);
+  hot.drive().heat_q30ms = hot.drive().i2t_budget_q30ms - five_a2s; // 5 A²s left
+  const Run h = run(hot);
+  printf("calibration heat: %.1f of %.0f A2s a run; started with 5 A2s left: status %d after %.2f s, faults 0x%04x, "
+         "brake %d\n", spent, budget, (int)h.status, h.seconds, (unsigned)h.faults, (int)h.brake_at_end);
+  TEST_ASSERT_TRUE(spent > 8.0 && spent < 30.0);
+  TEST_ASSERT_EQUAL_INT(POUR_MOTOR_CAL_ABORTED, h.status);
+  TEST_ASSERT_BITS_HIGH(POUR_DRIVE_FAULT_I2T | POUR_DRIVE_FAULT_CALIBRATION, h.faults);
+  TEST_ASSERT_TRUE(h.brake_at_end);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, hot.drive().state);
+  TEST_ASSERT_TRUE(h.seconds < c.seconds);
+  TEST_ASSERT_TRUE(h.peak_motion <= 10.0 * kPi / 180);
 }
 
 static void assert_refused(const Run &r, pour_motor_cal_status_t why) {
@@ -371,6 +401,7 @@ int main(void) {
   RUN_TEST(test_motor_cal_AFaultEndsItHeld);
   RUN_TEST(test_motor_cal_AStopEndsItHeld);
   RUN_TEST(test_motor_cal_RefusedWhileRunningAndRetriedAfterAStop);
+  RUN_TEST(test_motor_cal_TheSequenceSpendsTheI2tBudgetAndAHotStartEndsInTheFault);
   RUN_TEST(test_calibration_flow_AGoodResultIsStoredAndTheBoardIsCalibrated);
   RUN_TEST(test_calibration_flow_AFailedFlashWriteIsReported);
   RUN_TEST(test_calibration_flow_TheEstopEndsItHeldAndSaysSo);

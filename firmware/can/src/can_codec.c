@@ -121,7 +121,7 @@ pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_c
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_CALIBRATION_RESULT, POUR_CAN_DLC_CALIBRATION_RESULT);
-  frame->data[0] = (uint8_t)(msg->status | (uint8_t)(msg->stored << 4));
+  frame->data[0] = (uint8_t)(msg->status | (uint8_t)(msg->stored << 5));
   frame->data[1] = msg->encoder_reversed;
   frame->data[2] = msg->pole_pairs;
   put_u16(&frame->data[3], msg->resistance_mohm);
@@ -132,17 +132,20 @@ pour_status_t pour_can_pack_calibration_result(uint8_t node_id, const pour_can_c
 
 static int current_ok(int16_t i) { return i >= -POUR_CAN_CURRENT_MAX; }
 
+#define DRIVE_CRYSTAL_SHIFT 11u /* DriveTelemetry.Crystal above the 11 fault bits in bytes 6..7 */
+
 pour_status_t pour_can_pack_drive_telemetry(uint8_t node_id, const pour_can_drive_telemetry_t *msg,
                                             pour_can_frame_t *frame) {
   if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || !current_ok(msg->id_2ma) ||
-      !current_ok(msg->iq_2ma)) {
+      !current_ok(msg->iq_2ma) || msg->crystal_4mhz > POUR_CAN_CRYSTAL_MAX) {
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_DRIVE_TELEMETRY, POUR_CAN_DLC_DRIVE_TELEMETRY);
   put_u16(&frame->data[0], i16_bits(msg->id_2ma));
   put_u16(&frame->data[2], i16_bits(msg->iq_2ma));
   put_u16(&frame->data[4], msg->vbus_mv);
-  put_u16(&frame->data[6], (uint16_t)(msg->drive_faults & POUR_CAN_DRIVE_FAULT_MASK));
+  put_u16(&frame->data[6], (uint16_t)((msg->drive_faults & POUR_CAN_DRIVE_FAULT_MASK) |
+                                      ((uint32_t)msg->crystal_4mhz << DRIVE_CRYSTAL_SHIFT)));
   return POUR_OK;
 }
 
@@ -423,8 +426,8 @@ pour_can_rx_t pour_can_unpack_calibration_result(const pour_can_frame_t *frame, 
     return rc != POUR_CAN_RX_OK ? rc : POUR_CAN_RX_BAD_ID;
   }
   pour_can_calibration_result_t m;
-  m.status = (uint8_t)(frame->data[0] & 0x0Fu);
-  m.stored = (uint8_t)(frame->data[0] >> 4);
+  m.status = (uint8_t)(frame->data[0] & 0x1Fu);
+  m.stored = (uint8_t)(frame->data[0] >> 5);
   m.encoder_reversed = (uint8_t)(frame->data[1] & 1u); /* bits 9..15 are not signals */
   m.pole_pairs = frame->data[2];
   m.resistance_mohm = get_u16(&frame->data[3]);
@@ -444,12 +447,15 @@ pour_can_rx_t pour_can_unpack_drive_telemetry(const pour_can_frame_t *frame, pou
   }
   const int16_t id = as_i16(get_u16(&frame->data[0]));
   const int16_t iq = as_i16(get_u16(&frame->data[2]));
-  if (!current_ok(id) || !current_ok(iq)) {
+  const uint16_t word = get_u16(&frame->data[6]);
+  const uint8_t crystal = (uint8_t)((word >> DRIVE_CRYSTAL_SHIFT) & 0xFu);
+  if (!current_ok(id) || !current_ok(iq) || crystal > POUR_CAN_CRYSTAL_MAX) {
     return POUR_CAN_RX_OUT_OF_RANGE;
   }
   msg->id_2ma = id;
   msg->iq_2ma = iq;
   msg->vbus_mv = get_u16(&frame->data[4]);
-  msg->drive_faults = (uint16_t)(get_u16(&frame->data[6]) & POUR_CAN_DRIVE_FAULT_MASK);
+  msg->drive_faults = (uint16_t)(word & POUR_CAN_DRIVE_FAULT_MASK);
+  msg->crystal_4mhz = crystal;
   return POUR_CAN_RX_OK;
 }

@@ -37,6 +37,7 @@ pour_status_t pour_can_node_init(pour_can_node_t *node, const pour_can_node_conf
   pour_commands_init(&node->commands);
   node->calibration.status = POUR_CAN_CAL_UNAVAILABLE;
   node->calibration.stored = POUR_CAN_CAL_EMPTY;
+  node->calibration_gate = POUR_CAN_CAL_MEASURING;
   return POUR_OK;
 }
 
@@ -263,8 +264,8 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
     } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
       r.status = POUR_CAN_CAL_REFUSED_ESTOP;
     } else if (node->config.can_calibrate) {
-      r.status = POUR_CAN_CAL_MEASURING;
-      node->calibration_start = true;
+      r.status = node->calibration_gate;
+      node->calibration_start = node->calibration_start || r.status == POUR_CAN_CAL_MEASURING;
     }
     if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
       ++n;
@@ -288,6 +289,8 @@ void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_cali
   node->calibration = *result;
   node->calibration_report = true;
 }
+
+void pour_can_node_gate_calibration(pour_can_node_t *node, uint8_t answer) { node->calibration_gate = answer; }
 
 bool pour_can_node_take_calibration_start(pour_can_node_t *node) {
   const bool start = node->calibration_start;

@@ -170,19 +170,33 @@ void pour_drive_trip(pour_drive_t *drv, uint16_t fault) {
   drv->iq_cmd_q15 = 0;
 }
 
+/* Back to zero current: the PI loops, the command and the supervision windows start afresh. */
+static void restart(pour_drive_t *drv) {
+  pour_current_pi_reset(&drv->pi_d);
+  pour_current_pi_reset(&drv->pi_q);
+  drv->iq_cmd_q15 = 0;
+  drv->phase_loss_count = 0;
+  drv->motor_counts = drv->output_urad = 0;
+}
+
 uint16_t pour_drive_clear_faults(pour_drive_t *drv) {
-  if (drv->state != POUR_DRIVE_FAULTED || !drv->sense.calibrated) return drv->faults;
+  if (drv->state != POUR_DRIVE_FAULTED) return drv->faults;
+  if (drv->faults & POUR_DRIVE_FAULT_CURRENT_OFFSET) {
+    /* Measured again with the gates off (CALIBRATING); the fault stays latched until they are in range. */
+    const pour_current_sense_config_t sc = drv->sense.config;
+    (void)pour_current_sense_init(&drv->sense, &sc); /* valid: checked at init */
+    restart(drv);
+    drv->state = POUR_DRIVE_CALIBRATING;
+    return drv->faults;
+  }
+  if (!drv->sense.calibrated) return drv->faults;
   uint16_t keep = (uint16_t)(drv->faults & ~POUR_DRIVE_FAULT_CLEARABLE);
   if (drv->vbus_q15 > drv->ov_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_OVERVOLTAGE);
   if (drv->vbus_q15 < drv->uv_q15) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_UNDERVOLTAGE);
   if (drv->heat_q30ms > drv->i2t_budget_q30ms / 2) keep |= (uint16_t)(drv->faults & POUR_DRIVE_FAULT_I2T);
   drv->faults = keep;
   if (keep != 0u) return keep;
-  pour_current_pi_reset(&drv->pi_d);
-  pour_current_pi_reset(&drv->pi_q);
-  drv->iq_cmd_q15 = 0;
-  drv->phase_loss_count = 0;
-  drv->motor_counts = drv->output_urad = 0;
+  restart(drv);
   drv->state = POUR_DRIVE_RUN;
   return 0u;
 }
@@ -208,12 +222,16 @@ static uint16_t compare_of(int32_t duty_q15, uint16_t period) {
 
 static int32_t vmax_of(q15_t vbus) { return (int32_t)(((int64_t)vbus * VMAX_OF_BUS_Q15) >> 15); }
 
+bool pour_drive_can_calibrate(const pour_drive_t *drv) {
+  /* the latched faults a calibration may start from are those its success clears */
+  return drv->state == POUR_DRIVE_RUN ||
+         (drv->state == POUR_DRIVE_FAULTED && drv->sense.calibrated &&
+          (drv->faults & (uint16_t)~POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION) == 0u);
+}
+
 pour_status_t pour_drive_calibrate(pour_drive_t *drv) {
   const pour_drive_config_t *c = &drv->config;
-  /* a missing calibration is the one latched fault a calibration may start from (it clears it) */
-  const int uncalibrated = drv->state == POUR_DRIVE_FAULTED && drv->faults == POUR_DRIVE_FAULT_CALIBRATION &&
-                           drv->sense.calibrated;
-  if (drv->state != POUR_DRIVE_RUN && !uncalibrated) return POUR_EINVAL;
+  if (!pour_drive_can_calibrate(drv)) return POUR_EINVAL;
   const pour_motor_cal_config_t mc = {
       c->pwm_hz, I_BASE, V_BASE, c->cal_current_ma, c->cal_l_test_mv, c->encoder_cpr,
       (uint32_t)((uint64_t)c->cal_motion_urad * c->gear_ratio * c->encoder_cpr / TWO_PI_URAD)};
@@ -268,10 +286,8 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
       drv->pi_q = pi_q;
       drv->cal_status = POUR_MOTOR_CAL_OK;
       drv->cal_result = r;
-      drv->faults = 0; /* nothing else can be latched: a trip would have ended the sequence */
-      drv->iq_cmd_q15 = 0;
-      drv->motor_counts = drv->output_urad = 0;
-      drv->phase_loss_count = 0;
+      drv->faults = 0; /* what it started from (POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION): a trip would end it */
+      restart(drv);
       drv->last_encoder = encoder;
       drv->state = POUR_DRIVE_RUN; /* at zero current from the next period */
       hold(drv, out);
@@ -294,7 +310,8 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
     if (r < 0) {
       pour_drive_trip(drv, POUR_DRIVE_FAULT_CURRENT_OFFSET);
     } else if (r > 0) {
-      drv->state = POUR_DRIVE_RUN;
+      drv->faults = (uint16_t)(drv->faults & ~POUR_DRIVE_FAULT_CURRENT_OFFSET); /* a clear's re-measure passed */
+      drv->state = drv->faults != 0u ? POUR_DRIVE_FAULTED : POUR_DRIVE_RUN;
       drv->last_encoder = in->encoder;
     }
     hold(drv, out);
@@ -326,6 +343,8 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   pour_foc_sincos_q15(angle, &s, &co);
   pour_foc_clarke_q15(i[0], i[1], i[2], &alpha, &beta);
   if (drv->state == POUR_DRIVE_MEASURING) {
+    drv->i2_sum_q30 += (int64_t)alpha * alpha + (int64_t)beta * beta; /* |i|², as id² + iq² (Park rotates) */
+    drv->i2_n++;
     measure(drv, in->encoder, i, alpha, beta, out);
     return;
   }
@@ -398,6 +417,11 @@ void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta
   const pour_drive_config_t *c = &drv->config;
   if (drv->state == POUR_DRIVE_FAULTED) {
     accrue_i2t(drv); /* the motor cools while held: a clear waits for it */
+    return;
+  }
+  if (drv->state == POUR_DRIVE_MEASURING) {
+    /* the sequence's test current heats the motor as a torque would: a hot start ends in the I²t fault */
+    if (accrue_i2t(drv) && drv->heat_q30ms > drv->i2t_budget_q30ms) pour_drive_trip(drv, POUR_DRIVE_FAULT_I2T);
     return;
   }
   if (drv->state != POUR_DRIVE_RUN) {

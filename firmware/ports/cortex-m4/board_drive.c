@@ -2,6 +2,7 @@
 #include "board_drive.h"
 
 #include <stddef.h>
+#include <string.h>
 
 #include "board_guard.h"
 #include "hal_drive.h"
@@ -25,11 +26,11 @@ static struct {
   uint16_t faults;                 /* the loop's and the protection's, as the core and the bus see them */
   pour_board_calibration_fn calibration; /* the port's calibration flow, or NULL */
   uint16_t settle_ms;              /* after a self-calibration: the brake engaging, the power kept on */
+  pour_motor_cal_status_t cal_seen; /* the drive's calibration status at the last tick */
 } bd;
 
 pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t tau_max_mnm, bool calibration_valid) {
-  static const pour_drive_t no_drive;
-  bd.drive = no_drive;
+  memset(&bd.drive, 0, sizeof bd.drive); /* not a copy of a const zero: that would be 512 B of flash */
   bd.periods = bd.periods_seen = 0u;
   bd.armed = false;
   bd.faults = 0u;
@@ -41,6 +42,7 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   bd.calibration_valid = calibration_valid;
   bd.calibration = NULL;
   bd.settle_ms = 0u;
+  bd.cal_seen = POUR_MOTOR_CAL_NONE;
   if (config == NULL || tau_max_mnm <= 0 || pour_drive_init(&bd.drive, config) != POUR_OK) {
     return POUR_EINVAL;
   }
@@ -60,12 +62,12 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
 void pour_board_drive_set_calibration(pour_board_calibration_fn flow) { bd.calibration = flow; }
 
 void pour_board_drive_calibrated(void) {
-  if (!bd.calibration_valid) {
-    bd.calibration_valid = true;
-    const pour_guard_config_t gc = bd.guard.config;
-    const pour_protect_config_t pc = bd.guard.protect.config;
-    (void)pour_guard_init(&bd.guard, &gc, &pc); /* both checked at init */
-  }
+  /* The protection starts afresh: the drive's own sequence has just checked the motor encoder against its
+   * commutation, so the encoder faults it latched go too, and the output is anchored again. */
+  bd.calibration_valid = true;
+  const pour_guard_config_t gc = bd.guard.config;
+  const pour_protect_config_t pc = bd.guard.protect.config;
+  (void)pour_guard_init(&bd.guard, &gc, &pc); /* both checked at init */
 }
 
 void pour_board_drive_isr(void) {
@@ -105,8 +107,14 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   /* After a clear the core accepted, the protection judges the board's sensors afresh without the loop's
    * faults a clear may fix; the loop clears only if the protection did, so it never runs while the
    * protection still holds. */
-  const uint16_t loop_faults =
-      bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
+  uint16_t loop_faults = bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
+  const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
+  if (calibrating) {
+    /* The offsets measured (again, after a clear of CURRENT_OFFSET): the gates off and the brake engaged
+     * below; the cut is armed on the new ones once they pass. */
+    loop_faults = (uint16_t)(loop_faults & ~POUR_DRIVE_FAULT_CURRENT_OFFSET);
+    bd.armed = false;
+  }
   if (!bd.armed && bd.drive.state == POUR_DRIVE_RUN) {
     bd.armed = true; /* the thresholds sit above the offsets the loop has just measured */
     if (pour_hal_drive_arm_overcurrent(bd.drive.sense.offset) != POUR_OK) {
@@ -127,17 +135,22 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   if (bd.clear && p.faults == 0u) {
     (void)pour_drive_clear_faults(&bd.drive); /* what it keeps stays in bd.faults: the core latches it again */
   }
-  /* A missing calibration alone does not trip a drive that measures its offsets (the interrupt trips it
-   * then), measures the motor, or has just measured it (the flow stores it this tick). */
+  /* What a calibration clears does not trip (nor short) a drive that measures the motor or has just measured
+   * it (the flow stores it this tick); a missing calibration alone not one that measures its offsets with the
+   * gates off (the interrupt trips it then). */
   const pour_motor_cal_status_t cal = pour_drive_calibration(&bd.drive, NULL);
-  const bool measures = bd.drive.state == POUR_DRIVE_CALIBRATING || cal == POUR_MOTOR_CAL_RUNNING ||
-                        (cal == POUR_MOTOR_CAL_OK && bd.drive.state == POUR_DRIVE_RUN);
-  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && bd.drive.state != POUR_DRIVE_FAULTED &&
-      !(measures && p.faults == POUR_DRIVE_FAULT_CALIBRATION)) {
-    pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
+  const bool measures =
+      cal == POUR_MOTOR_CAL_RUNNING || (cal == POUR_MOTOR_CAL_OK && bd.cal_seen == POUR_MOTOR_CAL_RUNNING);
+  bd.cal_seen = cal;
+  const uint16_t exempt = measures ? POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION
+                                   : (calibrating ? POUR_DRIVE_FAULT_CALIBRATION : 0u);
+  if ((p.action == POUR_PROTECT_SHORT || p.action == POUR_PROTECT_HELD) && (p.faults & (uint16_t)~exempt) != 0u) {
+    pour_hal_drive_short_low_sides(); /* now, not at the next period: the loop may not be tripped yet */
+    if (bd.drive.state != POUR_DRIVE_FAULTED) {
+      pour_drive_trip(&bd.drive, p.faults); /* the loop stops following a torque: its periods short the phases */
+    }
   }
   bd.faults = (uint16_t)(bd.drive.faults | p.faults);
-  const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
   in->drive_faults = bd.faults;
   in->drive_trusted = bd.drive.state == POUR_DRIVE_RUN;
   pour_hal_drive_mask(false);

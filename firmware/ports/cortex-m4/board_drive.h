@@ -32,8 +32,8 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
 typedef bool (*pour_board_calibration_fn)(pour_drive_t *drv, uint8_t mode);
 void pour_board_drive_set_calibration(pour_board_calibration_fn flow);
 
-/* A valid calibration is stored now (one measured in this power cycle): the protection starts afresh, as at
- * boot, and a ClearErrors lets the core run. Nothing if it already was. */
+/* A calibration measured in this power cycle is stored now: the protection starts afresh, as at boot (its
+ * latched encoder faults gone, the output anchored again), and a ClearErrors lets the core run. */
 void pour_board_drive_calibrated(void);
 
 /* One PWM period (the ADC's end-of-sequence interrupt); nothing if the period's sample is not complete. */

@@ -63,7 +63,4 @@ void pour_guard_tick(pour_guard_t *g, const pour_hal_drive_sample_t *sample, uin
   if (out->brake) {
     pour_hal_brake_set(true);
   }
-  if (out->action == POUR_PROTECT_SHORT || out->action == POUR_PROTECT_HELD) {
-    pour_hal_drive_short_low_sides();
-  }
 }

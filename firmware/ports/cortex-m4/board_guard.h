@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* The board's protection wired to its HAL, once per 1 kHz tick: the bus voltage, the NTC and the motor
  * encoder of the current loop's latest sample (hal_drive's, which the loop's interrupt takes), the hardware
- * overcurrent cut, pour_protect_step, and what it says: the brake (hal_brake) and, unless the drive is still
- * trusted to stop the bucket, the phases shorted (hal_drive). The output angle and ClearErrors come from the
+ * overcurrent cut, pour_protect_step, and what it says: the brake (hal_brake) at once; the phases shorted,
+ * unless the drive is still trusted to stop the bucket, are the caller's (board_drive: not while the drive
+ * measures the motor). The output angle and ClearErrors come from the
  * bus; the calibration's validity from its storage. */
 #ifndef POUR_BOARD_GUARD_H
 #define POUR_BOARD_GUARD_H

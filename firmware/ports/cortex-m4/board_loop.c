@@ -5,6 +5,7 @@
 
 #include "board_drive.h"
 #include "calibration_flow.h"
+#include "clock.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
 #include "hal_estop.h"
@@ -16,7 +17,7 @@ static pour_can_node_t *flow_node;
 /* The drive's tick calls it after the core's step: a good result stored makes the calibration valid. */
 static bool calibration_tick(pour_drive_t *drv, uint8_t mode) {
   const bool measuring = pour_calibration_flow_tick(&flow, flow_node, drv, mode, pour_hal_calibration_flash());
-  if (flow.stored == POUR_CAL_OK) {
+  if (flow.stored_now) {
     pour_board_drive_calibrated();
   }
   return measuring;
@@ -55,9 +56,12 @@ void pour_board_loop_tick(pour_control_t *ctl, pour_can_node_t *node, uint32_t o
   }
   pour_control_output_t out;
   pour_board_drive_tick(ctl, &in, &out);
+  pour_calibration_flow_sense(&flow, node, pour_board_drive_state(), &in.sensors, in.sensors_fresh,
+                              ctl->config.sensors.encoder_bits);
   pour_hal_led_show(out.mode, false);
   pour_can_drive_telemetry_t drive;
   pour_board_drive_telemetry(&drive);
+  drive.crystal_4mhz = (uint8_t)(pour_clock_crystal() / 4000000u);
   pour_can_node_set_drive(node, &drive);
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   pour_board_transmit(tx, pour_can_node_end_tick(node, &out, overruns, tx));

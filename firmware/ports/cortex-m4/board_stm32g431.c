@@ -70,15 +70,21 @@ static void clock_on(uint32_t enr, uint32_t mask) {
   (void)RCC_R[enr]; /* the enable takes effect before the peripheral is touched */
 }
 
-static pour_clock_source_t clock_source = POUR_CLOCK_HSI16;
+static uint32_t crystal_hz;
 
 pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
-  const pour_clock_hw_t hw = {POUR_PERIPH(RCC), POUR_PERIPH(PWR), POUR_PERIPH(FLASH)};
+  const pour_clock_hw_t hw = {POUR_PERIPH(RCC), POUR_PERIPH(PWR), POUR_PERIPH(FLASH), POUR_PERIPH(LPTIM1),
+                              (volatile uint32_t *)(uintptr_t)POUR_SYSTICK_BASE};
   const pour_clock_config_t config = pour_clock_default_config();
-  return pour_clock_setup(&hw, &config, core_clock_hz, &clock_source);
+  pour_clock_source_t source;
+  const pour_status_t status = pour_clock_setup(&hw, &config, core_clock_hz, &source, &crystal_hz);
+  if (source != POUR_CLOCK_HSE) {
+    crystal_hz = 0u;
+  }
+  return status;
 }
 
-pour_clock_source_t pour_clock_source(void) { return clock_source; }
+uint32_t pour_clock_crystal(void) { return crystal_hz; }
 
 static void ports_on(void) {
   clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, GPIOAEN) | POUR_MSK(RCC, AHB2ENR, GPIOBEN) |

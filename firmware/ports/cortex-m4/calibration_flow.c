@@ -6,6 +6,9 @@
 void pour_calibration_flow_init(pour_calibration_flow_t *flow, pour_cal_status_t stored, const pour_calibration_t *cal) {
   flow->seen = POUR_MOTOR_CAL_NONE;
   flow->stored = stored;
+  flow->stored_now = false;
+  flow->sample_ms = UINT16_MAX; /* none yet */
+  flow->theta_urad = flow->scale_rotating_g = 0;
   if (stored == POUR_CAL_OK && cal != NULL) flow->calibration = *cal;
 }
 
@@ -18,6 +21,30 @@ uint8_t pour_calibration_flow_reason(pour_motor_cal_status_t status) {
     case POUR_MOTOR_CAL_MOTION: return POUR_CAN_CAL_MOTION_RANGE;
     default: return POUR_CAN_CAL_ABORTED;
   }
+}
+
+void pour_calibration_flow_sense(pour_calibration_flow_t *flow, pour_can_node_t *node, const pour_drive_t *drv,
+                                 const pour_sensors_t *sample, bool fresh, uint8_t encoder_bits) {
+  if (fresh && sample->encoder < (1u << encoder_bits)) {
+    flow->sample_ms = 0u;
+    flow->theta_urad = pour_sensors_theta_urad(sample->encoder, encoder_bits);
+    flow->scale_rotating_g = sample->scale_rotating_g;
+  } else if (flow->sample_ms < UINT16_MAX) {
+    flow->sample_ms++;
+  }
+  uint8_t answer = POUR_CAN_CAL_MEASURING;
+  if (drv->state == POUR_DRIVE_MEASURING) {
+    answer = POUR_CAN_CAL_MEASURING; /* the one running: the answer stays true, nothing restarts */
+  } else if (flow->sample_ms > POUR_CALIBRATION_SAMPLE_MS) {
+    answer = POUR_CAN_CAL_REFUSED_NO_SENSORS;
+  } else if (flow->theta_urad > POUR_CALIBRATION_UPRIGHT_URAD || flow->theta_urad < -POUR_CALIBRATION_UPRIGHT_URAD) {
+    answer = POUR_CAN_CAL_REFUSED_NOT_UPRIGHT;
+  } else if (flow->scale_rotating_g > POUR_CALIBRATION_EMPTY_G || flow->scale_rotating_g < -POUR_CALIBRATION_EMPTY_G) {
+    answer = POUR_CAN_CAL_REFUSED_NOT_EMPTY;
+  } else if (!pour_drive_can_calibrate(drv)) {
+    answer = POUR_CAN_CAL_ABORTED;
+  }
+  pour_can_node_gate_calibration(node, answer);
 }
 
 static void report(pour_calibration_flow_t *flow, pour_can_node_t *node, uint8_t status) {
@@ -39,6 +66,7 @@ static uint8_t store(pour_calibration_flow_t *flow, pour_can_node_t *node, const
     return POUR_CAN_CAL_WRITE_FAILED;
   }
   flow->stored = POUR_CAL_OK;
+  flow->stored_now = true;
   flow->calibration = c;
   if (node->config.identity.init_status == (int8_t)POUR_ECALIBRATION) {
     node->config.identity.init_status = (int8_t)POUR_OK; /* Identity no longer says uncalibrated */
@@ -48,8 +76,11 @@ static uint8_t store(pour_calibration_flow_t *flow, pour_can_node_t *node, const
 
 bool pour_calibration_flow_tick(pour_calibration_flow_t *flow, pour_can_node_t *node, pour_drive_t *drv, uint8_t mode,
                                 const pour_flash_t *flash) {
-  if (pour_can_node_take_calibration_start(node) && pour_drive_calibrate(drv) != POUR_OK) {
-    report(flow, node, POUR_CAN_CAL_ABORTED); /* the drive does not run: a latched fault, or its offsets */
+  flow->stored_now = false;
+  /* A start the interlock passed; one taken while the sequence runs was answered MEASURING: it stands. */
+  if (pour_can_node_take_calibration_start(node) && drv->state != POUR_DRIVE_MEASURING &&
+      pour_drive_calibrate(drv) != POUR_OK) {
+    report(flow, node, POUR_CAN_CAL_ABORTED); /* the drive changed since the interlock passed it */
   }
   if (drv->state == POUR_DRIVE_MEASURING && (mode == (uint8_t)POUR_MODE_ESTOP || mode == (uint8_t)POUR_MODE_RUN)) {
     pour_drive_calibrate_abort(drv);

@@ -1,24 +1,21 @@
 /* SPDX-License-Identifier: MIT */
 #include "hal_timer.h"
 
+#include "regs.h"
+
 /* SysTick is part of every Cortex-M4 core, so this one file serves the STM32G431 and QEMU alike. */
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYST_CSR_ENABLE 0x1u
-#define SYST_CSR_TICKINT 0x2u
-#define SYST_CSR_CLKSOURCE_CORE 0x4u
+#define SYST ((volatile uint32_t *)(uintptr_t)POUR_SYSTICK_BASE)
 
 static volatile uint32_t ticks;
 static uint32_t ticks_seen;
 
 void pour_hal_timer_init(uint32_t core_clock_hz) {
-  SYST_CSR = 0u;
-  SYST_RVR = core_clock_hz / 1000u - 1u;
-  SYST_CVR = 0u;
+  SYST[POUR_SYST_CSR] = 0u;
+  SYST[POUR_SYST_RVR] = core_clock_hz / 1000u - 1u;
+  SYST[POUR_SYST_CVR] = 0u;
   ticks = 0u;
   ticks_seen = 0u;
-  SYST_CSR = SYST_CSR_ENABLE | SYST_CSR_TICKINT | SYST_CSR_CLKSOURCE_CORE;
+  SYST[POUR_SYST_CSR] = POUR_SYST_CSR_ENABLE | POUR_SYST_CSR_TICKINT | POUR_SYST_CSR_CLKSOURCE_CORE;
 }
 
 void pour_hal_timer_isr(void) { ticks = ticks + 1u; }

@@ -41,6 +41,15 @@ static inline int pour_regs_wait(const volatile uint32_t *reg, uint32_t mask, ui
   return -1;
 }
 
+/* The Cortex-M4's SysTick (ARMv7-M architecture, not in ST's description of the chip): its base and word
+ * indices, and the control bits the port uses. */
+#define POUR_SYSTICK_BASE 0xE000E010u
+enum { POUR_SYST_CSR = 0, POUR_SYST_RVR = 1, POUR_SYST_CVR = 2 };
+#define POUR_SYST_CSR_ENABLE 0x1u
+#define POUR_SYST_CSR_TICKINT 0x2u
+#define POUR_SYST_CSR_CLKSOURCE_CORE 0x4u
+#define POUR_SYST_MAX 0xFFFFFFu /* the 24-bit down-counter's reload */
+
 /* An instance's registers as a word array (only where the driver runs on the chip, never in host tests). */
 #define POUR_PERIPH(inst) ((volatile uint32_t *)(uintptr_t)POUR_##inst##_BASE)
 

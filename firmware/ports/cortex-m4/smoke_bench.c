@@ -67,6 +67,9 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
   return POUR_OK;
 }
 
+#define SMOKE_CRYSTAL_HZ 8000000u /* what the scripted board says it found; DriveTelemetry must carry it */
+uint32_t pour_clock_crystal(void) { return SMOKE_CRYSTAL_HZ; }
+
 /* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
 pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
 int pour_hal_calibration_reason(void) { return 0; }
@@ -229,7 +232,7 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
     seen.telemetry++;
     seen.telemetry_faulted += dt.drive_faults != 0u ? 1u : 0u;
     const int32_t iq_2ma = (int32_t)pour_board_drive_output()->iq * 1000 / 1024;
-    seen.telemetry_iq_wrong += dt.iq_2ma == iq_2ma ? 0u : 1u;
+    seen.telemetry_iq_wrong += dt.iq_2ma == iq_2ma && dt.crystal_4mhz == SMOKE_CRYSTAL_HZ / 4000000u ? 0u : 1u;
   } else if (pour_can_unpack_identity(frame, &id) == POUR_CAN_RX_OK) {
     seen.identities++;
     if (id.weights_hash != pour_weights_compiled.content_hash || id.init_status != 0 ||

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The STM32G431's shared blocks as the board code uses them (regs.h's table form): reset and clock control,
- * power, the flash interface's access control, the independent watchdog, and the GPIO ports. */
+ * power, the flash interface's access control, the independent watchdog, the low-power timer that times the
+ * crystal against HSI16 at boot (clock.c), and the GPIO ports. */
 #ifndef POUR_STM32G431_REGS_H
 #define POUR_STM32G431_REGS_H
 
@@ -11,6 +12,7 @@
   P(PWR, PWR, 0x40007000)                                                                                      \
   P(FLASH, FLASH, 0x40022000)                                                                                  \
   P(IWDG, IWDG, 0x40003000)                                                                                    \
+  P(LPTIM1, LPTIM, 0x40007C00)                                                                                 \
   P(GPIOA, GPIO, 0x48000000)                                                                                   \
   P(GPIOB, GPIO, 0x48000400)                                                                                   \
   P(GPIOC, GPIO, 0x48000800)
@@ -29,6 +31,11 @@
   R(IWDG, PR, 0x04)                                                                                            \
   R(IWDG, RLR, 0x08)                                                                                           \
   R(IWDG, SR, 0x0C)                                                                                            \
+  R(LPTIM, ISR, 0x00)                                                                                          \
+  R(LPTIM, CFGR, 0x0C)                                                                                         \
+  R(LPTIM, CR, 0x10)                                                                                           \
+  R(LPTIM, ARR, 0x18)                                                                                          \
+  R(LPTIM, CNT, 0x1C)                                                                                          \
   R(GPIO, MODER, 0x00)                                                                                         \
   R(GPIO, OTYPER, 0x04)                                                                                        \
   R(GPIO, PUPDR, 0x0C)                                                                                         \
@@ -41,6 +48,8 @@
 /* GPIO fields repeat per pin: pin n's field is at n x WIDTH (AFRH: (n - 8) x WIDTH); pins 0 and 15 are
  * checked, the stride between them follows. */
 #define POUR_CHIP_FIELDS(F)                                                                                    \
+  F(RCC, CR, HSION, 8, 1)                                                                                      \
+  F(RCC, CR, HSIRDY, 10, 1)                                                                                    \
   F(RCC, CR, HSEON, 16, 1)                                                                                     \
   F(RCC, CR, HSERDY, 17, 1)                                                                                    \
   F(RCC, CR, HSEBYP, 18, 1)                                                                                    \
@@ -65,8 +74,10 @@
   F(RCC, APB1ENR1, TIM4EN, 2, 1)                                                                               \
   F(RCC, APB1ENR1, FDCANEN, 25, 1)                                                                             \
   F(RCC, APB1ENR1, PWREN, 28, 1)                                                                               \
+  F(RCC, APB1ENR1, LPTIM1EN, 31, 1)                                                                            \
   F(RCC, APB2ENR, SYSCFGEN, 0, 1)                                                                              \
   F(RCC, APB2ENR, TIM1EN, 11, 1)                                                                               \
+  F(RCC, CCIPR, LPTIM1SEL, 18, 2)                                                                              \
   F(RCC, CCIPR, FDCANSEL, 24, 2)                                                                               \
   F(PWR, CR5, R1MODE, 8, 1)                                                                                    \
   F(FLASH, ACR, LATENCY, 0, 4)                                                                                 \
@@ -79,6 +90,12 @@
   F(IWDG, SR, PVU, 0, 1)                                                                                       \
   F(IWDG, SR, RVU, 1, 1)                                                                                       \
   F(IWDG, SR, WVU, 2, 1)                                                                                       \
+  F(LPTIM, ISR, ARROK, 4, 1)                                                                                   \
+  F(LPTIM, CFGR, PRESC, 9, 3)                                                                                  \
+  F(LPTIM, CR, ENABLE, 0, 1)                                                                                   \
+  F(LPTIM, CR, CNTSTRT, 2, 1)                                                                                  \
+  F(LPTIM, ARR, ARR, 0, 16)                                                                                    \
+  F(LPTIM, CNT, CNT, 0, 16)                                                                                    \
   F(GPIO, MODER, MODER0, 0, 2)                                                                                 \
   F(GPIO, MODER, MODER15, 30, 2)                                                                               \
   F(GPIO, OTYPER, OT0, 0, 1)                                                                                   \

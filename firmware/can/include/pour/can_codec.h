@@ -70,6 +70,7 @@
 #define POUR_CAN_POLE_PAIRS_MAX 32u
 #define POUR_CAN_CURRENT_MAX 32767 /* |Id|, |Iq| [2 mA]; -32768 is out of range */
 #define POUR_CAN_DRIVE_FAULT_MASK 0x07FFu /* the 11 bits of pour/drive_faults.h, in their order */
+#define POUR_CAN_CRYSTAL_MAX 12u /* DriveTelemetry.Crystal [4 MHz]: 4 .. 48 MHz; 0 = no crystal, HSI16 */
 
 /* CalibrationResult.Status: 0 .. 5 the stored block's state (as calibration_store.h's pour_cal_status_t),
  * then the refusals of a CalibrationStart, each with its reason, then the measurement's progress and why it
@@ -90,7 +91,11 @@
 #define POUR_CAN_CAL_BAD_POLE_PAIRS 13u /* the counts of an electrical turn fit no pole-pair count 1 .. 32 */
 #define POUR_CAN_CAL_MOTION_RANGE 14u   /* the output moved beyond the sequence's range: stopped there */
 #define POUR_CAN_CAL_ABORTED 15u        /* a fault, the e-stop or a stop ended it, or a latched fault refused it */
-#define POUR_CAN_CAL_STATUS_MAX 15u
+/* The interlock of the brake's release (calibration_flow.h): the bucket must be upright and empty. */
+#define POUR_CAN_CAL_REFUSED_NOT_UPRIGHT 16u /* the output is more than 5° from upright */
+#define POUR_CAN_CAL_REFUSED_NOT_EMPTY 17u   /* the rotating scale reads more than 200 g (or below -200 g) */
+#define POUR_CAN_CAL_REFUSED_NO_SENSORS 18u  /* no sensor sample within 20 ms: no data is not "empty" */
+#define POUR_CAN_CAL_STATUS_MAX 18u
 #define POUR_CAN_CAL_STORED_MAX 5u
 #define POUR_CAN_PARAM_RESULT_MAX 9u    /* ParamAck.Result: a pour_param_result_t, or an ExperimentStart's refusal */
 /* ParamAck.Result for an ExperimentStart (beyond pour_param_result_t; OK: accepted, OUT_OF_RANGE: a kind
@@ -168,6 +173,7 @@ typedef struct {
   int16_t iq_2ma;        /* q current [2 mA], |.| <= POUR_CAN_CURRENT_MAX */
   uint16_t vbus_mv;      /* bus voltage [mV] */
   uint16_t drive_faults; /* POUR_DRIVE_FAULT_* (pour/drive_faults.h); only POUR_CAN_DRIVE_FAULT_MASK is carried */
+  uint8_t crystal_4mhz;  /* the crystal the core clock runs from [4 MHz], <= POUR_CAN_CRYSTAL_MAX; 0: HSI16 */
 } pour_can_drive_telemetry_t;
 /* ParamRead: which parameter. */
 typedef struct {

@@ -62,6 +62,7 @@ typedef struct {
   bool calibration_requested;                /* a CalibrationStart arrived since the last tick */
   bool calibration_start;                    /* one was accepted: the port has not taken it yet */
   bool calibration_report;                   /* the port's outcome waits to be sent */
+  uint8_t calibration_gate;                  /* the port's interlock: POUR_CAN_CAL_MEASURING or a refusal */
   pour_can_calibration_result_t calibration; /* what the port says a start does and what is stored */
   bool experiment_requested;                 /* an ExperimentStart arrived and waits for the port */
   uint8_t experiment_kind;                   /* ... of this kind */
@@ -88,6 +89,11 @@ void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemet
  * CalibrationResult at the end of a tick (after a pending request's answer, if any: one a tick). */
 void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result);
 
+/* The port's interlock, each tick before end_tick: what a CalibrationStart that RUN and the e-stop do not
+ * refuse is answered with (config.can_calibrate): POUR_CAN_CAL_MEASURING accepts it, any other status
+ * refuses it with that reason. MEASURING until called. */
+void pour_can_node_gate_calibration(pour_can_node_t *node, uint8_t answer);
+
 /* Takes an accepted CalibrationStart (config.can_calibrate), once: true if one waits. */
 bool pour_can_node_take_calibration_start(pour_can_node_t *node);
 
@@ -109,7 +115,8 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 /* End of a tick: advances the watchdog by 1 ms, then writes the torque frame, when due the heartbeat and
  * the identity frame (and DriveTelemetry, once pour_can_node_set_drive was called), and after a
  * CalibrationStart its CalibrationResult into tx: refused in RUN (REFUSED_RUNNING) and in ESTOP
- * (REFUSED_ESTOP), else MEASURING if the port measures (config.can_calibrate), else the port's answer
+ * (REFUSED_ESTOP), else the port's gate if it measures (config.can_calibrate: MEASURING, or its
+ * interlock's refusal; pour_can_node_gate_calibration), else the port's answer
  * (pour_can_node_set_calibration); or else a reported outcome. overruns: the port's missed deadlines.
  * Returns the count. */
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,

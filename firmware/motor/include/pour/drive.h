@@ -8,6 +8,7 @@
 #ifndef POUR_DRIVE_H
 #define POUR_DRIVE_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "pour/current_pi.h"
@@ -149,13 +150,18 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
  * output's motion since the last tick output_delta_urad [µrad]. */
 void pour_drive_tick(pour_drive_t *drv, int32_t torque_mnm, int32_t output_delta_urad);
 
-/* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: from RUN, or FAULTED with
- * POUR_DRIVE_FAULT_CALIBRATION alone (no valid calibration, or the last one failed) once the current offsets
- * are measured; else POUR_EINVAL. The brake is released while it runs (3.1 s). Success applies the results to
+/* Starts the self-calibration (pour/motor_cal.h) with the bucket empty: from RUN, or FAULTED with nothing
+ * latched but POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION (no valid calibration, the last one failed, an encoder
+ * fault) once the current offsets are measured; else POUR_EINVAL. The brake is released while it runs (3.1 s). Success applies the results to
  * the configuration (R, L, pole pairs, encoder direction and offset; the current loop's gains from R and L),
  * the brake requested for that period, then RUN at zero current; a failure or a fault latches
- * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. */
+ * POUR_DRIVE_FAULT_CALIBRATION (phases shorted, brake engaged) with the reason in cal_status. Its current
+ * accrues to the I²t budget as a torque's does (pour_drive_tick): spent, the sequence ends ABORTED with
+ * POUR_DRIVE_FAULT_I2T. */
 pour_status_t pour_drive_calibrate(pour_drive_t *drv);
+
+/* Whether pour_drive_calibrate would start the sequence now. */
+bool pour_drive_can_calibrate(const pour_drive_t *drv);
 
 /* Ends a running self-calibration (a stop, the e-stop): cal_status ABORTED, POUR_DRIVE_FAULT_CALIBRATION
  * latched, the bucket held. Nothing if none runs. */
@@ -169,8 +175,10 @@ void pour_drive_trip(pour_drive_t *drv, uint16_t fault);
 
 /* ClearErrors: clears the latched faults whose cause is judged gone (POUR_DRIVE_FAULT_CLEARABLE, with the
  * bus and I²t conditions there); with none left, FAULTED becomes RUN at zero current, the PI loops reset.
- * Returns the faults still latched (0: cleared). Nothing changes outside FAULTED, nor before the current
- * offsets were measured (a reset measures them). */
+ * With POUR_DRIVE_FAULT_CURRENT_OFFSET latched it clears nothing yet: the offsets are measured again with the
+ * gates off (CALIBRATING, 256 periods), and the fault clears there only if they are in range (then RUN, or
+ * FAULTED while others stay latched); out of range it stays. Returns the faults still latched (0: cleared).
+ * Nothing changes outside FAULTED. */
 uint16_t pour_drive_clear_faults(pour_drive_t *drv);
 
 #endif /* POUR_DRIVE_H */

@@ -22,12 +22,19 @@
  * afresh once cleared. OVERCURRENT and PHASE: the loop checks every period again. HW_OVERCURRENT: the board
  * re-arms the break, which fires again while a comparator still trips. OVERVOLTAGE, UNDERVOLTAGE: only with
  * the last bus sample in range. OVERTEMP: the board's protection reads the NTC again. I2T: only once the
- * motor has cooled to half its budget.
- * Kept until a reset: CURRENT_OFFSET (a broken amplifier or an unarmed cut), ENCODER_DIRECTION (wiring or
- * a wrong calibration: the motor would run away), ENCODER_MISMATCH (a slipped coupling would look fine
- * once re-anchored). Kept until a self-calibration succeeds: CALIBRATION. */
+ * motor has cooled to half its budget. CURRENT_OFFSET (a broken amplifier, or a cut that would not arm on
+ * the offsets): the offsets are measured again with the gates off and the brake engaged, and it clears only
+ * if they are in range (the board then re-arms the cut on them).
+ * Kept until a self-calibration succeeds (POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION; a CalibrationStart may
+ * start from them): CALIBRATION, ENCODER_DIRECTION (wiring or a wrong calibration: the motor would run
+ * away), ENCODER_MISMATCH (a slipped coupling would look fine once re-anchored: the sequence measures the
+ * motor's encoder against its own commutation again). */
 #define POUR_DRIVE_FAULT_CLEARABLE                                                                            \
   (POUR_DRIVE_FAULT_OVERCURRENT | POUR_DRIVE_FAULT_HW_OVERCURRENT | POUR_DRIVE_FAULT_OVERVOLTAGE |            \
-   POUR_DRIVE_FAULT_UNDERVOLTAGE | POUR_DRIVE_FAULT_OVERTEMP | POUR_DRIVE_FAULT_PHASE | POUR_DRIVE_FAULT_I2T)
+   POUR_DRIVE_FAULT_UNDERVOLTAGE | POUR_DRIVE_FAULT_OVERTEMP | POUR_DRIVE_FAULT_PHASE | POUR_DRIVE_FAULT_I2T |  \
+   POUR_DRIVE_FAULT_CURRENT_OFFSET)
+
+#define POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION                                                               \
+  (POUR_DRIVE_FAULT_CALIBRATION | POUR_DRIVE_FAULT_ENCODER_DIRECTION | POUR_DRIVE_FAULT_ENCODER_MISMATCH)
 
 #endif /* POUR_DRIVE_FAULTS_H */

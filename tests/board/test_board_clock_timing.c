@@ -1,0 +1,148 @@
+/* SPDX-License-Identifier: MIT */
+/* The crystal timed against HSI16 and used, against register files a second thread keeps moving as the chip
+ * would: CFGR.SWS follows CFGR.SW, LPTIM1 reports ARROK once enabled and counts HSI16 through its prescaler
+ * once started, SysTick counts down at HCLK (the core's clock / 2 while the crystal is timed). Both counters
+ * follow one emulated time, the host's monotonic clock slowed 10 times and advanced at most 1 us per step of
+ * the thread: the ratio of their counts is that of the two oscillators, and a thread descheduled on a loaded
+ * machine stalls the chip's time rather than making it jump. Host only: a POSIX thread plays the chip. */
+#define _POSIX_C_SOURCE 200112L /* clock_gettime under -std=c99 */
+#include <pthread.h>
+#include <string.h>
+#include <time.h>
+
+#include "clock.h"
+#include "stm32g431_regs.h"
+#include "unity.h"
+
+#define SLOWDOWN 10u
+#define STEP_MAX_NS 1000u
+
+static volatile uint32_t rcc[0x100 / 4], pwr[0x100 / 4], flash[0x100 / 4], lptim[0x40 / 4], systick[0x10 / 4];
+static const pour_clock_hw_t hw = {rcc, pwr, flash, lptim, systick};
+static volatile int running; /* the test's flag to the chip thread (set before it starts, cleared to end it) */
+static uint64_t crystal_mhz_x10; /* the emulated crystal [0.1 MHz] */
+
+static uint64_t host_ns(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
+}
+
+static void *chip(void *arg) {
+  (void)arg;
+  uint64_t last = host_ns(), now = 0u, lptim_start = 0u, systick_start = 0u; /* the chip's times [ns] */
+  while (running) {
+    const uint64_t host = host_ns(), step = (host - last) / SLOWDOWN;
+    last = host;
+    now += step < STEP_MAX_NS ? step : STEP_MAX_NS;
+    const uint32_t cfgr = rcc[POUR_RCC_CFGR];
+    const uint32_t sw = POUR_GET(RCC, CFGR, SW, cfgr);
+    if (POUR_GET(RCC, CFGR, SWS, cfgr) != sw) { /* written only on a switch, while the code only polls */
+      rcc[POUR_RCC_CFGR] = (cfgr & ~POUR_MSK(RCC, CFGR, SWS)) | POUR_VAL(RCC, CFGR, SWS, sw);
+    }
+    const uint32_t cr = lptim[POUR_LPTIM_CR];
+    if ((cr & POUR_MSK(LPTIM, CR, ENABLE)) != 0u && lptim[POUR_LPTIM_ARR] != 0u) {
+      lptim[POUR_LPTIM_ISR] |= POUR_MSK(LPTIM, ISR, ARROK);
+    }
+    if ((cr & POUR_MSK(LPTIM, CR, CNTSTRT)) == 0u) {
+      lptim_start = 0u;
+    } else {
+      lptim_start = lptim_start != 0u ? lptim_start : now;
+      const uint64_t presc = 1u << POUR_GET(LPTIM, CFGR, PRESC, lptim[POUR_LPTIM_CFGR]);
+      lptim[POUR_LPTIM_CNT] = (uint32_t)((now - lptim_start) * 16u / 1000u / presc) & 0xFFFFu; /* HSI16 */
+    }
+    if ((systick[POUR_SYST_CSR] & POUR_SYST_CSR_ENABLE) == 0u || sw != 2u) {
+      systick_start = 0u;
+    } else {
+      systick_start = systick_start != 0u ? systick_start : now;
+      const uint64_t ticks = (now - systick_start) * crystal_mhz_x10 / 20000u; /* crystal / 2 */
+      systick[POUR_SYST_CVR] = (uint32_t)(0u - ticks) & POUR_SYST_MAX;
+    }
+  }
+  return NULL;
+}
+
+static pthread_t thread;
+static pour_clock_config_t config;
+static uint32_t hz, crystal;
+static pour_clock_source_t source;
+
+static void start_chip(uint32_t mhz_x10) {
+  crystal_mhz_x10 = mhz_x10;
+  running = 1;
+  TEST_ASSERT_EQUAL_INT(0, pthread_create(&thread, NULL, chip, NULL));
+}
+
+void setUp(void) {
+  memset((void *)rcc, 0, sizeof rcc);
+  memset((void *)pwr, 0, sizeof pwr);
+  memset((void *)flash, 0, sizeof flash);
+  memset((void *)lptim, 0, sizeof lptim);
+  memset((void *)systick, 0, sizeof systick);
+  rcc[POUR_RCC_CR] = POUR_MSK(RCC, CR, HSERDY) | POUR_MSK(RCC, CR, PLLRDY);
+  rcc[POUR_RCC_CFGR] = POUR_VAL(RCC, CFGR, SW, 1u) | POUR_VAL(RCC, CFGR, SWS, 1u); /* reset: HSI16 */
+  config = pour_clock_default_config();
+  config.ready_polls = 500000000u; /* the timing takes 80 ms of the host's time: polls enough for it */
+}
+
+void tearDown(void) {
+  running = 0;
+  pthread_join(thread, NULL);
+}
+
+static void expect_crystal_pll(uint32_t crystal_hz) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_clock_setup(&hw, &config, &hz, &source, &crystal));
+  TEST_ASSERT_EQUAL_UINT32(170000000u, hz);
+  TEST_ASSERT_EQUAL_INT(POUR_CLOCK_HSE, source);
+  TEST_ASSERT_EQUAL_UINT32(crystal_hz, crystal);
+  /* crystal / M = 4 MHz, x N 85 = 340 MHz, / R 2 */
+  TEST_ASSERT_EQUAL_HEX32(POUR_VAL(RCC, PLLCFGR, PLLSRC, 3u) | POUR_VAL(RCC, PLLCFGR, PLLM, crystal_hz / 4000000u - 1u) |
+                              POUR_VAL(RCC, PLLCFGR, PLLN, 85u) | POUR_MSK(RCC, PLLCFGR, PLLREN),
+                          rcc[POUR_RCC_PLLCFGR]);
+  TEST_ASSERT_BITS_HIGH(POUR_MSK(RCC, CR, HSEON) | POUR_MSK(RCC, CR, CSSON) | POUR_MSK(RCC, CR, PLLON),
+                        rcc[POUR_RCC_CR]);
+  TEST_ASSERT_EQUAL_UINT32(3u, POUR_GET(RCC, CFGR, SW, rcc[POUR_RCC_CFGR]));
+  TEST_ASSERT_EQUAL_UINT32(0u, POUR_GET(RCC, CFGR, HPRE, rcc[POUR_RCC_CFGR]));
+  TEST_ASSERT_EQUAL_UINT32(0u, POUR_GET(PWR, CR5, R1MODE, pwr[POUR_PWR_CR5])); /* boost */
+  TEST_ASSERT_EQUAL_UINT32(4u, POUR_GET(FLASH, ACR, LATENCY, flash[POUR_FLASH_ACR]));
+  TEST_ASSERT_EQUAL_UINT32(2u, POUR_GET(RCC, CCIPR, LPTIM1SEL, rcc[POUR_RCC_CCIPR])); /* timed against HSI16 */
+  TEST_ASSERT_BITS_LOW(POUR_MSK(RCC, APB1ENR1, LPTIM1EN), rcc[POUR_RCC_APB1ENR1]);  /* and off again */
+  TEST_ASSERT_EQUAL_HEX32(0u, lptim[POUR_LPTIM_CR]);
+  TEST_ASSERT_EQUAL_HEX32(0u, systick[POUR_SYST_CSR]);
+}
+
+static void test_clock_timing_Finds24MHz(void) {
+  start_chip(240u);
+  expect_crystal_pll(24000000u);
+}
+
+static void test_clock_timing_Finds8MHz(void) {
+  start_chip(80u);
+  expect_crystal_pll(8000000u);
+}
+
+/* HSI16 1 % fast makes a 24 MHz crystal time at 23.76 MHz: still 24. */
+static void test_clock_timing_ToleratesHsi16sError(void) {
+  start_chip(238u);
+  expect_crystal_pll(24000000u);
+}
+
+/* A 25 MHz crystal (the frequency of many other boards) cannot give the PLL its 4 MHz: HSI16, and said. */
+static void test_clock_timing_RefusesA25MHzCrystal(void) {
+  start_chip(250u);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_clock_setup(&hw, &config, &hz, &source, &crystal));
+  TEST_ASSERT_EQUAL_UINT32(170000000u, hz);
+  TEST_ASSERT_EQUAL_INT(POUR_CLOCK_HSI16, source);
+  TEST_ASSERT_EQUAL_UINT32(0u, crystal);
+  TEST_ASSERT_EQUAL_UINT32(2u, POUR_GET(RCC, PLLCFGR, PLLSRC, rcc[POUR_RCC_PLLCFGR]));
+  TEST_ASSERT_BITS_LOW(POUR_MSK(RCC, CR, HSEON) | POUR_MSK(RCC, CR, CSSON), rcc[POUR_RCC_CR]);
+}
+
+int main(void) {
+  UNITY_BEGIN();
+  RUN_TEST(test_clock_timing_Finds24MHz);
+  RUN_TEST(test_clock_timing_Finds8MHz);
+  RUN_TEST(test_clock_timing_ToleratesHsi16sError);
+  RUN_TEST(test_clock_timing_RefusesA25MHzCrystal);
+  return UNITY_END();
+}
