@@ -257,6 +257,9 @@ static void take_experiment_request(pour_control_t *ctl) {
     pour_estimator_expect_empty(&ctl->estimator, ctl->experiment_kind == (uint8_t)POUR_EXPERIMENT_IDENTIFY);
     ctl->held = false;
   }
+  if (answer != (uint8_t)POUR_CONTROL_EXPERIMENT_ACCEPTED) {
+    count_refused(ctl);
+  }
   ctl->experiment_answer = answer;
 }
 
@@ -302,6 +305,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     if (ctl->experiment_asked) {
       ctl->experiment_asked = false;
       ctl->experiment_answer = (uint8_t)POUR_CONTROL_EXPERIMENT_REFUSED_ESTOP;
+      count_refused(ctl);
     }
     if (in->stop) {
       count_refused(ctl);

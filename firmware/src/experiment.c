@@ -4,12 +4,20 @@
 #include <stddef.h>
 
 /* The identify script [ms]: a ramp to the hold angle, steps (alternating every STEP_HALF_MS), a chirp
- * from f0 to f1, a ramp back. 14 s in all: the empty bucket needs no more to show its inertia, friction,
- * gravity arm, latency and the scale's filter. */
+ * from f0 to f1, a sweep, a ramp back. 18 s in all: the empty bucket needs no more to show its inertia,
+ * friction, gravity arm, latency and the scale's filter. The sweep runs a triangle of ±SWEEP_URAD about
+ * the hold angle, one cycle at 0.5 rad/s, then three at 1.5 rad/s (within the envelope's 2 rad/s): two
+ * steady speeds each way are what tell viscous friction (b θ̇, a few % of Coulomb's) from Coulomb's. */
 #define RAMP_MS 1500u
 #define STEPS_MS 3000u
 #define STEP_HALF_MS 250u
 #define CHIRP_MS 8000u
+#define SWEEP_URAD 250000u
+#define SWEEP_SLOW_MS 2000u      /* one cycle: 4 * SWEEP_URAD at SWEEP_SLOW_URAD_MS */
+#define SWEEP_SLOW_URAD_MS 500u  /* [µrad/ms] = [mrad/s] */
+#define SWEEP_FAST_MS 2000u      /* three cycles */
+#define SWEEP_FAST_URAD_MS 1500u
+#define SWEEP_MS (SWEEP_SLOW_MS + SWEEP_FAST_MS)
 #define TILT_DWELL_MS 1000u
 #define TILT_RETURN_FACTOR 4 /* the empty bucket comes back four times as fast as it went */
 #define ANGLE_MAX_URAD 3141593   /* angles and ranges within half a turn */
@@ -55,7 +63,7 @@ static uint32_t tilt_up_ms(const pour_experiment_config_t *c) {
 
 uint32_t pour_experiment_duration_ms(const pour_experiment_config_t *c, uint8_t kind) {
   if (kind == (uint8_t)POUR_EXPERIMENT_IDENTIFY) {
-    return RAMP_MS + STEPS_MS + CHIRP_MS + RAMP_MS;
+    return RAMP_MS + STEPS_MS + CHIRP_MS + SWEEP_MS + RAMP_MS;
   }
   if (kind == (uint8_t)POUR_EXPERIMENT_TILT) {
     const uint32_t up = tilt_up_ms(c);
@@ -88,6 +96,14 @@ static int32_t pd(int32_t kp, int32_t kd, int32_t ref_urad, const pour_state_t *
   return pour_sat_i32(t);
 }
 
+/* pd toward ref moving at speed [µrad/s]: the damping acts on the speed error, so that a ramp is tracked
+ * without a lag of kd * speed / kp. */
+static int32_t track(int32_t kp, int32_t kd, int32_t ref_urad, int32_t speed_urad_s, const pour_state_t *s) {
+  pour_state_t rel = *s;
+  rel.omega_urad_s = pour_sat_i32((int64_t)s->omega_urad_s - speed_urad_s);
+  return pd(kp, kd, ref_urad, &rel);
+}
+
 /* sin(2π · turn / 2^32) by the parabola 4x(1 - |x|), x = the phase in half turns in [-1, 1), Q15; within
  * 0.06 of the sine, smooth, and the fitter sees the command itself, so its shape need not be exact. */
 static int32_t sine_q15(uint32_t turn) {
@@ -107,6 +123,7 @@ static int32_t identify(pour_experiment_t *e, const pour_state_t *s) {
   const uint32_t t = e->ms;
   const int32_t hold = c->hold_theta_urad;
   int32_t ref = hold;
+  int32_t speed = 0;
   int32_t excite = 0;
   if (t < RAMP_MS) {
     e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_RAMP;
@@ -125,11 +142,21 @@ static int32_t identify(pour_experiment_t *e, const pour_state_t *s) {
     /* One tick advances the phase by f [mHz] * 2^32 / 10^6 (f <= 50 Hz: < 2^28 a tick). */
     e->phase_turn += (uint32_t)(((uint64_t)chirp_mhz(c, t - RAMP_MS - STEPS_MS) << 32) / 1000000u);
     excite = (c->chirp_torque * sine_q15(e->phase_turn)) / POUR_Q15_ONE_INT;
+  } else if (t < RAMP_MS + STEPS_MS + CHIRP_MS + SWEEP_MS) {
+    e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_SWEEP;
+    /* Along the triangle [µrad]: up to +SWEEP_URAD, down to -SWEEP_URAD, up to the hold angle. */
+    const uint32_t k = t - (RAMP_MS + STEPS_MS + CHIRP_MS);
+    const bool fast = k >= SWEEP_SLOW_MS;
+    const uint32_t v = fast ? SWEEP_FAST_URAD_MS : SWEEP_SLOW_URAD_MS;
+    const int32_t p = (int32_t)(((fast ? k - SWEEP_SLOW_MS : k) * v) % (4u * SWEEP_URAD));
+    const int32_t a = (int32_t)SWEEP_URAD;
+    speed = (p < a || p >= 3 * a ? 1000 : -1000) * (int32_t)v;
+    ref = hold + (p < a ? p : (p < 3 * a ? 2 * a - p : p - 4 * a));
   } else {
     e->phase = (uint8_t)POUR_EXPERIMENT_PHASE_BACK;
-    ref = lerp(hold, e->start_theta_urad, t - (RAMP_MS + STEPS_MS + CHIRP_MS), RAMP_MS);
+    ref = lerp(hold, e->start_theta_urad, t - (RAMP_MS + STEPS_MS + CHIRP_MS + SWEEP_MS), RAMP_MS);
   }
-  return pd(c->kp_per_rad, c->kd_per_rad_s, ref, s) + excite;
+  return track(c->kp_per_rad, c->kd_per_rad_s, ref, speed, s) + excite;
 }
 
 static int32_t tilt(pour_experiment_t *e, const pour_state_t *s) {
@@ -153,10 +180,7 @@ static int32_t tilt(pour_experiment_t *e, const pour_state_t *s) {
     ref = lerp(c->tilt_theta_urad, e->start_theta_urad, k < back ? k : back, back);
     speed = -c->tilt_speed_urad_s * TILT_RETURN_FACTOR;
   }
-  /* Damping acts on the speed error, so the ramp is tracked without a lag of kd * speed / kp. */
-  pour_state_t rel = *s;
-  rel.omega_urad_s = pour_sat_i32((int64_t)s->omega_urad_s - speed);
-  return pd(c->tilt_kp_per_rad, c->tilt_kd_per_rad_s, ref, &rel);
+  return track(c->tilt_kp_per_rad, c->tilt_kd_per_rad_s, ref, speed, s);
 }
 
 static bool in_range(const pour_experiment_t *e, int32_t theta) {

@@ -596,6 +596,8 @@ static void test_can_node_RefusedResetInRunChangesNothing(void) {
 
 /* An ExperimentStart through node and core as the port runs them: the core's answer becomes a ParamAck with
  * its reason, and an accepted experiment drives the run's torque (Action = its phase). */
+static pour_control_output_t experiment_out; /* the output of experiment_answer's tick */
+
 static pour_can_param_ack_t experiment_answer(uint8_t kind, bool estop) {
   const pour_can_experiment_start_t m = {.kind = kind};
   pour_can_frame_t f;
@@ -611,6 +613,7 @@ static pour_can_param_ack_t experiment_answer(uint8_t kind, bool estop) {
   in.estop = estop;
   pour_control_output_t out;
   pour_control_step(&ctl, &in, &out);
+  experiment_out = out;
   pour_can_frame_t ack;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_experiment_ack(&node, kind, pour_control_experiment_answer(&ctl), &ack));
   TEST_ASSERT_EQUAL_UINT16(pour_can_id(cfg.node_id, POUR_CAN_CMD_PARAM_ACK), ack.id);
@@ -621,11 +624,23 @@ static pour_can_param_ack_t experiment_answer(uint8_t kind, bool estop) {
   return a;
 }
 
+/* The Refused count of the heartbeat the port sends after the tick of out. */
+static uint8_t heartbeat_refused(const pour_control_output_t *out) {
+  pour_can_frame_t tx[2];
+  TEST_ASSERT_EQUAL_UINT8(2u, pour_can_node_status_frames(&node, out, 0u, tx));
+  pour_can_heartbeat_t hb;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[0], &hb));
+  return hb.refused;
+}
+
 static void test_can_node_ExperimentStart_AnsweredWithTheCoresReason(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_ESTOP, experiment_answer(POUR_EXPERIMENT_IDENTIFY, true).result);
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.refused);
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_FAULT, experiment_answer(POUR_EXPERIMENT_IDENTIFY, false).result);
+  TEST_ASSERT_EQUAL_UINT32(2u, ctl.refused);
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init(&ctl, &ccfg, &pour_weights_compiled));
   TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, experiment_answer(POUR_EXPERIMENT_IDENTIFY, false).result);
+  TEST_ASSERT_EQUAL_UINT32(0u, ctl.refused); /* an accepted start is no refusal */
   send_sample(1, 0);
   pour_control_input_t in;
   pour_can_node_begin_tick(&node, &in);
@@ -634,6 +649,9 @@ static void test_can_node_ExperimentStart_AnsweredWithTheCoresReason(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_EQUAL_UINT8(POUR_EXPERIMENT_PHASE_RAMP, out.action);
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_ACK_REFUSED_RUNNING, experiment_answer(POUR_EXPERIMENT_TILT, false).result);
+  /* Counted as the refused Stops, Resets and clears are: the heartbeat's Refused moves. */
+  TEST_ASSERT_EQUAL_UINT32(1u, ctl.refused);
+  TEST_ASSERT_EQUAL_UINT8(1u, heartbeat_refused(&experiment_out));
   /* Nothing asked, nothing to answer. */
   pour_can_frame_t ack;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_can_node_experiment_ack(&node, 1u, pour_control_experiment_answer(&ctl), &ack));

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """pour-bench's bad input on any kernel (the bus itself is tested in the user-mode Linux guest,
-tests/can/guest/test_bench.py): a bad command line is 2, a bus that cannot open or a command this firmware
-lacks is 1, each with a message that names the problem."""
+tests/can/guest/test_bench.py): a bad command line is 2, a bus that cannot open is 1, each with a message that
+names the problem."""
 from __future__ import annotations
 
 import subprocess
@@ -40,10 +40,11 @@ def test_a_bad_weights_file_is_status_2(tmp_path):
     assert r.returncode == 2 and "'reset' can move the axis: give the policy you expect" in r.stderr, r.stderr
 
 
-def test_calibrate_is_not_available_over_this_firmware():
-    r = bench("calibrate")
-    assert r.returncode == 1
-    assert "calibrate is not available over this firmware" in r.stderr
+def test_calibrate_moves_the_axis_so_it_needs_the_expected_policy():
+    r = bench("--iface", "nosuchcan0", "calibrate")
+    assert r.returncode == 2 and "'calibrate' can move the axis: give the policy you expect" in r.stderr, r.stderr
+    r = bench("--iface", "nosuchcan0", "--expect-hash", "1", "calibrate", "--seconds", "0")
+    assert r.returncode == 2 and "not a number of seconds" in r.stderr, r.stderr
 
 
 def test_a_bus_that_cannot_open_says_which():

@@ -33,6 +33,7 @@ def run(*argv: str) -> subprocess.CompletedProcess:
     ("can:vcan0,watchdog-ms=x", "watchdog-ms needs an integer in [1, 65535]"),
     ("can:vcan0,speed=1", "unknown key 'speed'"),
     ("can:vcan0,node", "'node' is not key=value"),
+    ("can:vcan0,drive=board", "drive can only be 'sim'"),
 ])
 def test_controller_rejects_bad_can_specs(spec, needle):
     r = run(exe("pour_controller"), "--io", spec)

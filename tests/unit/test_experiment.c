@@ -64,6 +64,12 @@ static void test_experiment_validate_RefusesBadConfig(void) {
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_control_init_external(&ctl, &config, 10u));
 }
 
+/* The identify phases in their order (the sweep, numbered after the ends, comes between chirp and back). */
+static int identify_order(uint8_t phase) {
+  return phase == POUR_EXPERIMENT_PHASE_SWEEP ? 2 * POUR_EXPERIMENT_PHASE_CHIRP + 1
+                                              : (phase <= POUR_EXPERIMENT_PHASE_BACK ? 2 * phase : 100);
+}
+
 static void test_experiment_identify_RunsItsPhasesInOrderAndEndsHeld(void) {
   pour_control_experiment(&ctl, POUR_EXPERIMENT_IDENTIFY);
   tick();
@@ -73,12 +79,16 @@ static void test_experiment_identify_RunsItsPhasesInOrderAndEndsHeld(void) {
   uint8_t last = out.action;
   int32_t theta_max = 0;
   bool moved_both_ways = false;
+  int64_t sweep_fastest = 0; /* [nrad/s] */
+  int64_t sweep_fastest_back = 0;
   int32_t torque_min = 0;
   int32_t torque_max = 0;
   for (uint32_t t = 1; t < duration; ++t) {
     TEST_ASSERT_EQUAL_UINT16(0u, out.faults);
     TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
-    TEST_ASSERT_TRUE(out.action >= last && out.action <= POUR_EXPERIMENT_PHASE_BACK); /* in order */
+    TEST_ASSERT_TRUE(identify_order(out.action) >= identify_order(last) && identify_order(out.action) < 100);
+    if (out.action == POUR_EXPERIMENT_PHASE_SWEEP && omega_nrad_s > sweep_fastest) sweep_fastest = omega_nrad_s;
+    if (out.action == POUR_EXPERIMENT_PHASE_SWEEP && -omega_nrad_s > sweep_fastest_back) sweep_fastest_back = -omega_nrad_s;
     last = out.action;
     if (out.torque < torque_min) torque_min = out.torque;
     if (out.torque > torque_max) torque_max = out.torque;
@@ -89,6 +99,9 @@ static void test_experiment_identify_RunsItsPhasesInOrderAndEndsHeld(void) {
   }
   TEST_ASSERT_EQUAL_UINT8(POUR_EXPERIMENT_PHASE_BACK, last);
   TEST_ASSERT_TRUE(moved_both_ways);
+  /* The sweep ran at its 1.5 rad/s both ways, within the envelope's 2 rad/s. */
+  TEST_ASSERT_TRUE(sweep_fastest > 1400000000 && sweep_fastest < 2000000000);
+  TEST_ASSERT_TRUE(sweep_fastest_back > 1400000000 && sweep_fastest_back < 2000000000);
   TEST_ASSERT_TRUE(torque_min < 0 && torque_max > 0);
   /* It stayed within its range about the hold angle, and came back to upright. */
   TEST_ASSERT_TRUE(theta_max > config.experiment.hold_theta_urad);

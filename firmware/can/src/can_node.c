@@ -242,6 +242,26 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
   return 2u;
 }
 
+bool pour_can_node_calibration_frame(pour_can_node_t *node, uint8_t mode, pour_can_frame_t *frame) {
+  pour_can_calibration_result_t r = node->calibration;
+  if (node->calibration_requested) {
+    node->calibration_requested = false;
+    if (mode == (uint8_t)POUR_MODE_RUN) {
+      r.status = POUR_CAN_CAL_REFUSED_RUNNING;
+    } else if (mode == (uint8_t)POUR_MODE_ESTOP) {
+      r.status = POUR_CAN_CAL_REFUSED_ESTOP;
+    } else if (node->config.can_calibrate) {
+      r.status = node->calibration_gate;
+      node->calibration_start = node->calibration_start || r.status == POUR_CAN_CAL_MEASURING;
+    }
+  } else if (node->calibration_report) {
+    node->calibration_report = false;
+  } else {
+    return false;
+  }
+  return pour_can_pack_calibration_result(node->config.node_id, &r, frame) == POUR_OK;
+}
+
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]) {
   (void)pour_can_node_watchdog(node, 1);
@@ -257,25 +277,8 @@ uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_
     node->ms_to_heartbeat = node->config.heartbeat_period_ms;
   }
   --node->ms_to_heartbeat;
-  if (node->calibration_requested) {
-    pour_can_calibration_result_t r = node->calibration;
-    if (out->mode == (uint8_t)POUR_MODE_RUN) {
-      r.status = POUR_CAN_CAL_REFUSED_RUNNING;
-    } else if (out->mode == (uint8_t)POUR_MODE_ESTOP) {
-      r.status = POUR_CAN_CAL_REFUSED_ESTOP;
-    } else if (node->config.can_calibrate) {
-      r.status = node->calibration_gate;
-      node->calibration_start = node->calibration_start || r.status == POUR_CAN_CAL_MEASURING;
-    }
-    if (pour_can_pack_calibration_result(node->config.node_id, &r, &tx[n]) == POUR_OK) {
-      ++n;
-    }
-    node->calibration_requested = false;
-  } else if (node->calibration_report) {
-    if (pour_can_pack_calibration_result(node->config.node_id, &node->calibration, &tx[n]) == POUR_OK) {
-      ++n;
-    }
-    node->calibration_report = false;
+  if (pour_can_node_calibration_frame(node, out->mode, &tx[n])) {
+    ++n;
   }
   return n;
 }

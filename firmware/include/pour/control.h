@@ -87,7 +87,7 @@ typedef struct {
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
   uint32_t tick;   /* ticks since init */
-  uint32_t refused; /* Stop, Reset and clear requests refused so far (they changed nothing else) */
+  uint32_t refused; /* Stop, Reset, clear and experiment requests refused so far (they changed nothing else) */
   bool brake;      /* engage the holding brake (IDLE, ESTOP, and FAULT once the stop is done) */
   bool power;      /* motor power stage enabled (RUN and an active stop only) */
 } pour_control_output_t;
@@ -113,7 +113,7 @@ typedef struct {
   uint32_t stop_ms;       /* ticks of the active stop so far */
   bool stopped;           /* the stop is over: brake and power cut until a clear */
   uint32_t refused;       /* Resets refused (RUN, ESTOP, the active stop), clears during the active stop, Stops
-                           * outside RUN */
+                           * outside RUN, experiments refused (pour_control_experiment_answer_t) */
   bool have_trusted;      /* a fresh, plausible sample was taken since init */
   int32_t trusted_theta_urad; /* the angle of the latest one: a restart of a held axis must find it again [µrad] */
   bool check_restart;     /* the next fresh sample is the first after a restart of a held axis */

@@ -14,7 +14,7 @@
 
 typedef enum {
   POUR_EXPERIMENT_NONE = 0,
-  POUR_EXPERIMENT_IDENTIFY = 1, /* bucket empty: torque steps, then a chirp, about a hold angle */
+  POUR_EXPERIMENT_IDENTIFY = 1, /* bucket empty: torque steps, a chirp, a sweep, about a hold angle */
   POUR_EXPERIMENT_TILT = 2      /* with water: a slow tilt to an angle and back */
 } pour_experiment_kind_t;
 #define POUR_EXPERIMENT_KIND_MAX 2u
@@ -30,7 +30,9 @@ typedef enum {
   POUR_EXPERIMENT_PHASE_DWELL = 6,  /* tilt: held at the top */
   POUR_EXPERIMENT_PHASE_RETURN = 7, /* tilt: back to the start angle */
   POUR_EXPERIMENT_PHASE_DONE = 8,   /* ended: the script ran to its end */
-  POUR_EXPERIMENT_PHASE_OUT_OF_RANGE = 9 /* ended: the angle left the range */
+  POUR_EXPERIMENT_PHASE_OUT_OF_RANGE = 9, /* ended: the angle left the range */
+  POUR_EXPERIMENT_PHASE_SWEEP = 10       /* identify, after the chirp: a triangle about the hold angle at a
+                                          * steady speed (viscous friction), then BACK */
 } pour_experiment_phase_t;
 
 /* Defaults: pour_experiment_default_config (docs/bench.md gives the reasons). Gains in torque Q15 (of

@@ -178,6 +178,13 @@ static void serve_experiment(socketcan_t *s, pour_control_t *ctl) {
  * start (a new node_id takes effect at the next start). */
 static void can_service(pour_io_t *io, pour_control_t *ctl) {
   socketcan_t *s = io->ctx;
+  if (s->config.drive_tick != NULL) {
+    (void)s->config.drive_tick(&s->node, s->out.mode);
+  }
+  pour_can_frame_t cal;
+  if (pour_can_node_calibration_frame(&s->node, s->out.mode, &cal)) {
+    (void)send_frame(s, &cal);
+  }
   serve_experiment(s, ctl);
   pour_can_param_request_t r;
   if (!pour_can_node_take_param_request(&s->node, &r)) {
@@ -246,7 +253,8 @@ static int parse_field(const char *what, const char *v, unsigned long max, unsig
 int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config) {
   char buf[128];
   if (spec == NULL || strlen(spec) >= sizeof buf) {
-    fprintf(stderr, "pour_controller: --io can: needs IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N][,params=FILE]\n");
+    fprintf(stderr, "pour_controller: --io can: needs IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N][,params=FILE]"
+            "[,drive=sim]\n");
     return -1;
   }
   strcpy(buf, spec);
@@ -288,8 +296,15 @@ int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config
         return -1;
       }
       strcpy(config->params_path, v);
+    } else if (strcmp(kv, "drive") == 0) {
+      if (strcmp(v, "sim") != 0) {
+        fprintf(stderr, "pour_controller: --io can: drive can only be 'sim' (host_sim's motor model), got '%s'\n", v);
+        return -1;
+      }
+      config->sim_drive = true;
     } else {
-      fprintf(stderr, "pour_controller: --io can: unknown key '%s' (node, heartbeat-ms, watchdog-ms, params)\n", kv);
+      fprintf(stderr, "pour_controller: --io can: unknown key '%s' (node, heartbeat-ms, watchdog-ms, params, drive)\n",
+              kv);
       return -1;
     }
   }
@@ -331,6 +346,9 @@ int pour_io_socketcan_open(pour_io_t *io, const pour_io_socketcan_config_t *conf
   nc.watchdog_ms = (uint16_t)(wd > UINT16_MAX ? UINT16_MAX : wd);
   if (pour_can_node_init(&s->node, &nc) != POUR_OK) {
     fprintf(stderr, "pour_controller: --io can: bad node configuration\n");
+    return -1;
+  }
+  if (config->drive_open != NULL && config->drive_open(&s->node) != 0) {
     return -1;
   }
   s->fd = socket(PF_CAN, SOCK_RAW, CAN_RAW);

@@ -6,6 +6,7 @@
 #ifndef POUR_LINUX_IO_SOCKETCAN_H
 #define POUR_LINUX_IO_SOCKETCAN_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "io.h"
@@ -18,9 +19,15 @@ typedef struct {
   uint32_t watchdog_grace_ms;    /* added to the watchdog (lockstep: the loop's stall time) [ms] */
   char params_path[256];         /* parameter file ("": parameters in memory only, save refused) */
   pour_params_t params;          /* the parameters at start (pour_io_socketcan_load_params) */
+  bool sim_drive;                /* drive=sim: the caller attaches a drive of the port's own below */
+  /* A drive of the port's own, or NULL (a CalibrationStart is then answered UNAVAILABLE): drive_open is
+   * called once the node exists (0, or -1: the transport does not open), drive_tick once a tick before the
+   * core's step with the mode of the latest step (sim_drive.h). */
+  int (*drive_open)(pour_can_node_t *node);
+  bool (*drive_tick)(pour_can_node_t *node, uint8_t mode);
 } pour_io_socketcan_config_t;
 
-/* Parses "IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N][,params=FILE]" onto *config (whose other fields
+/* Parses "IFACE[,node=N][,heartbeat-ms=N][,watchdog-ms=N][,params=FILE][,drive=sim]" onto *config (whose other fields
  * keep their values). Returns 0, or -1 with a message naming the bad part on stderr. */
 int pour_io_socketcan_parse(const char *spec, pour_io_socketcan_config_t *config);
 

@@ -11,6 +11,7 @@
 #include "controller.h"
 #include "io_lcm.h"
 #include "io_socketcan.h"
+#include "sim_drive.h"
 #include "pour/weights_compiled.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -98,6 +99,10 @@ static int open_io(const char *spec, pour_io_t *io, pour_linux_config_t *cfg) {
     can.watchdog_grace_ms = cfg->lockstep ? (uint32_t)cfg->stall_ms : 0u;
     if (pour_io_socketcan_parse(spec + 4, &can) != 0) {
       return -2;
+    }
+    if (can.sim_drive) {
+      can.drive_open = pour_sim_drive_open;
+      can.drive_tick = pour_sim_drive_tick;
     }
     return pour_io_socketcan_load_params(&can, &cfg->control, cfg->weights) == 0 ? pour_io_socketcan_open(io, &can) : -1;
   }

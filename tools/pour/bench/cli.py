@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: MIT
 """pour-bench: bring a pour controller up on a CAN bus (scan, info, faults, e-stop, parameters, logs).
 
-Commands that can make the axis move (clear, which resumes a run, reset, and identify, the controller's own
-identification experiment) say so, check the node's policy hash against --expect-hash or --weights first,
-and ask for confirmation unless --yes.
+Commands that can make the axis move (clear, which resumes a run, reset, identify, the controller's own
+identification experiment, and calibrate, the drive's) say so, check the node's policy hash against
+--expect-hash or --weights first, and ask for confirmation unless --yes.
 """
 from __future__ import annotations
 
@@ -22,7 +22,10 @@ EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a fa
           "hash may be 0x hex.")
 
 
-MOTION = ("clear", "reset", "identify")  # commands that can move the axis
+# Commands that can move the axis, and how.
+MOTION = {"clear": "a run resumes", "reset": "a new run starts once samples flow",
+          "identify": "the identification experiment moves the bucket",
+          "calibrate": "the drive's calibration releases the brake and turns the motor (up to 10 deg of output)"}
 
 
 class UsageError(Exception):
@@ -111,7 +114,10 @@ def parser() -> argparse.ArgumentParser:
                    help="identify: bucket EMPTY, steps and a chirp about 20 deg within -3..43 deg; tilt: with "
                         "water, to 90 deg at 0.1 rad/s and back (default %(default)s)")
     p.add_argument("--seconds", type=_seconds, default=60.0, help="give up after this long (default %(default)s)")
-    sub.add_parser("calibrate", help="drive calibration (not in this tool yet: docs/bringup.md)")
+    p = sub.add_parser("calibrate", help="the drive's self-calibration: R, L, pole pairs, encoder direction and "
+                                         "offset, stored by the node (MOVES the axis)")
+    p.add_argument("--seconds", type=_seconds, default=bn.CALIBRATION_S,
+                   help="wait this long for its outcome (default %(default)s)")
     return ap
 
 
@@ -137,7 +143,8 @@ def _confirm_motion(a: argparse.Namespace, n: bn.Node, want: int) -> None:
         return
     if not sys.stdin.isatty():
         raise bn.BenchError(f"'{a.cmd}' can move the axis: confirm with --yes (no terminal to ask on)")
-    answer = input(f"'{a.cmd}' can move the axis of node {n.id} (policy 0x{want:08x}). Type yes to go on: ")
+    answer = input(f"'{a.cmd}' can move the axis of node {n.id} ({MOTION[a.cmd]}; policy 0x{want:08x}). Type yes "
+                   f"to go on: ")
     if answer.strip() != "yes":
         raise bn.BenchError(f"'{a.cmd}' not confirmed")
 
@@ -173,10 +180,6 @@ def _plot(a: argparse.Namespace) -> int:
 
 
 def run(a: argparse.Namespace) -> int:
-    if a.cmd == "calibrate":
-        raise bn.BenchError("calibrate is not available over this firmware's bench tool yet: send CalibrationStart "
-                            "(can/pour.dbc, 0x05) and read the CalibrationResult frames (docs/bringup.md, "
-                            "'Calibration')")
     if a.cmd == "config" and a.config_cmd == "list":
         for pid, name in bn.param_names(bn.load_dbc()).items():
             print(f"{pid:3d} {name}")
@@ -235,6 +238,10 @@ def run(a: argparse.Namespace) -> int:
             _confirm_motion(a, n, want)
             count, ended = n.identify(a.output, a.kind, a.seconds)
             print(f"{a.output}: {count} frames; the {a.kind} experiment ended: {ended} (bucket held)")
+        elif a.cmd == "calibrate":
+            assert want is not None
+            _confirm_motion(a, n, want)
+            print(f"node {n.id}: calibrated: {n.calibrate(a.seconds, a.timeout).describe()}")
         elif a.cmd == "log":
             count = n.record(a.output, a.seconds)
             print(f"{a.output}: {count} frames in {a.seconds:g} s")

@@ -29,9 +29,28 @@ START_TRIES = 5  # identify: a Stop and a start that missed one tick are sent ag
 REST_S = 1.0  # identify: recorded after the end
 # pour/experiment.h's phases: Torque.Action while an experiment runs, and how it ended (8, 9) after it.
 EXPERIMENT_PHASES = {1: "ramp", 2: "steps", 3: "chirp", 4: "back", 5: "tilt", 6: "dwell", 7: "return", 8: "done",
-                     9: "out of range"}
+                     9: "out of range", 10: "sweep"}
 EXPERIMENT_ENDED = 8  # Action >= this outside RUN: the experiment is over
 HEARTBEAT_WAIT_S = 0.5  # five heartbeat periods of the default 100 ms
+CALIBRATION_S = 30.0  # calibrate: the outcome's wait (the board's sequence takes 3.1 s)
+# Why a CalibrationResult's Status is not OK (names as the DBC's value table gives them; a status this table
+# does not know is still shown by its DBC name).
+CALIBRATION_REASONS = {
+    "REFUSED_RUNNING": "the controller runs: stop it first",
+    "REFUSED_ESTOP": "the e-stop is asserted: release and clear it first",
+    "UNAVAILABLE": "this controller has no drive of its own to measure (pour_controller --io can:IFACE,drive=sim "
+                   "simulates one)",
+    "BAD_RESISTANCE": "the phase resistance is out of range or unequal on the two axes (an open phase?)",
+    "BAD_INDUCTANCE": "the phase inductance is out of range",
+    "NO_ENCODER": "the motor encoder did not count over an electrical turn (unplugged?)",
+    "BAD_POLE_PAIRS": "the counts of an electrical turn fit no pole-pair count 1..32",
+    "MOTION_RANGE": "the output moved beyond the sequence's range: stopped there",
+    "ABORTED": "a fault, the e-stop or a stop ended it, or a latched drive fault refused it",
+    "WRITE_FAILED": "measured, but the flash refused it: no valid calibration stored",
+    "REFUSED_NOT_UPRIGHT": "the output is not within 5 deg of upright: bring the bucket upright first",
+    "REFUSED_NOT_EMPTY": "the rotating scale reads more than 200 g beyond its tare: empty the bucket first",
+    "REFUSED_NO_SENSORS": "no sensor sample in the last 20 ms: start the rig's sensor node first",
+}
 TARE_ROTATING = 1
 TARE_TARGET = 2
 
@@ -63,6 +82,34 @@ class ParamRefused(BenchError):
         super().__init__(message)
         self.param = param
         self.result = result
+
+
+class CalibrationFailed(BenchError):
+    """A CalibrationStart refused, or a calibration that did not end OK; .result says what the node sent."""
+
+    def __init__(self, message: str, result: "Calibration") -> None:
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass
+class Calibration:
+    """A CalibrationResult: the request's status and the calibration stored in flash (read back by the node)."""
+    status: str
+    stored: str
+    resistance_ohm: float
+    inductance_mh: float
+    pole_pairs: int
+    encoder_reversed: bool
+    electrical_offset_deg: float
+
+    def describe(self) -> str:
+        if self.stored != "OK":
+            return f"stored calibration: {self.stored}"
+        direction = "reversed" if self.encoder_reversed else "normal"
+        return (f"resistance {self.resistance_ohm:.3f} Ohm, inductance {self.inductance_mh:.3f} mH, pole pairs "
+                f"{self.pole_pairs}, encoder direction {direction}, electrical offset "
+                f"{self.electrical_offset_deg:.1f} deg (stored {self.stored})")
 
 
 @dataclass
@@ -362,6 +409,40 @@ class Node:
     def zero(self, timeout: float = DEFAULT_TIMEOUT_S) -> None:
         self._request("Zero", 0, timeout)
 
+    # -- calibration ---------------------------------------------------------------------------------------
+    def _calibration(self, sig: dict) -> Calibration:
+        m = self.bench.message("CalibrationResult")
+
+        def name(signal: str) -> str:
+            return str(m.get_signal_by_name(signal).choices.get(sig[signal], sig[signal]))
+
+        def scaled(signal: str) -> float:
+            return float(sig[signal] * m.get_signal_by_name(signal).scale)
+
+        return Calibration(name("Status"), name("Stored"), scaled("Resistance"), scaled("Inductance"),
+                           int(sig["PolePairs"]), bool(sig["EncoderReversed"]), scaled("ElectricalOffset"))
+
+    def calibrate(self, seconds: float = CALIBRATION_S, timeout: float = DEFAULT_TIMEOUT_S) -> Calibration:
+        """Starts the drive's self-calibration (CalibrationStart) and follows it to its outcome: the stored
+        calibration when it ends OK. CalibrationFailed names a refusal (the first answer is not MEASURING) or why
+        the measurement stopped; NodeTimeout (with the node's last state) if no answer comes within timeout, or
+        no outcome within seconds."""
+        self.bench.send(self.id, "CalibrationStart")
+        _, sig = self.bench.wait_for(self.id, lambda n, s: n == "CalibrationResult", timeout, "CalibrationStart")
+        first = self._calibration(sig)
+        if first.status != "MEASURING":
+            raise CalibrationFailed(f"node {self.id} refused the calibration: {first.status} "
+                                    f"({CALIBRATION_REASONS.get(first.status, 'see can/pour.dbc')}); "
+                                    f"{first.describe()}", first)
+        _, sig = self.bench.wait_for(self.id, lambda n, s: n == "CalibrationResult", seconds,
+                                     "with the calibration's outcome")
+        done = self._calibration(sig)
+        if done.status != "OK":
+            raise CalibrationFailed(f"node {self.id}'s calibration failed: {done.status} "
+                                    f"({CALIBRATION_REASONS.get(done.status, 'see can/pour.dbc')}); "
+                                    f"{done.describe()}", done)
+        return done
+
     # -- identification ------------------------------------------------------------------------------------
     def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
         """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and
@@ -418,11 +499,13 @@ class Node:
                         break
             finally:
                 writer.stop()
+            last = self.state.describe() if self.state else f"node {self.id}: never heard on {self.bench.channel}"
             if not answered:
-                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart: no log written", self.state)
+                raise NodeTimeout(f"node {self.id} did not answer the ExperimentStart within {seconds:g} s ({last}): "
+                                  "no log written", self.state)
             if ended is None:
-                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s: no log "
-                                  "written", self.state)
+                raise NodeTimeout(f"node {self.id}'s {kind} experiment did not end within {seconds:g} s ({last}): no "
+                                  "log written", self.state)
         return n, ended
 
     # -- telemetry -----------------------------------------------------------------------------------------

@@ -31,8 +31,9 @@ SG_ORDER = 3
 LATENCY_MAX = 12     # [ticks] searched
 OMEGA_MIN = 0.05     # [rad/s] below it the axis may stick: left out
 DELAY_MAX = 400      # [ticks] of scale delay searched
-FIT_PHASES = (2, 3)  # steps and chirp: the excitation (pour/experiment.h)
+FIT_PHASES = (2, 3, 10)  # steps, chirp and sweep: the excitation (pour/experiment.h)
 REL_SIGMA_MAX = 0.25  # a parameter known worse than this is not identified by the log
+VISCOUS_SIGMA_MAX = 0.05  # viscous friction known worse than this (batch means) is not identified
 BATCHES = 8          # batch means for the reported uncertainties
 REST_TICKS_MIN = 250  # [ticks] at rest (the filter settled) for the scale's noise: ~20 conversions
 TRUST_SIGMA_MAX = 0.05
@@ -135,7 +136,7 @@ def fit_identify(run: Run, rig: dict) -> Fit:
     use = edge & win & np.isin(run.action, FIT_PHASES)
     if use.sum() < 200:
         raise LogError("cannot identify inertia, friction or torque scale: the bucket hardly moved "
-                       f"({int(use.sum())} usable ticks of steps and chirp): the experiment did not excite them")
+                       f"({int(use.sum())} usable ticks of steps, chirp and sweep): the experiment did not excite them")
     fit = Fit()
     md, j_bucket = bucket_arm_and_inertia(rig)
     g_known = md * G0
@@ -158,7 +159,13 @@ def fit_identify(run: Run, rig: dict) -> Fit:
         raise LogError("cannot identify " + ", ".join(weak) + ": the experiment did not excite "
                        + ("it" if len(weak) == 1 else "them") + " (relative uncertainty "
                        + ", ".join(f"{rel[names.index(w)]:.0%}" for w in weak) + ")")
-    viscous_fitted = rel[2] <= REL_SIGMA_MAX and coef[2] > 0
+    # J = G / (G/J); every other figure is J times its ratio.
+    def figures(c: np.ndarray) -> np.ndarray:
+        j = g_known / c[3]
+        return np.array([j * c[0], j * c[1], j * c[2], j])
+    # b: by the batch means (the conservative bound above is for the figures the fit cannot do without).
+    b_free, sb_free = figures(coef)[2], _batch_sigma(X, y, coef, figures, free=True)[2]
+    viscous_fitted = b_free > 0 and sb_free <= VISCOUS_SIGMA_MAX * b_free
     if not viscous_fitted:
         # At the experiment's speeds b θ̇ is a few % of F_c and the two look alike: b is the base rig's, and
         # F_c is what friction is left beyond it (rather than F_c taking b's share).
@@ -168,10 +175,6 @@ def fit_identify(run: Run, rig: dict) -> Fit:
         coef = np.array([sub[0], sub[1], b_ratio, sub[2]])
         cov = np.zeros((4, 4))
         cov[np.ix_(keep, keep)] = sub_cov
-    # J = G / (G/J); every other figure is J times its ratio.
-    def figures(c: np.ndarray) -> np.ndarray:
-        j = g_known / c[3]
-        return np.array([j * c[0], j * c[1], j * c[2], j])
     s, Fc, b, J = figures(coef)
     sigma = _batch_sigma(X, y, coef, figures, free=viscous_fitted)
     s_sigma, sFc, sb, sJ = sigma

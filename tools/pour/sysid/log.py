@@ -16,6 +16,7 @@ PHASES = bn.EXPERIMENT_PHASES
 PHASE_DONE = 8
 PHASE_OUT_OF_RANGE = 9
 MODE_RUN = 1
+MODE_FAULT = 2  # pour_mode_t, the DBC's Mode "FAULT"
 
 
 class LogError(ValueError):
@@ -118,6 +119,11 @@ def read(path: Path, node_id: int) -> Run:
     action = np.array([r[2]["Action"] for r in rows])
     mode = mode[running[0]:]
     end = int(action[-1])
+    if mode[-1] == MODE_FAULT:
+        k = int(np.flatnonzero(mode == MODE_FAULT)[0])
+        raise LogError(f"{path}: a fault ended the experiment at t = {t[k] - t[0]:.3f} s in phase "
+                       f"'{PHASES.get(int(action[k - 1]), int(action[k - 1]))}' (pour-bench faults names it; a "
+                       "bucket that does not move under torque latches Encoder): nothing fitted")
     if mode[-1] == MODE_RUN or end not in (PHASE_DONE, PHASE_OUT_OF_RANGE):
         raise LogError(f"{path}: truncated: it ends at t = {t[-1] - t[0]:.3f} s in phase "
                        f"'{PHASES.get(end, end)}', before the experiment ended")

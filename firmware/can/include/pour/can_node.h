@@ -122,6 +122,11 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
 
+/* The CalibrationResult end_tick sends, for a port that sends it itself (mode: the core's pour_mode_t of
+ * the tick): the answer to a CalibrationStart since the last call (its refusal, MEASURING, or the port's
+ * answer), else a reported outcome. Returns false if there is none. */
+bool pour_can_node_calibration_frame(pour_can_node_t *node, uint8_t mode, pour_can_frame_t *frame);
+
 /* Advances the command watchdog by elapsed_ms (end_tick does it by 1 each tick; a port without a tick of
  * its own, such as the Linux one, by wall-clock time). Returns whether it has tripped. */
 bool pour_can_node_watchdog(pour_can_node_t *node, uint32_t elapsed_ms);
