@@ -13,9 +13,13 @@ pour_control_config_t firmware_config(const poursim_config_t &sim) {
 }
 
 void CoreController::reset(uint32_t seed) {
+  seq_ = 0;
+  if (restart_by_reset_ && status_ == POUR_OK) {
+    restart_pending_ = true; // the core and its output carry on, as a linked controller's do
+    return;
+  }
   status_ = init(&ctl_, firmware_config(sim_), seed);
   out_ = pour_control_output_t{};
-  seq_ = 0;
 }
 
 double CoreController::command(const poursim_obs_t &obs) {
@@ -25,6 +29,10 @@ double CoreController::command(const poursim_obs_t &obs) {
   in.sensors = to_sensor_sample(obs, seq_++);
   in.drive_faults = static_cast<uint16_t>(obs.drive_faults); // the full drive's (drive = 1), as a board's reach its core
   in.drive_trusted = obs.drive_trusted != 0;
+  if (restart_pending_) { // what LcmLink::request_new_run and the CAN bridge ask for, taken in one tick
+    in.clear_faults = in.stop = in.reset = true;
+    restart_pending_ = false;
+  }
   if (pour_control_update(&ctl_, &in)) decide(&ctl_, *pour_control_state(&ctl_));
   pour_control_shape(&ctl_, &out_);
   return out_.torque / 32768.0;
@@ -137,8 +145,10 @@ pour_sensors_t to_sensor_sample(const poursim_obs_t &obs, uint32_t seq) {
 }
 
 std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &w, bool sampled,
-                                                     const poursim_config_t &config) {
-  return std::make_unique<FirmwareController>(w, sampled, config);
+                                                     const poursim_config_t &config, bool restart_by_reset) {
+  auto ctl = std::make_unique<FirmwareController>(w, sampled, config);
+  ctl->restart_by_reset(restart_by_reset);
+  return ctl;
 }
 std::unique_ptr<Controller> make_rate_controller(double rate, const poursim_config_t &c) {
   return std::make_unique<RateController>(rate, c);

@@ -57,6 +57,9 @@ class CoreController : public Controller {
   bool brake() const override { return status_ == POUR_OK && out_.brake; }
   uint16_t faults() const override { return out_.faults; }
   const pour_control_output_t &output() const { return out_; }
+  // On (after the first episode): reset() restarts the same core by ClearErrors, Stop and Reset in the next
+  // tick instead of initialising a fresh one, as a linked pour_controller is restarted between episodes.
+  void restart_by_reset(bool on) { restart_by_reset_ = on; }
 
  protected:
   explicit CoreController(const poursim_config_t &sim) : sim_(sim) {}
@@ -71,12 +74,13 @@ class CoreController : public Controller {
   pour_control_output_t out_{};
   pour_status_t status_ = POUR_EINVAL;
   uint32_t seq_ = 0;
+  bool restart_by_reset_ = false, restart_pending_ = false;
 };
 
 // The firmware core (pour_control_step) with a weights.h loaded at run time, fed the rig's sensor sample
 // as it would cross the wire; its encoder resolution is the simulator's.
 std::unique_ptr<Controller> make_firmware_controller(const poursim_weights_file_t &weights, bool sampled,
-                                                     const poursim_config_t &config);
+                                                     const poursim_config_t &config, bool restart_by_reset);
 
 // Baselines, each a request from outside into the firmware's pipeline (default config): they see the rig
 // through its estimator and command through its envelope, supervisor and controlled stop.

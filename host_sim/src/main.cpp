@@ -59,6 +59,9 @@ const char *kUsage =
     "  --config FILE       simulator config, 'key = value' lines (configs/sim/default.cfg)\n"
     "  --set KEY=VALUE     override one config value (repeatable)\n"
     "  --sampled           sample the policy's actions (seeded) instead of greedy argmax\n"
+    "  --core-reset        one firmware core for every episode, restarted between them by ClearErrors, Stop\n"
+    "                      and Reset in the next episode's first tick, as --lcm and the CAN bridge restart\n"
+    "                      pour_controller (default: a fresh core each episode, as at power-on)\n"
     "  --rate R            rate of the 'rate' baseline [rad/s]\n"
     "  --json              print the summary as one JSON object (per-episode lines go to stderr)\n"
     "  --csv FILE          write every step of every episode as CSV\n"
@@ -101,7 +104,7 @@ constexpr int kFrameEverySteps = 80; // 12.5 frames/s at 1 ms: smooth enough, an
 struct Options {
   std::string policy, baseline, config_path, csv, render, experiment, candump;
   int node_id = 0;
-  bool bench = false, sampled = false, json = false, quiet = false;
+  bool bench = false, sampled = false, core_reset = false, json = false, quiet = false;
   int episodes = 1;
   long long seed = -1;
   double rate = 1.5;
@@ -180,7 +183,7 @@ std::string key_hint(const std::string &key) {
 
 enum {
   kOptPolicy = 256, kOptBaseline, kOptConfig, kOptCsv, kOptRender, kOptEpisodes, kOptSeed, kOptSet, kOptRate,
-  kOptLcm, kOptRealtime, kOptLcmTimeout, kOptBench, kOptSampled, kOptJson, kOptQuiet, kOptListConfig, kOptVersion,
+  kOptLcm, kOptRealtime, kOptLcmTimeout, kOptBench, kOptSampled, kOptCoreReset, kOptJson, kOptQuiet, kOptListConfig, kOptVersion,
   kOptExperiment, kOptCandump, kOptNodeId
 };
 
@@ -202,6 +205,7 @@ const option kOptions[] = {
     {"lcm-timeout-ms", required_argument, nullptr, kOptLcmTimeout},
     {"bench", no_argument, nullptr, kOptBench},
     {"sampled", no_argument, nullptr, kOptSampled},
+    {"core-reset", no_argument, nullptr, kOptCoreReset},
     {"json", no_argument, nullptr, kOptJson},
     {"quiet", no_argument, nullptr, kOptQuiet},
     {"experiment", required_argument, nullptr, kOptExperiment},
@@ -266,6 +270,7 @@ int parse_args(int argc, char **argv, Options &o) {
       break;
     case kOptBench: o.bench = true; break;
     case kOptSampled: o.sampled = true; break;
+    case kOptCoreReset: o.core_reset = true; break;
     case kOptJson: o.json = true; break;
     case kOptQuiet: o.quiet = true; break;
     case kOptExperiment:
@@ -294,6 +299,8 @@ int parse_args(int argc, char **argv, Options &o) {
     return usage_error("%s", "--experiment runs the controller in-process, with no policy: no --lcm, no --policy");
   if (o.lcm && (o.bench || !o.baseline.empty())) return usage_error("%s", "--lcm goes with --policy FILE or alone");
   if (o.realtime && !o.lcm) return usage_error("%s", "--realtime needs --lcm");
+  if (o.core_reset && (o.lcm || o.policy.empty()))
+    return usage_error("%s", "--core-reset goes with --policy FILE and no --lcm (the linked controller restarts so)");
   if (o.lcm && modes == 0) modes = 1;
   if (modes != 1)
     return usage_error("%s", "choose exactly one of --policy FILE, --baseline NAME, --bench, --experiment KIND");
@@ -435,7 +442,7 @@ int main(int argc, char **argv) {
     }
     lcm_ctl = lc.get();
     ctl = std::move(lc);
-  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled, cfg);
+  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled, cfg, o.core_reset);
   else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, cfg);
   else if (o.baseline == "full") ctl = poursim::make_full_torque_controller(cfg);
   else ctl = poursim::make_hand_controller(cfg);
