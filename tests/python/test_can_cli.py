@@ -34,6 +34,7 @@ def run(*argv: str) -> subprocess.CompletedProcess:
     ("can:vcan0,speed=1", "unknown key 'speed'"),
     ("can:vcan0,node", "'node' is not key=value"),
     ("can:vcan0,drive=board", "drive can only be 'sim'"),
+    ("can:vcan0,drive=sim", "run pour_controller_sim"),  # the simulated drive is the twin's, not this build's
 ])
 def test_controller_rejects_bad_can_specs(spec, needle):
     r = run(exe("pour_controller"), "--io", spec)

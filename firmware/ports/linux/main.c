@@ -11,7 +11,9 @@
 #include "controller.h"
 #include "io_lcm.h"
 #include "io_socketcan.h"
+#ifdef POUR_SIM_DRIVE
 #include "sim_drive.h"
+#endif
 #include "pour/weights_compiled.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -101,8 +103,14 @@ static int open_io(const char *spec, pour_io_t *io, pour_linux_config_t *cfg) {
       return -2;
     }
     if (can.sim_drive) {
+#ifdef POUR_SIM_DRIVE
       can.drive_open = pour_sim_drive_open;
       can.drive_tick = pour_sim_drive_tick;
+#else
+      fprintf(stderr, "pour_controller: drive=sim needs the simulated drive, which this build leaves out: run "
+                      "pour_controller_sim (the same controller with host_sim's motor model linked in)\n");
+      return -2;
+#endif
     }
     return pour_io_socketcan_load_params(&can, &cfg->control, cfg->weights) == 0 ? pour_io_socketcan_open(io, &can) : -1;
   }

@@ -34,7 +34,7 @@ extern "C" int pour_sim_drive_open(pour_can_node_t *node) {
   c.drive = 1;
   g_sim.foc.reset(c, 1u);
   if (!g_sim.foc.running()) {
-    std::fprintf(stderr, "pour_controller: drive=sim: the simulated drive did not start (faults 0x%04x)\n",
+    std::fprintf(stderr, "pour_controller_sim: drive=sim: the simulated drive did not start (faults 0x%04x)\n",
                  static_cast<unsigned>(g_sim.foc.drive().faults));
     return -1;
   }

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* A drive of the controller's own for a bench without a board (pour_controller --io can:IFACE,drive=sim): the
+/* A drive of the controller's own for a bench without a board (pour_controller_sim --io can:IFACE,drive=sim): the
  * firmware's drive (pour::motor) and the board's calibration flow (calibration_flow.c, its block stored by
  * calibration_store.c in a flash page held in memory) run against host_sim's motor model, the default motor
  * with the empty bucket on its bearing. It serves CalibrationStart only: the torque the core commands still

@@ -118,10 +118,10 @@ class Bus:
 
 
 class Controller:
-    """pour_controller --io can:vcan0,... as a child process."""
+    """pour_controller --io can:vcan0,... as a child process (program: pour_controller_sim for drive=sim)."""
 
-    def __init__(self, *args: str, io: str = f"can:{IFACE},heartbeat-ms=10") -> None:
-        exe = BUILD_DIR / "bin" / "pour_controller"
+    def __init__(self, *args: str, io: str = f"can:{IFACE},heartbeat-ms=10", program: str = "pour_controller") -> None:
+        exe = BUILD_DIR / "bin" / program
         if not exe.exists():
             raise FileNotFoundError(f"{exe} not built")
         self.proc = subprocess.Popen([str(exe), "--io", io, *args], stdout=subprocess.PIPE,

@@ -230,13 +230,13 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
 
 
 def test_calibrate_with_the_simulated_drive(tmp_path):
-    """pour-bench calibrate against pour_controller --io can:vcan0,drive=sim (the firmware's drive and the
+    """pour-bench calibrate against pour_controller_sim --io can:vcan0,drive=sim (the firmware's drive and the
     board's calibration flow on host_sim's motor model): refused for another policy, then measured and
     stored, the stored values read back in the result; refused by name with the e-stop asserted, the stored
     block shown; a node that stops answering mid-way times out with its last state; a controller without a
     drive refuses by name."""
     policy = f"0x{weights_h.parse_weights_h(WEIGHTS).content_hash:08x}"
-    ctl = Controller(io="can:vcan0,heartbeat-ms=10,drive=sim")
+    ctl = Controller(io="can:vcan0,heartbeat-ms=10,drive=sim", program="pour_controller_sim")
     try:
         assert "runs policy" in refused("--expect-hash", "0x1", "--yes", "calibrate")
         r = bench("--expect-hash", policy, "--yes", "calibrate", "--seconds", "120", timeout=180)

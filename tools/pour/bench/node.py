@@ -38,8 +38,8 @@ CALIBRATION_S = 30.0  # calibrate: the outcome's wait (the board's sequence take
 CALIBRATION_REASONS = {
     "REFUSED_RUNNING": "the controller runs: stop it first",
     "REFUSED_ESTOP": "the e-stop is asserted: release and clear it first",
-    "UNAVAILABLE": "this controller has no drive of its own to measure (pour_controller --io can:IFACE,drive=sim "
-                   "simulates one)",
+    "UNAVAILABLE": "this controller has no drive of its own to measure (pour_controller_sim --io "
+                   "can:IFACE,drive=sim simulates one)",
     "BAD_RESISTANCE": "the phase resistance is out of range or unequal on the two axes (an open phase?)",
     "BAD_INDUCTANCE": "the phase inductance is out of range",
     "NO_ENCODER": "the motor encoder did not count over an electrical turn (unplugged?)",
