@@ -131,7 +131,7 @@ ALLOWED: dict[str, set[str]] = {
     "lcm": {"eval", "sim"},
     "can": set(),
     "bench": {"can", "policy"},
-    "examples": {"sim", "policy"},
+    "examples": {"train", "sim", "policy"},
     "sysid": {"bench", "sim"},
 }
 

@@ -30,8 +30,9 @@ tests/python/test_imports.py checks it:
     pour.can       -
     pour.bench     can, policy
     pour.sysid     bench, sim
-    pour.examples  sim, policy
+    pour.examples  train, sim, policy
 
 So the simulator never reaches the trainer, and nothing but the evaluation (a sweep trains its trials;
-results and robust_scale read training runs and use the trainer's Ray executors) imports pour.train.
+results and robust_scale read training runs and use the trainer's Ray executors) and the examples (sb3_ppo
+--like reads a training config and validates as the trainer does) imports pour.train.
 """
