@@ -71,6 +71,7 @@ static void test_clock_setup_StaysOnHsi16WhenThePllDoesNotLock(void) {
   TEST_ASSERT_EQUAL_UINT32(16000000u, hz);
   TEST_ASSERT_EQUAL_INT(POUR_CLOCK_HSI16, source);
   TEST_ASSERT_EQUAL_UINT32(1u, POUR_GET(RCC, CFGR, SW, rcc[POUR_RCC_CFGR])); /* HSI16, never the PLL */
+  TEST_ASSERT_EQUAL_UINT32(0u, crystal); /* the PLL does not run from it */
   TEST_ASSERT_EQUAL_UINT32(0u, POUR_GET(RCC, CFGR, HPRE, rcc[POUR_RCC_CFGR])); /* AHB /1 again */
 }
 

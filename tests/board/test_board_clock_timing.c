@@ -138,11 +138,23 @@ static void test_clock_timing_RefusesA25MHzCrystal(void) {
   TEST_ASSERT_BITS_LOW(POUR_MSK(RCC, CR, HSEON) | POUR_MSK(RCC, CR, CSSON), rcc[POUR_RCC_CR]);
 }
 
+/* The crystal timed, but the PLL never locks: the core stays on HSI16, and no crystal is reported in use. */
+static void test_clock_timing_APllThatDoesNotLockReportsNoCrystal(void) {
+  rcc[POUR_RCC_CR] = POUR_MSK(RCC, CR, HSERDY);
+  start_chip(240u);
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_clock_setup(&hw, &config, &hz, &source, &crystal));
+  TEST_ASSERT_EQUAL_UINT32(16000000u, hz);
+  TEST_ASSERT_EQUAL_INT(POUR_CLOCK_HSI16, source);
+  TEST_ASSERT_EQUAL_UINT32(0u, crystal);
+  TEST_ASSERT_EQUAL_UINT32(3u, POUR_GET(RCC, PLLCFGR, PLLSRC, rcc[POUR_RCC_PLLCFGR])); /* it was the crystal's */
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_clock_timing_Finds24MHz);
   RUN_TEST(test_clock_timing_Finds8MHz);
   RUN_TEST(test_clock_timing_ToleratesHsi16sError);
   RUN_TEST(test_clock_timing_RefusesA25MHzCrystal);
+  RUN_TEST(test_clock_timing_APllThatDoesNotLockReportsNoCrystal);
   return UNITY_END();
 }

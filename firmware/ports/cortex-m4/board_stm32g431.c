@@ -77,11 +77,7 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
                               (volatile uint32_t *)(uintptr_t)POUR_SYSTICK_BASE};
   const pour_clock_config_t config = pour_clock_default_config();
   pour_clock_source_t source;
-  const pour_status_t status = pour_clock_setup(&hw, &config, core_clock_hz, &source, &crystal_hz);
-  if (source != POUR_CLOCK_HSE) {
-    crystal_hz = 0u;
-  }
-  return status;
+  return pour_clock_setup(&hw, &config, core_clock_hz, &source, &crystal_hz);
 }
 
 uint32_t pour_clock_crystal(void) { return crystal_hz; }

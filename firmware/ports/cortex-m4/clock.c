@@ -106,6 +106,14 @@ static uint32_t time_crystal(const pour_clock_hw_t *hw, uint32_t polls) {
   return hz;
 }
 
+/* The PLL never came: the core stays on HSI16 at AHB /1, and says so (no crystal in use). */
+static pour_status_t stay_on_hsi16(volatile uint32_t *rcc, pour_clock_source_t *source, uint32_t *crystal_hz) {
+  rcc[POUR_RCC_CFGR] &= ~POUR_MSK(RCC, CFGR, HPRE);
+  *source = POUR_CLOCK_HSI16;
+  *crystal_hz = 0u;
+  return POUR_EINVAL;
+}
+
 static void pll_from(volatile uint32_t *rcc, uint32_t src, uint32_t in_hz) {
   rcc[POUR_RCC_PLLCFGR] = POUR_VAL(RCC, PLLCFGR, PLLSRC, src) | POUR_VAL(RCC, PLLCFGR, PLLM, in_hz / PLL_IN_HZ - 1u) |
                           POUR_VAL(RCC, PLLCFGR, PLLN, PLL_N) | POUR_MSK(RCC, PLLCFGR, PLLREN) |
@@ -155,14 +163,10 @@ pour_status_t pour_clock_setup(const pour_clock_hw_t *hw, const pour_clock_confi
   rcc[POUR_RCC_CR] |= POUR_MSK(RCC, CR, PLLON);
   const uint32_t pllrdy = POUR_MSK(RCC, CR, PLLRDY);
   if (pour_regs_wait(&rcc[POUR_RCC_CR], pllrdy, pllrdy, polls) != 0) {
-    rcc[POUR_RCC_CFGR] &= ~hpre;
-    *source = POUR_CLOCK_HSI16;
-    return POUR_EINVAL;
+    return stay_on_hsi16(rcc, source, crystal_hz);
   }
   if (switch_to(rcc, SW_PLL, polls) != 0) {
-    rcc[POUR_RCC_CFGR] &= ~hpre;
-    *source = POUR_CLOCK_HSI16;
-    return POUR_EINVAL;
+    return stay_on_hsi16(rcc, source, crystal_hz);
   }
   for (volatile uint32_t i = 0; i < 200u; ++i) { /* >= 1 µs at 85 MHz before HPRE /1 (RM0440 §6.2.7) */
   }

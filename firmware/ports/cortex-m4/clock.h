@@ -36,8 +36,9 @@ uint32_t pour_clock_crystal_hz(uint32_t measured_hz);
 
 /* PLL to 170 MHz from the crystal, HSI16 if the crystal is not ready in time or times at no usable
  * frequency; *core_clock_hz gets the clock the core runs at [Hz] (also APB1, FDCAN's kernel clock), *source
- * where it came from, *crystal_hz the crystal timed at boot (0: none). POUR_EINVAL for a bad config or a
- * PLL that does not lock (the core then stays on HSI16 at 16 MHz, as *core_clock_hz says). */
+ * where it came from, *crystal_hz the crystal the PLL runs from (0: none, the core is on HSI16). POUR_EINVAL
+ * for a bad config or a PLL that does not lock (the core then stays on HSI16 at 16 MHz, as *core_clock_hz
+ * says). */
 pour_status_t pour_clock_setup(const pour_clock_hw_t *hw, const pour_clock_config_t *config, uint32_t *core_clock_hz,
                                pour_clock_source_t *source, uint32_t *crystal_hz);
 
