@@ -136,3 +136,28 @@ def test_plot_bad_input(tmp_path, make, argv, status, needle):
     r = bench("plot", *(["--replay", str(log)] if make else []), "--fast", *argv)
     assert r.returncode == status, (r.stdout, r.stderr)
     assert needle in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("fw, refused", [(None, False), (-1, True)])
+def test_a_node_of_another_protocol_is_refused_before_motion(fw, refused):
+    """check_protocol (which every motion command runs first) against a node on a python-can virtual bus
+    whose Identity reports this DBC's protocol (None) or the one before it (-1)."""
+    import can
+
+    from pour.bench import node as bn
+    channel = f"proto{fw}"
+    with bn.Bench(bus=can.Bus(interface="virtual", channel=channel)) as b, \
+            can.Bus(interface="virtual", channel=channel) as peer:
+        version = b.protocol + (fw or 0)
+        for name, sig in (("Identity", dict(WeightsHash=0x1234, TauMax=2000, FwVersion=version, InitStatus=0)),
+                          ("Heartbeat", dict(Mode=0, Faults=0, RxDropped=0, Overruns=0, Counter=1, Refused=0))):
+            m = b.db.get_message_by_name(name)
+            sig = {s.name: sig.get(s.name, 0) for s in m.signals}
+            peer.send(can.Message(arbitration_id=m.frame_id, data=m.encode(sig, scaling=False), is_extended_id=False))
+        n = b.node(0)
+        if refused:
+            with pytest.raises(bn.BenchError, match=f"node 0 runs firmware {version}, but this DBC is protocol "
+                                                    f"{b.protocol}"):
+                n.check_protocol(timeout=1.0)
+        else:
+            assert n.check_protocol(timeout=1.0).identity.fw_version == b.protocol

@@ -386,3 +386,16 @@ def test_the_heartbeat_carries_one_signal_per_fault_the_core_names(db):
     signals = {s.name: 1 << (s.start - 8) for s in hb.signals if s.name.startswith("Fault_")}
     assert signals == FAULT_BITS
     assert sorted(signals.values()) == [1 << i for i in range(16) if libpoursim.fault_name(1 << i) is not None]
+
+
+def test_the_dbc_protocol_is_the_firmware_version():
+    """Identity's FwVersion is the DBC's protocol number, so a tool can tell that it holds the node's DBC."""
+    control_h = (SOURCE_DIR / "firmware/include/pour/control.h").read_text()
+    fw = int(re.search(r"#define POUR_FIRMWARE_VERSION (\d+)u", control_h).group(1))
+    assert dbc.protocol_version(cantools.database.load_file(str(dbc.default_dbc())).version) == fw
+
+
+@pytest.mark.parametrize("version", [None, "", "pour CAN protocol", "pour CAN protocol 6b", "other 6"])
+def test_a_dbc_version_that_names_no_protocol_is_refused(version):
+    with pytest.raises(ValueError, match="is not 'pour CAN protocol N'"):
+        dbc.protocol_version(version)

@@ -19,8 +19,11 @@
 /* Version of the firmware as the bus reports it (Identity.FwVersion): +1 with any change in behaviour a
  * host or a bench engineer must know of. 2: supervisor, controlled stop, explicit stop/reset, identity.
  * 3: raw sensor samples in (the estimator), the motion envelope (speed governor, acceleration ramp).
- * 4: parameters and calibration over CAN, the transitions of docs/safety.md (torque continuity, refusals). */
-#define POUR_FIRMWARE_VERSION 5u
+ * 4: parameters and calibration over CAN, the transitions of docs/safety.md (torque continuity, refusals).
+ * 5: the drive (DRIVE fault, DriveTelemetry, calibration results), ExperimentStart.
+ * 6: CalibrationResult's 5-bit Status (the interlock's refusals) and Stored in bits 5..7; the Crystal signal.
+ * It is the DBC's protocol number (VERSION "pour CAN protocol N"), which test_can_dbc pins. */
+#define POUR_FIRMWARE_VERSION 6u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {

@@ -134,7 +134,7 @@ def _expected_hash(a: argparse.Namespace) -> int:
 
 
 def _confirm_motion(a: argparse.Namespace, n: bn.Node, want: int) -> None:
-    st = n.info(a.timeout)
+    st = n.check_protocol(a.timeout)
     assert st.identity is not None
     if st.identity.weights_hash != want:
         raise bn.BenchError(f"node {n.id} runs policy 0x{st.identity.weights_hash:08x}, not the expected "
@@ -202,6 +202,9 @@ def run(a: argparse.Namespace) -> int:
             i = st.identity
             print(f"node {st.node_id}: policy 0x{i.weights_hash:08x}, tau_max {i.tau_max_nm:.2f} N.m, firmware "
                   f"{i.fw_version}, init status {i.init_status}")
+            if i.fw_version != bench.protocol:
+                print(f"pour-bench: warning: firmware {i.fw_version} and this DBC (protocol {bench.protocol}) "
+                      f"differ: some frames may be misread", file=sys.stderr)
             _print_state(st)
         elif a.cmd == "faults":
             _print_state(n.info(a.timeout))

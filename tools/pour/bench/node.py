@@ -185,6 +185,10 @@ class Bench:
     def __init__(self, channel: str = "vcan0", interface: str = "socketcan", bus: can.BusABC | None = None,
                  dbc_path: Path | None = None) -> None:
         self.db = load_dbc(dbc_path)
+        try:
+            self.protocol = dbc.protocol_version(self.db.version)
+        except ValueError as e:
+            raise BenchError(str(e)) from e
         self.channel = channel
         try:
             self.bus = bus if bus is not None else can.Bus(interface=interface, channel=channel)
@@ -313,6 +317,16 @@ class Node:
             self.bench.wait_for(self.id, lambda n, s: n == "Identity", timeout, "with its identity")
         assert self.state is not None
         return self.state
+
+    def check_protocol(self, timeout: float = DEFAULT_TIMEOUT_S) -> NodeState:
+        """info(), and BenchError unless the node speaks the DBC's protocol: frames whose layout changed
+        between versions (CalibrationResult's Stored, in 6) would be misread."""
+        st = self.info(timeout)
+        assert st.identity is not None
+        if st.identity.fw_version != self.bench.protocol:
+            raise BenchError(f"node {self.id} runs firmware {st.identity.fw_version}, but this DBC is protocol "
+                             f"{self.bench.protocol}: use the DBC of that firmware")
+        return st
 
     # -- commands (no answer of their own: the next heartbeat shows their effect) ---------------------------
     def estop(self, asserted: bool = True) -> None:

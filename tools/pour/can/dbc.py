@@ -24,6 +24,15 @@ def default_dbc() -> Path:
     return paths.data_file("pour.dbc")
 
 
+def protocol_version(db_version: str | None) -> int:
+    """The protocol number of a DBC's VERSION string ("pour CAN protocol N"), which a node reports as
+    Identity's FwVersion; ValueError for any other string."""
+    m = re.fullmatch(r"pour CAN protocol (\d+)", db_version or "")
+    if m is None:
+        raise ValueError(f"DBC VERSION {db_version!r} is not 'pour CAN protocol N'")
+    return int(m.group(1))
+
+
 def can_id(node_id: int, cmd: int) -> int:
     """Frame id of cmd for node_id."""
     check_node_id(node_id)
