@@ -21,6 +21,7 @@
 
 #include "board_drive.h"
 #include "clock.h"
+#include "drive_without_cut.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
@@ -132,13 +133,6 @@ void pour_hal_drive_set_compares(const uint16_t compare[3]) {
 }
 void pour_hal_drive_enable(bool on) { gates_on = on; }
 void pour_hal_drive_short_low_sides(void) { gates_on = false; }
-pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
-  (void)offset_counts;
-  return POUR_OK;
-}
-bool pour_hal_drive_overcurrent_tripped(void) { return false; }
-void pour_hal_drive_clear_overcurrent(void) {}
-void pour_hal_drive_mask(bool masked) { (void)masked; }
 
 /* The PWM periods of one tick: the interrupt as the ADC's end of sequence would raise it. */
 static void run_periods(void) {
