@@ -84,8 +84,8 @@ bench_core() {
         drive_flash=$((drive_flash + t + d)); drive_ram=$((drive_ram + d + b)) ;;
     esac
   done
-  # On the linked image: under LTO the objects' symbols are the compiler's, the image's are what runs.
-  softfloat=$(arm-none-eabi-nm "$port/pour_firmware.elf" | grep -cE ' __aeabi_(f|d|[ui]2[fd]|[fd]2)|__(add|sub|mul|div)[sd]f3' || true)
+  # The linked image's symbol table: what runs (the build's check reads the same, check_no_float.cmake).
+  softfloat=$(arm-none-eabi-readelf -sW "$port/pour_firmware.elf" | grep -cE ' __aeabi_(f|d|[ui]2[fd]|[fd]2)|__(add|sub|mul|div)[sd]f3' || true)
 
   echo "-- against the bars:"
   verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
@@ -100,7 +100,7 @@ bench_core() {
   printf '   STM32G431 image: %d B flash (bar 32768: %s), %d B static RAM (bar 8192: %s); with every motor driver and the protection linked at most %d B flash, %d B static RAM\n' \
     "$image_flash" "$(verdict "$image_flash" 32768)" "$image_ram" "$(verdict "$image_ram" 8192)" \
     $((image_flash + drive_flash)) $((image_ram + drive_ram))
-  printf '   soft-float helpers in the image (arm-none-eabi-nm): %d (bar 0)\n' "$softfloat"
+  printf '   soft-float helpers in the image (arm-none-eabi-readelf -s): %d (bar 0)\n' "$softfloat"
 }
 
 # --- section: motor — the drive's current loop on the emulated Cortex-M4, and the full drive in the simulator
