@@ -31,9 +31,14 @@
 static pour_control_t controller;
 static pour_can_node_t can_node;
 
+/* main's three phases each get a frame of their own, popped (or never pushed) when another runs: the
+ * start-up's configurations, the report's frames and the loop's locals would otherwise all sit in one frame,
+ * inlined into the reset handler's, under the deepest chain of each. */
+#define PHASE static __attribute__((noinline))
+
 /* A controller that cannot run says why, forever: brake engaged, power off, heartbeat and identity frames
  * with the start-up status (Identity.InitStatus), and no motion whatever arrives. */
-static void report_forever(void) {
+PHASE void report_forever(void) {
   pour_control_output_t out = {0};
   out.mode = (uint8_t)POUR_MODE_IDLE;
   out.brake = true;
@@ -53,7 +58,25 @@ static void report_forever(void) {
   }
 }
 
-int main(void) {
+/* The controller and the drive from their default configurations, which their instances copy: each
+ * configuration lives only in its own function's scope, so the two are never on the stack together. */
+static pour_status_t controller_init(void) {
+  const pour_control_config_t config = pour_control_default_config();
+  return pour_control_init(&controller, &config, &pour_weights_compiled);
+}
+
+static pour_status_t drive_init(void) {
+  /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
+  const bool calibrated = pour_hal_calibration_load() == POUR_OK;
+  const pour_drive_config_t drive = pour_drive_default_config();
+  const pour_status_t status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, calibrated);
+  return status == POUR_OK && !calibrated ? POUR_ECALIBRATION : status; /* what Identity says until then */
+}
+
+/* The start-up: the board at safe levels, the clock, the watchdog, the controller, the drive and the node.
+ * Returns false when the node or the bus cannot start; *status is what Identity says. The drive's interrupt
+ * is enabled inside (pour_board_drive_init, last), so the stack of this chain counts with the interrupt's. */
+PHASE bool start_up(pour_status_t *status_out) {
   /* Safe levels first: the brake engaged and the power off until the core says otherwise. */
   pour_hal_brake_init();
   pour_hal_power_init();
@@ -64,20 +87,14 @@ int main(void) {
   pour_hal_watchdog_start(WATCHDOG_TIMEOUT_MS);
   pour_hal_timer_init(clock_hz);
 
-  const pour_control_config_t config = pour_control_default_config();
-  pour_status_t status = pour_control_init(&controller, &config, &pour_weights_compiled);
+  pour_status_t status = controller_init();
   if (status == POUR_OK) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
   }
   if (status == POUR_OK) {
-    /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
-    const bool calibrated = pour_hal_calibration_load() == POUR_OK;
-    const pour_drive_config_t drive = pour_drive_default_config();
-    status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, calibrated);
-    if (status == POUR_OK && !calibrated) {
-      status = POUR_ECALIBRATION; /* what Identity says until then */
-    }
+    status = drive_init();
   }
+  *status_out = status;
   pour_can_node_config_t nc = pour_can_node_default_config();
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
@@ -86,17 +103,15 @@ int main(void) {
   pour_can_calibration_result_t calibration;
   pour_hal_calibration_result(&calibration); /* the stored calibration a CalibrationStart is answered with */
   if (pour_can_node_init(&can_node, &nc) != POUR_OK || pour_hal_can_init(clock_hz, nc.node_id) != POUR_OK) {
-    /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
-     * watchdog resets the MCU, which tries again. */
-    for (;;) {
-    }
+    return false;
   }
   pour_can_node_set_calibration(&can_node, &calibration);
-  if (status != POUR_OK && status != POUR_ECALIBRATION) {
-    report_forever();
-  }
-  pour_board_loop_init(&can_node);
+  return true;
+}
 
+/* The 1 kHz loop, for ever. */
+PHASE void run(void) {
+  pour_board_loop_init(&can_node);
   uint32_t overruns = 0u;
   for (;;) {
     const uint32_t missed = pour_hal_timer_wait_tick();
@@ -106,4 +121,18 @@ int main(void) {
       pour_hal_watchdog_feed(); /* a healthy tick: on time, stepped, outputs written */
     }
   }
+}
+
+int main(void) {
+  pour_status_t status = POUR_OK;
+  if (!start_up(&status)) {
+    /* No bus: nobody can command or hear this controller. Brake engaged, power off; without a feed the
+     * watchdog resets the MCU, which tries again. */
+    for (;;) {
+    }
+  }
+  if (status != POUR_OK && status != POUR_ECALIBRATION) {
+    report_forever();
+  }
+  run();
 }
