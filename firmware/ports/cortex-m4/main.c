@@ -31,9 +31,9 @@
 static pour_control_t controller;
 static pour_can_node_t can_node;
 
-/* main's three phases each get a frame of their own, popped (or never pushed) when another runs: the
- * start-up's configurations, the report's frames and the loop's locals would otherwise all sit in one frame,
- * inlined into the reset handler's, under the deepest chain of each. */
+/* main's phases each get a frame of their own, popped (or never pushed) when another runs: the start-up's
+ * configurations, the report's frames and the loop's locals would otherwise all sit in one frame, inlined into
+ * the reset handler's, under the deepest chain of each. */
 #define PHASE static __attribute__((noinline))
 
 /* A controller that cannot run says why, forever: brake engaged, power off, heartbeat and identity frames
@@ -59,13 +59,13 @@ PHASE void report_forever(void) {
 }
 
 /* The controller and the drive from their default configurations, which their instances copy: each
- * configuration lives only in its own function's scope, so the two are never on the stack together. */
-static pour_status_t controller_init(void) {
+ * configuration lives only in its own function's frame, so the two are never on the stack together. */
+PHASE pour_status_t controller_init(void) {
   const pour_control_config_t config = pour_control_default_config();
   return pour_control_init(&controller, &config, &pour_weights_compiled);
 }
 
-static pour_status_t drive_init(void) {
+PHASE pour_status_t drive_init(void) {
   /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
   const bool calibrated = pour_hal_calibration_load() == POUR_OK;
   const pour_drive_config_t drive = pour_drive_default_config();
