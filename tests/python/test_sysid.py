@@ -70,10 +70,9 @@ def test_recovers_the_hidden_rig(tmp_path, seed):
     print(f"draw {seed}: " + ", ".join(f"{k} {100 * v:+.2f} %" for k, v in err.items())
           + f", latency {int(got['command_latency_ticks'])} (hidden {truth['command_latency_ticks']}), "
             f"scale delay {delay_ms:+.1f} ms")
-    # Issue 20's bar is 5 % for each; viscous friction is recovered within 10 % (the fit reads it 3..8 % high
-    # on these draws: the simulated axis' friction at the sweep's 0.5 rad/s falls short of Coulomb's).
+    # Issue 20's bar: 5 % for each.
     for k, e in err.items():
-        assert abs(e) < (0.10 if k == "friction_viscous" else 0.05), (k, e)
+        assert abs(e) < 0.05, (k, e)
     assert int(got["command_latency_ticks"]) == truth["command_latency_ticks"]
     assert abs(delay_ms) < 10.0
     # The rig file is the simulator's: the same keys and values, as host_sim and the trainer read them.
