@@ -14,8 +14,8 @@ shares a count's quantisation error with θ̈, negatively correlated, which read
 on the default rig's 17 bits), and every term passes one smoothing filter (Savitzky-Golay), under which
 the equation stays exact. Samples near standstill (stiction: the friction is anything up to F_c there)
 are left out. b is fitted where the bucket keeps moving one way (the chirp and the sweep): in the steps,
-which reverse every 250 ms, b θ̇ is about 1 % of F_c and their b reads 3.5 % high even with a 24-bit
-encoder; the other figures are fitted on every phase with that b.
+which reverse every 250 ms, b θ̇ is about 1 % of F_c and their b alone reads 13 % high even with a
+24-bit encoder; the other figures are fitted on every phase with that b.
 
 The pivot's load cell carries the bucket's inertial load m a_y = m d (θ̈ sin θ + θ̇² cos θ) [g]; each of
 its conversions reports the mean load over the scale's delay before it. The delay is the span that best
