@@ -215,3 +215,46 @@ def test_train_and_robust_refuse_a_bad_rig_file(tmp_path, argv):
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=SOURCE_DIR, timeout=120)
     assert r.returncode == 2 and "torque_scale = 7 is out of range" in r.stderr, r.stderr
     assert not (tmp_path / "run").exists() and not (tmp_path / "rob").exists()
+
+
+# The tilt experiment's hidden liquids (seed, fluid_viscosity) across the map's range, seeds other than the
+# map's 1-4.
+TILT_DRAWS = [(11, 2.5), (12, 5.5), (13, 8.0)]
+# A tilt's C_d scatters about the map's mean by its seeds' spread (CD_MAP: at most 0.020 from 1 to 7 1/s,
+# 0.045 at 10) and the map's mean by half of it: three standard deviations of the difference.
+CD_TOL = 3 * 0.020 * (1 + 1 / 4) ** 0.5
+
+
+@pytest.mark.parametrize("seed, viscosity", TILT_DRAWS)
+def test_recovers_the_flow_coefficient_at_the_lip(tmp_path, nominal_log, seed, viscosity):
+    from pour.sysid import flow
+    tilt, rig = tmp_path / "tilt.log", tmp_path / "rig.toml"
+    experiment(tilt, "tilt", seed, {"fluid_viscosity": viscosity})
+    r = sysid(nominal_log, rig, "--tilt", tilt, "--json")
+    assert r.returncode == 0, r.stderr
+    got = json.loads(r.stdout)
+    cd, key = got["flow_coefficient"], got["fluid_viscosity"]
+    print(f"fluid_viscosity {viscosity}: C_d {cd['value']:.4f} +- {cd['sigma']:.4f} (the map's {flow.cd_of(viscosity):.4f}), "
+          f"fluid_viscosity fitted {key['value']:.2f} +- {key['sigma']:.2f}")
+    assert abs(cd["value"] - flow.cd_of(viscosity)) < CD_TOL
+    assert 0 < cd["sigma"] < CD_TOL
+    # The key is the map's inverse at the fitted C_d, written to the rig file with its sigma.
+    assert flow.cd_of(key["value"]) == pytest.approx(cd["value"], abs=1e-6)
+    doc = tomllib.loads(rig.read_text())
+    assert doc["fluid_viscosity"] == pytest.approx(key["value"]) and doc["sigma"]["fluid_viscosity"] > 0
+
+
+def test_a_tilt_log_without_outflow_names_the_flow_coefficient(tmp_path, nominal_log):
+    tilt, lidded = tmp_path / "tilt.log", tmp_path / "lidded.log"
+    experiment(tilt, "tilt")
+    # A lidded bucket: the rotating scale (the Sensors frame's bytes 4-5, ScaleRotating) keeps its first reading.
+    lines = tilt.read_text().splitlines(keepends=True)
+    first = next(line for line in lines if " 010#" in line).split("#")[1][8:12]
+    lidded.write_text("".join(line[:line.index("#") + 9] + first + line[line.index("#") + 13:] if " 010#" in line
+                              else line for line in lines))
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--tilt", lidded)
+    assert r.returncode == 1 and "cannot identify the flow coefficient at the lip: no liquid left" in r.stderr, r.stderr
+    assert not (tmp_path / "rig.toml").exists()
+    # The identify log is no tilt log.
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--tilt", nominal_log)
+    assert r.returncode == 1 and "needs the tilt experiment's" in r.stderr, r.stderr

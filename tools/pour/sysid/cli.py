@@ -2,7 +2,8 @@
 """pour-sysid: fit a rig file from the log of the controller's identify experiment (bucket empty).
 
 LOG is a candump -L log as pour-bench identify records it on a rig, or as host_sim --experiment identify
-writes it. The figures the log cannot give (the bucket's mass and drawing, the gear ratio, the encoder's
+writes it; --tilt adds the tilt experiment's log (with water), which gives the flow coefficient at the lip
+and the simulator's fluid_viscosity that reproduces it. The figures the log cannot give (the bucket's mass and drawing, the gear ratio, the encoder's
 bits, the scale's resolution) come from --base (a rig file or simulator config; default: the simulator's
 defaults). The rig file gets the fitted keys with their standard deviations; --png draws the measured and
 the fitted responses over each other.
@@ -18,6 +19,7 @@ import numpy as np
 from pour import atomic, cli
 from pour.sim import poursim
 from pour.sysid import fit as sf
+from pour.sysid import flow
 from pour.sysid import log as slog
 from pour.sysid import rig as srig
 
@@ -33,6 +35,8 @@ def parser():
     ap.add_argument("--out", type=Path, required=True, help="the rig file to write (.toml, or .cfg for host_sim)")
     ap.add_argument("--node", type=int, default=0, help="the controller's node id (default 0)")
     ap.add_argument("--base", type=Path, help="rig file or simulator config with the rig's known figures")
+    ap.add_argument("--tilt", type=Path, help="candump -L log of the tilt experiment (with water): the flow "
+                    "coefficient at the lip")
     ap.add_argument("--png", type=Path, help="measured vs fitted responses")
     ap.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     return ap
@@ -111,16 +115,23 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run = slog.read(a.log, a.node)
         fit = sf.fit_identify(run, base)
-    except slog.LogError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+        e = fit.estimates
+        if a.tilt is not None:
+            # The tilt's scale lags by the delay the identify log just measured.
+            cd, _ = flow.fit_flow(slog.read(a.tilt, a.node), {**base, "scale_delay_s": e["scale_delay_s"].value})
+            e["flow_coefficient"] = cd
+            e[flow.KEY] = flow.key_of(cd)
+    except slog.LogError as err:
+        print(f"{PROG}: error: {err}", file=sys.stderr)
         return 1
-    e = fit.estimates
-    fitted = srig.Rig({k: e[k].value for k in srig.FITTED},
-                      {k: e[k].sigma for k in srig.FITTED if np.isfinite(e[k].sigma)})
+    fitted = srig.Rig({k: e[k].value for k in srig.FITTED if k in e},
+                      {k: e[k].sigma for k in srig.FITTED if k in e and np.isfinite(e[k].sigma)})
     fitted.values["friction_viscous"] = max(0.0, fitted.values["friction_viscous"])
     flagged = sf.check_trust(fit)
-    header = [f"Fitted by {PROG} {cli.version()} from {a.log.name} (node {a.node}): do not edit by hand.",
-              "The identify experiment (bucket empty); docs/bench.md says what each figure means."]
+    header = [f"Fitted by {PROG} {cli.version()} from {a.log.name}" + (f" and {a.tilt.name}" if a.tilt else "")
+              + f" (node {a.node}): do not edit by hand.",
+              "The identify experiment (bucket empty)" + (", the tilt (with water)" if a.tilt else "")
+              + "; docs/bench.md says what each figure means."]
     header += [f"{k}: {v.value:.6g} +- {v.sigma:.3g} {v.unit}: {v.meaning}" for k, v in e.items()]
     if flagged:
         header.append("uncertain beyond 5 %: " + ", ".join(flagged))
