@@ -228,10 +228,11 @@ CD_TOL = 3 * 0.020 * (1 + 1 / 4) ** 0.5
 @pytest.mark.parametrize("seed, viscosity", TILT_DRAWS)
 def test_recovers_the_flow_coefficient_at_the_lip(tmp_path, nominal_log, seed, viscosity):
     from pour.sysid import flow
-    tilt, rig = tmp_path / "tilt.log", tmp_path / "rig.toml"
+    tilt, rig, png = tmp_path / "tilt.log", tmp_path / "rig.toml", tmp_path / "fit.png"
     experiment(tilt, "tilt", seed, {"fluid_viscosity": viscosity})
-    r = sysid(nominal_log, rig, "--tilt", tilt, "--json")
+    r = sysid(nominal_log, rig, "--tilt", tilt, "--json", "--png", png)
     assert r.returncode == 0, r.stderr
+    assert png.read_bytes()[:4] == b"\x89PNG"
     got = json.loads(r.stdout)
     cd, key = got["flow_coefficient"], got["fluid_viscosity"]
     print(f"fluid_viscosity {viscosity}: C_d {cd['value']:.4f} +- {cd['sigma']:.4f} (the map's {flow.cd_of(viscosity):.4f}), "

@@ -42,15 +42,18 @@ def parser():
     return ap
 
 
-def figure(fit: sf.Fit, path: Path) -> None:
+def figure(fit: sf.Fit, path: Path, tilt: dict | None = None) -> None:
     """Three panels: the acceleration against the fitted model's, the angle against the fitted model
-    run from the measured state every 0.5 s, and the rotating scale's readings against the fitted cell's."""
+    run from the measured state every 0.5 s, and the rotating scale's readings against the fitted cell's;
+    with tilt (flow.fit_flow's series) a fourth: the outflow over the lip against the fitted weir's."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     s = fit.series
     t, use = s["t"], s["use"]
-    fig, ax = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    fig, ax = plt.subplots(4 if tilt else 3, 1, figsize=(10, 10.5 if tilt else 8))
+    for a in ax[1:3]:
+        a.sharex(ax[0])
     ax[0].plot(t, s["accel"], lw=0.8, label="measured (filtered)")
     ax[0].plot(t[use], s["accel_model"][use], ".", ms=1, label="the fitted model's, from the commanded torque")
     ax[0].set_ylabel("θ̈ [rad/s²]")
@@ -60,11 +63,17 @@ def figure(fit: sf.Fit, path: Path) -> None:
     ax[2].plot(t[s["conv"]], s["reading"], ".", ms=2, label="rotating scale, measured")
     ax[2].plot(t[s["conv"]], s["reading_model"], lw=0.8, label="the fitted cell (inertial load, delay)")
     ax[2].set_ylabel("scale [g]")
-    ax[2].set_xlabel("t [s]")
+    ax[2].set_xlabel("t [s] (identify)")
+    if tilt:
+        u = tilt["use"]
+        ax[3].plot(tilt["t"], 1e3 * tilt["q"], lw=0.8, label="outflow, from the rotating scale (tilt)")
+        ax[3].plot(tilt["t"][u], 1e3 * tilt["q_model"][u], ".", ms=1, label="C_d (2/3) sqrt(2g) H^1.5, H by hydrostatics")
+        ax[3].set_ylabel("q [L/s per m of lip, 2D]")
+        ax[3].set_xlabel("t [s] (tilt)")
     for a in ax:
         a.legend(loc="upper right", fontsize=8)
         a.grid(alpha=0.3)
-    fig.suptitle("pour-sysid: the identify experiment, measured and fitted")
+    fig.suptitle("pour-sysid: the identify experiment" + (" and the tilt" if tilt else "") + ", measured and fitted")
     fig.tight_layout()
     with atomic.atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100, format="png")
@@ -118,7 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         e = fit.estimates
         if a.tilt is not None:
             # The tilt's scale lags by the delay the identify log just measured.
-            cd, _ = flow.fit_flow(slog.read(a.tilt, a.node), {**base, "scale_delay_s": e["scale_delay_s"].value})
+            cd, tilt = flow.fit_flow(slog.read(a.tilt, a.node), {**base, "scale_delay_s": e["scale_delay_s"].value})
             e["flow_coefficient"] = cd
             e[flow.KEY] = flow.key_of(cd)
     except slog.LogError as err:
@@ -138,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
     srig.save(a.out, fitted, header)
     if a.png is not None:
         fit.series["theta_sim"] = simulate(run, fit, base)
-        figure(fit, a.png)
+        figure(fit, a.png, tilt if a.tilt is not None else None)
     if a.json:
         print(json.dumps({k: {"value": v.value, "sigma": v.sigma, "unit": v.unit} for k, v in e.items()}))
     else:
