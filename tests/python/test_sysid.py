@@ -235,8 +235,8 @@ def test_recovers_the_flow_coefficient_at_the_lip(tmp_path, nominal_log, seed, v
     assert png.read_bytes()[:4] == b"\x89PNG"
     got = json.loads(r.stdout)
     cd, key = got["flow_coefficient"], got["fluid_viscosity"]
-    print(f"fluid_viscosity {viscosity}: C_d {cd['value']:.4f} +- {cd['sigma']:.4f} (the map's {flow.cd_of(viscosity):.4f}), "
-          f"fluid_viscosity fitted {key['value']:.2f} +- {key['sigma']:.2f}")
+    print(f"fluid_viscosity {viscosity}: C_d {cd['value']:.4f} +- {cd['sigma']:.4f} (the map's "
+          f"{flow.cd_of(viscosity):.4f}), fluid_viscosity fitted {key['value']:.2f} +- {key['sigma']:.2f}")
     assert abs(cd["value"] - flow.cd_of(viscosity)) < CD_TOL
     assert 0 < cd["sigma"] < CD_TOL
     # The key is the map's inverse at the fitted C_d, written to the rig file with its sigma.
@@ -259,3 +259,9 @@ def test_a_tilt_log_without_outflow_names_the_flow_coefficient(tmp_path, nominal
     # The identify log is no tilt log.
     r = sysid(nominal_log, tmp_path / "rig.toml", "--tilt", nominal_log)
     assert r.returncode == 1 and "needs the tilt experiment's" in r.stderr, r.stderr
+
+
+def test_the_flow_map_refuses_values_it_cannot_tabulate():
+    r = subprocess.run([sys.executable, "-m", "pour.sysid.flowmap", "--values", "5", "2"], capture_output=True,
+                       text=True, timeout=60)
+    assert r.returncode == 2 and "--values must be >= 0 and increasing" in r.stderr, r.stderr

@@ -3,8 +3,9 @@
 
 LOG is a candump -L log as pour-bench identify records it on a rig, or as host_sim --experiment identify
 writes it; --tilt adds the tilt experiment's log (with water), which gives the flow coefficient at the lip
-and the simulator's fluid_viscosity that reproduces it. The figures the log cannot give (the bucket's mass and drawing, the gear ratio, the encoder's
-bits, the scale's resolution) come from --base (a rig file or simulator config; default: the simulator's
+and the simulator's fluid_viscosity that reproduces it. The figures the log cannot give (the bucket's mass
+and drawing, the gear ratio, the encoder's bits, the scale's resolution, the liquid's density) come from
+--base (a rig file or simulator config; default: the simulator's
 defaults). The rig file gets the fitted keys with their standard deviations; --png draws the measured and
 the fitted responses over each other.
 """
@@ -26,7 +27,8 @@ from pour.sysid import rig as srig
 PROG = "pour-sysid"
 EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a log that cannot be fitted "
           "(truncated, of another node, with gaps, a refused or cut-short experiment, a parameter it does not "
-          "excite); 2 bad input (the command line, the base rig file).")
+          "excite, a --tilt log without outflow over the lip); 2 bad input (the command line, the base rig "
+          "file).")
 
 
 def parser():
@@ -67,7 +69,8 @@ def figure(fit: sf.Fit, path: Path, tilt: dict | None = None) -> None:
     if tilt:
         u = tilt["use"]
         ax[3].plot(tilt["t"], 1e3 * tilt["q"], lw=0.8, label="outflow, from the rotating scale (tilt)")
-        ax[3].plot(tilt["t"][u], 1e3 * tilt["q_model"][u], ".", ms=1, label="C_d (2/3) sqrt(2g) H^1.5, H by hydrostatics")
+        ax[3].plot(tilt["t"][u], 1e3 * tilt["q_model"][u], ".", ms=1,
+                   label="C_d (2/3) sqrt(2g) H^1.5, H by hydrostatics")
         ax[3].set_ylabel("q [L/s per m of lip, 2D]")
         ax[3].set_xlabel("t [s] (tilt)")
     for a in ax:

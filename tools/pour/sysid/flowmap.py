@@ -29,7 +29,8 @@ def tilt_cd(host_sim: Path, viscosity: float, seed: int, work: Path) -> float:
     r = subprocess.run([str(host_sim), "--experiment", "tilt", "--candump", str(log), "--seed", str(seed),
                         "--set", f"fluid_viscosity={viscosity:g}"], capture_output=True, text=True, timeout=600)
     if r.returncode != 0:
-        raise RuntimeError(f"host_sim tilt at fluid_viscosity {viscosity:g}, seed {seed}: {r.stdout[-300:]}{r.stderr[-300:]}")
+        raise RuntimeError(f"host_sim tilt at fluid_viscosity {viscosity:g}, seed {seed}: "
+                           f"{r.stdout[-300:]}{r.stderr[-300:]}")
     base = poursim.default_config()
     base["fluid_viscosity"] = viscosity
     return flow.fit_flow(slog.read(log, 0), base)[0].value
