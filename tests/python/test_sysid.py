@@ -265,3 +265,13 @@ def test_the_flow_map_refuses_values_it_cannot_tabulate():
     r = subprocess.run([sys.executable, "-m", "pour.sysid.flowmap", "--values", "5", "2"], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 2 and "--values must be >= 0 and increasing" in r.stderr, r.stderr
+
+
+def test_the_flow_map_is_the_simulators_own_at_the_default(tmp_path):
+    # flow.CD_MAP is pasted output of pour.sysid.flowmap: re-measured at the default liquid, it must be what
+    # the simulator does now (deterministic), or the map is stale and pour-sysid would invert the wrong one.
+    from pour.sysid import flow, flowmap
+    cd = [flowmap.tilt_cd(HOST_SIM, 5.0, s, tmp_path) for s in flowmap.SEEDS]
+    row = next(r for r in flow.CD_MAP if r[0] == 5)
+    assert float(np.mean(cd)) == pytest.approx(row[1], abs=1e-4)
+    assert float(np.std(cd, ddof=1)) == pytest.approx(row[2], abs=1e-4)
