@@ -2,8 +2,10 @@
 """pour-sysid: fit a rig file from the log of the controller's identify experiment (bucket empty).
 
 LOG is a candump -L log as pour-bench identify records it on a rig, or as host_sim --experiment identify
-writes it. The figures the log cannot give (the bucket's mass and drawing, the gear ratio, the encoder's
-bits, the scale's resolution) come from --base (a rig file or simulator config; default: the simulator's
+writes it; --tilt adds the tilt experiment's log (with water), which gives the flow coefficient at the lip
+and the simulator's fluid_viscosity that reproduces it. The figures the log cannot give (the bucket's mass
+and drawing, the gear ratio, the encoder's bits, the scale's resolution, the liquid's density) come from
+--base (a rig file or simulator config; default: the simulator's
 defaults). The rig file gets the fitted keys with their standard deviations; --png draws the measured and
 the fitted responses over each other.
 """
@@ -18,13 +20,15 @@ import numpy as np
 from pour import atomic, cli
 from pour.sim import poursim
 from pour.sysid import fit as sf
+from pour.sysid import flow
 from pour.sysid import log as slog
 from pour.sysid import rig as srig
 
 PROG = "pour-sysid"
 EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a log that cannot be fitted "
           "(truncated, of another node, with gaps, a refused or cut-short experiment, a parameter it does not "
-          "excite); 2 bad input (the command line, the base rig file).")
+          "excite, a --tilt log without outflow over the lip); 2 bad input (the command line, the base rig "
+          "file).")
 
 
 def parser():
@@ -33,20 +37,25 @@ def parser():
     ap.add_argument("--out", type=Path, required=True, help="the rig file to write (.toml, or .cfg for host_sim)")
     ap.add_argument("--node", type=int, default=0, help="the controller's node id (default 0)")
     ap.add_argument("--base", type=Path, help="rig file or simulator config with the rig's known figures")
+    ap.add_argument("--tilt", type=Path, help="candump -L log of the tilt experiment (with water): the flow "
+                    "coefficient at the lip")
     ap.add_argument("--png", type=Path, help="measured vs fitted responses")
     ap.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     return ap
 
 
-def figure(fit: sf.Fit, path: Path) -> None:
+def figure(fit: sf.Fit, path: Path, tilt: dict | None = None) -> None:
     """Three panels: the acceleration against the fitted model's, the angle against the fitted model
-    run from the measured state every 0.5 s, and the rotating scale's readings against the fitted cell's."""
+    run from the measured state every 0.5 s, and the rotating scale's readings against the fitted cell's;
+    with tilt (flow.fit_flow's series) a fourth: the outflow over the lip against the fitted weir's."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     s = fit.series
     t, use = s["t"], s["use"]
-    fig, ax = plt.subplots(3, 1, figsize=(10, 8), sharex=True)
+    fig, ax = plt.subplots(4 if tilt else 3, 1, figsize=(10, 10.5 if tilt else 8))
+    for a in ax[1:3]:
+        a.sharex(ax[0])
     ax[0].plot(t, s["accel"], lw=0.8, label="measured (filtered)")
     ax[0].plot(t[use], s["accel_model"][use], ".", ms=1, label="the fitted model's, from the commanded torque")
     ax[0].set_ylabel("θ̈ [rad/s²]")
@@ -56,11 +65,18 @@ def figure(fit: sf.Fit, path: Path) -> None:
     ax[2].plot(t[s["conv"]], s["reading"], ".", ms=2, label="rotating scale, measured")
     ax[2].plot(t[s["conv"]], s["reading_model"], lw=0.8, label="the fitted cell (inertial load, delay)")
     ax[2].set_ylabel("scale [g]")
-    ax[2].set_xlabel("t [s]")
+    ax[2].set_xlabel("t [s] (identify)")
+    if tilt:
+        u = tilt["use"]
+        ax[3].plot(tilt["t"], 1e3 * tilt["q"], lw=0.8, label="outflow, from the rotating scale (tilt)")
+        ax[3].plot(tilt["t"][u], 1e3 * tilt["q_model"][u], ".", ms=1,
+                   label="C_d (2/3) sqrt(2g) H^1.5, H by hydrostatics")
+        ax[3].set_ylabel("q [L/s per m of lip, 2D]")
+        ax[3].set_xlabel("t [s] (tilt)")
     for a in ax:
         a.legend(loc="upper right", fontsize=8)
         a.grid(alpha=0.3)
-    fig.suptitle("pour-sysid: the identify experiment, measured and fitted")
+    fig.suptitle("pour-sysid: the identify experiment" + (" and the tilt" if tilt else "") + ", measured and fitted")
     fig.tight_layout()
     with atomic.atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100, format="png")
@@ -111,23 +127,30 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run = slog.read(a.log, a.node)
         fit = sf.fit_identify(run, base)
-    except slog.LogError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+        e = fit.estimates
+        if a.tilt is not None:
+            # The tilt's scale lags by the delay the identify log just measured.
+            cd, tilt = flow.fit_flow(slog.read(a.tilt, a.node), {**base, "scale_delay_s": e["scale_delay_s"].value})
+            e["flow_coefficient"] = cd
+            e[flow.KEY] = flow.key_of(cd)
+    except slog.LogError as err:
+        print(f"{PROG}: error: {err}", file=sys.stderr)
         return 1
-    e = fit.estimates
-    fitted = srig.Rig({k: e[k].value for k in srig.FITTED},
-                      {k: e[k].sigma for k in srig.FITTED if np.isfinite(e[k].sigma)})
+    fitted = srig.Rig({k: e[k].value for k in srig.FITTED if k in e},
+                      {k: e[k].sigma for k in srig.FITTED if k in e and np.isfinite(e[k].sigma)})
     fitted.values["friction_viscous"] = max(0.0, fitted.values["friction_viscous"])
     flagged = sf.check_trust(fit)
-    header = [f"Fitted by {PROG} {cli.version()} from {a.log.name} (node {a.node}): do not edit by hand.",
-              "The identify experiment (bucket empty); docs/bench.md says what each figure means."]
+    header = [f"Fitted by {PROG} {cli.version()} from {a.log.name}" + (f" and {a.tilt.name}" if a.tilt else "")
+              + f" (node {a.node}): do not edit by hand.",
+              "The identify experiment (bucket empty)" + (", the tilt (with water)" if a.tilt else "")
+              + "; docs/bench.md says what each figure means."]
     header += [f"{k}: {v.value:.6g} +- {v.sigma:.3g} {v.unit}: {v.meaning}" for k, v in e.items()]
     if flagged:
         header.append("uncertain beyond 5 %: " + ", ".join(flagged))
     srig.save(a.out, fitted, header)
     if a.png is not None:
         fit.series["theta_sim"] = simulate(run, fit, base)
-        figure(fit, a.png)
+        figure(fit, a.png, tilt if a.tilt is not None else None)
     if a.json:
         print(json.dumps({k: {"value": v.value, "sigma": v.sigma, "unit": v.unit} for k, v in e.items()}))
     else:

@@ -15,9 +15,9 @@ from pathlib import Path
 from pour import atomic
 from pour.sim import poursim
 
-# The figures pour-sysid fits, in the order it writes them.
+# The figures pour-sysid fits, in the order it writes them (fluid_viscosity with a tilt log only).
 FITTED = ("torque_scale", "motor_rotor_inertia", "friction_coulomb", "friction_viscous", "command_latency_ticks",
-          "scale_delay_s", "scale_noise_g")
+          "scale_delay_s", "scale_noise_g", "fluid_viscosity")
 
 
 class RigError(ValueError):
