@@ -217,6 +217,24 @@ static void test_motor_cal_AnInductanceBelowAnyMotorsIsRefused(void) {
   assert_refused(run(foc), POUR_MOTOR_CAL_INDUCTANCE);
 }
 
+static void test_motor_cal_AResultTheConfigurationRefusesLeavesItsMotor(void) {
+  poursim::FocDrive foc = drive_with(nullptr, 0);
+  foc.set_motor(other_motor(foc), 7);
+  // Injected: a configuration that its check refuses once the measured numbers are tried in it.
+  foc.drive().config.bandwidth_rad_s = 0u;
+  const pour_drive_config_t before = foc.drive().config;
+  const Run r = run(foc);
+  assert_refused(r, POUR_MOTOR_CAL_INDUCTANCE);
+  TEST_ASSERT_NOT_EQUAL(before.pole_pairs, r.result.pole_pairs); // a motor unlike the configuration's was measured
+  const pour_drive_config_t &after = foc.drive().config;
+  TEST_ASSERT_EQUAL_UINT32(before.r_phase_uohm, after.r_phase_uohm);
+  TEST_ASSERT_EQUAL_UINT32(before.ld_nh, after.ld_nh);
+  TEST_ASSERT_EQUAL_UINT32(before.lq_nh, after.lq_nh);
+  TEST_ASSERT_EQUAL_UINT32(before.pole_pairs, after.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT32(before.encoder_reversed, after.encoder_reversed);
+  TEST_ASSERT_EQUAL_UINT16(before.encoder_offset, after.encoder_offset);
+}
+
 static void test_motor_cal_MorePolePairsThanAnyMotorIsRefused(void) {
   poursim::FocDrive foc = drive_with(nullptr, 0);
   poursim::MotorParams p = other_motor(foc);
@@ -396,6 +414,7 @@ int main(void) {
   RUN_TEST(test_motor_cal_AnOpenPhaseIsAResistanceOutOfRange);
   RUN_TEST(test_motor_cal_AnUnpluggedEncoderIsNamed);
   RUN_TEST(test_motor_cal_AnInductanceBelowAnyMotorsIsRefused);
+  RUN_TEST(test_motor_cal_AResultTheConfigurationRefusesLeavesItsMotor);
   RUN_TEST(test_motor_cal_MorePolePairsThanAnyMotorIsRefused);
   RUN_TEST(test_motor_cal_MotionBeyondTheRangeStopsTheSequence);
   RUN_TEST(test_motor_cal_AFaultEndsItHeld);

@@ -253,6 +253,25 @@ pour_motor_cal_status_t pour_drive_calibration(const pour_drive_t *drv, pour_mot
   return drv->cal_status;
 }
 
+/* The motor's numbers a self-calibration measures, as the configuration holds them. */
+typedef struct {
+  uint32_t r_phase_uohm, ld_nh, lq_nh, pole_pairs, encoder_reversed;
+  uint16_t encoder_offset;
+} motor_numbers_t;
+
+/* Puts *m into the configuration; returns the numbers it held. */
+static motor_numbers_t exchange_motor_numbers(pour_drive_config_t *c, const motor_numbers_t *m) {
+  const motor_numbers_t was = {c->r_phase_uohm, c->ld_nh, c->lq_nh, c->pole_pairs, c->encoder_reversed,
+                               c->encoder_offset};
+  c->r_phase_uohm = m->r_phase_uohm;
+  c->ld_nh = m->ld_nh;
+  c->lq_nh = m->lq_nh;
+  c->pole_pairs = m->pole_pairs;
+  c->encoder_reversed = m->encoder_reversed;
+  c->encoder_offset = m->encoder_offset;
+  return was;
+}
+
 /* A period of the self-calibration: its voltage vector through the same modulation as the current loop's;
  * at its end, the results into the configuration and RUN, or the reason latched. */
 static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t alpha, q15_t beta,
@@ -269,19 +288,18 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
   }
   if (st == POUR_MOTOR_CAL_OK) {
     const pour_motor_cal_result_t r = drv->cal.result;
-    pour_drive_config_t c = drv->config;
-    c.r_phase_uohm = r.r_phase_uohm;
-    c.ld_nh = c.lq_nh = r.l_phase_nh;
-    c.pole_pairs = r.pole_pairs;
-    c.encoder_reversed = r.encoder_direction < 0 ? 1u : 0u;
-    c.encoder_offset = r.electrical_offset;
+    /* The results go into the configuration itself, the numbers they replace kept to be put back if it
+     * fails its check (a copy of the whole configuration would be 140 B on this interrupt's stack). */
+    const motor_numbers_t measured = {r.r_phase_uohm, r.l_phase_nh, r.l_phase_nh, r.pole_pairs,
+                                      r.encoder_direction < 0 ? 1u : 0u, r.electrical_offset};
+    const motor_numbers_t was = exchange_motor_numbers(&drv->config, &measured);
+    const pour_drive_config_t *c = &drv->config;
     /* Only the motor's numbers change: the current loop's gains from them, the rest (the offsets, the bases,
      * the limits) stays, so this period costs two gain computations rather than a whole init. */
     pour_current_pi_t pi_d, pi_q;
-    if (pour_drive_config_check(&c) == NULL &&
-        pour_current_pi_init(&pi_d, c.bandwidth_rad_s, c.ld_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK &&
-        pour_current_pi_init(&pi_q, c.bandwidth_rad_s, c.lq_nh, c.r_phase_uohm, c.pwm_hz, I_BASE, V_BASE) == POUR_OK) {
-      drv->config = c;
+    if (pour_drive_config_check(c) == NULL &&
+        pour_current_pi_init(&pi_d, c->bandwidth_rad_s, c->ld_nh, c->r_phase_uohm, c->pwm_hz, I_BASE, V_BASE) == POUR_OK &&
+        pour_current_pi_init(&pi_q, c->bandwidth_rad_s, c->lq_nh, c->r_phase_uohm, c->pwm_hz, I_BASE, V_BASE) == POUR_OK) {
       drv->pi_d = pi_d;
       drv->pi_q = pi_q;
       drv->cal_status = POUR_MOTOR_CAL_OK;
@@ -293,6 +311,7 @@ static void measure(pour_drive_t *drv, uint16_t encoder, const q15_t i[3], q15_t
       hold(drv, out);
       return;
     }
+    (void)exchange_motor_numbers(&drv->config, &was);
   }
   pour_drive_trip(drv, POUR_DRIVE_FAULT_CALIBRATION);
   /* R and L in range whose current-loop gains (Kp = ωc·L) do not fit Q16.16: L is what is implausible */
