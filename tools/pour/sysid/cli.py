@@ -1,6 +1,9 @@
 # SPDX-License-Identifier: MIT
 """pour-sysid: fit a rig file from the log of the controller's identify experiment (bucket empty).
 
+With --tilt, the log of the tilt experiment (with water) weighs the fill: a tofu line's batch volume is the
+installation's, so the rig file carries it (fill_depth) and pour-train --rig centres the fill range on it.
+
 LOG is a candump -L log as pour-bench identify records it on a rig, or as host_sim --experiment identify
 writes it. The figures the log cannot give (the bucket's mass and drawing, the gear ratio, the encoder's
 bits, the scale's resolution) come from --base (a rig file or simulator config; default: the simulator's
@@ -26,6 +29,8 @@ EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a lo
           "(truncated, of another node, with gaps, a refused or cut-short experiment, a parameter it does not "
           "excite); 2 bad input (the command line, the base rig file).")
 
+NO_FILL = "fill_depth: not identified (no --tilt log with water): training keeps its config's fill and range"
+
 
 def parser():
     ap = cli.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
@@ -33,6 +38,9 @@ def parser():
     ap.add_argument("--out", type=Path, required=True, help="the rig file to write (.toml, or .cfg for host_sim)")
     ap.add_argument("--node", type=int, default=0, help="the controller's node id (default 0)")
     ap.add_argument("--base", type=Path, help="rig file or simulator config with the rig's known figures")
+    ap.add_argument("--tilt", type=Path, metavar="LOG", help="candump -L log of the tilt experiment (the bucket "
+                    "filled as for a pour): the fill (fill_depth) is weighed from it; without it the fill is not "
+                    "identified and the rig file leaves it out")
     ap.add_argument("--png", type=Path, help="measured vs fitted responses")
     ap.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     return ap
@@ -111,12 +119,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run = slog.read(a.log, a.node)
         fit = sf.fit_identify(run, base)
+        if a.tilt is not None:
+            fit.estimates["fill_depth"] = sf.fit_fill(slog.read(a.tilt, a.node), base)
     except slog.LogError as e:
         print(f"{PROG}: error: {e}", file=sys.stderr)
         return 1
     e = fit.estimates
-    fitted = srig.Rig({k: e[k].value for k in srig.FITTED},
-                      {k: e[k].sigma for k in srig.FITTED if np.isfinite(e[k].sigma)})
+    keys = [k for k in srig.FITTED if k in e]
+    fitted = srig.Rig({k: e[k].value for k in keys}, {k: e[k].sigma for k in keys if np.isfinite(e[k].sigma)})
     fitted.values["friction_viscous"] = max(0.0, fitted.values["friction_viscous"])
     flagged = sf.check_trust(fit)
     header = [f"Fitted by {PROG} {cli.version()} from {a.log.name} (node {a.node}): do not edit by hand.",
@@ -124,6 +134,8 @@ def main(argv: list[str] | None = None) -> int:
     header += [f"{k}: {v.value:.6g} +- {v.sigma:.3g} {v.unit}: {v.meaning}" for k, v in e.items()]
     if flagged:
         header.append("uncertain beyond 5 %: " + ", ".join(flagged))
+    if "fill_depth" not in e:
+        header.append(NO_FILL)
     srig.save(a.out, fitted, header)
     if a.png is not None:
         fit.series["theta_sim"] = simulate(run, fit, base)
@@ -133,6 +145,8 @@ def main(argv: list[str] | None = None) -> int:
     else:
         for k, v in e.items():
             print(f"{k:22s} {v.value:12.6g} +- {v.sigma:<10.3g} {v.unit:18s} {v.meaning}")
+        if "fill_depth" not in e:
+            print(NO_FILL)
         print(f"{PROG}: rig file {a.out}" + (f", figure {a.png}" if a.png else ""))
     return 0
 
