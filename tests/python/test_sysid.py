@@ -257,3 +257,19 @@ def test_a_fill_deeper_than_the_bucket_is_refused(tmp_path, nominal_log):
     r = sysid(nominal_log, tmp_path / "rig.toml", "--tilt", tilt, "--base", base)
     assert r.returncode == 1 and "not tared with it empty" in r.stderr, r.stderr
     assert not (tmp_path / "rig.toml").exists()
+
+
+def test_a_tilt_too_fast_to_weigh_the_fill_is_refused(tmp_path):
+    # The same log with every angle ten times larger: the bucket passes 20° in a tenth of the time, too few
+    # readings before the liquid may leave.
+    from pour.sim import poursim
+    from pour.sysid import fit as sf
+    from pour.sysid import log as slog
+    tilt = tmp_path / "tilt.log"
+    experiment(tilt, "tilt")
+    run = slog.read(tilt, 0)
+    base = poursim.default_config()
+    assert sf.fit_fill(run, base).value == pytest.approx(base["fill_depth"], rel=0.005)
+    run.encoder = np.minimum(run.encoder * 10, (1 << int(base["encoder_bits"])) // 2)
+    with pytest.raises(slog.LogError, match="cannot weigh the fill: .* a faster tilt than 0.1 rad/s"):
+        sf.fit_fill(run, base)
