@@ -60,14 +60,12 @@ bench_core() {
   printf '   control core (fixed, obs, policy, safety, sensors, supervisor, control): %d B flash, %d B static RAM;\n' \
     "$core_text" "$core_ram"
   printf '   one controller instance (pour_control_t): %s B RAM\n' "${state:-?}"
-  # Deepest stack of one step: pour_control_step -> pour_policy_eval -> its deepest kernel (gcc -fstack-usage).
-  stack=$(cat "$objdir"/*.su 2>/dev/null | awk -F'\t' '
-    { split($1, a, ":"); f[a[4]] = $2 }
-    END { k = f["pour_policy_logits"]; if (f["pour_policy_softmax_q15"] > k) k = f["pour_policy_softmax_q15"];
-          if (f["pour_policy_sample"] > k) k = f["pour_policy_sample"];
-          print f["pour_control_step"] + f["pour_policy_eval"] + k }')
-  printf '   deepest stack of a control step: %s B (pour_control_step + pour_policy_eval + deepest kernel)\n' \
-    "${stack:-?}"
+  # Deepest stack of one step: the deepest chain of frames from pour_control_step in the benchmark image, from
+  # the call graph its link-time optimisation writes (-fcallgraph-info=su; scripts/lib/stack_depth.py).
+  local chain
+  chain=$(python3 scripts/lib/stack_depth.py "$port"/pour_bench_control_11.elf.ltrans*.ci --root pour_control_step) || chain=""
+  stack=$(cut -d' ' -f2 <<<"$chain")
+  printf '   deepest stack of a control step: %s B (%s)\n' "${stack:-?}" "$(cut -d' ' -f3- <<<"$chain")"
   printf '   whole pour_core library: %d B flash\n' "$all_text"
   read -r t d b < <(arm-none-eabi-size "$port/pour_firmware.elf" | awk 'NR == 2 {print $1, $2, $3}')
   printf '   image pour_firmware.elf: %d B flash (text+data), %d B RAM (data+bss) + 2048 B stack reserve\n' \
@@ -86,7 +84,8 @@ bench_core() {
         drive_flash=$((drive_flash + t + d)); drive_ram=$((drive_ram + d + b)) ;;
     esac
   done
-  softfloat=$(arm-none-eabi-nm "$port/pour_firmware.elf" | grep -cE ' __aeabi_(f|d|[ui]2[fd]|[fd]2)|__(add|sub|mul|div)[sd]f3' || true)
+  # The linked image's symbol table: what runs (the build's check reads the same, check_no_float.cmake).
+  softfloat=$(arm-none-eabi-readelf -sW "$port/pour_firmware.elf" | grep -cE ' __aeabi_(f|d|[ui]2[fd]|[fd]2)|__(add|sub|mul|div)[sd]f3' || true)
 
   echo "-- against the bars:"
   verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
@@ -101,19 +100,19 @@ bench_core() {
   printf '   STM32G431 image: %d B flash (bar 32768: %s), %d B static RAM (bar 8192: %s); with every motor driver and the protection linked at most %d B flash, %d B static RAM\n' \
     "$image_flash" "$(verdict "$image_flash" 32768)" "$image_ram" "$(verdict "$image_ram" 8192)" \
     $((image_flash + drive_flash)) $((image_ram + drive_ram))
-  printf '   soft-float helpers in the image (arm-none-eabi-nm): %d (bar 0)\n' "$softfloat"
+  printf '   soft-float helpers in the image (arm-none-eabi-readelf -s): %d (bar 0)\n' "$softfloat"
 }
 
 # --- section: motor — the drive's current loop on the emulated Cortex-M4, and the full drive in the simulator
 # Instructions per current-loop interrupt (pour_drive_isr, each call timed on its own; SysTick resolution
 # 40 instructions) and per drive tick under -icount shift=0; the worst-case stack of the interrupt over the
-# 1 kHz step from -fstack-usage; then bench_motor's figures (docs/motor.md).
+# thread from the image's call graph; then bench_motor's figures (docs/motor.md).
 # Bars: interrupt <= 850 instructions worst; interrupt + 1 kHz step <= 1024 B of stack.
 bench_motor() {
   local build=build/cortex-m4 log out
   log=$(mktemp)
   echo "== motor: the current loop on a Cortex-M4 (QEMU mps2-an386, -icount shift=0) =="
-  if ! { cmake --preset cortex-m4 && cmake --build --preset cortex-m4 -j2 --target pour_bench_drive pour_bench_board_isr pour_core; } >"$log" 2>&1; then
+  if ! { cmake --preset cortex-m4 && cmake --build --preset cortex-m4 -j2 --target pour_bench_drive pour_bench_board_isr pour_bench_control_11 pour_firmware; } >"$log" 2>&1; then
     cat "$log"; rm -f "$log"; echo "error: the cortex-m4 build failed" >&2; return 1
   fi
   rm -f "$log"
@@ -133,24 +132,22 @@ bench_motor() {
   fi
   echo "$board_out" | sed 's/^/   /'
   board_worst=$(sed -nE 's/.*compares\): worst ([0-9]+) instructions.*/\1/p' <<<"$board_out")
-  # Stack: the exception frame (8 words, no FPU) + pour_drive_isr + its deepest callee, preempting the
-  # 1 kHz step at its deepest (pour_control_step + pour_policy_eval + deepest kernel, or pour_drive_tick +
-  # pour_drive_trip) and the exception frame of the 1 kHz interrupt.
-  local stack
-  stack=$(cat "$build"/firmware/motor/CMakeFiles/pour_motor.dir/src/*.su "$build"/firmware/CMakeFiles/pour_core.dir/src/*.su |
-    awk -F'\t' '{ split($1, a, ":"); f[a[4]] = $2 }
-      END { callee = 0
-            n = split("pour_current_sense_calibrate pour_current_sense_convert pour_foc_sincos_q15 pour_foc_clarke_q15 pour_foc_park_q15 pour_current_pi_step pour_foc_isqrt_u32 pour_foc_inv_park_q15 pour_foc_modulate_q15 pour_drive_trip", c, " ")
-            for (i = 1; i <= n; ++i) if (f[c[i]] > callee) callee = f[c[i]]
-            isr = 32 + f["pour_drive_isr"] + callee
-            k = f["pour_policy_logits"]; if (f["pour_policy_softmax_q15"] > k) k = f["pour_policy_softmax_q15"]
-            if (f["pour_policy_sample"] > k) k = f["pour_policy_sample"]
-            step = f["pour_control_step"] + f["pour_policy_eval"] + k
-            tick = f["pour_drive_tick"] + f["pour_drive_trip"]; if (tick > step) step = tick
-            printf "%d %d %d\n", isr, step + 32, isr + step + 32 }')
-  read -r isr_stack step_stack total_stack <<<"$stack"
-  printf '   stack: interrupt %s B (frame + pour_drive_isr + deepest callee), 1 kHz step %s B, both %s B\n' \
-    "$isr_stack" "$step_stack" "$total_stack"
+  # Stack, from the call graph of the image's link (-fcallgraph-info=su under LTO; scripts/lib/stack_depth.py):
+  # the current loop's interrupt (8-word exception frame, no FPU, + the deepest chain from
+  # pour_board_drive_isr) over the thread at its deepest (main: start-up and the 1 kHz loop, whose tick, the
+  # control step included, LTO inlines into main's frame), and, for comparison with the earlier figure, over
+  # the control step alone (its deepest chain in the benchmark image + the 1 kHz tick's frame).
+  local port=$build/firmware/ports/cortex-m4 image step isr_stack thread_stack step_stack total_stack
+  image=$(python3 scripts/lib/stack_depth.py "$port"/pour_firmware.elf.ltrans*.ci --root pour_board_drive_isr --root main \
+            --entry Reset_Handler --entry Fault_Handler --entry Default_Handler --entry pour_hal_timer_isr) || image=""
+  step=$(python3 scripts/lib/stack_depth.py "$port"/pour_bench_control_11.elf.ltrans*.ci --root pour_control_step) || step=""
+  isr_stack=$(awk '$1 == "pour_board_drive_isr" {print 32 + $2}' <<<"$image")
+  thread_stack=$(awk '$1 == "main" {print $2}' <<<"$image")
+  step_stack=$(awk '{print 32 + $2}' <<<"$step")
+  total_stack=$((${isr_stack:-99999} + ${thread_stack:-99999}))
+  sed 's/^/   call graph: /' <<<"$image"
+  printf '   stack: interrupt %s B (frame + pour_board_drive_isr chain), thread %s B (main: start-up, the 1 kHz loop and its tick), both %s B; interrupt over the control step alone %s B\n' \
+    "${isr_stack:-?}" "${thread_stack:-?}" "$total_stack" "$(( ${isr_stack:-0} + ${step_stack:-0} ))"
   verdict() { if [ "$1" -le "$2" ]; then echo "within"; else echo "OVER"; fi; }
   printf '   bars: interrupt worst %s instructions (bar 850: %s), as the board runs it %s (a quarter of the 50 us period at 170 MHz: 2125 cycles); stack %s B (bar 1024: %s)\n' \
     "$worst" "$(verdict "${worst:-99999}" 850)" "${board_worst:-?}" "$total_stack" "$(verdict "${total_stack:-99999}" 1024)"

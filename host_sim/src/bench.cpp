@@ -184,6 +184,9 @@ int bench_rig(const poursim_config_t &cfg) {
     std::printf("  full command, Coulomb %.1f N m: terminal speed %.3f rad/s, datasheet line %.3f rad/s (%+.2f %%)\n",
                 d.terminal_load[r], d.terminal_speed[r], d.terminal_expected[r],
                 100 * (d.terminal_speed[r] / d.terminal_expected[r] - 1));
+  for (int r = 0; r < POURSIM_FRICTION_SPEEDS; ++r)
+    std::printf("  friction at %.3f rad/s: %.4f N m by Newton, F_c + b w %.4f N m (%+.4f N m)\n", d.friction_speed[r],
+                d.friction_measured[r], d.friction_expected[r], d.friction_measured[r] - d.friction_expected[r]);
   poursim_sensor_check_t s;
   if (poursim_measure_sensors(&cfg, 1, &s, err, sizeof err) != POURSIM_OK) {
     std::fprintf(stderr, "host_sim: %s\n", err);

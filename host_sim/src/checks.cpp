@@ -332,6 +332,32 @@ extern "C" int poursim_measure_drive(const poursim_config_t *cfg, poursim_drive_
     out->terminal_expected[r] = cr.motor_no_load_speed * (1.0 - cr.friction_coulomb / P) /
                                 (1.0 + cr.motor_no_load_speed * cr.friction_viscous / P);
   }
+  // Friction at steady speeds: a speed loop (gravity fed forward) holds each speed from upright, no stops;
+  // after 0.3 s of spin-up, each step's friction by Newton (delivered − gravity − J·α) is averaged over
+  // one radian of travel.
+  static const double kSpeeds[POURSIM_FRICTION_SPEEDS] = {0.2, 0.5, 1.0, 1.5, 2.0};
+  const double gain = out->inertia_expected / 0.02; // [N·m per rad/s]: a 20 ms speed loop
+  for (int r = 0; r < POURSIM_FRICTION_SPEEDS; ++r) {
+    WorldGuard g{empty_world(c, true, err, err_len)};
+    if (g.w == nullptr) return POURSIM_EINVAL;
+    const double v = kSpeeds[r];
+    const int spin = static_cast<int>(std::lround(0.3 / c.dt)), n = spin + static_cast<int>(std::lround(1.0 / v / c.dt));
+    poursim_observe(g.w, &o);
+    double omega0 = o.omega, theta0 = o.theta, sum_f = 0, sum_w = 0;
+    for (int k = 0; k < n; ++k) {
+      const double gravity = c.bucket_mass * kG * com_y * std::sin(theta0);
+      const double tau = c.friction_coulomb + c.friction_viscous * v - gravity + gain * (v - omega0);
+      poursim_step(g.w, tau / c.tau_max, &o);
+      if (k >= spin) {
+        sum_f += o.motor_torque + gravity - out->inertia_expected * (o.omega - omega0) / c.dt;
+        sum_w += o.omega;
+      }
+      omega0 = o.omega, theta0 = o.theta;
+    }
+    out->friction_speed[r] = sum_w / (n - spin);
+    out->friction_measured[r] = sum_f / (n - spin);
+    out->friction_expected[r] = c.friction_coulomb + c.friction_viscous * out->friction_speed[r];
+  }
   return POURSIM_OK;
 }
 

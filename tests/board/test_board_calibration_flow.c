@@ -3,7 +3,8 @@
  * drive fed scripted samples (no motor: the closed loop with one is tests/sim/test_calibration.cpp): an open
  * circuit named on the bus with nothing stored, the e-stop ending it, a start the drive refuses, what a
  * controller that cannot measure answers, the brake-release interlock's refusals (tilted, not empty, no or
- * stale sensors) and its limits, a second start while one runs, and a start from a latched encoder fault.
+ * stale sensors) and its limits, a second start while one runs, a start from a latched encoder fault, and
+ * the read-only CalibrationRead of what flash holds (a valid block, an erased page, a corrupt block).
  * Runs on the host and on the emulated Cortex-M4. */
 #include <string.h>
 
@@ -226,6 +227,86 @@ static void test_calibration_flow_AControllerThatCannotMeasureSaysSo(void) {
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
 }
 
+/* What main.c and board_loop do at boot, on this page: the block loaded and checked, handed to the node and
+ * the flow. Returns the block's state. */
+static pour_cal_status_t boot_from_flash(void) {
+  pour_calibration_t cal;
+  const pour_cal_status_t st = pour_calibration_load(&f, &cal);
+  pour_can_calibration_result_t r;
+  pour_calibration_can_result(st, &cal, POUR_CAN_CAL_UNAVAILABLE, &r);
+  pour_can_node_set_calibration(&node, &r);
+  pour_calibration_flow_init(&flow, st, &cal);
+  return st;
+}
+
+/* A CalibrationRead and the tick that answers it: its one CalibrationResult. */
+static pour_can_calibration_result_t read_back(pour_mode_t mode) {
+  pour_can_frame_t fr;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(0, POUR_CAN_CMD_CALIBRATION_READ, &fr));
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &fr));
+  const int before = n_sent;
+  tick(mode);
+  TEST_ASSERT_EQUAL_INT(before + 1, n_sent);
+  return sent[before];
+}
+
+static const pour_calibration_t good = {304000u, 231000u, -1, 8u, 200u << 8};
+
+static void test_calibration_flow_AReadSendsTheStoredBlockInAnyMode(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_save(&f, &good));
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, boot_from_flash());
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE); /* the current offsets: the drive ready */
+  const pour_mode_t modes[] = {POUR_MODE_IDLE, POUR_MODE_RUN, POUR_MODE_FAULT, POUR_MODE_ESTOP};
+  for (unsigned i = 0; i < sizeof modes / sizeof modes[0]; ++i) {
+    const pour_can_calibration_result_t r = read_back(modes[i]);
+    TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_STORED, r.status);
+    TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, r.stored);
+    TEST_ASSERT_EQUAL_UINT8(1u, r.encoder_reversed);
+    TEST_ASSERT_EQUAL_UINT8(8u, r.pole_pairs);
+    TEST_ASSERT_EQUAL_UINT16(304u, r.resistance_mohm);
+    TEST_ASSERT_EQUAL_UINT16(231u, r.inductance_uh);
+    TEST_ASSERT_EQUAL_UINT8(200u, r.electrical_offset);
+    TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state); /* nothing started, the brake never released */
+    TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node));
+  }
+  TEST_ASSERT_EQUAL_INT(0, released_outside);
+}
+
+/* A read, in the given mode, of a page without a valid block: STORED, the block's state, and no values. */
+static void assert_read_shows_no_block(pour_mode_t mode, uint8_t stored) {
+  const pour_can_calibration_result_t r = read_back(mode);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_STORED, r.status);
+  TEST_ASSERT_EQUAL_UINT8(stored, r.stored);
+  TEST_ASSERT_EQUAL_UINT8(0u, r.pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(0u, r.resistance_mohm);
+}
+
+static void test_calibration_flow_AReadOfAnErasedPageSaysEmpty(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_EMPTY, boot_from_flash());
+  assert_read_shows_no_block(POUR_MODE_IDLE, POUR_CAN_CAL_EMPTY);
+}
+
+static void test_calibration_flow_AReadOfACorruptBlockSaysCorruptAndShowsNoValues(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_save(&f, &good));
+  page[3] ^= 0x10u; /* one bit flipped in the stored words: the CRC no longer matches */
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_CORRUPT, boot_from_flash());
+  assert_read_shows_no_block(POUR_MODE_FAULT, POUR_CAN_CAL_CORRUPT);
+}
+
+/* A read while the sequence runs: the block stored before it, and the measurement runs on. */
+static void test_calibration_flow_AReadWhileMeasuringLeavesItRunning(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_save(&f, &good));
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, boot_from_flash());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, answer_with_rig());
+  const uint32_t n_before = drv.cal.n;
+  const pour_can_calibration_result_t r = read_back(POUR_MODE_IDLE);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_STORED, r.status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, r.stored);
+  TEST_ASSERT_EQUAL_UINT16(304u, r.resistance_mohm);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_MEASURING, drv.state);
+  TEST_ASSERT_TRUE(drv.cal.n > n_before);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_calibration_flow_AnOpenCircuitIsNamedAndNothingStored);
@@ -241,5 +322,9 @@ int main(void) {
   RUN_TEST(test_calibration_flow_UprightAndEmptyWithinTheLimitsStarts);
   RUN_TEST(test_calibration_flow_ASecondStartWhileMeasuringIsAnsweredMeasuring);
   RUN_TEST(test_calibration_flow_AnEncoderFaultMayBeCalibratedAway);
+  RUN_TEST(test_calibration_flow_AReadSendsTheStoredBlockInAnyMode);
+  RUN_TEST(test_calibration_flow_AReadOfAnErasedPageSaysEmpty);
+  RUN_TEST(test_calibration_flow_AReadOfACorruptBlockSaysCorruptAndShowsNoValues);
+  RUN_TEST(test_calibration_flow_AReadWhileMeasuringLeavesItRunning);
   return UNITY_END();
 }

@@ -26,6 +26,7 @@ extern "C" {
 #include "board_loop.h"
 #include "calibration_flow.h"
 #include "clock.h"
+#include "drive_without_cut.h"
 #include "flash_page_file.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
@@ -84,13 +85,6 @@ uint16_t pour_hal_drive_period(void) { return kPeriod; }
 void pour_hal_drive_set_compares(const uint16_t c[3]) { std::memcpy(plant.compare, c, sizeof plant.compare); }
 void pour_hal_drive_enable(bool on) { plant.gates = on ? Gates::On : Gates::Off; }
 void pour_hal_drive_short_low_sides(void) { plant.gates = Gates::Shorted; }
-pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
-  (void)offset_counts;
-  return POUR_OK;
-}
-bool pour_hal_drive_overcurrent_tripped(void) { return false; }
-void pour_hal_drive_clear_overcurrent(void) {}
-void pour_hal_drive_mask(bool masked) { (void)masked; }
 bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_config_t &c = pour_board_drive_state()->config;
   for (int k = 0; k < 3; ++k) s->phase[k] = plant.sample.adc_phase[k];

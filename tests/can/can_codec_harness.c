@@ -7,7 +7,7 @@
  * heartbeat (mode faults rx_dropped overruns counter refused), estop (assert), identity (hash tau_max fw init),
  * param_read (id), param_value and param_write (id value), param_ack (request id result), tare (scales),
  * experiment_start (kind),
- * clear_errors, stop, reset, param_save and zero (no fields).
+ * clear_errors, stop, reset, param_save, zero and calibration_read (no fields).
  *   param <id>                          -> "ok <name> <unit or -> <min> <max>" | "none" (pour/params.h's table)
  * A line it cannot parse gets "error <reason>"; the harness never exits on bad input before EOF. */
 #include <stdio.h>
@@ -65,6 +65,9 @@ static uint8_t command_of(const char *msg) {
   }
   if (strcmp(msg, "zero") == 0) {
     return POUR_CAN_CMD_ZERO;
+  }
+  if (strcmp(msg, "calibration_read") == 0) {
+    return POUR_CAN_CMD_CALIBRATION_READ;
   }
   return strcmp(msg, "reset") == 0 ? POUR_CAN_CMD_RESET : 0u;
 }

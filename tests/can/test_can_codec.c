@@ -185,7 +185,12 @@ static void test_can_calibration_result_RoundTripsAndNamesTheReason(void) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, got.status);
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_WRITE_FAILED, got.stored);
-  f.data[0] = 19u; /* a status beyond the last */
+  const pour_can_calibration_result_t read = {.status = POUR_CAN_CAL_STORED, .stored = POUR_CAN_CAL_CORRUPT};
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &read, &f));
+  TEST_ASSERT_EQUAL_HEX8(0x53u, f.data[0]); /* the read's answer: 19 | 2 << 5 */
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&f, &got));
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_STORED, got.status);
+  f.data[0] = 20u; /* a status beyond the last */
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OUT_OF_RANGE, pour_can_unpack_calibration_result(&f, &got));
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_calibration_result(2, &r, &f));
   pour_can_calibration_result_t bad = r;

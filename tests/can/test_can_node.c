@@ -500,6 +500,116 @@ static void run_ticks(unsigned n, uint32_t *seq, pour_control_output_t *out) {
   }
 }
 
+/* A CalibrationRead with the core behind the node: the one CalibrationResult of the next tick, decoded; the
+ * core's mode and refusal count as they were, and nothing handed to the port to measure. */
+static pour_can_calibration_result_t read_calibration(pour_control_output_t *out) {
+  const uint8_t mode = out->mode;
+  const uint32_t refused = ctl.refused;
+  receive_command(POUR_CAN_CMD_CALIBRATION_READ);
+  /* no sample with it: in IDLE one would start a run */
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  pour_can_node_begin_tick(&node, &in);
+  pour_control_step(&ctl, &in, out);
+  const uint8_t n = pour_can_node_end_tick(&node, out, 0, tx);
+  pour_can_calibration_result_t r;
+  memset(&r, 0xFF, sizeof r);
+  int answers = 0;
+  for (uint8_t i = 0; i < n; ++i) {
+    if (tx[i].id == pour_can_id(cfg.node_id, POUR_CAN_CMD_CALIBRATION_RESULT)) {
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&tx[i], &r));
+      ++answers;
+    }
+  }
+  TEST_ASSERT_EQUAL_INT(1, answers);
+  TEST_ASSERT_EQUAL_UINT8(mode, out->mode);
+  TEST_ASSERT_EQUAL_UINT32(refused, ctl.refused);
+  TEST_ASSERT_FALSE(pour_can_node_take_calibration_start(&node));
+  return r;
+}
+
+static void assert_stored_block(const pour_can_calibration_result_t *r) {
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_STORED, r->status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, r->stored);
+  TEST_ASSERT_EQUAL_UINT8(1u, r->encoder_reversed);
+  TEST_ASSERT_EQUAL_UINT8(8u, r->pole_pairs);
+  TEST_ASSERT_EQUAL_UINT16(304u, r->resistance_mohm);
+  TEST_ASSERT_EQUAL_UINT16(231u, r->inductance_uh);
+  TEST_ASSERT_EQUAL_UINT8(17u, r->electrical_offset);
+}
+
+/* The read-only query: answered in RUN, ESTOP, FAULT and IDLE with the stored block, status STORED, and
+ * never a start, a refusal or a change of mode. */
+static void test_can_node_CalibrationReadAnswersTheStoredBlockInEveryModeAndChangesNothing(void) {
+  cfg.can_calibrate = true;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &cfg));
+  const pour_can_calibration_result_t stored = {.status = POUR_CAN_CAL_UNAVAILABLE, .stored = POUR_CAN_CAL_OK,
+                                                .encoder_reversed = 1u, .pole_pairs = 8u, .resistance_mohm = 304u,
+                                                .inductance_uh = 231u, .electrical_offset = 17u};
+  pour_can_node_set_calibration(&node, &stored);
+  pour_control_output_t out;
+  uint32_t seq = 0;
+  run_ticks(30u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  pour_can_calibration_result_t r = read_calibration(&out);
+  assert_stored_block(&r);
+  receive_estop(true);
+  run_ticks(5u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_ESTOP, out.mode);
+  r = read_calibration(&out);
+  assert_stored_block(&r);
+  receive_estop(false);
+  run_ticks(5u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  r = read_calibration(&out);
+  assert_stored_block(&r);
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  run_ticks(5u, &seq, &out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  receive_command(POUR_CAN_CMD_STOP);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  r = read_calibration(&out);
+  assert_stored_block(&r);
+  TEST_ASSERT_EQUAL_UINT32(0u, ctl.refused);
+}
+
+/* A controller without a calibration of its own says so; a read waits behind a start's answer (one
+ * CalibrationResult a tick) and does not feed the command watchdog. */
+static void test_can_node_CalibrationReadWithoutAStoreIsUnavailableAndWaitsItsTurn(void) {
+  pour_control_input_t in;
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  receive_command(POUR_CAN_CMD_CALIBRATION_READ);
+  receive_command(POUR_CAN_CMD_CALIBRATION_START);
+  uint8_t statuses[3] = {0xFFu, 0xFFu, 0xFFu};
+  for (int t = 0; t < 3; ++t) {
+    pour_can_node_begin_tick(&node, &in);
+    pour_control_output_t out;
+    memset(&out, 0, sizeof out);
+    out.mode = (uint8_t)POUR_MODE_IDLE;
+    const uint8_t n = pour_can_node_end_tick(&node, &out, 0, tx);
+    for (uint8_t i = 0; i < n; ++i) {
+      pour_can_calibration_result_t r;
+      if (tx[i].id != pour_can_id(cfg.node_id, POUR_CAN_CMD_CALIBRATION_RESULT)) continue;
+      TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_calibration_result(&tx[i], &r));
+      TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_EMPTY, r.stored);
+      statuses[t] = r.status;
+    }
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_UNAVAILABLE, statuses[0]); /* the start's answer: it cannot measure */
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_UNAVAILABLE, statuses[1]); /* the read's: nothing of its own stored */
+  TEST_ASSERT_EQUAL_UINT8(0xFFu, statuses[2]);                    /* one answer each */
+  /* Only reads since: the watchdog is not fed by them and trips on the silence. */
+  pour_can_node_init(&node, &cfg);
+  send_sample(1, 0);
+  for (unsigned t = 0; t <= cfg.watchdog_ms; ++t) {
+    receive_command(POUR_CAN_CMD_CALIBRATION_READ);
+    tick(0, &in, tx);
+  }
+  pour_can_node_begin_tick(&node, &in);
+  TEST_ASSERT_TRUE(in.link_fault);
+}
+
 /* After a clear that did not count (dropped clears so far): FAULT, the e-stop fault latched, the brake on. */
 static void assert_estop_still_latched(const pour_control_output_t *out, uint32_t dropped) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out->mode);
@@ -746,6 +856,8 @@ int main(void) {
   RUN_TEST(test_can_node_CalibrationStartIsRefusedInRunAndEstopWithItsReason);
   RUN_TEST(test_can_node_CalibrationStartGoesToAPortThatMeasuresAndItsOutcomeFollows);
   RUN_TEST(test_can_node_CalibrationStartFollowsThePortsGate);
+  RUN_TEST(test_can_node_CalibrationReadAnswersTheStoredBlockInEveryModeAndChangesNothing);
+  RUN_TEST(test_can_node_CalibrationReadWithoutAStoreIsUnavailableAndWaitsItsTurn);
   RUN_TEST(test_can_node_SensorsFrameBecomesOneFreshRawSample);
   RUN_TEST(test_can_node_TorqueFrameEchoesSeqEveryTick);
   RUN_TEST(test_can_node_HeartbeatAtConfiguredPeriod);

@@ -161,3 +161,82 @@ def test_a_node_of_another_protocol_is_refused_before_motion(fw, refused):
                 n.check_protocol(timeout=1.0)
         else:
             assert n.check_protocol(timeout=1.0).identity.fw_version == b.protocol
+
+
+class _FakeNode:
+    """A controller of this DBC's protocol on a python-can virtual bus, for the read-only calibration query:
+    its heartbeat and identity every 20 ms, and the given CalibrationResult (signal names and value names as
+    the DBC gives them) to each CalibrationRead, after an unasked outcome of a measurement that is not the
+    answer. Every frame it receives is kept."""
+
+    def __init__(self, channel: str, answer: dict) -> None:
+        import threading
+
+        import can
+
+        from pour.bench import node as bn
+        self.db = bn.load_dbc()
+        self.bus = can.Bus(interface="virtual", channel=channel)
+        self.answer = answer
+        self.received: list[str] = []
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self.run, daemon=True)
+
+    def send(self, name: str, **named) -> None:
+        import can
+        m = self.db.get_message_by_name(name)
+        raw = {}
+        for s in m.signals:
+            v = named.get(s.name, 0)
+            raw[s.name] = ({str(n): k for k, n in s.choices.items()}[v] if isinstance(v, str)
+                           else round(v / s.scale))
+        self.bus.send(can.Message(arbitration_id=m.frame_id, data=m.encode(raw, scaling=False),
+                                  is_extended_id=False))
+
+    def run(self) -> None:
+        from pour.can import dbc
+        counter = 0
+        while not self.stop.is_set():
+            self.send("Identity", WeightsHash=0x1234, TauMax=20.0, FwVersion=dbc.protocol_version(self.db.version))
+            self.send("Heartbeat", Mode="RUN", Counter=counter % 256)
+            counter += 1
+            msg = self.bus.recv(0.02)
+            if msg is None:
+                continue
+            name = self.db.get_message_by_frame_id(msg.arbitration_id).name
+            self.received.append(name)
+            if name == "CalibrationRead":
+                self.send("CalibrationResult", Status="NO_ENCODER", Stored="EMPTY")
+                self.send("CalibrationResult", **self.answer)
+
+    def __enter__(self) -> "_FakeNode":
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop.set()
+        self.thread.join(5)
+        self.bus.shutdown()
+
+
+@pytest.mark.parametrize("answer, status, needle", [
+    (dict(Status="STORED", Stored="OK", EncoderReversed=1, PolePairs=8, Resistance=0.304, Inductance=0.231,
+          ElectricalOffset=28.125),
+     0, "node 0: resistance 0.304 Ohm, inductance 0.231 mH, pole pairs 8, encoder direction reversed, "
+        "electrical offset 28.1 deg (stored OK)"),
+    (dict(Status="STORED", Stored="CORRUPT"), 0, "node 0: stored calibration: CORRUPT"),
+    (dict(Status="UNAVAILABLE", Stored="EMPTY"), 1, "pour-bench: error: node 0 has no calibration of its own: "
+                                                    "UNAVAILABLE (this controller has no drive of its own"),
+])
+def test_calibration_reads_the_stored_block_without_asking_or_moving(answer, status, needle, capsys, monkeypatch):
+    """pour-bench calibration against a node on a python-can virtual bus: no --expect-hash, no confirmation
+    (stdin is never read), one CalibrationRead and nothing else on the bus, and the answer by name."""
+    from pour.bench import cli as bench_cli
+    monkeypatch.setattr("sys.stdin", None)
+    channel = f"calread{status}{answer['Stored']}"
+    with _FakeNode(channel, answer) as node:
+        rc = bench_cli.main(["--interface", "virtual", "--iface", channel, "calibration"])
+    out = capsys.readouterr()
+    assert rc == status, out
+    assert needle in (out.out if status == 0 else out.err), out
+    assert node.received == ["CalibrationRead"]

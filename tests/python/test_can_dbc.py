@@ -42,8 +42,9 @@ MESSAGES = {
     "experiment_start": ("ExperimentStart", ["Kind"]),
     "param_save": ("ParamSave", []),
     "zero": ("Zero", []),
+    "calibration_read": ("CalibrationRead", []),
 }
-SIGNAL_FREE = ("clear_errors", "stop", "reset", "calibration_start", "param_save", "zero")
+SIGNAL_FREE = ("clear_errors", "stop", "reset", "calibration_start", "param_save", "zero", "calibration_read")
 FAULT_BITS = {"Fault_StaleInput": 0x0001, "Fault_EStop": 0x0002, "Fault_BadInput": 0x0004,
               "Fault_Position": 0x0008, "Fault_Overspeed": 0x0010, "Fault_TorqueSign": 0x0020,
               "Fault_Encoder": 0x0040, "Fault_Volume": 0x0080, "Fault_CanWatchdog": 0x0100,
@@ -263,7 +264,7 @@ def test_cmd_ids_and_lengths_match_the_c_header(db, source_dir):
              "CalibrationResult": "CALIBRATION_RESULT", "DriveTelemetry": "DRIVE_TELEMETRY",
              "ParamRead": "PARAM_READ", "ParamValue": "PARAM_VALUE",
              "ParamWrite": "PARAM_WRITE", "ParamSave": "PARAM_SAVE", "ParamAck": "PARAM_ACK", "Tare": "TARE", "ExperimentStart": "EXPERIMENT_START",
-             "Zero": "ZERO"}
+             "Zero": "ZERO", "CalibrationRead": "CALIBRATION_READ"}
     assert sorted(m.name for m in db.messages) == sorted(names)
     for m in db.messages:
         c = names[m.name]
@@ -290,6 +291,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
               ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5, 2]), ("estop", [1]),
               ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", []),
               ("calibration_start", []), ("calibration_result", [7, 2, 0, 0, 0, 0, 0]),
+              ("calibration_read", []), ("calibration_result", [19, 0, 1, 4, 450, 220, 12]),
               ("drive_telemetry", [-1500, 2500, 24100, 0x0102, 6])]
     for cname, values in frames:
         frame_id, _, data = c_pack(harness, cname, 0, values)
@@ -306,6 +308,8 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     assert "TauMax: 20.0 N.m" in text
     assert "Assert: ASSERT" in text
     assert "Status: REFUSED_ESTOP" in text and "Stored: CORRUPT" in text  # a refusal's reason, by name
+    assert "CalibrationRead(" in text
+    assert "Status: STORED" in text and "Stored: OK" in text and "Resistance: 0.45 Ohm" in text  # the read's answer
     assert "Iq: 5.0 A" in text and "Vbus: 24.1 V" in text and "Crystal: 24 MHz" in text
     assert "DriveFault_HwOvercurrent: 1" in text and "DriveFault_EncoderMismatch: 1" in text
     assert "ClearErrors(" in text
@@ -319,7 +323,8 @@ def test_calibration_status_names_are_the_codec_s(db):
             if not k.endswith("_MAX")}
     choices = db.get_message_by_name("CalibrationResult").get_signal_by_name("Status").choices
     assert {int(k): str(v) for k, v in choices.items()} == ours
-    assert len(ours) == 19 and "MEASURING" in ours.values() and "REFUSED_NO_SENSORS" in ours.values()
+    assert len(ours) == 20 and "MEASURING" in ours.values() and "REFUSED_NO_SENSORS" in ours.values()
+    assert ours[19] == "STORED"
 
 
 def test_param_ids_in_the_dbc_are_the_firmware_table(db, harness):

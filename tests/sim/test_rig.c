@@ -72,6 +72,24 @@ static void test_rig_TerminalSpeedsLieOnTheTorqueSpeedLine(void) {
   TEST_ASSERT_TRUE(d.terminal_speed[1] < 0.65 * cfg.motor_no_load_speed); /* the load slows it down the line */
 }
 
+/* Friction at steady speed, by Newton on the empty bucket, is what its keys say: F_c + b·ω from 0.2 to
+ * 2 rad/s, for the default and for a stiffer and a lighter axis. 2 mN·m is 0.3 % of F_c, b·ω at 0.1 rad/s. */
+static void test_rig_SteadyFrictionIsCoulombPlusViscous(void) {
+  const double coulomb[3] = {0.6, 1.2, 0.3}, viscous[3] = {0.02, 0.05, 0.01};
+  for (int v = 0; v < 3; ++v) {
+    cfg.friction_coulomb = coulomb[v];
+    cfg.friction_viscous = viscous[v];
+    poursim_drive_check_t d = drive(&cfg);
+    for (int r = 0; r < POURSIM_FRICTION_SPEEDS; ++r) {
+      printf("F_c %.2f, b %.3f: at %.3f rad/s friction %.4f N m, F_c + b w %.4f N m\n", coulomb[v], viscous[v],
+             d.friction_speed[r], d.friction_measured[r], d.friction_expected[r]);
+      TEST_ASSERT_DOUBLE_WITHIN(0.002, d.friction_expected[r], d.friction_measured[r]);
+    }
+    TEST_ASSERT_DOUBLE_WITHIN(0.02, 0.2, d.friction_speed[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.02, 2.0, d.friction_speed[POURSIM_FRICTION_SPEEDS - 1]);
+  }
+}
+
 static void test_rig_SensorsAgainstMassMomentumAndTheirConfig(void) {
   poursim_sensor_check_t s = sensors(&cfg);
   printf("encoder max error %.4f counts, at the lower stop %u; rotating at rest %.1f g of %.1f g; target %.1f g of "
@@ -300,6 +318,7 @@ int main(void) {
   RUN_TEST(test_rig_SpinUpMeasuresTheReflectedRotorInertia);
   RUN_TEST(test_rig_CoulombFrictionHoldsUntilTheTorqueExceedsIt);
   RUN_TEST(test_rig_TerminalSpeedsLieOnTheTorqueSpeedLine);
+  RUN_TEST(test_rig_SteadyFrictionIsCoulombPlusViscous);
   RUN_TEST(test_rig_SensorsAgainstMassMomentumAndTheirConfig);
   RUN_TEST(test_rig_ScaleRateLagAndNoiseFollowTheConfig);
   RUN_TEST(test_rig_NoiseIsSeededAndLeavesTheTrajectory);

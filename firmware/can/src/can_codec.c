@@ -207,7 +207,8 @@ pour_status_t pour_can_pack_experiment_start(uint8_t node_id, const pour_can_exp
 
 static int is_signal_free_command(uint8_t cmd) {
   return cmd == POUR_CAN_CMD_CLEAR_ERRORS || cmd == POUR_CAN_CMD_STOP || cmd == POUR_CAN_CMD_RESET ||
-         cmd == POUR_CAN_CMD_CALIBRATION_START || cmd == POUR_CAN_CMD_PARAM_SAVE || cmd == POUR_CAN_CMD_ZERO;
+         cmd == POUR_CAN_CMD_CALIBRATION_START || cmd == POUR_CAN_CMD_PARAM_SAVE || cmd == POUR_CAN_CMD_ZERO ||
+         cmd == POUR_CAN_CMD_CALIBRATION_READ;
 }
 
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame) {
@@ -226,6 +227,7 @@ int pour_can_dlc_of(uint8_t cmd) {
     case POUR_CAN_CMD_IDENTITY: return (int)POUR_CAN_DLC_IDENTITY;
     case POUR_CAN_CMD_CALIBRATION_START: return (int)POUR_CAN_DLC_CALIBRATION_START;
     case POUR_CAN_CMD_CALIBRATION_RESULT: return (int)POUR_CAN_DLC_CALIBRATION_RESULT;
+    case POUR_CAN_CMD_CALIBRATION_READ: return (int)POUR_CAN_DLC_CALIBRATION_READ;
     case POUR_CAN_CMD_DRIVE_TELEMETRY: return (int)POUR_CAN_DLC_DRIVE_TELEMETRY;
     case POUR_CAN_CMD_RESET: return (int)POUR_CAN_DLC_RESET;
     case POUR_CAN_CMD_SENSORS: return (int)POUR_CAN_DLC_SENSORS;

@@ -10,7 +10,8 @@
                     (1u << POUR_CAN_CMD_PARAM_SAVE) | (1u << POUR_CAN_CMD_TARE) | (1u << POUR_CAN_CMD_ZERO))
 #define ACCEPT_MASK ((1u << POUR_CAN_CMD_ESTOP) | (1u << POUR_CAN_CMD_STOP) | (1u << POUR_CAN_CMD_SENSORS) | \
                      (1u << POUR_CAN_CMD_CLEAR_ERRORS) | (1u << POUR_CAN_CMD_RESET) |                             \
-                     (1u << POUR_CAN_CMD_CALIBRATION_START) | (1u << POUR_CAN_CMD_EXPERIMENT_START) | PARAM_MASK)
+                     (1u << POUR_CAN_CMD_CALIBRATION_START) | (1u << POUR_CAN_CMD_EXPERIMENT_START) | PARAM_MASK | \
+                     (1u << POUR_CAN_CMD_CALIBRATION_READ))
 
 pour_can_node_config_t pour_can_node_default_config(void) {
   pour_can_node_config_t c;
@@ -173,6 +174,9 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
       node->calibration_requested = true;
       kick(node);
       break;
+    case POUR_CAN_CMD_CALIBRATION_READ: /* a query, like a parameter read: no command, no watchdog feed */
+      node->calibration_read = true;
+      break;
     default: /* POUR_CAN_CMD_CLEAR_ERRORS */
       pour_commands_clear(&node->commands);
       kick(node);
@@ -256,6 +260,9 @@ bool pour_can_node_calibration_frame(pour_can_node_t *node, uint8_t mode, pour_c
     }
   } else if (node->calibration_report) {
     node->calibration_report = false;
+  } else if (node->calibration_read) {
+    node->calibration_read = false;
+    r.status = node->config.can_calibrate ? POUR_CAN_CAL_STORED : POUR_CAN_CAL_UNAVAILABLE;
   } else {
     return false;
   }

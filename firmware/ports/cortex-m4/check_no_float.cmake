@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: MIT
-# cmake -DNM=<nm> -DFILES="<obj/lib/elf>;..." -P check_no_float.cmake
+# cmake -DREADELF=<readelf> -DFILES="<obj/lib/elf>;..." -P check_no_float.cmake
 # Fails (and names the symbols) if any file references or contains a software floating-point helper:
-# the fixed-point core and the image must not need one.
-if(NOT NM OR NOT FILES)
-  message(FATAL_ERROR "usage: cmake -DNM=<nm> -DFILES=<files> -P check_no_float.cmake")
+# the fixed-point core and the image must not need one. It reads each file's ELF symbol table (readelf -s),
+# not what nm shows: the cortex-m4 objects are LTO objects, for which nm lists the compiler's intermediate
+# symbols, without the helpers the code generated beside them calls.
+if(NOT READELF OR NOT FILES)
+  message(FATAL_ERROR "usage: cmake -DREADELF=<readelf> -DFILES=<files> -P check_no_float.cmake")
 endif()
 set(float_re "(__aeabi_([fd][a-z0-9]+|u?i2[fd]|u?l2[fd])|__(add|sub|mul|div|neg)[sd]f3|__float(un)?[sd]i[sd]f|__fix(uns)?[sd]f[sd]i|__extendsfdf2|__truncdfsf2|__(eq|ne|lt|le|gt|ge|un|c?mp)[sd]f2)$")
 set(found "")
@@ -11,9 +13,9 @@ foreach(file IN LISTS FILES)
   if(NOT EXISTS "${file}")
     message(FATAL_ERROR "check_no_float: no such file: ${file}")
   endif()
-  execute_process(COMMAND "${NM}" "${file}" OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "check_no_float: ${NM} failed on ${file}: ${err}")
+  execute_process(COMMAND "${READELF}" -sW "${file}" OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "Symbol table '.symtab'")
+    message(FATAL_ERROR "check_no_float: ${READELF} found no symbol table in ${file}: ${err}")
   endif()
   string(REPLACE "\n" ";" lines "${out}")
   foreach(line IN LISTS lines)

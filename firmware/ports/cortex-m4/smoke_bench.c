@@ -6,14 +6,16 @@
  * follow the drive's references (tests/board/ideal_drive.h), and the bucket moves with that motor's torque.
  * The script, by tick:
  *     10..169  states of a bucket that moves with the torque (StateA + StateB frames, seq counting)
+ *         60  CalibrationRead (while running)
  *   100..119  the hardwired e-stop line asserted
  *        130  ClearErrors
  *      170..  no more states: the input times out
  *        205  the verdict (exit status 0 or 1), after the heartbeat of tick 201
  * Checked: the current loop's periods (20 a tick), its offsets measured with the gates off and the brake
  * held meanwhile, then its compares written and its q current following the torque frame's sign;
- * DriveTelemetry with every heartbeat, without a fault, its q current that of the loop; RUN and torque before the e-stop; zero torque, brake engaged and power off in the e-stop's own
- * tick; ESTOP latched until the clear, then RUN again through the slew limit; the stale-input fault and the
+ * DriveTelemetry with every heartbeat, without a fault, its q current that of the loop; RUN and torque
+ * before the e-stop; the read answered once with the stored block (STORED, OK, its pole pairs), the run
+ * going on; zero torque, brake engaged and power off in the e-stop's own tick; ESTOP latched until the clear, then RUN again through the slew limit; the stale-input fault and the
  * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
  * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
@@ -21,6 +23,7 @@
 
 #include "board_drive.h"
 #include "clock.h"
+#include "drive_without_cut.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
 #include "hal_can.h"
@@ -40,6 +43,7 @@
 #define ESTOP_FROM 100u
 #define ESTOP_TO 120u
 #define CLEAR_AT 130u
+#define READ_AT 60u
 #define STATES_TO 170u
 #define PERIODS_PER_TICK 20u /* 20 kHz PWM under the 1 kHz loop */
 #define VBUS_MV 24000u
@@ -55,8 +59,8 @@ static unsigned rx_n, rx_i;
 static struct {
   uint32_t feeds, heartbeats, identities, bad_identity, slew_steps, led_shows, led_wrong;
   uint32_t periods, gates_on_calibrating, released_calibrating, compares, iq_sign_wrong, iq_sign_checked;
-  uint32_t telemetry, telemetry_faulted, telemetry_iq_wrong;
-  bool ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
+  uint32_t telemetry, telemetry_faulted, telemetry_iq_wrong, calibration_read, calibration_wrong;
+  bool ran_after_read, ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
   q15_t peak, last_torque;
   uint8_t last_mode;
   uint16_t last_faults;
@@ -132,13 +136,6 @@ void pour_hal_drive_set_compares(const uint16_t compare[3]) {
 }
 void pour_hal_drive_enable(bool on) { gates_on = on; }
 void pour_hal_drive_short_low_sides(void) { gates_on = false; }
-pour_status_t pour_hal_drive_arm_overcurrent(const uint16_t offset_counts[3]) {
-  (void)offset_counts;
-  return POUR_OK;
-}
-bool pour_hal_drive_overcurrent_tripped(void) { return false; }
-void pour_hal_drive_clear_overcurrent(void) {}
-void pour_hal_drive_mask(bool masked) { (void)masked; }
 
 /* The PWM periods of one tick: the interrupt as the ADC's end of sequence would raise it. */
 static void run_periods(void) {
@@ -176,6 +173,9 @@ void pour_hal_can_poll(void) {
   if (tick == CLEAR_AT) {
     (void)pour_can_pack_command(0, POUR_CAN_CMD_CLEAR_ERRORS, &rx[rx_n++]);
   }
+  if (tick == READ_AT) {
+    (void)pour_can_pack_command(0, POUR_CAN_CMD_CALIBRATION_READ, &rx[rx_n++]);
+  }
 }
 
 int pour_hal_can_receive(pour_can_frame_t *frame) {
@@ -207,6 +207,9 @@ static void on_torque(const pour_can_torque_t *t) {
     seen.ran = true;
     seen.peak = t->torque > seen.peak ? t->torque : seen.peak;
   }
+  if (tick == READ_AT + 1u) {
+    seen.ran_after_read = t->mode == POUR_MODE_RUN && power && !brake;
+  }
   if (tick == ESTOP_FROM) {
     seen.estop_same_tick = t->torque == 0 && t->mode == POUR_MODE_ESTOP && brake && !power;
   }
@@ -223,6 +226,7 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
   pour_can_heartbeat_t hb;
   pour_can_identity_t id;
   pour_can_drive_telemetry_t dt;
+  pour_can_calibration_result_t cal;
   if (pour_can_unpack_torque(frame, &t) == POUR_CAN_RX_OK) {
     on_torque(&t);
   } else if (pour_can_unpack_heartbeat(frame, &hb) == POUR_CAN_RX_OK) {
@@ -233,6 +237,11 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
     seen.telemetry_faulted += dt.drive_faults != 0u ? 1u : 0u;
     const int32_t iq_2ma = (int32_t)pour_board_drive_output()->iq * 1000 / 1024;
     seen.telemetry_iq_wrong += dt.iq_2ma == iq_2ma && dt.crystal_4mhz == SMOKE_CRYSTAL_HZ / 4000000u ? 0u : 1u;
+  } else if (pour_can_unpack_calibration_result(frame, &cal) == POUR_CAN_RX_OK) {
+    const bool stored = cal.status == POUR_CAN_CAL_STORED && cal.stored == POUR_CAN_CAL_OK && tick == READ_AT &&
+                        cal.pole_pairs == pour_board_drive_state()->config.pole_pairs;
+    seen.calibration_read += stored ? 1u : 0u;
+    seen.calibration_wrong += stored ? 0u : 1u;
   } else if (pour_can_unpack_identity(frame, &id) == POUR_CAN_RX_OK) {
     seen.identities++;
     if (id.weights_hash != pour_weights_compiled.content_hash || id.init_status != 0 ||
@@ -257,12 +266,15 @@ void pour_hal_watchdog_feed(void) {
                   seen.periods == tick * PERIODS_PER_TICK && seen.gates_on_calibrating == 0u &&
                   seen.released_calibrating == 0u && seen.compares > 0u && seen.iq_sign_checked > 0u &&
                   seen.iq_sign_wrong == 0u && seen.telemetry == seen.heartbeats && seen.telemetry_faulted == 0u &&
-                  seen.telemetry_iq_wrong == 0u;
+                  seen.telemetry_iq_wrong == 0u && seen.calibration_read == 1u && seen.calibration_wrong == 0u &&
+                  seen.ran_after_read;
   printf("smoke: current loop %u periods (gates on %u, brake released %u while measuring its offsets), %u with "
          "compares, q current against the torque %u of %u; drive telemetry %u (%u faulted, %u not the loop's)\n",
          (unsigned)seen.periods, (unsigned)seen.gates_on_calibrating, (unsigned)seen.released_calibrating,
          (unsigned)seen.compares, (unsigned)seen.iq_sign_wrong, (unsigned)seen.iq_sign_checked,
          (unsigned)seen.telemetry, (unsigned)seen.telemetry_faulted, (unsigned)seen.telemetry_iq_wrong);
+  printf("smoke: CalibrationRead answered with the stored block %u time(s), other calibration frames %u, RUN "
+         "after it %d\n", (unsigned)seen.calibration_read, (unsigned)seen.calibration_wrong, (int)seen.ran_after_read);
   printf("smoke: %u ticks, watchdog fed %u; ran %d (peak torque %d); e-stop: zero torque, brake, power off in its "
          "tick %d, latched %d; after the clear ran %d; stale at the end %d (faults 0x%x); heartbeats %u, identities "
          "%u (%u wrong); slew-limit breaches %u; LED shown %u ticks, %u not the tick's mode: %s\n",

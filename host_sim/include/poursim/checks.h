@@ -61,6 +61,8 @@ int poursim_measure_slosh(const poursim_config_t *config, uint32_t seed, int n_s
 
 /* ---- The rig: the drive and the sensors against their references (docs/simulator.md, "The rig"). ---- */
 
+#define POURSIM_FRICTION_SPEEDS 5 /* steady speeds of the friction sweep: 0.2, 0.5, 1, 1.5, 2 rad/s */
+
 typedef struct {
   int latency_ticks;           /* steps from the call that commands torque to the first step the bucket moves */
   double inertia_measured;     /* Σ net torque / Σ α over a spin-up from rest at upright [kg·m²] */
@@ -70,10 +72,13 @@ typedef struct {
   double terminal_load[2];     /* Coulomb friction of the two free-spin runs (the config's, and 10 N·m) [N·m] */
   double terminal_speed[2];    /* full command, no stops, mean speed over the last second of 1.5 s [rad/s] */
   double terminal_expected[2]; /* the datasheet line: ω₀·(1 − (τ_c + b·ω)/τ_peak), solved for ω [rad/s] */
+  double friction_speed[POURSIM_FRICTION_SPEEDS];    /* mean speed over the span, held by a speed loop [rad/s] */
+  double friction_measured[POURSIM_FRICTION_SPEEDS]; /* mean of τ_delivered − G·sinθ − J·α over it [N·m] */
+  double friction_expected[POURSIM_FRICTION_SPEEDS]; /* F_c + b·ω at that speed [N·m] */
 } poursim_drive_check_t;
 
 /* Runs the drive on the empty bucket (the liquid taken out) of config: latency, reflected inertia,
- * Coulomb breakaway, and terminal speeds on the torque–speed line. */
+ * Coulomb breakaway, terminal speeds on the torque–speed line, and the friction torque at steady speeds. */
 int poursim_measure_drive(const poursim_config_t *config, poursim_drive_check_t *out, char *err, size_t err_len);
 
 typedef struct {

@@ -232,9 +232,9 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
 def test_calibrate_with_the_simulated_drive(tmp_path):
     """pour-bench calibrate against pour_controller_sim --io can:vcan0,drive=sim (the firmware's drive and the
     board's calibration flow on host_sim's motor model): refused for another policy, then measured and
-    stored, the stored values read back in the result; refused by name with the e-stop asserted, the stored
-    block shown; a node that stops answering mid-way times out with its last state; a controller without a
-    drive refuses by name."""
+    stored, the stored values read back in the result and by pour-bench calibration (also in ESTOP); refused by
+    name with the e-stop asserted, the stored block shown; a node that stops answering mid-way times out with
+    its last state; a controller without a drive refuses by name, and says it has no calibration to read."""
     policy = f"0x{weights_h.parse_weights_h(WEIGHTS).content_hash:08x}"
     ctl = Controller(io="can:vcan0,heartbeat-ms=10,drive=sim", program="pour_controller_sim")
     try:
@@ -248,7 +248,11 @@ def test_calibrate_with_the_simulated_drive(tmp_path):
         mh = float(out.split("inductance ")[1].split()[0])
         assert abs(ohm / 0.2865 - 1) <= 0.05 and abs(mh / 0.1505 - 1) <= 0.05, out  # the model's motor
         print(out)
+        read = ok("calibration")  # read-only: no hash, no confirmation, the block just stored
+        assert f"node 0: resistance {ohm:.3f} Ohm, inductance {mh:.3f} mH, pole pairs 8" in read, read
+        assert "(stored OK)" in read, read
         ok("estop")
+        assert ok("calibration") == read  # answered in ESTOP too, the same block
         err = refused("--expect-hash", policy, "--yes", "calibrate")
         assert "refused the calibration: REFUSED_ESTOP (the e-stop is asserted" in err, err
         assert f"resistance {ohm:.3f} Ohm" in err and "(stored OK)" in err, err  # what is stored, read back
@@ -270,5 +274,7 @@ def test_calibrate_with_the_simulated_drive(tmp_path):
         err = refused("--expect-hash", policy, "--yes", "calibrate")
         assert "refused the calibration: UNAVAILABLE (this controller has no drive of its own" in err, err
         assert "stored calibration: EMPTY" in err, err
+        err = refused("calibration")
+        assert "node 0 has no calibration of its own: UNAVAILABLE" in err, err
     finally:
         ctl.stop()

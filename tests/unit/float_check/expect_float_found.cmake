@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
-# cmake -DCHECKER=<check_no_float.cmake> -DNM=<nm> -DFILE=<object> -DSYMBOL=<helper> -P expect_float_found.cmake
+# cmake -DCHECKER=<check_no_float.cmake> -DREADELF=<readelf> -DFILE=<object> -DSYMBOL=<helper> -P expect_float_found.cmake
 # Passes only if the checker fails on FILE and names SYMBOL in its message.
-execute_process(COMMAND "${CMAKE_COMMAND}" "-DNM=${NM}" "-DFILES=${FILE}" -P "${CHECKER}"
+execute_process(COMMAND "${CMAKE_COMMAND}" "-DREADELF=${READELF}" "-DFILES=${FILE}" -P "${CHECKER}"
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(rc EQUAL 0)
   message(FATAL_ERROR "check_no_float accepted ${FILE}, which uses float:\n${out}${err}")

@@ -118,6 +118,7 @@ def parser() -> argparse.ArgumentParser:
                                          "offset, stored by the node (MOVES the axis)")
     p.add_argument("--seconds", type=_seconds, default=bn.CALIBRATION_S,
                    help="wait this long for its outcome (default %(default)s)")
+    sub.add_parser("calibration", help="read the calibration the node stores (read-only: no motion, in any mode)")
     return ap
 
 
@@ -245,6 +246,9 @@ def run(a: argparse.Namespace) -> int:
             assert want is not None
             _confirm_motion(a, n, want)
             print(f"node {n.id}: calibrated: {n.calibrate(a.seconds, a.timeout).describe()}")
+        elif a.cmd == "calibration":
+            n.check_protocol(a.timeout)  # the frame's layout is this DBC's: another protocol would be misread
+            print(f"node {n.id}: {n.read_calibration(a.timeout).describe()}")
         elif a.cmd == "log":
             count = n.record(a.output, a.seconds)
             print(f"{a.output}: {count} frames in {a.seconds:g} s")

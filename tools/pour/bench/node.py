@@ -457,6 +457,23 @@ class Node:
                                     f"{done.describe()}", done)
         return done
 
+    def read_calibration(self, timeout: float = DEFAULT_TIMEOUT_S) -> Calibration:
+        """Reads the calibration the node stores (CalibrationRead): answered in any mode, it moves nothing,
+        starts nothing and is never counted as refused. The answer's status is STORED and its stored field
+        the block's state (OK with the values, or EMPTY, CORRUPT, OLD_VERSION, ...). CalibrationFailed if the
+        node has no calibration of its own (UNAVAILABLE); NodeTimeout if it does not answer within timeout."""
+        status = self.bench.message("CalibrationResult").get_signal_by_name("Status").choices
+        answers = {"STORED", "UNAVAILABLE"}  # an unasked outcome of a measurement is not the answer
+        self.bench.send(self.id, "CalibrationRead")
+        _, sig = self.bench.wait_for(
+            self.id, lambda n, s: n == "CalibrationResult" and str(status.get(s["Status"])) in answers, timeout,
+            "CalibrationRead")
+        r = self._calibration(sig)
+        if r.status != "STORED":
+            raise CalibrationFailed(f"node {self.id} has no calibration of its own: {r.status} "
+                                    f"({CALIBRATION_REASONS.get(r.status, 'see can/pour.dbc')})", r)
+        return r
+
     # -- identification ------------------------------------------------------------------------------------
     def identify(self, path: str | Path, kind: str, seconds: float) -> tuple[int, str]:
         """Starts the controller's own experiment (ExperimentStart: identify or tilt, pour/experiment.h) and

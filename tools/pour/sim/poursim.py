@@ -100,6 +100,8 @@ class DriveCheckStruct(C.Structure):
         ("latency_ticks", C.c_int), ("inertia_measured", C.c_double), ("inertia_expected", C.c_double),
         ("inertia_bucket", C.c_double), ("breakaway_torque", C.c_double), ("terminal_load", C.c_double * 2),
         ("terminal_speed", C.c_double * 2), ("terminal_expected", C.c_double * 2),
+        ("friction_speed", C.c_double * 5), ("friction_measured", C.c_double * 5),
+        ("friction_expected", C.c_double * 5),
     ]
 
 

@@ -15,9 +15,9 @@ from pathlib import Path
 from pour import atomic
 from pour.sim import poursim
 
-# The figures pour-sysid fits, in the order it writes them (fill_depth only from a tilt log, with water).
+# The figures pour-sysid fits, in the order it writes them (fill_depth and fluid_viscosity with a tilt log only).
 FITTED = ("torque_scale", "motor_rotor_inertia", "friction_coulomb", "friction_viscous", "command_latency_ticks",
-          "scale_delay_s", "scale_noise_g", "fill_depth")
+          "scale_delay_s", "scale_noise_g", "fill_depth", "fluid_viscosity")
 
 
 class RigError(ValueError):

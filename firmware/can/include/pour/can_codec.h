@@ -35,6 +35,7 @@
 #define POUR_CAN_CMD_TORQUE 0x12u       /* controller -> host, one per control tick */
 #define POUR_CAN_CMD_CLEAR_ERRORS 0x18u /* host -> controller */
 #define POUR_CAN_CMD_RESET 0x19u        /* host -> controller: start a new run (refused while running) */
+#define POUR_CAN_CMD_CALIBRATION_READ 0x1Au /* host -> controller: send the stored calibration (no motion) */
 
 /* Data length of each message [bytes]; a frame with another DLC is malformed. */
 #define POUR_CAN_DLC_HEARTBEAT 8u
@@ -56,6 +57,7 @@
 #define POUR_CAN_DLC_TORQUE 7u
 #define POUR_CAN_DLC_CLEAR_ERRORS 0u
 #define POUR_CAN_DLC_RESET 0u
+#define POUR_CAN_DLC_CALIBRATION_READ 0u
 
 /* Signal ranges, as the DBC's [min|max] in raw units; a value outside is out of range. */
 #define POUR_CAN_ENCODER_MAX 0xFFFFFFu /* 24-bit count field: encoders of up to 24 bits; the core's estimator
@@ -95,7 +97,10 @@
 #define POUR_CAN_CAL_REFUSED_NOT_UPRIGHT 16u /* the output is more than 5° from upright */
 #define POUR_CAN_CAL_REFUSED_NOT_EMPTY 17u   /* the rotating scale reads more than 200 g (or below -200 g) */
 #define POUR_CAN_CAL_REFUSED_NO_SENSORS 18u  /* no sensor sample within 20 ms: no data is not "empty" */
-#define POUR_CAN_CAL_STATUS_MAX 18u
+/* The answer to a CalibrationRead: the frame carries the stored block (Stored says its state), not a new
+ * measurement; a controller without a calibration of its own answers UNAVAILABLE instead. */
+#define POUR_CAN_CAL_STORED 19u
+#define POUR_CAN_CAL_STATUS_MAX 19u
 #define POUR_CAN_CAL_STORED_MAX 5u
 #define POUR_CAN_PARAM_RESULT_MAX 9u    /* ParamAck.Result: a pour_param_result_t, or an ExperimentStart's refusal */
 /* ParamAck.Result for an ExperimentStart (beyond pour_param_result_t; OK: accepted, OUT_OF_RANGE: a kind
@@ -240,8 +245,8 @@ pour_status_t pour_can_pack_param_ack(uint8_t node_id, const pour_can_param_ack_
 pour_status_t pour_can_pack_tare(uint8_t node_id, const pour_can_tare_t *msg, pour_can_frame_t *frame);
 pour_status_t pour_can_pack_experiment_start(uint8_t node_id, const pour_can_experiment_start_t *msg,
                                              pour_can_frame_t *frame);
-/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET, _CALIBRATION_START, _PARAM_SAVE and
- * _ZERO (POUR_EINVAL
+/* The commands without signals: POUR_CAN_CMD_CLEAR_ERRORS, _STOP, _RESET, _CALIBRATION_START, _PARAM_SAVE,
+ * _ZERO and _CALIBRATION_READ (POUR_EINVAL
  * for another cmd). */
 pour_status_t pour_can_pack_command(uint8_t node_id, uint8_t cmd, pour_can_frame_t *frame);
 

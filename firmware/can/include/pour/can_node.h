@@ -60,6 +60,7 @@ typedef struct {
   uint8_t heartbeat_counter;
   pour_can_node_counters_t counters;
   bool calibration_requested;                /* a CalibrationStart arrived since the last tick */
+  bool calibration_read;                     /* a CalibrationRead waits for its answer */
   bool calibration_start;                    /* one was accepted: the port has not taken it yet */
   bool calibration_report;                   /* the port's outcome waits to be sent */
   uint8_t calibration_gate;                  /* the port's interlock: POUR_CAN_CAL_MEASURING or a refusal */
@@ -117,14 +118,17 @@ void pour_can_node_begin_tick(pour_can_node_t *node, pour_control_input_t *in);
  * CalibrationStart its CalibrationResult into tx: refused in RUN (REFUSED_RUNNING) and in ESTOP
  * (REFUSED_ESTOP), else the port's gate if it measures (config.can_calibrate: MEASURING, or its
  * interlock's refusal; pour_can_node_gate_calibration), else the port's answer
- * (pour_can_node_set_calibration); or else a reported outcome. overruns: the port's missed deadlines.
+ * (pour_can_node_set_calibration); or else a reported outcome; or else, after a CalibrationRead, the stored
+ * calibration with Status STORED (UNAVAILABLE without config.can_calibrate: no calibration of its own), in
+ * any mode, changing nothing. One CalibrationResult a tick: a read waits behind the others. overruns: the
+ * port's missed deadlines.
  * Returns the count. */
 uint8_t pour_can_node_end_tick(pour_can_node_t *node, const pour_control_output_t *out, uint32_t overruns,
                                pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX]);
 
 /* The CalibrationResult end_tick sends, for a port that sends it itself (mode: the core's pour_mode_t of
  * the tick): the answer to a CalibrationStart since the last call (its refusal, MEASURING, or the port's
- * answer), else a reported outcome. Returns false if there is none. */
+ * answer), else a reported outcome, else the answer to a CalibrationRead. Returns false if there is none. */
 bool pour_can_node_calibration_frame(pour_can_node_t *node, uint8_t mode, pour_can_frame_t *frame);
 
 /* Advances the command watchdog by elapsed_ms (end_tick does it by 1 each tick; a port without a tick of
