@@ -116,3 +116,21 @@ def test_a_bad_reversal_cost_is_refused_by_the_c_rollout():
         pol = poursim.Policy(np.zeros((6, 2)), np.array([-1.0, 1.0]), 10, 0.0, 2.356194, 4.0, True, bad)
         with pytest.raises(poursim.SimError, match="k_reversal"):
             poursim.World(cfg).rollout(pol, 1)
+
+
+def test_a_rig_file_that_weighs_the_fill_narrows_the_fill_edges_to_its_range(tmp_path, source_dir, build_dir):
+    # 11.7 L weighed to ±0.1 mm: ±20 % would ask for 14 L, more than the bucket holds; the edges are the range
+    # pour-train --rig trains over, ±√3 σ.
+    rig = tmp_path / "rig.toml"
+    rig.write_text("fill_depth = 0.2595\n[sigma]\nfill_depth = 0.0001\n")
+    out = tmp_path / "rob"
+    r = subprocess.run([sys.executable, "-m", "pour.eval.evaluate", "robust", "--header",
+                        str(source_dir / "policy" / "weights.h"), "--out", str(out), "--nominal-episodes", "1",
+                        "--edge-episodes", "1", "--build-dir", str(build_dir), "--rig", str(rig)],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode in (0, 1), r.stderr
+    rows = {row["scene"]: row for row in json.loads((out / "robustness.json").read_text())["rows"]}
+    w = 3 ** 0.5 * 0.0001 / 0.2595
+    assert rows[f"fill +{w * 100:.2g} %"]["sets"] == [f"fill_depth={0.2595 * (1 + w):.6g}"]
+    assert rows[f"fill -{w * 100:.2g} %"]["sets"] == [f"fill_depth={0.2595 * (1 - w):.6g}"]
+    assert rows["nominal"]["poured_l"] > 11.0   # the rig's fill, not the default 10 L

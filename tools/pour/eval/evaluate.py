@@ -121,15 +121,17 @@ def robust(args: argparse.Namespace) -> int:
         weights_h.parse_weights_h(args.header)
         if not args.out.parent.is_dir():
             raise ValueError(f"--out: folder {args.out.parent} does not exist")
-        nominal, rig_sets = poursim.default_config(), []
+        nominal, rig_sets, fill_edge = poursim.default_config(), [], robustness.FILL_EDGE
         if args.rig is not None:
             from pour.sysid import rig as srig
             rig = srig.load(args.rig)
             nominal.update(rig.values)
             rig_sets = srig.host_sim_sets(rig)
+            # A weighed fill: its edges are the range pour-train --rig trains over.
+            fill_edge = srig.centred({"rand_fill": fill_edge}, rig)["rand_fill"]
         rows = robustness.run(args.header, args.out, args.nominal_episodes, args.edge_episodes, args.seed,
                               lambda a: run_host_sim(a, args.build_dir), nominal, args.workers, args.quiet,
-                              rig_sets)
+                              rig_sets, fill_edge)
     except (OSError, RuntimeError, ValueError, weights_h.WeightsHError, poursim.SimError) as exc:
         print(f"pour-eval: error: {exc}", file=sys.stderr)
         return 2

@@ -31,12 +31,17 @@ class Scene:
     nominal: bool = False
 
 
-def scenes() -> list[Scene]:
-    """Nominal, then each perturbation at the edge of the range the policy is trained over."""
+FILL_EDGE = 0.2   # the fill's range, relative; a rig file that weighs the fill narrows it (rig.centred)
+
+
+def scenes(fill: float = FILL_EDGE) -> list[Scene]:
+    """Nominal, then each perturbation at the edge of the range the policy is trained over (the fill's: ±fill,
+    relative)."""
+    pct = f"{fill * 100:.2g}"
     return [
         Scene("nominal", nominal=True),
-        Scene("fill -20 %", {"fill_depth": lambda c: 0.8 * c["fill_depth"]}),
-        Scene("fill +20 %", {"fill_depth": lambda c: 1.2 * c["fill_depth"]}),
+        Scene(f"fill -{pct} %", {"fill_depth": lambda c: (1.0 - fill) * c["fill_depth"]}),
+        Scene(f"fill +{pct} %", {"fill_depth": lambda c: (1.0 + fill) * c["fill_depth"]}),
         Scene("target -2 cm", {"target_dx": lambda c: c["target_dx"] - 0.02}),
         Scene("target +2 cm", {"target_dx": lambda c: c["target_dx"] + 0.02}),
         Scene("pivot -2 cm", {"pivot_height": lambda c: c["pivot_height"] - 0.02}),
@@ -132,11 +137,13 @@ def plot(rows: Sequence[dict[str, Any]], path: Path) -> None:
 
 def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed: int,
         run_host_sim: Callable[[Sequence[str]], Any], nominal_config: dict[str, float],
-        workers: int = 2, quiet: bool = False, rig_sets: Sequence[str] = ()) -> list[dict[str, Any]]:
+        workers: int = 2, quiet: bool = False, rig_sets: Sequence[str] = (),
+        fill_edge: float = FILL_EDGE) -> list[dict[str, Any]]:
     """Every scene's row (and the table, JSON and plot in out); progress on stderr by episodes unless quiet.
-    rig_sets: host_sim --set arguments of the nominal rig (a fitted rig file), before each scene's own."""
+    rig_sets: host_sim --set arguments of the nominal rig (a fitted rig file), before each scene's own;
+    fill_edge: the fill's edges, relative."""
     out.mkdir(parents=True, exist_ok=True)
-    todo = scenes()
+    todo = scenes(fill_edge)
     episodes = {sc.name: nominal_episodes if sc.nominal else edge_episodes for sc in todo}
 
     with cli.bar(sum(episodes.values()), f"{len(todo)} scenes", quiet, unit="episode") as progress:

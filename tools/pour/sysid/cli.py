@@ -2,12 +2,13 @@
 """pour-sysid: fit a rig file from the log of the controller's identify experiment (bucket empty).
 
 LOG is a candump -L log as pour-bench identify records it on a rig, or as host_sim --experiment identify
-writes it; --tilt adds the tilt experiment's log (with water), which gives the flow coefficient at the lip
-and the simulator's fluid_viscosity that reproduces it. The figures the log cannot give (the bucket's mass
-and drawing, the gear ratio, the encoder's bits, the scale's resolution, the liquid's density) come from
---base (a rig file or simulator config; default: the simulator's
-defaults). The rig file gets the fitted keys with their standard deviations; --png draws the measured and
-the fitted responses over each other.
+writes it; --tilt adds the tilt experiment's log (with water), which weighs the fill (fill_depth: a tofu
+line's batch volume is the installation's, and pour-train --rig centres the fill range on it) and gives the
+flow coefficient at the lip and the simulator's fluid_viscosity that reproduces it. The figures the log
+cannot give (the bucket's mass and drawing, the gear ratio, the encoder's bits, the scale's resolution, the
+liquid's density) come from --base (a rig file or simulator config; default: the simulator's defaults). The
+rig file gets the fitted keys with their standard deviations; --png draws the measured and the fitted
+responses over each other.
 """
 from __future__ import annotations
 
@@ -30,6 +31,8 @@ EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a lo
           "excite, a --tilt log without outflow over the lip); 2 bad input (the command line, the base rig "
           "file).")
 
+NO_FILL = "fill_depth: not identified (no --tilt log with water): training keeps its config's fill and range"
+
 
 def parser():
     ap = cli.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
@@ -37,8 +40,9 @@ def parser():
     ap.add_argument("--out", type=Path, required=True, help="the rig file to write (.toml, or .cfg for host_sim)")
     ap.add_argument("--node", type=int, default=0, help="the controller's node id (default 0)")
     ap.add_argument("--base", type=Path, help="rig file or simulator config with the rig's known figures")
-    ap.add_argument("--tilt", type=Path, help="candump -L log of the tilt experiment (with water): the flow "
-                    "coefficient at the lip")
+    ap.add_argument("--tilt", type=Path, metavar="LOG", help="candump -L log of the tilt experiment (the bucket "
+                    "filled as for a pour): the fill (fill_depth) weighed, and the flow coefficient at the lip; "
+                    "without it the fill is not identified and the rig file leaves it out")
     ap.add_argument("--png", type=Path, help="measured vs fitted responses")
     ap.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     return ap
@@ -129,8 +133,10 @@ def main(argv: list[str] | None = None) -> int:
         fit = sf.fit_identify(run, base)
         e = fit.estimates
         if a.tilt is not None:
+            tilt_run = slog.read(a.tilt, a.node)
+            e["fill_depth"] = sf.fit_fill(tilt_run, base)
             # The tilt's scale lags by the delay the identify log just measured.
-            cd, tilt = flow.fit_flow(slog.read(a.tilt, a.node), {**base, "scale_delay_s": e["scale_delay_s"].value})
+            cd, tilt = flow.fit_flow(tilt_run, {**base, "scale_delay_s": e["scale_delay_s"].value})
             e["flow_coefficient"] = cd
             e[flow.KEY] = flow.key_of(cd)
     except slog.LogError as err:
@@ -147,6 +153,8 @@ def main(argv: list[str] | None = None) -> int:
     header += [f"{k}: {v.value:.6g} +- {v.sigma:.3g} {v.unit}: {v.meaning}" for k, v in e.items()]
     if flagged:
         header.append("uncertain beyond 5 %: " + ", ".join(flagged))
+    if "fill_depth" not in e:
+        header.append(NO_FILL)
     srig.save(a.out, fitted, header)
     if a.png is not None:
         fit.series["theta_sim"] = simulate(run, fit, base)
@@ -156,6 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     else:
         for k, v in e.items():
             print(f"{k:22s} {v.value:12.6g} +- {v.sigma:<10.3g} {v.unit:18s} {v.meaning}")
+        if "fill_depth" not in e:
+            print(NO_FILL)
         print(f"{PROG}: rig file {a.out}" + (f", figure {a.png}" if a.png else ""))
     return 0
 

@@ -262,3 +262,45 @@ def check_trust(fit: Fit) -> list[str]:
     """Names of the rig file's figures whose relative uncertainty exceeds TRUST_SIGMA_MAX (they are written,
     and flagged)."""
     return [k for k, e in fit.estimates.items() if e.value and e.sigma / abs(e.value) > TRUST_SIGMA_MAX]
+
+
+FILL_PHASE = 5           # tilt: up at the tilt speed (pour/experiment.h)
+FILL_SETTLE_S = 0.25     # [s] from the start: the liquid still settles on its cell (-0.5 % in that span)
+FILL_THETA_MAX = np.radians(20.0)  # [rad] below it nothing has left: an ideal liquid below 12.7 L in the default
+                                   # bucket first leaves beyond it (41° at 10 L), the circle pile later still
+FILL_TICKS_MIN = 1000    # [ticks] of readings the mean needs: ~80 conversions
+
+
+def fit_fill(run: Run, rig: dict) -> Estimate:
+    """fill_depth [m] from the tilt experiment's log (the bucket filled as for a pour, the scales tared with
+    it empty): the rotating cell's mean reading while the bucket tilts slowly through its first 20°, before
+    any liquid leaves, is the liquid's mass; depth = mass / (liquid_density π (width/2)²), the
+    simulator's own relation. At 0.1 rad/s the inertial load is ~1e-4 of the weight. The readings scatter
+    by a few % as the liquid jostles on the cell (the cell's own noise, under a gram, is far below that):
+    the standard deviation is the spread of 8 contiguous batch means over √8, the liquid's density being
+    the base rig's (the recipe's) and taken as exact."""
+    if run.kind != 2:
+        raise LogError("the fill's log is of the identify experiment (bucket empty): weighing the fill needs the "
+                       "tilt experiment's (pour-bench identify --kind tilt, the bucket filled)")
+    theta = run.theta(int(rig["encoder_bits"]))
+    t = run.t - run.t[0]
+    use = (run.action == FILL_PHASE) & (theta < FILL_THETA_MAX) & (t >= FILL_SETTLE_S)
+    if use.sum() < FILL_TICKS_MIN:
+        raise LogError(f"cannot weigh the fill: {int(use.sum())} ticks of the tilt below "
+                       f"{np.degrees(FILL_THETA_MAX):.0f}° after the first {FILL_SETTLE_S} s (at least "
+                       f"{FILL_TICKS_MIN}): a faster tilt than 0.1 rad/s?")
+    reading = run.scale_rotating[use]
+    mass_g = float(np.mean(reading))
+    batches = np.array([b.mean() for b in np.array_split(reading, BATCHES)])
+    sigma_g = float(np.std(batches, ddof=1) / np.sqrt(BATCHES))
+    area = np.pi * (0.5 * rig["bucket_inner_width"]) ** 2
+    per_m = rig["liquid_density"] * area * 1000.0   # [g] per metre of depth
+    depth, sigma = mass_g / per_m, sigma_g / per_m
+    inner = rig["bucket_height"] - rig["bucket_wall"]
+    if mass_g < 20 * rig["scale_resolution_g"] or depth > inner:
+        raise LogError(f"the rotating scale weighs {mass_g:.0f} g before the tilt, a depth of {depth * 100:.1f} cm "
+                       f"at liquid_density {rig['liquid_density']:g} kg/m^3 (the bucket is {inner * 100:.1f} cm "
+                       "deep): no water in the bucket, or the scales were not tared with it empty")
+    litres = area * depth * 1000.0
+    return Estimate(depth, sigma, "m", f"the liquid's depth upright: {mass_g:.0f} +- {sigma_g:.0f} g weighed "
+                                       f"before the tilt, {litres:.2f} L at liquid_density {rig['liquid_density']:g}")

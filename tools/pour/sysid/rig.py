@@ -15,9 +15,9 @@ from pathlib import Path
 from pour import atomic
 from pour.sim import poursim
 
-# The figures pour-sysid fits, in the order it writes them (fluid_viscosity with a tilt log only).
+# The figures pour-sysid fits, in the order it writes them (fill_depth and fluid_viscosity with a tilt log only).
 FITTED = ("torque_scale", "motor_rotor_inertia", "friction_coulomb", "friction_viscous", "command_latency_ticks",
-          "scale_delay_s", "scale_noise_g", "fluid_viscosity")
+          "scale_delay_s", "scale_noise_g", "fill_depth", "fluid_viscosity")
 
 
 class RigError(ValueError):
@@ -93,7 +93,7 @@ def save(path: Path, rig: Rig, header: list[str]) -> None:
 
 # The simulator's randomisation keys that spread each fitted figure (config_fields.h, "domain randomisation").
 SPREAD = {"motor_rotor_inertia": "rand_motor", "friction_coulomb": "rand_motor", "friction_viscous": "rand_motor",
-          "scale_delay_s": "rand_sensor", "scale_noise_g": "rand_sensor"}
+          "scale_delay_s": "rand_sensor", "scale_noise_g": "rand_sensor", "fill_depth": "rand_fill"}
 
 
 def centred(options: dict, rig: Rig) -> dict:
