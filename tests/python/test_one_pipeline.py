@@ -9,6 +9,7 @@ import subprocess
 import numpy as np
 import pytest
 
+import pour.sim.envs
 import pour.sim.gym_env
 from pour.policy import fixedpoint as fp
 from pour.policy import linear, weights_h
@@ -76,3 +77,25 @@ def test_host_sim_rollout_and_gym_env_give_bit_identical_torques(build_dir, sour
     # the rate elsewhere), so the three runs are one run.
     np.testing.assert_array_equal(r_actions, h_actions)
     np.testing.assert_array_equal(r_torque, h_torque)
+
+
+def test_the_env_measures_an_episode_as_the_c_rollout_does():
+    """gym_env.greedy_metrics (how pour-results evaluates an actor poursim_rollout cannot run, such as an MLP)
+    gives the C rollout's figures for the same greedy policy: volumes, finish time, torque reversals and the
+    discounted return. The policy is a stiff feedback hold (u = -8 θn - 4.5 ωn + 8.9) that chatters over three
+    torque levels, so the reversal count is not zero."""
+    levels = linear.action_levels(11)
+    beta = np.array([-8.0, -4.5, 0.0, 0.0, 0.0, 8.9])
+    bias = np.zeros(6)
+    bias[5] = 1.0
+    w = 50.0 * (2.0 * np.outer(beta, levels) - np.outer(bias, levels ** 2))
+    env = pour.sim.gym_env.PourEnv("sim", n_actions=11, decision_period_ms=PERIOD, episode_s=EPISODE_S)
+    sim = pour.sim.envs.make_env("sim", 11, PERIOD, EPISODE_S)
+    act = lambda obs: int(np.argmax(np.append(obs.astype(np.float64), 1.0) @ w))  # noqa: E731
+    for seed in SEEDS:
+        want = sim.rollout(w, seed, True).metrics
+        got = pour.sim.gym_env.greedy_metrics(env, act, seed)
+        assert want["reversals"] > 5 and got["reversals"] == want["reversals"]
+        for key in ("v_target", "v_spill", "finish_s"):
+            assert got[key] == want[key], key
+        assert got["return"] == pytest.approx(want["return"], rel=1e-12)

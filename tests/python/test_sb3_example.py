@@ -15,6 +15,7 @@ import pytest
 from conftest import BUILD_DIR
 from pour.examples import sb3_ppo
 from pour.policy import linear, weights_h
+from pour.sim import gym_env
 
 STEPS = 2048
 
@@ -87,6 +88,8 @@ def test_an_actor_with_a_hidden_layer_is_refused():
     (["--env", "pour/Nope-v0"], "Nope"),
     (["--header", "/nonexistent/dir/w.h"], "--header"),
     (["--init-header", "/nonexistent/w.h"], "cannot read"),
+    (["--actor", "mlp"], "--actor mlp needs --like"),
+    (["--actor", "tree"], "invalid choice: 'tree'"),
 ])
 def test_bad_input_is_a_clear_error(tmp_path, argv, message):
     r = subprocess.run([sys.executable, "-m", "pour.examples.sb3_ppo", "--steps", "64", "--out",
@@ -214,3 +217,74 @@ def test_a_missing_or_bad_like_config_is_a_clear_error(tmp_path):
                             "--validate-every", "1", "--out", str(tmp_path / "run")],
                            capture_output=True, text=True, timeout=300)
         assert r.returncode != 0 and "Traceback" not in r.stderr and message in r.stderr, r.stderr
+
+
+def test_the_mlp_actor_in_numpy_is_sb3s_deterministic_action():
+    """gym_env.mlp_actor on sb3_ppo.mlp_layers (how validation and pour-results run an MLP actor, without torch)
+    picks SB3's own deterministic action."""
+    import gymnasium as gym
+
+    model = sb3_ppo.make_model(gym.make("pour/PourToy-v0"), seed=2, actor="mlp")
+    layers = sb3_ppo.mlp_layers(model)
+    assert [a.shape for a in layers] == [(5, 64), (64,), (64, 64), (64,), (64, 11), (11,)]
+    with pytest.raises(sb3_ppo.ExampleError, match="not softmax-linear"):
+        sb3_ppo.linear_weights(model)
+    obs = np.random.default_rng(2).random((500, 5)).astype(np.float32)
+    want, _ = model.predict(obs, deterministic=True)
+    act = gym_env.mlp_actor(layers)
+    assert [act(o) for o in obs] == list(want)
+    assert len(set(want)) > 1   # the observations reach more than one action
+    with pytest.raises(sb3_ppo.ExampleError, match="actor 'tree'"):
+        sb3_ppo.make_model(gym.make("pour/PourToy-v0"), seed=2, actor="tree")
+
+
+def test_an_mlp_run_is_read_through_the_env(tmp_path):
+    """--actor mlp: every validation is the env's greedy run of that actor on the trainer's validation seeds,
+    the actors are the checkpoint's history, and pour-results reads the run through the env (no W, no
+    policy.json: pour-export refuses it)."""
+    from pour.eval import results
+    from pour.train import config as cfgmod
+    from pour.train import trainer
+
+    (tmp_path / "toy.toml").write_text(LIKE)
+    run = tmp_path / "run"
+    final = sb3_ppo.train_run(tmp_path / "toy.toml", run, episodes=6, every=2, seed=4, actor="mlp",
+                              n_steps=128, batch_size=64)
+    log = trainer.read_log(run / "log.csv")
+    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    assert [int(r["episodes"]) for r in log] == [2, 4, 6] and ck["history_mlp_0"].shape == (3, 5, 64)
+    assert all(np.array_equal(ck[f"history_mlp_{k}"][-1], final[k]) for k in range(6))
+    assert not np.array_equal(ck["history_mlp_4"][0], ck["history_mlp_4"][-1])   # PPO updated the actor
+    cfg = cfgmod.load(tmp_path / "toy.toml")
+    seeds = trainer.episode_seeds(4, trainer.STREAM_VALID, 0, 2)
+    for i, row in enumerate(log):
+        ev = sb3_ppo.mlp_validation(cfg, [ck[f"history_mlp_{k}"][i] for k in range(6)], seeds)
+        assert float(row["eval_v_target"]) == pytest.approx(ev["eval_v_target"])
+        assert float(row["eval_score"]) == pytest.approx(ev["eval_score"])
+    best = int(np.argmax([float(r["eval_score"]) for r in log]))
+    assert np.array_equal(ck["best_mlp_4"], ck["history_mlp_4"][best])
+    doc = json.loads((run / "actor.json").read_text())
+    assert doc["actor"] == "mlp" and doc["hidden"] == [64, 64] and not (run / "policy.json").exists()
+    # pour-results: the final actor on the held-out seeds through the env, as the validation runs it.
+    row = results.float_rows("PPO MLP", [run], 2, "last")
+    assert "Gymnasium env" in row["how"]
+    env = gym_env.PourEnv("toy", 11, 10, 10.0)
+    want = [100 * gym_env.greedy_metrics(env, gym_env.mlp_actor(final), s)["v_target"]
+            for s in range(results.FIRST_SEED, results.FIRST_SEED + 2)]
+    assert row["poured_pct"] == pytest.approx(np.mean(want))
+    assert results.reach(run, 2)["run"] == str(run)
+    r = subprocess.run([str(Path(sys.executable).parent / "pour-export"), str(run), "--out", str(tmp_path / "w.h")],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode != 0 and "policy.json" in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_an_mlp_run_with_a_broken_description_is_a_clear_error(tmp_path):
+    from pour.eval import results
+
+    (tmp_path / "toy.toml").write_text(LIKE)
+    run = tmp_path / "run"
+    sb3_ppo.train_run(tmp_path / "toy.toml", run, episodes=2, every=2, seed=4, actor="mlp", n_steps=128,
+                      batch_size=64)
+    (run / "actor.json").write_text("{}")
+    with pytest.raises(ValueError, match="actor.json: not an MLP actor's description"):
+        results.reach(run, 2)

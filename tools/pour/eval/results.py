@@ -21,7 +21,7 @@ import numpy as np
 from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
-from pour.sim import envs
+from pour.sim import envs, gym_env
 from pour.train import trainer
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
@@ -49,24 +49,59 @@ def host_sim_row(name: str, args: Sequence[str], n: int, build_dir: str | None) 
                 [e["finish_s"] for e in per], [e["return"] for e in per], [e["reversals"] for e in per])
 
 
-_SIMS: dict[tuple[int, int], Any] = {}
+_SIMS: dict[tuple[str, int, int], Any] = {}
 
 
 def _greedy_metrics(job: tuple) -> dict[str, float]:
-    kind, n_actions, period_ms, w, seed = job
+    """One held-out episode of 10 s on the nominal rig: a W through the C rollout, an MLP actor (a tuple of its
+    layers) through the Gymnasium env, which runs the same simulator and firmware pipeline tick by tick."""
+    kind, n_actions, period_ms, policy, seed = job
+    if isinstance(policy, tuple):
+        key = ("env:" + kind, n_actions, period_ms)
+        if key not in _SIMS:
+            _SIMS[key] = gym_env.PourEnv(kind, n_actions, period_ms, 10.0)
+        return gym_env.greedy_metrics(_SIMS[key], gym_env.mlp_actor(policy), seed)
     if (kind, n_actions, period_ms) not in _SIMS:
         _SIMS[(kind, n_actions, period_ms)] = envs.make_env(kind, n_actions, period_ms, 10.0)
-    return dict(_SIMS[(kind, n_actions, period_ms)].rollout(w, seed, True).metrics)
+    return dict(_SIMS[(kind, n_actions, period_ms)].rollout(policy, seed, True).metrics)
+
+
+def _mlp_layers(state: dict[str, Any], prefix: str) -> list[np.ndarray]:
+    return [state[f"{prefix}{k}"] for k in range(sum(1 for key in state if key.startswith(prefix)))]
+
+
+def _run_policies(run: Path) -> tuple[tuple[str, int, int], dict[str, Any], list[Any]]:
+    """A run's (env kind, n_actions, decision period), its output policies ('best', 'last') and its validated
+    history: W arrays for the trainer's and the linear actors' runs (policy.json, history_w), tuples of layers for
+    an MLP actor's (actor.json, pour.examples.sb3_ppo --actor mlp: history_mlp_<k>)."""
+    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    if (run / "actor.json").exists():
+        try:
+            doc = json.loads((run / "actor.json").read_text(encoding="utf-8"))
+            spec = (doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]))
+        except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"{run}/actor.json: not an MLP actor's description ({exc})") from None
+        hist = _mlp_layers(ck, "history_mlp_")
+        if not hist:
+            raise ValueError(f"{run}: its checkpoint has no MLP actor history (history_mlp_0...)")
+        history = [tuple(layer[i] for layer in hist) for i in range(len(hist[0]))]
+        return spec, {"best": tuple(_mlp_layers(ck, "best_mlp_")), "last": history[-1]}, history
+    doc = export.load_policy(run)
+    spec = (doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]))
+    if "history_w" not in ck:
+        raise ValueError(f"{run}: its checkpoint has no W history (history_w): train it again with this pour-train")
+    return spec, {w: export.weights_of(doc, w) for w in ("best", "last")}, list(ck["history_w"])
 
 
 def _jobs(runs: Sequence[Path], n: int, which: str) -> list[tuple]:
-    """The held-out episodes of several runs' policies (export.weights_of's which), as _greedy_metrics jobs."""
+    """The held-out episodes of several runs' policies ('best' or 'last', as export.weights_of's which), as
+    _greedy_metrics jobs."""
+    if which not in ("best", "last"):
+        raise export.ExportError(f"which = {which!r}: expected 'best' or 'last'")
     jobs = []
     for run in runs:
-        doc = export.load_policy(run)
-        w = export.weights_of(doc, which)
-        jobs += [(doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]), w, seed)
-                 for seed in range(FIRST_SEED, FIRST_SEED + n)]
+        spec, out, _ = _run_policies(run)
+        jobs += [(*spec, out[which], seed) for seed in range(FIRST_SEED, FIRST_SEED + n)]
     return jobs
 
 
@@ -74,13 +109,15 @@ def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> 
     """The output policies of several runs (which 'best': policy.json's best_w, the best greedy-validated
     weights, or the last ones for configs with eval.select_best = false; 'last': the final weights),
     greedy, n held-out episodes each, pooled."""
-    ms = _held_out(_jobs(runs, n, which))
+    jobs = _jobs(runs, n, which)
+    ms = _held_out(jobs)
     p = [100 * m["v_target"] for m in ms]
     s = [100 * m["v_spill"] for m in ms]
     f = [m["finish_s"] for m in ms]
     r = [m["return"] for m in ms]
     what = "output" if which == "best" else "final"
-    return _row(name, f"{what} float policies of {len(runs)} runs, greedy (C rollout)", p, s, f, r,
+    how = "Gymnasium env" if any(isinstance(j[3], tuple) for j in jobs) else "C rollout"
+    return _row(name, f"{what} policies of {len(runs)} runs, greedy ({how})", p, s, f, r,
                 [m["reversals"] for m in ms])
 
 
@@ -99,24 +136,19 @@ def _held_out(jobs: list[tuple]) -> list[dict[str, float]]:
 
 def reach(run: Path, n: int) -> dict[str, Any]:
     """When a run's greedy policy first pours >= 98 % and spills <= 1 % on average over n held-out episodes
-    of 10 s: its training episodes and wall time then (None when it never did), from the W history in its
-    checkpoint and the validation columns of its log."""
-    cfg_doc = export.load_policy(run)
+    of 10 s: its training episodes and wall time then (None when it never did), from the actor history in its
+    checkpoint (W, or an MLP's layers, _run_policies) and the validation columns of its log."""
+    spec, _, history = _run_policies(run)
     log = trainer.read_log(run / "log.csv")
-    ck = trainer.load_checkpoint(run / "checkpoint.npz")
-    if "history_w" not in ck:
-        raise ValueError(f"{run}: its checkpoint has no W history (history_w): train it again with this pour-train")
-    kind = cfg_doc["config"]["env"]["kind"]
-    na, period = int(cfg_doc["n_actions"]), int(cfg_doc["decision_period_ms"])
     checks = 0
     for i, row in enumerate(log):
         vt, vs = float(row["eval_v_target"]), float(row["eval_v_spill"])
-        if not (vt >= PREFILTER[0] and vs <= PREFILTER[1]) or i >= len(ck["history_w"]):
+        if not (vt >= PREFILTER[0] and vs <= PREFILTER[1]) or i >= len(history):
             continue
         if checks == MAX_CHECKS:
             break
         checks += 1
-        ms = _held_out([(kind, na, period, ck["history_w"][i], seed) for seed in range(FIRST_SEED, FIRST_SEED + n)])
+        ms = _held_out([(*spec, history[i], seed) for seed in range(FIRST_SEED, FIRST_SEED + n)])
         poured = 100 * float(np.mean([m["v_target"] for m in ms]))
         spilled = 100 * float(np.mean([m["v_spill"] for m in ms]))
         if poured >= BAR_POURED_PCT and spilled <= BAR_SPILLED_PCT:

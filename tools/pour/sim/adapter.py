@@ -20,6 +20,10 @@ from pour.policy import fixedpoint as fp
 from pour.sim import episode, poursim
 
 
+# A torque command beyond +-1 N.m has a sign; a flip of it is a reversal (host_sim's kReversalTorque).
+REVERSAL_NM = 1.0
+
+
 @contextmanager
 def _env_errors(what: str) -> Iterator[None]:
     """Re-raises pour.sim.poursim's SimError as the trainer's EnvError, prefixed with what was being done."""
@@ -104,6 +108,8 @@ class SimStepper:
         self.seq = 0
         self.out: core.Output | None = None
         self.torques: list[int] = []  # the core's command of every tick so far, Q15
+        self.settled: list[float] = []  # V_target + V_spill after every tick so far
+        self.ret, self._discount, self.reversals, self._last_sign = 0.0, 1.0, 0, 0
         self._sense()
 
     def _sense(self) -> None:
@@ -141,5 +147,28 @@ class SimStepper:
                 self.world.set_brake(self.out.brake)
                 self.obs = self.world.step(self.out.torque / 32768.0)
                 self._sense()
+                self._meter(self.out.torque / 32768.0 * self.tau_max_nm)
                 r += self.reward.step(self.obs.v_target, self.obs.v_spill)
         return r
+
+    def _meter(self, command_nm: float) -> None:
+        """The C rollout's episode meter (host_sim's EpisodeMeter) for one tick: the settled share, a torque
+        reversal (the command's sign beyond REVERSAL_NM flipping) and the discounted return."""
+        o = self.obs
+        self.settled.append(float(o.v_target + o.v_spill))
+        sign = 1 if command_nm > REVERSAL_NM else (-1 if command_nm < -REVERSAL_NM else 0)
+        if sign:
+            self.reversals += int(self._last_sign != 0 and sign != self._last_sign)
+            self._last_sign = sign
+        self.ret += self._discount * self.reward.step(o.v_target, o.v_spill)
+        self._discount *= self.reward.gamma
+
+    def metrics(self) -> dict[str, float]:
+        """The episode so far as the C rollout reports it: volumes, finish time (the first tick by which 99 %
+        of what left the bucket had settled, -1 when less than 1 % left), torque reversals and the return."""
+        o, dt = self.obs, float(self.world.config.dt)
+        fin = self.settled[-1] if self.settled else 0.0
+        done = np.flatnonzero(np.asarray(self.settled) >= 0.99 * fin) if fin >= 0.01 else np.array([], dtype=int)
+        return {"v_target": float(o.v_target), "v_spill": float(o.v_spill), "v_rotating": float(o.v_rotating),
+                "finish_s": float((done[0] + 1) * dt) if done.size else -1.0, "reversals": self.reversals,
+                "return": self.ret}

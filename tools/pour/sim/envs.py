@@ -59,6 +59,7 @@ class ToyEnv:
         self.theta, self.omega = 0.0, 0.0
         self.v_rot, self.v_tgt, self.v_spill = 1.0, 0.0, 0.0
         self.pour_at = 0.55 + 0.05 * rng.standard_normal()  # the full bucket's first-pour angle [rad]
+        self._moved: list[float] = []  # V_target + V_spill after every advance
         return rng
 
     def features(self) -> np.ndarray:
@@ -90,7 +91,16 @@ class ToyEnv:
                 v_tgt += dv * (1.0 - spill)
             r_sum += self.reward.step(v_tgt, v_spill)
         self.theta, self.omega, self.v_rot, self.v_tgt, self.v_spill = theta, omega, v_rot, v_tgt, v_spill
+        self._moved.append(v_tgt + v_spill)
         return r_sum
+
+    def metrics(self) -> dict[str, float]:
+        """The episode so far: volumes, and the finish time (the first decision by whose start 99 % of what
+        left the bucket had landed; -1 when less than 1 % left)."""
+        moved, final = np.asarray(self._moved[:-1]), self.v_tgt + self.v_spill
+        done = np.flatnonzero(moved >= 0.99 * final) if final >= 0.01 else np.array([], dtype=int)
+        return {"v_target": self.v_tgt, "v_spill": self.v_spill, "v_rotating": self.v_rot,
+                "finish_s": float((done[0] + 1) * self.period * 1e-3) if done.size else -1.0}
 
     def rollout(self, w: np.ndarray, seed: int, greedy: bool) -> Episode:
         rng = self.reset(seed)
@@ -103,13 +113,7 @@ class ToyEnv:
             a = choose(w, x, greedy, rng)
             xs[d], acts[d] = x, a
             rews[d] = self.advance(float(self.levels[a]), self.period)
-        moved = xs[:, 3] + xs[:, 4]
-        final = self.v_tgt + self.v_spill
-        t_s = np.arange(n_dec) * self.period * 1e-3
-        done = np.flatnonzero(moved >= 0.99 * final) if final >= 0.01 else np.array([], dtype=int)
-        metrics = {"v_target": self.v_tgt, "v_spill": self.v_spill, "v_rotating": self.v_rot,
-                   "finish_s": float(t_s[done[0]]) if done.size else -1.0}
-        return Episode(xs, acts, rews, metrics, seed)
+        return Episode(xs, acts, rews, self.metrics(), seed)
 
 
 def make_env(kind: str, n_actions: int, decision_period_ms: int, episode_s: float,

@@ -18,7 +18,7 @@ time limit (truncated=True); nothing terminates it earlier.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable, Sequence
 
 import gymnasium as gym
 import numpy as np
@@ -116,6 +116,36 @@ class PourEnv(gym.Env):
         if self.render_mode != "rgb_array":
             return None
         return scene_rgb(self._plant.world)
+
+
+def greedy_metrics(env: PourEnv, act: Callable[[np.ndarray], int], seed: int) -> dict[str, float]:
+    """One whole episode of env from reset(seed=seed), act(observation) -> action at every decision, for a
+    policy that poursim_rollout cannot run (one that is not softmax-linear): the plant's end-of-episode
+    metrics (the 'sim' backend's are the C rollout's: volumes, finish_s, reversals, return; the toy counts
+    no reversals and has no discounted return: NaN) and reward_sum, the episode's rewards summed."""
+    obs, _ = env.reset(seed=seed)
+    truncated, reward_sum = False, 0.0
+    while not truncated:
+        obs, reward, _, truncated, _ = env.step(act(obs))
+        reward_sum += reward
+    return {"reversals": np.nan, "return": np.nan, **env.unwrapped._plant.metrics(), "reward_sum": reward_sum}
+
+
+def mlp_actor(layers: Sequence[np.ndarray]) -> Callable[[np.ndarray], int]:
+    """The greedy action of an MLP actor (Stable-Baselines3's MlpPolicy: tanh hidden layers, then a linear
+    layer to the action logits) from its layers [W1, b1, ..., Wk, bk] (W [inputs][outputs]): argmax of the
+    logits, ties to the lowest index, in float64."""
+    pairs = [(np.asarray(layers[i], dtype=np.float64), np.asarray(layers[i + 1], dtype=np.float64))
+             for i in range(0, len(layers), 2)]
+    if len(layers) % 2 or not pairs:
+        raise envs.EnvError(f"an MLP actor needs weight and bias pairs, got {len(layers)} arrays")
+
+    def act(obs: np.ndarray) -> int:
+        h = np.asarray(obs, dtype=np.float64)
+        for w, b in pairs[:-1]:
+            h = np.tanh(h @ w + b)
+        return int(np.argmax(h @ pairs[-1][0] + pairs[-1][1]))
+    return act
 
 
 # Liquid colours by where a circle is (poursim_particle_regions): bucket, target, spilled, in flight.
