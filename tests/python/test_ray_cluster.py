@@ -130,6 +130,8 @@ def test_robustness_at_scale_on_the_cluster_equals_one_host_sim_run(two_nodes, t
 @pytest.mark.parametrize("args, message", [
     (["--rigs", "0"], "--rigs 0: expected 1..10000000"),
     (["--per-task", "0"], "--per-task 0: expected 1..100000"),
+    (["--repeats", "0"], "--repeats 0: expected 1..1000"),
+    (["--repeats", "1001"], "--repeats 1001: expected 1..1000"),
     (["--set", "rand_fil=0.2"], "--set 'rand_fil=0.2': expected one of rand_fill"),
     (["--set", "rand_fill=lots"], "--set 'rand_fill=lots': 'lots' is not a number"),
     (["--header", "nowhere.h"], "--header nowhere.h: no such file"),

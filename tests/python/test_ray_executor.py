@@ -253,3 +253,23 @@ def test_robust_scale_prints_a_table_or_json_never_both(tmp_path, source_dir, ex
         assert r.stdout == (out / "robust_scale.md").read_text()
         assert not any(line.lstrip().startswith("{") for line in r.stdout.splitlines())
         assert "2 rigs" in r.stderr and "2/2" in r.stderr and "<" in r.stderr
+
+
+def test_robust_scale_repeats_each_rig_with_its_fill_stepped_and_judges_the_mean(tmp_path, source_dir):
+    """--repeats 2 over 2 rigs: 4 episodes, each seed twice, the second repeat holding 1e-4 more liquid than the
+    first (the rig's own draw, scaled), and the table's rows judging 2 rigs by their means."""
+    out = tmp_path / "r"
+    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", "--header", source_dir / "policy" / "weights.h",
+                        "--rigs", "2", "--repeats", "2", "--num-cpus", "2", "--quiet", "--json", "-o", out],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((out / "robust_scale.json").read_text())
+    assert json.loads(r.stdout)["repeats"] == 2 and doc["rows"][0]["episodes"] == 2
+    eps = {(e["seed"], e["repeat"]): e for e in doc["per_episode"]}
+    assert sorted(eps) == [(s, k) for s in (3_000_000, 3_000_001) for k in (0, 1)]
+    for s in (3_000_000, 3_000_001):
+        ratio = eps[s, 1]["liquid_l"] / eps[s, 0]["liquid_l"]
+        assert abs(ratio - 1 - 1e-4) < 3e-5, ratio    # the rig's own fill, stepped; not the nominal's
+        rig = next(g for g in doc["per_rig"] if g["seed"] == s)
+        assert rig["spilled_pct"] == (eps[s, 0]["spilled_pct"] + eps[s, 1]["spilled_pct"]) / 2
+    assert "Each rig ran 2 times" in (out / "robust_scale.md").read_text()

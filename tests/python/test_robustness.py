@@ -134,3 +134,31 @@ def test_a_rig_file_that_weighs_the_fill_narrows_the_fill_edges_to_its_range(tmp
     assert rows[f"fill +{w * 100:.2g} %"]["sets"] == [f"fill_depth={0.2595 * (1 + w):.6g}"]
     assert rows[f"fill -{w * 100:.2g} %"]["sets"] == [f"fill_depth={0.2595 * (1 - w):.6g}"]
     assert rows["nominal"]["poured_l"] > 11.0   # the rig's fill, not the default 10 L
+
+
+def test_repeats_step_the_fill_by_one_millilitre_centred_on_the_nominal():
+    from pour.eval import robust_scale
+    assert robust_scale.fill_factors(1) == [1.0]
+    f = robust_scale.fill_factors(4)
+    assert f == sorted(f) and abs(sum(f) / 4 - 1.0) < 1e-12
+    assert all(abs((b - a) - 1e-4) < 1e-12 for a, b in zip(f, f[1:]))
+
+
+def test_a_rig_is_judged_by_the_mean_of_its_repeats_and_the_worst_of_its_peaks():
+    """Two repeats of one rig become one record: the spill that one episode of 4.0 % and one of 1.0 % give is
+    2.5 %, not the 4.0 % that would fail the 3 % bar; the peaks are the worse one; an unfinished repeat makes
+    the rig unfinished."""
+    from pour.eval import robust_scale
+
+    def rep(seed, spilled, peak, finish, reversals):
+        return dict(episode(poured=100 - spilled, spilled=spilled, finish=finish, peak=peak, reversals=reversals),
+                    seed=seed, liquid_l=11.0 + spilled / 1000)
+    per = [rep(7, 4.0, 2.1, 2.0, 3), rep(5, 0.0, 1.0, 2.2, 0), rep(7, 1.0, 2.4, -1.0, 0), rep(5, 0.0, 1.1, 2.4, 1)]
+    rigs = robust_scale.per_rig(per)
+    assert [r["seed"] for r in rigs] == [5, 7] and [r["repeats"] for r in rigs] == [2, 2]
+    five, seven = rigs
+    assert seven["spilled_pct"] == 2.5 and seven["spilled_pct_worst"] == 4.0 and seven["poured_pct"] == 97.5
+    assert seven["peak_omega_rad_s"] == 2.4 and seven["reversals"] == 1.5 and seven["finish_s"] == -1.0
+    assert five["finish_s"] == 2.3 and five["reversals"] == 0.5 and five["peak_omega_rad_s"] == 1.1
+    rows = robust_scale.reduce(rigs, [])
+    assert rows[0]["episodes"] == 2 and rows[0]["spilled_pct_max"] == 2.5 and rows[0]["reversals_max"] == 1.5

@@ -11,6 +11,13 @@ depend on the cluster. The episodes are reduced to the table and the plot of `po
 (tools/pour/eval/robustness.py): all rigs, then the rigs by thirds of their drawn fill. Writes
 robust_scale.json (every episode), robust_scale.md and robust_scale.png.
 
+One episode is a noisy reading of a rig: the liquid is 150 particles (one is 0.67 %), and 1 mL more or less
+in the bucket moves one rig's spill anywhere over 0-4.7 % (docs/training.md, "Retraining for a rig's fill").
+--repeats K runs every rig K times, repeat r with the nominal fill depth scaled by 1 + (r - (K-1)/2)·1e-4
+(1 mL steps of a 10 L fill, centred on the nominal), and judges each rig by the mean of its K episodes:
+its expected spill, poured, finish time and reversals. Its peaks of θ̇ and θ̈ stay the worst of the K, and
+"worst episode" in the table is still one episode's. K = 1 (the default) runs the rig as drawn.
+
 Every node needs host_sim at the path the driver resolves (--build-dir, $POUR_BUILD_DIR or build/host).
 """
 from __future__ import annotations
@@ -26,6 +33,7 @@ import numpy as np
 
 from pour import atomic, cli
 from pour.eval import evaluate, robustness
+from pour.sim import poursim
 from pour.train import executors
 
 # The ranges of issue 10 ("Training for robustness"): fill ±20 %, target and pivot ±2 cm, motor ±15 %;
@@ -33,6 +41,8 @@ from pour.train import executors
 DEFAULT_RAND = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0.02, "rand_motor": 0.15,
                 "rand_bucket_mass": 0.2, "rand_liquid": 0.2, "rand_sensor": 0.5}
 FIRST_SEED = 3_000_000   # held out: training seeds come from SeedSequence streams
+FILL_STEP = 1e-4         # --repeats: relative fill step between repeats (1 mL of 10 L)
+MAX_REPEATS = 1000
 
 
 def run_batch(exe: str, header: str, first: int, n: int, sets: Sequence[str]) -> list[dict[str, Any]]:
@@ -61,6 +71,33 @@ def summary(per: list[dict[str, Any]], sets: Sequence[str]) -> dict[str, Any]:
             "finish_s": float(np.mean(fin)) if fin else -1.0}
 
 
+def fill_factors(repeats: int) -> list[float]:
+    """The relative fill of each repeat: 1 mL steps centred on the nominal (just 1.0 for one repeat)."""
+    return [1.0 + (r - (repeats - 1) / 2) * FILL_STEP for r in range(repeats)]
+
+
+MEAN_KEYS = ("poured_pct", "spilled_pct", "liquid_l", "reversals")
+WORST_KEYS = ("peak_omega_rad_s", "peak_alpha_rad_s2")
+
+
+def per_rig(per: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One record per seed from its repeats: the means of MEAN_KEYS and finish_s (-1 if any repeat did not
+    finish), the worst of WORST_KEYS and of the spill (spilled_pct_worst), and how many repeats there were."""
+    by_seed: dict[int, list[dict[str, Any]]] = {}
+    for e in per:
+        by_seed.setdefault(e["seed"], []).append(e)
+    rigs = []
+    for seed in sorted(by_seed):
+        eps = by_seed[seed]
+        rig = {"seed": seed, "repeats": len(eps), "spilled_pct_worst": max(e["spilled_pct"] for e in eps)}
+        rig.update({k: float(np.mean([e[k] for e in eps])) for k in MEAN_KEYS})
+        rig.update({k: max(e[k] for e in eps) for k in WORST_KEYS})
+        fin = [e["finish_s"] for e in eps]
+        rig["finish_s"] = float(np.mean(fin)) if min(fin) >= 0 else -1.0
+        rigs.append(rig)
+    return rigs
+
+
 def reduce(per: list[dict[str, Any]], sets: Sequence[str]) -> list[dict[str, Any]]:
     """Table rows: every rig, then the rigs by thirds of their drawn liquid volume."""
     per = sorted(per, key=lambda e: e["seed"])
@@ -78,10 +115,12 @@ def reduce(per: list[dict[str, Any]], sets: Sequence[str]) -> list[dict[str, Any
 
 def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None, rand: dict[str, float],
         build_dir: str | None, address: str | None, num_cpus: int | None,
-        quiet: bool = False) -> tuple[list[dict[str, Any]], dict]:
+        quiet: bool = False, repeats: int = 1) -> tuple[list[dict[str, Any]], dict]:
     exe = str(evaluate.host_sim_binary(build_dir).resolve())
     header = str(Path(header).resolve())
     sets = [f"{k}={v:g}" for k, v in rand.items()]
+    fills = [[]] if repeats == 1 else [[f"fill_depth={poursim.default_config()['fill_depth'] * f!r}"]
+                                       for f in fill_factors(repeats)]
     ray = executors.import_ray()
     owns = executors.connect(address, num_cpus)
     refs: list[Any] = []
@@ -90,21 +129,30 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
         k = per_task or max(1, min(200, math.ceil(rigs / (2 * cpus))))
         task = ray.remote(num_cpus=1, max_retries=executors.MAX_RETRIES, retry_exceptions=False)(run_batch)
         t0 = time.monotonic()
-        refs = [task.remote(exe, header, s, min(k, first_seed + rigs - s), sets)
-                for s in range(first_seed, first_seed + rigs, k)]
-        per = [e for batch in executors.gather(ray, refs, f"{rigs} rigs", quiet) for e in batch]
+        jobs = [(r, s) for r in range(repeats) for s in range(first_seed, first_seed + rigs, k)]
+        refs = [task.remote(exe, header, s, min(k, first_seed + rigs - s), sets + fills[r]) for r, s in jobs]
+        what = f"{rigs} rigs" if repeats == 1 else f"{rigs} rigs x {repeats} repeats"
+        batches = executors.gather(ray, refs, what, quiet)
+        per = [dict(e, repeat=r) if repeats > 1 else e for (r, _), batch in zip(jobs, batches) for e in batch]
         wall = time.monotonic() - t0
     finally:
         if owns:
             ray.shutdown()
-    rows = reduce(per, sets)
+    rigs_per = per if repeats == 1 else per_rig(per)
+    rows = reduce(rigs_per, sets)
     out.mkdir(parents=True, exist_ok=True)
-    meta = {"header": header, "rigs": rigs, "first_seed": first_seed, "per_task": k, "tasks": len(refs),
-            "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand}
-    atomic.write_atomic(out / "robust_scale.json", json.dumps({**meta, "rows": rows, "per_episode": per}) + "\n")
+    meta = {"header": header, "rigs": rigs, "repeats": repeats, "first_seed": first_seed, "per_task": k,
+            "tasks": len(refs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand}
+    doc = {**meta, "rows": rows, "per_episode": per} if repeats == 1 else \
+        {**meta, "fill_factors": fill_factors(repeats), "rows": rows, "per_rig": rigs_per, "per_episode": per}
+    atomic.write_atomic(out / "robust_scale.json", json.dumps(doc) + "\n")
+    how = "" if repeats == 1 else (
+        f" Each rig ran {repeats} times, its fill depth stepped by {FILL_STEP:g} of the nominal between repeats; "
+        f"a rig's figures are the means of its repeats (peaks the worst), \"worst spill\" is the worst rig's "
+        f"mean, and the worst single episode spilled {max(e['spilled_pct'] for e in per):.1f} %.")
     atomic.write_atomic(out / "robust_scale.md",
                         f"Randomised rigs: {', '.join(sets)}; {rigs} rigs in {len(refs)} Ray tasks of {k} on "
-                        f"{cpus} CPUs, {wall:.0f} s.\n\n" + robustness.table(rows, Path(header).name, first_seed))
+                        f"{cpus} CPUs, {wall:.0f} s.{how}\n\n" + robustness.table(rows, Path(header).name, first_seed))
     robustness.plot(rows, out / "robust_scale.png")
     return rows, meta
 
@@ -115,6 +163,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--rigs", type=int, default=100, help="randomised rigs (episodes), e.g. 10000 on a cluster")
     ap.add_argument("--seed", type=int, default=FIRST_SEED, help=f"first seed (default {FIRST_SEED})")
     ap.add_argument("--per-task", type=int, help="rigs per Ray task (default: 2 tasks a CPU, at most 200)")
+    ap.add_argument("--repeats", type=int, default=1, metavar="K",
+                    help="run each rig K times, its fill stepped by 1 mL, and judge it by the mean (default 1)")
     ap.add_argument("--set", action="append", default=[], metavar="rand_KEY=VALUE",
                     help="override a randomisation range (0 turns it off); repeatable")
     ap.add_argument("-o", "--out", default="results/robust_scale", type=Path)
@@ -130,6 +180,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError(f"--rigs {args.rigs}: expected 1..10000000")
         if args.per_task is not None and not 1 <= args.per_task <= 100_000:
             raise ValueError(f"--per-task {args.per_task}: expected 1..100000")
+        if not 1 <= args.repeats <= MAX_REPEATS:
+            raise ValueError(f"--repeats {args.repeats}: expected 1..{MAX_REPEATS}")
         if not 0 <= args.seed <= 2**32 - 1 - args.rigs:
             raise ValueError(f"--seed {args.seed}: the seeds must stay below 2^32")
         rand = dict(DEFAULT_RAND)
@@ -144,12 +196,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not Path(args.header).is_file():
             raise ValueError(f"--header {args.header}: no such file")
         rows, meta = run(args.header, args.out, args.rigs, args.seed, args.per_task, rand, args.build_dir,
-                         args.ray_address, args.num_cpus, args.quiet)
+                         args.ray_address, args.num_cpus, args.quiet, args.repeats)
     except (OSError, RuntimeError, ValueError) as exc:   # ExecutorError is a RuntimeError
         print(f"pour-robust-scale: error: {exc}", file=sys.stderr)
         return 2
     if args.json:
-        print(json.dumps({**{k: meta[k] for k in ("rigs", "tasks", "per_task", "cluster_cpus", "wall_s")},
+        print(json.dumps({**{k: meta[k] for k in ("rigs", "repeats", "tasks", "per_task", "cluster_cpus", "wall_s")},
                           "rows": rows, "out": str(args.out)}))
     else:
         print((args.out / "robust_scale.md").read_text(), end="")
