@@ -105,7 +105,7 @@ def table(rows: Sequence[dict[str, Any]], header: str, seed: int) -> str:
             f"| {r['spilled_pct']:.2f} ({r['spilled_l']:.3f}) | {r['spilled_pct_max']:.1f} "
             f"| {r['finish_s']:.2f} ({r['finish_max_s']:.2f}) | {r['meet_all_three']}/{r['episodes']} "
             f"| {r['peak_omega_max_rad_s']:.2f} | {r['peak_alpha_max_rad_s2']:.0f} "
-            f"| {r['reversals_mean']:.1f} ({r['reversals_max']:.3g}) | {'met' if r['bar_met'] else 'MISSED'} |")
+            f"| {r['reversals_mean']:.1f} ({r['reversals_max']:.4g}) | {'met' if r['bar_met'] else 'MISSED'} |")
     return "\n".join(lines) + "\n"
 
 
