@@ -43,6 +43,8 @@ DEFAULT_RAND = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0
 FIRST_SEED = 3_000_000   # held out: training seeds come from SeedSequence streams
 FILL_STEP = 1e-4         # --repeats: relative fill step between repeats (1 mL of 10 L)
 MAX_REPEATS = 1000
+MEAN_KEYS = ("poured_pct", "spilled_pct", "liquid_l", "reversals")   # --repeats: a rig's mean of its repeats
+WORST_KEYS = ("peak_omega_rad_s", "peak_alpha_rad_s2")                # and the worst of them
 
 
 def run_batch(exe: str, header: str, first: int, n: int, sets: Sequence[str]) -> list[dict[str, Any]]:
@@ -74,10 +76,6 @@ def summary(per: list[dict[str, Any]], sets: Sequence[str]) -> dict[str, Any]:
 def fill_factors(repeats: int) -> list[float]:
     """The relative fill of each repeat: 1 mL steps centred on the nominal (just 1.0 for one repeat)."""
     return [1.0 + (r - (repeats - 1) / 2) * FILL_STEP for r in range(repeats)]
-
-
-MEAN_KEYS = ("poured_pct", "spilled_pct", "liquid_l", "reversals")
-WORST_KEYS = ("peak_omega_rad_s", "peak_alpha_rad_s2")
 
 
 def per_rig(per: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -119,8 +117,9 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
     exe = str(evaluate.host_sim_binary(build_dir).resolve())
     header = str(Path(header).resolve())
     sets = [f"{k}={v:g}" for k, v in rand.items()]
+    factors = fill_factors(repeats)
     fills = [[]] if repeats == 1 else [[f"fill_depth={poursim.default_config()['fill_depth'] * f!r}"]
-                                       for f in fill_factors(repeats)]
+                                       for f in factors]
     ray = executors.import_ray()
     owns = executors.connect(address, num_cpus)
     refs: list[Any] = []
@@ -144,7 +143,7 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
     meta = {"header": header, "rigs": rigs, "repeats": repeats, "first_seed": first_seed, "per_task": k,
             "tasks": len(refs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand}
     doc = {**meta, "rows": rows, "per_episode": per} if repeats == 1 else \
-        {**meta, "fill_factors": fill_factors(repeats), "rows": rows, "per_rig": rigs_per, "per_episode": per}
+        {**meta, "fill_factors": factors, "rows": rows, "per_rig": rigs_per, "per_episode": per}
     atomic.write_atomic(out / "robust_scale.json", json.dumps(doc) + "\n")
     how = "" if repeats == 1 else (
         f" Each rig ran {repeats} times, its fill depth stepped by {FILL_STEP:g} of the nominal between repeats; "
