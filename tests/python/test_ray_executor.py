@@ -250,7 +250,7 @@ def test_robust_scale_prints_a_table_or_json_never_both(tmp_path, source_dir, ex
         assert doc["rigs"] == 2 and doc["tasks"] == 2 and doc["rows"][0]["episodes"] == 2
         assert "2/2" not in r.stderr
     else:
-        assert r.stdout == (out / "robust_scale.md").read_text()
+        assert r.stdout == (out / "robust_scale.md").read_text() and "| scene | episodes |" in r.stdout
         assert not any(line.lstrip().startswith("{") for line in r.stdout.splitlines())
         assert "2 rigs" in r.stderr and "2/2" in r.stderr and "<" in r.stderr
 
@@ -272,4 +272,5 @@ def test_robust_scale_repeats_each_rig_with_its_fill_stepped_and_judges_the_mean
         assert abs(ratio - 1 - 1e-4) < 3e-5, ratio    # the rig's own fill, stepped; not the nominal's
         rig = next(g for g in doc["per_rig"] if g["seed"] == s)
         assert rig["spilled_pct"] == (eps[s, 0]["spilled_pct"] + eps[s, 1]["spilled_pct"]) / 2
-    assert "Each rig ran 2 times" in (out / "robust_scale.md").read_text()
+    md = (out / "robust_scale.md").read_text()
+    assert "Each rig ran 2 times" in md and "| scene | rigs |" in md   # a row counts rigs, each a mean

@@ -151,7 +151,8 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
         f"mean, and the worst single episode spilled {max(e['spilled_pct'] for e in per):.1f} %.")
     atomic.write_atomic(out / "robust_scale.md",
                         f"Randomised rigs: {', '.join(sets)}; {rigs} rigs in {len(refs)} Ray tasks of {k} on "
-                        f"{cpus} CPUs, {wall:.0f} s.{how}\n\n" + robustness.table(rows, Path(header).name, first_seed))
+                        f"{cpus} CPUs, {wall:.0f} s.{how}\n\n" + robustness.table(rows, Path(header).name, first_seed,
+                                                                     "episodes" if repeats == 1 else "rigs"))
     robustness.plot(rows, out / "robust_scale.png")
     return rows, meta
 

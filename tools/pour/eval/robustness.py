@@ -91,12 +91,14 @@ def judge(scene: Scene, s: dict[str, Any]) -> dict[str, Any]:
     return row
 
 
-def table(rows: Sequence[dict[str, Any]], header: str, seed: int) -> str:
+def table(rows: Sequence[dict[str, Any]], header: str, seed: int, counted: str = "episodes") -> str:
+    """The markdown table; counted names what a row's count is (pour-robust-scale --repeats: "rigs", each the
+    mean of its repeats)."""
     lines = [f"Robustness of `{header}` (firmware core in the loop, host_sim; seeds {seed}.. never used in "
              "training). Bars: nominal poured >= 98 %, spilled <= 1 %, every pour finished within 6 s, >= 90 % of "
              "episodes meet all three; each edge poured >= 95 %, spilled <= 3 %; everywhere peak |θ̇| <= 2.5 rad/s "
              "and <= 30 torque reversals per episode.", "",
-             "| scene | episodes | poured % (L) | spilled % (L) | worst spill % | finish s (worst) | meet all three "
+             f"| scene | {counted} | poured % (L) | spilled % (L) | worst spill % | finish s (worst) | meet all three "
              "| peak θ̇ rad/s | peak θ̈ rad/s² | reversals mean (max) | bar |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
