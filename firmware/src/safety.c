@@ -12,6 +12,11 @@
 #define DEFAULT_ALPHA_MAX_URAD_S2 3400000 /* 3.4 rad/s²: ω_max reached in one 1.7 Hz slosh period */
 #define DEFAULT_OMEGA_SLACK_URAD_S 800000 /* 0.8 rad/s: K · slack = 0.4 τ_max holds the full bucket */
 #define DEFAULT_TORQUE_PER_RAD_S 16384    /* 0.5 τ_max per rad/s: stable with 2 ticks of latency */
+#define DEFAULT_SLOW_OMEGA_URAD_S 160000  /* fill schedule: 0.16 rad/s past the knee keeps a full bucket < 3 % */
+#define DEFAULT_KNEE_DECEL_URAD_S2 10000000 /* 10 rad/s²: 2 rad/s down to the slow speed within 11° */
+#define DEFAULT_SLOW_TORQUE_FF 1638       /* 0.05 τ_max = 1 N·m */
+#define DEFAULT_SLOW_KI_PER_S 5u          /* the integral takes up the full bucket's gravity in about a second */
+#define KNEE_SPAN_MAX_URAD 8388608        /* knee - θ saturates at 2^23 µrad (8.4 rad) in the braking curve */
 
 pour_safety_config_t pour_safety_default_config(void) {
   pour_safety_config_t config;
@@ -23,6 +28,11 @@ pour_safety_config_t pour_safety_default_config(void) {
   config.alpha_max_urad_s2 = DEFAULT_ALPHA_MAX_URAD_S2;
   config.omega_slack_urad_s = DEFAULT_OMEGA_SLACK_URAD_S;
   config.torque_per_rad_s = DEFAULT_TORQUE_PER_RAD_S;
+  config.knee_theta_urad = 0; /* no schedule: the rig file gives the knee (docs/safety.md) */
+  config.slow_omega_urad_s = DEFAULT_SLOW_OMEGA_URAD_S;
+  config.knee_decel_urad_s2 = DEFAULT_KNEE_DECEL_URAD_S2;
+  config.slow_torque_ff = DEFAULT_SLOW_TORQUE_FF;
+  config.slow_ki_per_s = DEFAULT_SLOW_KI_PER_S;
   return config;
 }
 
@@ -33,7 +43,10 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   const pour_safety_config_t *c = config;
   if (c->tau_limit <= 0 || c->slew_per_tick <= 0 || c->theta_max_urad <= c->theta_min_urad ||
       c->omega_max_urad_s <= 0 || c->omega_max_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->alpha_max_urad_s2 < 1000 ||
-      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->torque_per_rad_s <= 0) {
+      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->torque_per_rad_s <= 0 ||
+      c->knee_theta_urad < 0 || c->knee_theta_urad > POUR_SAFETY_KNEE_MAX_URAD || c->slow_omega_urad_s <= 0 ||
+      c->slow_omega_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->knee_decel_urad_s2 < 1000 ||
+      c->knee_decel_urad_s2 > POUR_SAFETY_DECEL_MAX_URAD_S2 || c->slow_torque_ff < 0) {
     return POUR_EINVAL;
   }
   safety->config = *c;
@@ -43,6 +56,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   safety->gain_q32 = (int32_t)(((int64_t)c->torque_per_rad_s * ((int64_t)1 << 32) + 500000) / 1000000);
   safety->ceiling_urad_s = c->omega_slack_urad_s;
   safety->floor_urad_s = -c->omega_slack_urad_s;
+  safety->integral_mq15 = 0;
   return POUR_OK;
 }
 
@@ -71,19 +85,56 @@ static int32_t band_torque(const pour_safety_t *s, int32_t margin_urad_s) {
   return t > lim ? lim : (t < -lim ? -lim : t);
 }
 
-/* Moves the band one tick on from the speed θ̇ [µrad/s]; returns the torque bounds it implies, Q15. */
-static void band_bounds(pour_safety_t *s, int32_t omega_urad_s, int32_t *lo, int32_t *hi) {
+/* floor(sqrt(x)), bit by bit: 32 rounds of shifts and compares, no division. */
+static uint32_t isqrt64(uint64_t x) {
+  uint64_t root = 0;
+  uint64_t bit = (uint64_t)1 << 62;
+  while (bit > x) {
+    bit >>= 2;
+  }
+  while (bit != 0u) {
+    if (x >= root + bit) {
+      x -= root + bit;
+      root = (root >> 1) + bit;
+    } else {
+      root >>= 1;
+    }
+    bit >>= 2;
+  }
+  return (uint32_t)root;
+}
+
+/* The speed limit at the tilt θ: omega_max, and with a knee the fill schedule's: slow past it, before it
+ * sqrt(slow² + 2 · decel · (knee - θ)). slow < 2^27, decel <= 10^9, knee - θ <= 2^23: the sum < 2^55. */
+static int32_t speed_limit(const pour_safety_config_t *c, int32_t theta_urad) {
+  if (c->knee_theta_urad == 0) {
+    return c->omega_max_urad_s;
+  }
+  const int32_t slow = c->slow_omega_urad_s < c->omega_max_urad_s ? c->slow_omega_urad_s : c->omega_max_urad_s;
+  if (theta_urad >= c->knee_theta_urad) {
+    return slow;
+  }
+  const int64_t span = (int64_t)c->knee_theta_urad - theta_urad;
+  const uint64_t d = (uint64_t)(span > KNEE_SPAN_MAX_URAD ? KNEE_SPAN_MAX_URAD : span);
+  const uint64_t sq = (uint64_t)slow * (uint64_t)slow + 2u * (uint64_t)c->knee_decel_urad_s2 * d;
+  const uint32_t curve = isqrt64(sq);
+  return curve < (uint32_t)c->omega_max_urad_s ? (int32_t)curve : c->omega_max_urad_s;
+}
+
+/* Moves the band one tick on from the speed θ̇ [µrad/s] under the limit lim; returns the torque bounds it
+ * implies, Q15, and the speed θ̇ saturated as the bounds used it. */
+static int32_t band_bounds(pour_safety_t *s, int32_t lim, int32_t omega_urad_s, int32_t *lo, int32_t *hi) {
   const pour_safety_config_t *c = &s->config;
   /* Speeds saturate at ±100 rad/s (twice the plausible), which keeps every sum below in int32. */
   const int32_t w = omega_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S
                         ? POUR_SAFETY_OMEGA_MAX_URAD_S
                         : (omega_urad_s < -POUR_SAFETY_OMEGA_MAX_URAD_S ? -POUR_SAFETY_OMEGA_MAX_URAD_S : omega_urad_s);
-  s->ceiling_urad_s = min3(c->omega_max_urad_s, s->ceiling_urad_s + s->alpha_step_urad_s,
-                           (w > 0 ? w : 0) + c->omega_slack_urad_s);
+  s->ceiling_urad_s = min3(lim, s->ceiling_urad_s + s->alpha_step_urad_s, (w > 0 ? w : 0) + c->omega_slack_urad_s);
   s->floor_urad_s = max3(-c->omega_max_urad_s, s->floor_urad_s - s->alpha_step_urad_s,
                          (w < 0 ? w : 0) - c->omega_slack_urad_s);
   *hi = band_torque(s, s->ceiling_urad_s - w);
   *lo = band_torque(s, s->floor_urad_s - w);
+  return w;
 }
 
 /* The limit bit for a cut at the ceiling (or floor): the speed limit itself, or the band still ramping. */
@@ -107,9 +158,28 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
    * turns into a brake beyond an edge. Braking, toward either edge, is never limited. */
   int32_t lo;
   int32_t hi;
-  band_bounds(safety, omega_urad_s, &lo, &hi);
-  const uint8_t hi_bit = band_bit(safety->ceiling_urad_s, c->omega_max_urad_s);
+  const int32_t lim = speed_limit(c, theta_urad);
+  const int32_t w = band_bounds(safety, lim, omega_urad_s, &lo, &hi);
+  const uint8_t hi_bit = band_bit(safety->ceiling_urad_s, lim);
   const uint8_t lo_bit = band_bit(safety->floor_urad_s, -c->omega_max_urad_s);
+  if (lim < c->omega_max_urad_s) {
+    /* Where the schedule slows the bucket (the braking curve's last stretch, and past the knee), a slow
+     * ceiling must still lift the load: the feed-forward and the integral carry what K (ceiling - θ̇) alone
+     * cannot (it would stall the bucket short of the knee), and the bound never speeds the bucket beyond
+     * omega_max. */
+    const int32_t lim_hi = band_torque(safety, c->omega_max_urad_s - w);
+    const int32_t sum = hi + c->slow_torque_ff + safety->integral_mq15 / 1000; /* each term < 2^16 */
+    hi = sum < lim_hi ? sum : lim_hi;
+    hi = hi > c->tau_limit ? c->tau_limit : hi;
+    if (cmd > hi || safety->ceiling_urad_s < w) { /* integrate only while the bound governs: no windup */
+      const int64_t next = (int64_t)safety->integral_mq15 +
+                           (int64_t)band_torque(safety, safety->ceiling_urad_s - w) * c->slow_ki_per_s;
+      const int64_t top = (int64_t)c->tau_limit * 500;
+      safety->integral_mq15 = (int32_t)(next < 0 ? 0 : (next > top ? top : next));
+    }
+  } else {
+    safety->integral_mq15 = 0;
+  }
   if (cmd > hi) {
     cmd = hi;
     active |= hi_bit;

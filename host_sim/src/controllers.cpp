@@ -1,14 +1,26 @@
 // SPDX-License-Identifier: MIT
 #include "controllers.hpp"
 
+#include "poursim_internal.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 namespace poursim {
 
+double fill_knee_rad(const poursim_config_t &rig) {
+  // A level liquid reaches the lip when the surface through the fill's centre line meets it: tan θ =
+  // (depth - fill) / (width / 2), while the fill is above half the depth (every fill a schedule is for).
+  const double depth = rig.bucket_height - rig.bucket_wall;
+  const double onset = std::atan2(std::max(0.0, depth - rig.fill_depth), 0.5 * rig.bucket_inner_width);
+  return std::max(0.0, onset - kFillKneeMarginRad);
+}
+
 pour_control_config_t firmware_config(const poursim_config_t &sim) {
   pour_control_config_t c = pour_control_default_config();
   c.sensors.encoder_bits = static_cast<uint8_t>(sim.encoder_bits);
+  if (sim.fill_schedule_l > 0.0 && liquid_litres(sim) > sim.fill_schedule_l)
+    c.safety.knee_theta_urad = std::max<int32_t>(1, static_cast<int32_t>(std::lround(fill_knee_rad(sim) * 1e6)));
   return c;
 }
 
@@ -18,7 +30,7 @@ void CoreController::reset(uint32_t seed) {
     restart_pending_ = true; // the core and its output carry on, as a linked controller's do
     return;
   }
-  status_ = init(&ctl_, firmware_config(sim_), seed);
+  status_ = init(&ctl_, firmware_config(rig_), seed);
   out_ = pour_control_output_t{};
 }
 

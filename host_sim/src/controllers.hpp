@@ -21,8 +21,10 @@ class Controller {
  public:
   virtual ~Controller() = default;
   virtual std::string name() const = 0;
-  // Called before every episode.
+  // Called before every episode, after set_rig.
   virtual void reset(uint32_t seed) = 0;
+  // The episode's rig as drawn from its seed: what a controller configured from the rig's file knows.
+  virtual void set_rig(const poursim_config_t & /*rig*/) {}
   // The torque for the coming step as a fraction of tau_max, from the state s_t measured after the
   // last step. Called once per 1 ms tick.
   virtual double command(const poursim_obs_t &obs) = 0;
@@ -43,6 +45,11 @@ class Controller {
 // builds its config here.
 pour_control_config_t firmware_config(const poursim_config_t &sim);
 
+// The fill schedule's knee for a rig whose file gives its fill (config key fill_schedule_l; docs/safety.md):
+// the angle at which a level liquid of the rig's fill reaches the lip, less kFillKneeMarginRad [rad].
+constexpr double kFillKneeMarginRad = 3.0 * 3.14159265358979323846 / 180.0;
+double fill_knee_rad(const poursim_config_t &rig);
+
 // The firmware's one pipeline (pour_control_update, a decision, pour_control_shape) fed the rig's sensor
 // sample each tick as it would cross the wire. The decision is decide()'s: the fixed-point policy of a
 // weights.h, or a request from outside (a float policy, a baseline) through pour_control_request. The
@@ -50,6 +57,7 @@ pour_control_config_t firmware_config(const poursim_config_t &sim);
 class CoreController : public Controller {
  public:
   void reset(uint32_t seed) override;
+  void set_rig(const poursim_config_t &rig) override { rig_ = rig; }
   double command(const poursim_obs_t &obs) override;
   int action() const override { return out_.action; }
   bool failed() const override { return status_ != POUR_OK; }
@@ -62,7 +70,7 @@ class CoreController : public Controller {
   void restart_by_reset(bool on) { restart_by_reset_ = on; }
 
  protected:
-  explicit CoreController(const poursim_config_t &sim) : sim_(sim) {}
+  explicit CoreController(const poursim_config_t &sim) : sim_(sim), rig_(sim) {}
   // Initialises ctl for the episode with seed (pour_control_init or pour_control_init_external on config).
   virtual pour_status_t init(pour_control_t *ctl, const pour_control_config_t &config, uint32_t seed) = 0;
   // The decision when one is due, on the state the core estimated: pour_control_decide or _request.
@@ -70,6 +78,7 @@ class CoreController : public Controller {
   const poursim_config_t sim_;
 
  private:
+  poursim_config_t rig_; // the episode's (set_rig), which the core's config is made for
   pour_control_t ctl_{};
   pour_control_output_t out_{};
   pour_status_t status_ = POUR_EINVAL;

@@ -28,6 +28,7 @@ Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, cons
     e.status = rc;
     return e;
   }
+  ctl.set_rig(*poursim_episode_config(world));
   ctl.reset(seed);
   const poursim_config_t *cfg = poursim_world_config(world);
   const int n = poursim_particle_count(world);

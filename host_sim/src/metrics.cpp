@@ -63,9 +63,7 @@ void EpisodeMeter::reset(const poursim_config_t &config, const poursim_reward_t 
   dt_ = config.dt;
   reward_ = reward;
   last_reward_ = 0.0;
-  // The fill of a round bucket of the cross-section's width (poursim_config_t.liquid_density) [L].
-  const double r = 0.5 * config.bucket_inner_width;
-  litres_ = 1000.0 * M_PI * r * r * config.fill_depth;
+  litres_ = liquid_litres(config);
   settled_.clear();
   settled_.reserve(static_cast<size_t>(std::lround(config.episode_s / config.dt)));
   steps_ = 0;

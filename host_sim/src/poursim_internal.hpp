@@ -28,9 +28,13 @@ inline double particle_spacing(const poursim_config_t *c) {
 // Radius of every circle (its contacts with the buckets) [m].
 inline double particle_radius(const poursim_config_t *c) { return c->fluid_contact_radius * particle_spacing(c); }
 
-// All the liquid: the fill of a round bucket of the inner width [kg].
+// All the liquid: the fill of a round bucket of the inner width [kg], and its volume [L].
 inline double liquid_mass(const poursim_config_t *c) {
   return c->liquid_density * c->fill_depth * M_PI * 0.25 * c->bucket_inner_width * c->bucket_inner_width;
+}
+inline double liquid_litres(const poursim_config_t &c) {
+  const double r = 0.5 * c.bucket_inner_width;
+  return 1000.0 * M_PI * r * r * c.fill_depth;
 }
 
 // The config of the episode of seed: each rand_* key draws its parameters uniformly in ± its value

@@ -156,6 +156,11 @@ pour_control_config_t fuzz_control_config(Provider &fdp) {
   c.safety.alpha_max_urad_s2 = fdp.template ConsumeIntegralInRange<int32_t>(1000, INT32_MAX);
   c.safety.omega_slack_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
   c.safety.torque_per_rad_s = fdp.template ConsumeIntegralInRange<q15_t>(1, 32767);
+  c.safety.knee_theta_urad = fdp.ConsumeBool() ? 0 : fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_KNEE_MAX_URAD);
+  c.safety.slow_omega_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
+  c.safety.knee_decel_urad_s2 = fdp.template ConsumeIntegralInRange<int32_t>(1000, POUR_SAFETY_DECEL_MAX_URAD_S2);
+  c.safety.slow_torque_ff = fdp.template ConsumeIntegralInRange<q15_t>(0, 32767);
+  c.safety.slow_ki_per_s = fdp.template ConsumeIntegralInRange<uint16_t>(0, 65535);
   c.sensors.encoder_bits = fdp.template ConsumeIntegralInRange<uint8_t>(POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX);
   c.sensors.bandwidth_rad_s = fdp.template ConsumeIntegralInRange<uint16_t>(1, 1000);
   c.sensors.scale_min_g = fdp.template ConsumeIntegralInRange<int32_t>(-POUR_SCALE_LIMIT_G, 0);

@@ -20,11 +20,12 @@ PERIOD = 10
 SEEDS = (3, 8)
 
 
-def host_sim_run(build_dir, source_dir, tmp_path, seed):
+def host_sim_run(build_dir, source_dir, tmp_path, seed, opts=None):
     """host_sim --policy policy/weights.h: per step the action in force and the core's torque, Q15."""
     out = tmp_path / f"steps_{seed}.csv"
+    sets = [a for k, v in {"episode_s": EPISODE_S, **(opts or {})}.items() for a in ("--set", f"{k}={v}")]
     subprocess.run([str(build_dir / "bin" / "host_sim"), "--policy", str(source_dir / "policy" / "weights.h"),
-                    "--seed", str(seed), "--set", f"episode_s={EPISODE_S}", "--quiet", "--csv", str(out)],
+                    "--seed", str(seed), *sets, "--quiet", "--csv", str(out)],
                    check=True, capture_output=True, timeout=300)
     with out.open() as f:
         rows = list(csv.DictReader(f))
@@ -34,19 +35,20 @@ def host_sim_run(build_dir, source_dir, tmp_path, seed):
     return torques, actions[::PERIOD]
 
 
-def gym_replay(seed, actions):
+def gym_replay(seed, actions, opts=None):
     """The Gymnasium env, reset(seed=seed) as host_sim --seed seed, fed one action per decision: the core's
     torque of every tick, Q15."""
-    env = pour.sim.gym_env.PourEnv("sim", n_actions=11, decision_period_ms=PERIOD, episode_s=EPISODE_S)
+    env = pour.sim.gym_env.PourEnv("sim", n_actions=11, decision_period_ms=PERIOD, episode_s=EPISODE_S,
+                                   options=opts)
     env.reset(seed=seed)
     for a in actions:
         env.step(int(a))
     return np.array(env._plant.torques, dtype=np.int64)
 
 
-def rollout_run(header, seed):
+def rollout_run(header, seed, opts=None):
     """poursim_rollout with the float policy of the header (greedy): its torques, Q15, and its actions."""
-    world = poursim.World({"episode_s": EPISODE_S})
+    world = poursim.World({"episode_s": EPISODE_S, **(opts or {})})
     pol = poursim.Policy(header.w_dequantized, header.levels_q15 / 32768.0, header.decision_period_ms,
                          episode.THETA_MIN_RAD, episode.THETA_MAX_RAD, episode.OMEGA_MAX_RAD_S, True, 0.0)
     ro = world.rollout(pol, seed, record_steps=True)
@@ -77,6 +79,22 @@ def test_host_sim_rollout_and_gym_env_give_bit_identical_torques(build_dir, sour
     # the rate elsewhere), so the three runs are one run.
     np.testing.assert_array_equal(r_actions, h_actions)
     np.testing.assert_array_equal(r_torque, h_torque)
+
+
+def test_the_fill_schedule_runs_alike_in_all_three(build_dir, source_dir, tmp_path, header):
+    """A rig whose file asks for the envelope's fill schedule (here any fill above 5 L, so the nominal 10 L
+    one; its knee 33.9° - 3°) configures the firmware the same way in host_sim, the C rollout and the
+    Gymnasium env, from the rig drawn for the episode: bit-identical torques again, and not the unscheduled
+    run's (the schedule slows this pour)."""
+    opts = {"fill_schedule_l": 5.0}
+    seed = SEEDS[0]
+    h_torque, h_actions = host_sim_run(build_dir, source_dir, tmp_path, seed, opts)
+    r_torque, r_actions = rollout_run(header, seed, opts)
+    np.testing.assert_array_equal(gym_replay(seed, h_actions, opts), h_torque)
+    np.testing.assert_array_equal(gym_replay(seed, r_actions, opts), r_torque)
+    np.testing.assert_array_equal(r_torque, h_torque)
+    plain, _ = host_sim_run(build_dir, source_dir, tmp_path, seed)
+    assert not np.array_equal(plain, h_torque)
 
 
 def test_the_env_measures_an_episode_as_the_c_rollout_does():

@@ -132,6 +132,8 @@ def test_robustness_at_scale_on_the_cluster_equals_one_host_sim_run(two_nodes, t
     (["--per-task", "0"], "--per-task 0: expected 1..100000"),
     (["--repeats", "0"], "--repeats 0: expected 1..1000"),
     (["--repeats", "1001"], "--repeats 1001: expected 1..1000"),
+    (["--fill-schedule", "-1"], "--fill-schedule -1.0: expected 0..100 L (0: off)"),
+    (["--fill-schedule", "nan"], "--fill-schedule nan: expected 0..100 L (0: off)"),
     (["--set", "rand_fil=0.2"], "--set 'rand_fil=0.2': expected one of rand_fill"),
     (["--set", "rand_fill=lots"], "--set 'rand_fill=lots': 'lots' is not a number"),
     (["--header", "nowhere.h"], "--header nowhere.h: no such file"),

@@ -274,3 +274,19 @@ def test_robust_scale_repeats_each_rig_with_its_fill_stepped_and_judges_the_mean
         assert rig["spilled_pct"] == (eps[s, 0]["spilled_pct"] + eps[s, 1]["spilled_pct"]) / 2
     md = (out / "robust_scale.md").read_text()
     assert "Each rig ran 2 times" in md and "| scene | rigs |" in md   # a row counts rigs, each a mean
+
+
+def test_robust_scale_fill_schedule_configures_the_rigs_above_it(tmp_path, source_dir):
+    """--fill-schedule 5 over 2 rigs (both hold 8-12 L): each rig's firmware gets the schedule's knee from its
+    own fill, so its pour, at 0.16 rad/s past the knee, finishes after 4 s or not at all (as shipped these rigs
+    finish near 2 s); the run records the setting in its JSON and the table's heading."""
+    out = tmp_path / "f"
+    r = subprocess.run([sys.executable, "-m", "pour.eval.robust_scale", "--header", source_dir / "policy" / "weights.h",
+                        "--rigs", "2", "--fill-schedule", "5", "--num-cpus", "2", "--quiet", "-o", out],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    doc = json.loads((out / "robust_scale.json").read_text())
+    assert doc["fill_schedule_l"] == 5.0 and len(doc["per_episode"]) == 2
+    for e in doc["per_episode"]:
+        assert e["liquid_l"] > 5 and (e["finish_s"] < 0 or e["finish_s"] > 4), e
+    assert "fill_schedule_l=5" in (out / "robust_scale.md").read_text()

@@ -83,8 +83,15 @@ static void test_golden_SampledPolicyDrawsThePythonKernelsActions(void) {
 static void test_golden_SafetyEnvelopeRepeatsItsRecordedCommandsAndLimits(void) {
   for (unsigned i = 0; i < POUR_GOLDEN_N_SAFETY; ++i) {
     const pour_golden_safety_t *g = &pour_golden_safety[i];
-    const pour_safety_config_t config = {(q15_t)g->config[0], (q15_t)g->config[1], g->config[2], g->config[3],
-                                         g->config[4], g->config[5], g->config[6], (q15_t)g->config[7]};
+    pour_safety_config_t config = pour_safety_default_config(); /* the vectors' configs have no fill schedule */
+    config.tau_limit = (q15_t)g->config[0];
+    config.slew_per_tick = (q15_t)g->config[1];
+    config.theta_min_urad = g->config[2];
+    config.theta_max_urad = g->config[3];
+    config.omega_max_urad_s = g->config[4];
+    config.alpha_max_urad_s2 = g->config[5];
+    config.omega_slack_urad_s = g->config[6];
+    config.torque_per_rad_s = (q15_t)g->config[7];
     pour_safety_t safety;
     TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
     for (unsigned t = 0; t < POUR_GOLDEN_SAFETY_LEN; ++t) {

@@ -258,14 +258,20 @@ static uint32_t encoder_count(int64_t theta_nrad) {
 typedef struct {
   int32_t peak_urad_s;     /* max |θ̇| of the bucket */
   int32_t over_ramp_urad_s; /* max of |θ̇(t)| - (slack + α_max t) over the run: > 0 = faster than the ramp */
+  int32_t knee_urad_s;      /* θ̇ when θ first reaches the knee (fill schedule; 0 if it never does) */
+  int32_t past_peak_urad_s; /* max |θ̇| from 0.1 rad past the knee on */
+  int32_t theta_end_urad;   /* θ at the end */
+  int64_t last_s_urad;      /* θ travelled in the last second */
 } run_t;
+
+static const pour_safety_config_t *loop_config; /* the closed loop's envelope, NULL: the defaults */
 
 static bool band_off; /* the same runs without the motion envelope: the tests must fail then */
 
 /* Requests `requested` for `ticks` from rest at theta0, with the estimator closing the loop. */
 static run_t closed_loop(int32_t j_gm2, int32_t g_mnm, unsigned latency, int32_t theta0_urad, q15_t requested,
                          unsigned ticks) {
-  config = pour_safety_default_config();
+  config = loop_config != NULL ? *loop_config : pour_safety_default_config();
   if (band_off) {
     config.omega_max_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
     config.omega_slack_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
@@ -275,8 +281,12 @@ static run_t closed_loop(int32_t j_gm2, int32_t g_mnm, unsigned latency, int32_t
   static pour_estimator_t est;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_estimator_init(&est, &sc));
   bucket_t b = {(int64_t)theta0_urad * 1000, 0, j_gm2, g_mnm, {0}, latency};
-  run_t r = {0, INT32_MIN};
+  run_t r = {0, INT32_MIN, 0, 0, 0, 0};
+  int64_t theta_1s_before_end_nrad = 0;
   for (uint32_t t = 0; t < ticks; ++t) {
+    if (t + 1000u == ticks) {
+      theta_1s_before_end_nrad = b.theta_nrad;
+    }
     const pour_sensors_t sample = {t, encoder_count(b.theta_nrad), 10000, 0};
     pour_state_t st;
     const bool ok = pour_estimator_update(&est, &sample, &st);
@@ -289,7 +299,16 @@ static run_t closed_loop(int32_t j_gm2, int32_t g_mnm, unsigned latency, int32_t
     r.peak_urad_s = w > r.peak_urad_s ? w : r.peak_urad_s;
     const int32_t ramp = config.omega_slack_urad_s + (int32_t)((int64_t)config.alpha_max_urad_s2 * t / 1000);
     r.over_ramp_urad_s = w - ramp > r.over_ramp_urad_s ? w - ramp : r.over_ramp_urad_s;
+    const int64_t theta_urad = b.theta_nrad / 1000;
+    if (config.knee_theta_urad != 0 && r.knee_urad_s == 0 && theta_urad >= config.knee_theta_urad) {
+      r.knee_urad_s = w;
+    }
+    if (config.knee_theta_urad != 0 && theta_urad >= config.knee_theta_urad + 100000 && w > r.past_peak_urad_s) {
+      r.past_peak_urad_s = w;
+    }
   }
+  r.theta_end_urad = (int32_t)(b.theta_nrad / 1000);
+  r.last_s_urad = (b.theta_nrad - theta_1s_before_end_nrad) / 1000;
   return r;
 }
 
@@ -332,6 +351,136 @@ static void test_safety_closed_loop_FullReverseRequestWithGravityStaysWithinTheD
   TEST_ASSERT_GREATER_THAN_INT32(10000000, free_start.peak_urad_s);
 }
 
+
+/* The fill schedule's speed limit at θ, read from the band with a slack wide enough never to bind. */
+static int32_t scheduled_ceiling(int32_t theta_urad) {
+  (void)pour_safety_apply(&safety, 0, theta_urad, 0);
+  return safety.ceiling_urad_s;
+}
+
+static void init_schedule(int32_t knee_urad) {
+  config = pour_safety_default_config();
+  config.omega_slack_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S;
+  config.alpha_max_urad_s2 = 1000000000;
+  config.slew_per_tick = POUR_Q15_MAX;
+  config.knee_theta_urad = knee_urad;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+}
+
+static void test_safety_schedule_RefusesBadConfigs(void) {
+  const int32_t knees[] = {-1, POUR_SAFETY_KNEE_MAX_URAD + 1};
+  for (unsigned i = 0; i < 2u; ++i) {
+    config = pour_safety_default_config();
+    config.knee_theta_urad = knees[i];
+    TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  }
+  config = pour_safety_default_config();
+  config.slow_omega_urad_s = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config.slow_omega_urad_s = POUR_SAFETY_OMEGA_MAX_URAD_S + 1;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.knee_decel_urad_s2 = 999;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config.knee_decel_urad_s2 = POUR_SAFETY_DECEL_MAX_URAD_S2 + 1;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+  config = pour_safety_default_config();
+  config.slow_torque_ff = -1;
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
+}
+
+/* Before the knee the ceiling is floor(sqrt(slow² + 2 · decel · (knee - θ))) up to omega_max, from the
+ * knee on it is slow; with no knee it is omega_max at every tilt. */
+static void test_safety_schedule_CeilingFollowsTheBrakingCurveToTheKnee(void) {
+  const int32_t knee = 600000;
+  init_schedule(knee);
+  const int32_t thetas[] = {-3141593, 0, 300000, 500000, 590000, 599999, 600000, 700000, 2356194};
+  for (unsigned i = 0; i < sizeof thetas / sizeof thetas[0]; ++i) {
+    const int32_t c = scheduled_ceiling(thetas[i]);
+    if (thetas[i] >= knee) {
+      TEST_ASSERT_EQUAL_INT32(config.slow_omega_urad_s, c);
+      continue;
+    }
+    const int64_t sq = (int64_t)config.slow_omega_urad_s * config.slow_omega_urad_s +
+                       2 * (int64_t)config.knee_decel_urad_s2 * (knee - thetas[i]);
+    if (sq >= (int64_t)config.omega_max_urad_s * config.omega_max_urad_s) {
+      TEST_ASSERT_EQUAL_INT32(config.omega_max_urad_s, c);
+    } else {
+      TEST_ASSERT_TRUE((int64_t)c * c <= sq && ((int64_t)c + 1) * ((int64_t)c + 1) > sq);
+    }
+  }
+  init_schedule(0);
+  for (unsigned i = 0; i < sizeof thetas / sizeof thetas[0]; ++i) {
+    TEST_ASSERT_EQUAL_INT32(config.omega_max_urad_s, scheduled_ceiling(thetas[i]));
+  }
+}
+
+/* Past the knee, at rest under a full request, the bound is K · slow + ff + I, and I grows by K · slow ·
+ * ki / 1000 a tick up to tau_limit / 2; a request below the bound does not wind it up, and back where the
+ * schedule's limit is omega_max again it is gone. */
+static void test_safety_schedule_IntegralLiftsTheBoundWithoutWindup(void) {
+  init_schedule(600000);
+  const int32_t k_slow = (int32_t)(((int64_t)config.slow_omega_urad_s * safety.gain_q32 + ((int64_t)1 << 31)) >> 32);
+  TEST_ASSERT_EQUAL_INT16(k_slow + config.slow_torque_ff, pour_safety_apply(&safety, POUR_Q15_MAX, 700000, 0));
+  for (int32_t n = 1; n <= 3000; ++n) {
+    const int32_t integral = (int32_t)((int64_t)k_slow * config.slow_ki_per_s * n < (int64_t)config.tau_limit * 500
+                                           ? (int64_t)k_slow * config.slow_ki_per_s * n
+                                           : (int64_t)config.tau_limit * 500);
+    TEST_ASSERT_EQUAL_INT16(k_slow + config.slow_torque_ff + integral / 1000,
+                            pour_safety_apply(&safety, POUR_Q15_MAX, 700000, 0));
+  }
+  TEST_ASSERT_EQUAL_INT32(config.tau_limit * 500, safety.integral_mq15);
+  (void)pour_safety_apply(&safety, 0, 590000, 0); /* still on the braking curve: I stays */
+  TEST_ASSERT_EQUAL_INT32(config.tau_limit * 500, safety.integral_mq15);
+  (void)pour_safety_apply(&safety, 0, 0, 0);
+  TEST_ASSERT_EQUAL_INT32(0, safety.integral_mq15);
+  for (int n = 0; n < 1000; ++n) {
+    TEST_ASSERT_EQUAL_INT16(100, pour_safety_apply(&safety, 100, 700000, 0)); /* below the bound */
+  }
+  TEST_ASSERT_EQUAL_INT32(0, safety.integral_mq15);
+}
+
+/* However large the feed-forward and the integral, the bound never speeds the bucket up beyond omega_max. */
+static void test_safety_schedule_NeverPushesBeyondTheSpeedLimit(void) {
+  init_schedule(600000);
+  config.slow_torque_ff = POUR_Q15_MAX;
+  config.slow_omega_urad_s = config.omega_max_urad_s;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+  TEST_ASSERT_EQUAL_INT16(POUR_Q15_MAX, pour_safety_apply(&safety, POUR_Q15_MAX, 700000, 0));
+  TEST_ASSERT_EQUAL_INT16(0, pour_safety_apply(&safety, POUR_Q15_MAX, 700000, config.omega_max_urad_s));
+  TEST_ASSERT_LESS_THAN_INT16(0, pour_safety_apply(&safety, POUR_Q15_MAX, 700000, config.omega_max_urad_s + 100000));
+}
+
+/* Closed loop on the gravity-loaded bucket (a full bucket's 5.4 N·m at 90 deg, the knee at 34 deg where it
+ * pulls 3.0 N·m back, plus 0.5 N·m of friction), full forward request from upright for 4 s: the braking
+ * curve brings the bucket to the knee below slow + 0.2 rad/s (0.07 rad/s light, 0.31 at twice the full
+ * bucket's inertia; unscheduled it peaks at 1.7 rad/s), past it |θ̇| stays below slow + 0.03 rad/s, and the
+ * last second moves 0.16 ± 0.03 rad (0.151). The ceiling alone bounds the torque by K · slow = 1.6 N·m
+ * and stalls the bucket short of the knee: without ff and integral it ends before knee + 0.05 rad. */
+static void test_safety_schedule_ClosedLoopPoursAtTheSlowSpeedPastTheKnee(void) {
+  const int32_t knee = 600000;
+  const int32_t inertias[] = {150, 300};
+  pour_safety_config_t c = pour_safety_default_config();
+  c.knee_theta_urad = knee;
+  loop_config = &c;
+  for (unsigned i = 0; i < 2u; ++i) {
+    for (unsigned lat = 1u; lat <= 2u; ++lat) {
+      const run_t r = closed_loop(inertias[i], 5400, lat, 0, POUR_Q15_MAX, 4000u);
+      TEST_ASSERT_LESS_OR_EQUAL_INT32(c.slow_omega_urad_s + 200000, r.knee_urad_s);
+      TEST_ASSERT_LESS_OR_EQUAL_INT32(c.slow_omega_urad_s + 30000, r.past_peak_urad_s);
+      TEST_ASSERT_INT64_WITHIN(30000, c.slow_omega_urad_s, r.last_s_urad);
+    }
+  }
+  c.slow_torque_ff = 0;
+  c.slow_ki_per_s = 0;
+  const run_t stalled = closed_loop(150, 5400, 1u, 0, POUR_Q15_MAX, 4000u);
+  c = pour_safety_default_config();
+  const run_t unscheduled = closed_loop(150, 5400, 1u, 0, POUR_Q15_MAX, 4000u);
+  loop_config = NULL;
+  TEST_ASSERT_LESS_THAN_INT32(knee + 50000, stalled.theta_end_urad);
+  TEST_ASSERT_GREATER_THAN_INT32(1500000, unscheduled.peak_urad_s);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_safety_init_StartsAtZeroTorque);
@@ -350,5 +499,10 @@ int main(void) {
   RUN_TEST(test_safety_band_SaturatesAbsurdSpeeds);
   RUN_TEST(test_safety_closed_loop_FullForwardRequestStaysWithinTheSpeedLimit);
   RUN_TEST(test_safety_closed_loop_FullReverseRequestWithGravityStaysWithinTheDroop);
+  RUN_TEST(test_safety_schedule_RefusesBadConfigs);
+  RUN_TEST(test_safety_schedule_CeilingFollowsTheBrakingCurveToTheKnee);
+  RUN_TEST(test_safety_schedule_IntegralLiftsTheBoundWithoutWindup);
+  RUN_TEST(test_safety_schedule_NeverPushesBeyondTheSpeedLimit);
+  RUN_TEST(test_safety_schedule_ClosedLoopPoursAtTheSlowSpeedPastTheKnee);
   return UNITY_END();
 }

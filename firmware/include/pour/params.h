@@ -47,9 +47,15 @@
   X(19, scale_rotating_factor, "ppm", 500000, 2000000, int32_t, scale_rotating_factor_ppm)                    \
   X(20, scale_rotating_tare, "g", -32767, 32767, int32_t, scale_rotating_tare_g)                             \
   X(21, scale_target_factor, "ppm", 500000, 2000000, int32_t, scale_target_factor_ppm)                        \
-  X(22, scale_target_tare, "g", -32767, 32767, int32_t, scale_target_tare_g)
+  X(22, scale_target_tare, "g", -32767, 32767, int32_t, scale_target_tare_g)                                 \
+  /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */          \
+  X(23, knee_theta, "urad", 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, control.safety.knee_theta_urad)           \
+  X(24, slow_omega, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.slow_omega_urad_s)    \
+  X(25, knee_decel, "urad/s2", 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, control.safety.knee_decel_urad_s2) \
+  X(26, slow_torque_ff, "Q15", 0, POUR_Q15_MAX, q15_t, control.safety.slow_torque_ff)                         \
+  X(27, slow_ki, "1/s", 0, UINT16_MAX, uint16_t, control.safety.slow_ki_per_s)
 
-#define POUR_PARAM_COUNT 23u
+#define POUR_PARAM_COUNT 28u
 
 /* POUR_PARAM_ID_<name>: each parameter's id, from the table. */
 typedef enum {

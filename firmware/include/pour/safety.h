@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The torque envelope applied to every command: clamp, slew-rate limit, angle limits, and the motion
- * envelope (a speed governor whose band widens at most at the acceleration limit). */
+ * envelope (a speed governor whose band widens at most at the acceleration limit), optionally scheduled by
+ * the fill: a slow ceiling past a knee angle, with a feed-forward and an integral in its governor. */
 #ifndef POUR_SAFETY_H
 #define POUR_SAFETY_H
 
@@ -16,6 +17,8 @@
 #define POUR_LIMIT_SPEED 0x10u     /* the governor cut the torque at the speed limit ±omega_max */
 #define POUR_LIMIT_ACCEL 0x20u     /* the governor cut it at a speed band still ramping at alpha_max */
 #define POUR_SAFETY_OMEGA_MAX_URAD_S 100000000 /* speeds the envelope works with, saturated: 100 rad/s */
+#define POUR_SAFETY_KNEE_MAX_URAD 3141593       /* the fill schedule's knee: at most π */
+#define POUR_SAFETY_DECEL_MAX_URAD_S2 1000000000 /* and its braking curve at most 1000 rad/s² */
 
 typedef struct {
   q15_t tau_limit;         /* |torque| <= tau_limit, fraction of tau_max Q15, > 0 */
@@ -26,6 +29,12 @@ typedef struct {
   int32_t alpha_max_urad_s2;  /* the speed band widens at most this fast [µrad/s²], >= 1000 */
   int32_t omega_slack_urad_s; /* the band reaches this far beyond the current speed [µrad/s], > 0 */
   q15_t torque_per_rad_s;     /* governor gain: torque bound per rad/s of speed margin, Q15, > 0 */
+  /* The fill schedule (docs/safety.md, "Fill schedule"): off while knee_theta_urad is 0. */
+  int32_t knee_theta_urad;    /* past this tilt the ceiling is slow_omega [µrad], 0 (off) .. KNEE_MAX */
+  int32_t slow_omega_urad_s;  /* the ceiling past the knee (at most omega_max) [µrad/s], 1 .. OMEGA_MAX */
+  int32_t knee_decel_urad_s2; /* before the knee the ceiling falls along this braking curve [µrad/s²], 1000 .. DECEL_MAX */
+  q15_t slow_torque_ff;       /* past the knee the bound carries this feed-forward, Q15, >= 0 */
+  uint16_t slow_ki_per_s;     /* and K · ki · ∫(ceiling - θ̇)dt, held within 0 .. tau_limit / 2 [1/s], 0: none */
 } pour_safety_config_t;
 
 typedef struct {
@@ -36,6 +45,7 @@ typedef struct {
   int32_t gain_q32;           /* torque_per_rad_s / 10^6: Q15 torque per µrad/s, Q32 (< 2^28) */
   int32_t ceiling_urad_s;     /* speed band: no torque that speeds θ̇ beyond [floor, ceiling] [µrad/s] */
   int32_t floor_urad_s;
+  int32_t integral_mq15;      /* the fill schedule's integral [Q15 / 1000], 0 .. tau_limit · 500 */
 } pour_safety_t;
 
 /* Defaults for the bench rig (docs/safety.md). */
@@ -48,8 +58,12 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
  * lies beyond the band or an angle limit (less torque never waits for the slew). The band follows the
  * estimated speed omega_urad_s: ceiling = min(omega_max, ceiling + alpha step, max(θ̇, 0) + slack), floor
  * likewise, torque within [K (floor - θ̇), K (ceiling - θ̇)] (K = torque_per_rad_s, each bound within
- * ±tau_limit): beyond the band the bound changes sign and brakes, against gravity too. Returns the command;
- * safety->active tells which rules shaped it. */
+ * ±tau_limit): beyond the band the bound changes sign and brakes, against gravity too. With a knee, the
+ * ceiling is also at most sqrt(slow² + 2 · knee_decel · (knee - θ)) before the knee and slow past it; where
+ * that limit is below omega_max the upper bound is min(K (ceiling - θ̇) + slow_torque_ff + I,
+ * K (omega_max - θ̇)), I integrating K · ki · (ceiling - θ̇) while that bound cuts the request (or the speed
+ * is above the ceiling), within 0 .. tau_limit / 2; elsewhere I is 0. Returns the command; safety->active
+ * tells which rules shaped it. */
 q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_urad, int32_t omega_urad_s);
 
 /* Sets the command at once, bypassing the slew limit (e-stop and faults must not wait). */

@@ -67,6 +67,8 @@
   X(DOUBLE, scale_delay_s, 0.05, 0.0, 1.0, "s", "a conversion reports the mean load over this span before it") \
   X(DOUBLE, scale_noise_g, 0.5, 0.0, 1000.0, "g", "Gaussian noise of a conversion, standard deviation") \
   X(DOUBLE, scale_resolution_g, 1.0, 1.0, 1000.0, "g", "readings are multiples of this") \
+  S("what the firmware's rig file tells its envelope (docs/safety.md: Fill schedule)") \
+  X(DOUBLE, fill_schedule_l, 0.0, 0.0, 100.0, "L", "a fill above this gets the knee of its onset angle less 3 deg (0: no schedule)") \
   S("domain randomisation: uniform +- around the nominal, drawn from the reset seed; 0 = off") \
   X(DOUBLE, rand_fill, 0.0, 0.0, 0.5, "relative", "fill_depth") \
   X(DOUBLE, rand_target_dx, 0.0, 0.0, 0.1, "m", "target_dx") \

@@ -18,6 +18,10 @@ in the bucket moves one rig's spill anywhere over 0-4.7 % (docs/training.md, "Re
 its expected spill, poured, finish time and reversals. Its peaks of θ̇ and θ̈ stay the worst of the K, and
 "worst episode" in the table is still one episode's. K = 1 (the default) runs the rig as drawn.
 
+--fill-schedule L configures each rig's firmware as its rig file would when the rig holds more than L litres:
+the envelope's fill schedule, its knee at the onset angle of the rig's own fill less 3° (the simulator's
+fill_schedule_l; docs/safety.md, "Fill schedule"). Rigs at or below L run the envelope as shipped.
+
 Every node needs host_sim at the path the driver resolves (--build-dir, $POUR_BUILD_DIR or build/host).
 """
 from __future__ import annotations
@@ -113,10 +117,10 @@ def reduce(per: list[dict[str, Any]], sets: Sequence[str]) -> list[dict[str, Any
 
 def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None, rand: dict[str, float],
         build_dir: str | None, address: str | None, num_cpus: int | None,
-        quiet: bool = False, repeats: int = 1) -> tuple[list[dict[str, Any]], dict]:
+        quiet: bool = False, repeats: int = 1, fill_schedule_l: float = 0.0) -> tuple[list[dict[str, Any]], dict]:
     exe = str(evaluate.host_sim_binary(build_dir).resolve())
     header = str(Path(header).resolve())
-    sets = [f"{k}={v:g}" for k, v in rand.items()]
+    sets = [f"{k}={v:g}" for k, v in rand.items()] + ([f"fill_schedule_l={fill_schedule_l:g}"] if fill_schedule_l else [])
     factors = fill_factors(repeats)
     fills = [[]] if repeats == 1 else [[f"fill_depth={poursim.default_config()['fill_depth'] * f!r}"]
                                        for f in factors]
@@ -141,7 +145,8 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
     rows = reduce(rigs_per, sets)
     out.mkdir(parents=True, exist_ok=True)
     meta = {"header": header, "rigs": rigs, "repeats": repeats, "first_seed": first_seed, "per_task": k,
-            "tasks": len(refs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand}
+            "tasks": len(refs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand,
+            "fill_schedule_l": fill_schedule_l}
     doc = {**meta, "rows": rows, "per_episode": per} if repeats == 1 else \
         {**meta, "fill_factors": factors, "rows": rows, "per_rig": rigs_per, "per_episode": per}
     atomic.write_atomic(out / "robust_scale.json", json.dumps(doc) + "\n")
@@ -165,6 +170,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--per-task", type=int, help="rigs per Ray task (default: 2 tasks a CPU, at most 200)")
     ap.add_argument("--repeats", type=int, default=1, metavar="K",
                     help="run each rig K times, its fill stepped by 1 mL, and judge it by the mean (default 1)")
+    ap.add_argument("--fill-schedule", type=float, default=0.0, metavar="L",
+                    help="give rigs above L litres the envelope's fill schedule from their rig file (default 0: off)")
     ap.add_argument("--set", action="append", default=[], metavar="rand_KEY=VALUE",
                     help="override a randomisation range (0 turns it off); repeatable")
     ap.add_argument("-o", "--out", default="results/robust_scale", type=Path)
@@ -182,6 +189,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError(f"--per-task {args.per_task}: expected 1..100000")
         if not 1 <= args.repeats <= MAX_REPEATS:
             raise ValueError(f"--repeats {args.repeats}: expected 1..{MAX_REPEATS}")
+        if not (0.0 <= args.fill_schedule <= 100.0):   # also refuses nan
+            raise ValueError(f"--fill-schedule {args.fill_schedule}: expected 0..100 L (0: off)")
         if not 0 <= args.seed <= 2**32 - 1 - args.rigs:
             raise ValueError(f"--seed {args.seed}: the seeds must stay below 2^32")
         rand = dict(DEFAULT_RAND)
@@ -196,7 +205,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if not Path(args.header).is_file():
             raise ValueError(f"--header {args.header}: no such file")
         rows, meta = run(args.header, args.out, args.rigs, args.seed, args.per_task, rand, args.build_dir,
-                         args.ray_address, args.num_cpus, args.quiet, args.repeats)
+                         args.ray_address, args.num_cpus, args.quiet, args.repeats, args.fill_schedule)
     except (OSError, RuntimeError, ValueError) as exc:   # ExecutorError is a RuntimeError
         print(f"pour-robust-scale: error: {exc}", file=sys.stderr)
         return 2

@@ -95,12 +95,12 @@ class SimStepper:
         self.world, self.reward = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
         self.period = int(decision_period_ms)
-        with _env_errors("the firmware core in libpoursim"):
-            self.fw_config = core.control_config(self.world.config)
 
     def reset(self, seed: int) -> None:
         with _env_errors("poursim_reset"):
             self.obs = self.world.reset(seed)
+        with _env_errors("the firmware core in libpoursim"):   # for the drawn rig, as the rollouts' is
+            self.fw_config = core.control_config(self.world.episode_rig())
         try:
             self.core = core.Controller(None, self.fw_config, decision_period_ms=self.period)
         except core.CoreError as exc:

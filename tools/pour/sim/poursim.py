@@ -530,6 +530,10 @@ class World:
         """This episode's config: the world's with the reset seed's rand_* draws applied."""
         return _read_all(self._lib.poursim_episode_config(self._check()))
 
+    def episode_rig(self) -> Config:
+        """This episode's config as a Config (a copy): the rig a controller configured from its file knows."""
+        return Config(self._lib.poursim_episode_config(self._check()))
+
     @property
     def n_particles(self) -> int:
         return self._lib.poursim_particle_count(self._check())
