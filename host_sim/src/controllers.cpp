@@ -9,10 +9,11 @@
 namespace poursim {
 
 double fill_knee_rad(const poursim_config_t &rig) {
-  // A level liquid reaches the lip when the surface through the fill's centre line meets it: tan θ =
-  // (depth - fill) / (width / 2), while the fill is above half the depth (every fill a schedule is for).
-  const double depth = rig.bucket_height - rig.bucket_wall;
-  const double onset = std::atan2(std::max(0.0, depth - rig.fill_depth), 0.5 * rig.bucket_inner_width);
+  // A level liquid reaches the lip when the surface through the lip holds the whole fill: a trapezoid,
+  // tan θ = 2 (depth - fill) / width, while the fill is at least half the depth; a triangle below that,
+  // tan θ = depth² / (2 width fill).
+  const double h = rig.bucket_height - rig.bucket_wall, w = rig.bucket_inner_width, d = rig.fill_depth;
+  const double onset = d >= 0.5 * h ? std::atan2(2.0 * std::max(0.0, h - d), w) : std::atan2(h * h, 2.0 * w * d);
   return std::max(0.0, onset - kFillKneeMarginRad);
 }
 
