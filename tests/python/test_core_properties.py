@@ -387,3 +387,23 @@ def test_an_outside_request_runs_the_same_pipeline_as_the_policy(example_weights
         got = ext.shape()
         assert (got.torque, got.action, got.mode, got.faults, got.limits, got.brake) == \
                (want.torque, want.action, want.mode, want.faults, want.limits, want.brake)
+
+
+@pytest.mark.parametrize("fill_depth", [0.10, 0.16, 0.2387, 0.2653])
+def test_fill_schedule_knee_is_the_hydrostatic_onset_less_3_degrees(fill_depth):
+    """A rig file that asks for the fill schedule gives the core the angle at which a level liquid of its fill
+    reaches the lip, less 3°: checked against the simulator's own hydrostatics (poursim_ideal_retained, the
+    level liquid's share kept), which keeps all of it just before that angle and loses some just after. The
+    fills cover both shapes of the liquid at the onset (a triangle below half the depth, a trapezoid above).
+    A fill at or below fill_schedule_l gets no schedule."""
+    lib = poursim.load_library()
+    lib.poursim_ideal_retained.argtypes = [ctypes.c_double] * 4
+    lib.poursim_ideal_retained.restype = ctypes.c_double
+    rig = poursim.make_config({"fill_depth": fill_depth, "fill_schedule_l": 1.0})
+    depth = rig["bucket_height"] - rig["bucket_wall"]
+    onset = core.control_config(rig).safety.knee_theta_urad * 1e-6 + np.radians(3.0)
+    kept = lambda theta: lib.poursim_ideal_retained(rig["bucket_inner_width"], depth, fill_depth, theta)  # noqa: E731
+    assert kept(onset - 2e-3) == 1.0 and kept(onset + 2e-3) < 1.0
+    litres = 1000 * np.pi * (rig["bucket_inner_width"] / 2) ** 2 * fill_depth
+    off = poursim.make_config({"fill_depth": fill_depth, "fill_schedule_l": round(litres + 0.01, 2)})
+    assert core.control_config(off).safety.knee_theta_urad == 0
