@@ -105,7 +105,8 @@ static uint32_t isqrt64(uint64_t x) {
 }
 
 /* The speed limit at the tilt θ: omega_max, and with a knee the fill schedule's: slow past it, before it
- * sqrt(slow² + 2 · decel · (knee - θ)). slow < 2^27, decel <= 10^9, knee - θ <= 2^23: the sum < 2^55. */
+ * sqrt(slow² + 2 · decel · (knee - θ)) up to omega_max (the root only where it is below: sq < omega_max²).
+ * slow < 2^27, decel <= 10^9, knee - θ <= 2^23: the sum < 2^55. */
 static int32_t speed_limit(const pour_safety_config_t *c, int32_t theta_urad) {
   if (c->knee_theta_urad == 0) {
     return c->omega_max_urad_s;
@@ -117,8 +118,8 @@ static int32_t speed_limit(const pour_safety_config_t *c, int32_t theta_urad) {
   const int64_t span = (int64_t)c->knee_theta_urad - theta_urad;
   const uint64_t d = (uint64_t)(span > KNEE_SPAN_MAX_URAD ? KNEE_SPAN_MAX_URAD : span);
   const uint64_t sq = (uint64_t)slow * (uint64_t)slow + 2u * (uint64_t)c->knee_decel_urad_s2 * d;
-  const uint32_t curve = isqrt64(sq);
-  return curve < (uint32_t)c->omega_max_urad_s ? (int32_t)curve : c->omega_max_urad_s;
+  const uint64_t top = (uint64_t)c->omega_max_urad_s * (uint64_t)c->omega_max_urad_s;
+  return sq < top ? (int32_t)isqrt64(sq) : c->omega_max_urad_s;
 }
 
 /* Moves the band one tick on from the speed θ̇ [µrad/s] under the limit lim; returns the torque bounds it
@@ -167,13 +168,12 @@ q15_t pour_safety_apply(pour_safety_t *safety, q15_t requested, int32_t theta_ur
      * ceiling must still lift the load: the feed-forward and the integral carry what K (ceiling - θ̇) alone
      * cannot (it would stall the bucket short of the knee), and the bound never speeds the bucket beyond
      * omega_max. */
-    const int32_t lim_hi = band_torque(safety, c->omega_max_urad_s - w);
-    const int32_t sum = hi + c->slow_torque_ff + safety->integral_mq15 / 1000; /* each term < 2^16 */
+    const int32_t proportional = hi; /* K (ceiling - θ̇) */
+    const int32_t lim_hi = band_torque(safety, c->omega_max_urad_s - w); /* within ±tau_limit */
+    const int32_t sum = proportional + c->slow_torque_ff + safety->integral_mq15 / 1000; /* each term < 2^16 */
     hi = sum < lim_hi ? sum : lim_hi;
-    hi = hi > c->tau_limit ? c->tau_limit : hi;
     if (cmd > hi || safety->ceiling_urad_s < w) { /* integrate only while the bound governs: no windup */
-      const int64_t next = (int64_t)safety->integral_mq15 +
-                           (int64_t)band_torque(safety, safety->ceiling_urad_s - w) * c->slow_ki_per_s;
+      const int64_t next = (int64_t)safety->integral_mq15 + (int64_t)proportional * c->slow_ki_per_s;
       const int64_t top = (int64_t)c->tau_limit * 500;
       safety->integral_mq15 = (int32_t)(next < 0 ? 0 : (next > top ? top : next));
     }
