@@ -33,7 +33,7 @@ APT_PACKAGES=(
   clang-14 libclang-rt-14-dev llvm-14
   libeigen3-dev
   gcc-arm-none-eabi libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm
-  can-utils user-mode-linux iproute2 kmod
+  can-utils iproute2 kmod patchelf
   default-jdk-headless default-jre fonts-dejavu-core xvfb xauth x11-apps
   python3 python3-venv python3-dev python3-tk libglib2.0-0
   ca-certificates xz-utils
@@ -153,5 +153,8 @@ print(next(os.path.dirname(p["manifest_path"]) for p in meta["packages"] if p["n
     echo "$dir" > "$SVD_WORK/$marker"
   done
 fi
+
+# The user-mode Linux kernel of the SocketCAN tests (scripts/lib/uml.sh says why not Debian 12's).
+scripts/lib/uml.sh
 
 log "ok"

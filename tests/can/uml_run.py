@@ -24,8 +24,10 @@ import tempfile
 import time
 from pathlib import Path
 
-UML_KERNEL = "/usr/bin/linux"
-UML_MODULES = Path("/usr/lib/uml/modules")
+# The kernel scripts/lib/uml.sh unpacks (Debian 12's own cannot run on a host CPU with AMX: see there).
+UML_DEPS = Path(__file__).resolve().parents[2] / ".deps" / "uml"
+UML_KERNEL = str(UML_DEPS / "linux")
+UML_MODULES = UML_DEPS / "root" / "usr" / "lib" / "uml" / "modules"
 EXIT_TIMEOUT = 124
 EXIT_NO_BOOT = 3
 EXIT_NO_VCAN = 4
@@ -77,9 +79,9 @@ def run(cmd: list[str], timeout: float, mem: str, cwd: str, env: list[str], keep
     if not cmd:
         return fail(2, "no command given (usage: uml_run.py [options] -- CMD [ARG ...])")
     if not os.access(kernel, os.X_OK):
-        return fail(EXIT_NO_BOOT, f"{kernel} not found: install Debian's user-mode-linux (scripts/setup.sh)")
+        return fail(EXIT_NO_BOOT, f"{kernel} not found: run scripts/setup.sh (scripts/lib/uml.sh)")
     if not UML_MODULES.is_dir():
-        return fail(EXIT_NO_BOOT, f"{UML_MODULES} not found: install Debian's user-mode-linux (scripts/setup.sh)")
+        return fail(EXIT_NO_BOOT, f"{UML_MODULES} not found: run scripts/setup.sh (scripts/lib/uml.sh)")
     for kv in env:
         if "=" not in kv or not kv.split("=", 1)[0].isidentifier():
             return fail(2, f"--env needs NAME=VALUE, got {kv!r}")

@@ -40,10 +40,10 @@ def test_a_guest_that_does_not_boot_fails_with_a_message():
     assert "did not boot" in out.stderr
 
 
-def test_a_missing_kernel_names_the_package():
+def test_a_missing_kernel_names_the_set_up_step():
     out = uml_run("--kernel", "/nonexistent/linux", "--", "true")
     assert out.returncode == 3
-    assert "user-mode-linux" in out.stderr
+    assert "/nonexistent/linux not found" in out.stderr and "scripts/lib/uml.sh" in out.stderr
 
 
 def test_a_hung_command_times_out_and_the_guest_is_ended():
