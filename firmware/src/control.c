@@ -331,9 +331,12 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
     ctl->mode = POUR_MODE_FAULT;
   }
   /* A clear or a restart in the middle of the active stop would drop a torque that is braking the bucket
-   * and start the speed estimate from rest while it turns: both wait until the stop is over. */
+   * and start the speed estimate from rest while it turns: both wait until the stop is over. A clear in a
+   * tick whose link or drive fault is still asserted is refused too: it would release the brake toward a
+   * transport or a drive that is still faulted (the level latches its bit again, but only after a first
+   * sample had already started a run). */
   const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
-  if (in->clear_faults && stopping) {
+  if (in->clear_faults && (stopping || in->link_fault || in->drive_faults != 0u)) {
     count_refused(ctl);
   } else if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
     expect_held_angle(ctl);
@@ -436,6 +439,14 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
 }
 
 const pour_state_t *pour_control_state(const pour_control_t *ctl) { return &ctl->state; }
+
+bool pour_control_clear_acceptable(const pour_control_t *ctl, const pour_control_input_t *in) {
+  if (in->estop || in->link_fault) {
+    return false;
+  }
+  /* The e-stop released this tick turns ESTOP into FAULT with its stop over (update_stage). */
+  return ctl->mode == POUR_MODE_ESTOP || (ctl->mode == POUR_MODE_FAULT && (ctl->stop_ms == 0u || ctl->stopped));
+}
 
 STAGE void decide_stage(pour_control_t *ctl) {
   const pour_policy_weights_t *w = ctl->policy.weights;

@@ -178,6 +178,25 @@ static void test_calibration_flow_AStaleSampleIsRefused(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, answer_with_rig());
 }
 
+/* The latest sample of the tick decides, not the latest usable one: a count out of range (the core latches
+ * BAD_INPUT on it) refuses the start although an upright, empty sample came 1 ms before, and so it does in
+ * every tick of samples that alternate between good and out of range. */
+static void test_calibration_flow_ALatestCountOutOfRangeRefusesAfterGoodSamples(void) {
+  for (int ms = 0; ms < 20; ++ms) tick(POUR_MODE_IDLE); /* the offsets measured: the drive could start */
+  for (int pair = 0; pair < 10; ++pair) {
+    rig.encoder = 0u; /* upright and empty */
+    tick(POUR_MODE_IDLE);
+    rig.encoder = 1u << ENCODER_BITS;
+    start();
+    n_sent = 0;
+    tick(POUR_MODE_IDLE); /* answered in this tick, on this tick's sample */
+    TEST_ASSERT_EQUAL_INT(1, n_sent);
+    TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_NO_SENSORS, sent[0].status);
+    TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
+  }
+  TEST_ASSERT_FALSE(released_outside);
+}
+
 static void test_calibration_flow_UprightAndEmptyWithinTheLimitsStarts(void) {
   rig.encoder = (1u << ENCODER_BITS) - DEG10_COUNTS(49);
   rig.scale_rotating_g = -200;
@@ -319,6 +338,7 @@ int main(void) {
   RUN_TEST(test_calibration_flow_AScaleFarBelowItsTareIsNotEmpty);
   RUN_TEST(test_calibration_flow_NoSampleSinceBootIsRefused);
   RUN_TEST(test_calibration_flow_AStaleSampleIsRefused);
+  RUN_TEST(test_calibration_flow_ALatestCountOutOfRangeRefusesAfterGoodSamples);
   RUN_TEST(test_calibration_flow_UprightAndEmptyWithinTheLimitsStarts);
   RUN_TEST(test_calibration_flow_ASecondStartWhileMeasuringIsAnsweredMeasuring);
   RUN_TEST(test_calibration_flow_AnEncoderFaultMayBeCalibratedAway);

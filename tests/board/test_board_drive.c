@@ -192,7 +192,7 @@ static void broken_amplifier_cleared(void) {
   TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* shorted */
   TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
   TEST_ASSERT_EQUAL_INT(0, armed);
-  run_ms(2, 2448u, true); /* the core takes the clear, the board's next tick hands it to the drive */
+  run_ms(1, 2448u, true); /* the board hands the clear to the drive before the core's step, in the same tick */
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv->state);
   TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, drv->faults); /* latched until they pass */
 }

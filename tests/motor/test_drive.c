@@ -329,6 +329,20 @@ static void test_drive_ClearKeepsTheBusFaultWhileTheBusIsOut(void) {
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv.state);
 }
 
+/* A clear right after the offsets were measured again judges the bus as it is now: the bus rose above its
+ * trip while the drive measured (the gates off), so OVERVOLTAGE stays, and the loop does not restart. */
+static void test_drive_ClearAfterTheOffsetsJudgesTheBusOfNow(void) {
+  run_calibration();
+  pour_drive_trip(&drv, POUR_DRIVE_FAULT_CURRENT_OFFSET | POUR_DRIVE_FAULT_OVERVOLTAGE);
+  pour_drive_isr(&drv, quiet(), &out); /* a faulted period at 24 V */
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET | POUR_DRIVE_FAULT_OVERVOLTAGE, pour_drive_clear_faults(&drv));
+  const pour_drive_sample_t high = sample(0, 0, 0, 30500, 0);
+  for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES; ++k) pour_drive_isr(&drv, &high, &out);
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv.state); /* the offsets passed; the bus fault is left */
+  TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_OVERVOLTAGE, pour_drive_clear_faults(&drv));
+  TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv.state);
+}
+
 static void test_drive_ClearKeepsTheI2tFaultUntilTheMotorCools(void) {
   run_calibration();
   const int32_t ib = 30000 * 866 / 1000;
@@ -381,6 +395,7 @@ int main(void) {
   RUN_TEST(test_drive_ClearKeepsTheKeptBitAndClearsTheOthers);
   RUN_TEST(test_drive_ClearOfACurrentOffsetMeasuresTheOffsetsAgain);
   RUN_TEST(test_drive_ClearKeepsTheBusFaultWhileTheBusIsOut);
+  RUN_TEST(test_drive_ClearAfterTheOffsetsJudgesTheBusOfNow);
   RUN_TEST(test_drive_ClearKeepsTheI2tFaultUntilTheMotorCools);
   RUN_TEST(test_drive_ClearDoesNothingOutsideFaulted);
   return UNITY_END();

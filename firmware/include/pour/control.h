@@ -70,7 +70,8 @@ typedef struct {
   bool sensors_fresh;     /* a new sensor sample arrived since the last tick */
   pour_sensors_t sensors; /* that sample, raw */
   bool estop;        /* e-stop line/frame asserted (level) */
-  bool clear_faults; /* request to clear latched faults (acted on in FAULT once the active stop is over) */
+  bool clear_faults; /* request to clear latched faults (acted on in FAULT once the active stop is over, and
+                      * only while link_fault and drive_faults are clear in the same tick) */
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
   bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
   bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN, ESTOP, active stop */
@@ -154,6 +155,13 @@ pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control
  * RUN on the first fresh sample, supervisor (RUN). Returns whether a decision is due: in RUN, on its first
  * tick and every decision period after. */
 bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in);
+
+/* Whether a ClearErrors with these inputs would be acted on, the drive's fault word aside: the e-stop
+ * released, no link fault, the core in FAULT with its active stop over (or in ESTOP, the line released
+ * now). A port with a drive of its own asks before its step, clears the drive first when this holds, and
+ * gives the step the drive's word as it stands after that: pour_control_update refuses a clear while the
+ * word (or the link fault) is set, so a clear never releases a drive that is still faulted. */
+bool pour_control_clear_acceptable(const pour_control_t *ctl, const pour_control_input_t *in);
 
 /* The state estimated from the latest fresh, plausible sample (read-only; zero before the first). */
 const pour_state_t *pour_control_state(const pour_control_t *ctl);

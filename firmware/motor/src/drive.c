@@ -325,6 +325,7 @@ void pour_drive_isr(pour_drive_t *drv, const pour_drive_sample_t *in, pour_drive
   out->limits = 0;
   out->vbus = pour_sat_q15((int32_t)(((int64_t)in->adc_vbus * drv->vbus_gain_q16 + (1 << 15)) >> 16)); /* < 2^47 >> 16 */
   if (drv->state == POUR_DRIVE_CALIBRATING) {
+    drv->vbus_q15 = out->vbus; /* a clear right after the offsets judges the bus of now, not of before them */
     const int r = pour_current_sense_calibrate(&drv->sense, in->adc_phase);
     if (r < 0) {
       pour_drive_trip(drv, POUR_DRIVE_FAULT_CURRENT_OFFSET);

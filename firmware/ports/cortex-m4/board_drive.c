@@ -22,7 +22,6 @@ static struct {
   uint32_t guard_seq;              /* the core's state the protection saw last: a new one is a fresh output angle */
   int32_t last_theta_urad;
   bool have_theta;                 /* last_theta_urad is a trusted angle */
-  bool clear;                      /* the core accepted a ClearErrors last tick: the protection clears now */
   uint16_t faults;                 /* the loop's and the protection's, as the core and the bus see them */
   pour_board_calibration_fn calibration; /* the port's calibration flow, or NULL */
   uint16_t settle_ms;              /* after a self-calibration: the brake engaging, the power kept on */
@@ -37,7 +36,6 @@ pour_status_t pour_board_drive_init(const pour_drive_config_t *config, int32_t t
   bd.guard_seq = 0u;
   bd.last_theta_urad = 0;
   bd.have_theta = false;
-  bd.clear = false;
   bd.tau_max_mnm = tau_max_mnm;
   bd.calibration_valid = calibration_valid;
   bd.calibration = NULL;
@@ -100,14 +98,17 @@ static int32_t torque_mnm(q15_t torque, q15_t scale, int32_t tau_max_mnm) {
 }
 
 void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_control_output_t *out) {
+  /* A ClearErrors the core would act on reaches the drive first: the protection judges the board's sensors
+   * afresh, the loop clears what it may, and the core sees the word as it stands after that. The core
+   * refuses the clear while any bit of it stays set, so the drive is never released while still faulted. */
+  const bool clear = in->clear_faults && pour_control_clear_acceptable(ctl, in);
   pour_hal_drive_mask(true);
   const bool sampled = bd.periods != bd.periods_seen;
   bd.periods_seen = bd.periods;
   const pour_hal_drive_sample_t s = bd.latest;
-  /* After a clear the core accepted, the protection judges the board's sensors afresh without the loop's
-   * faults a clear may fix; the loop clears only if the protection did, so it never runs while the
-   * protection still holds. */
-  uint16_t loop_faults = bd.clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
+  /* With a clear, the protection judges the sensors without the loop's faults a clear may fix; the loop
+   * clears only if the protection did, so it never runs while the protection still holds. */
+  uint16_t loop_faults = clear ? (uint16_t)(bd.drive.faults & ~POUR_DRIVE_FAULT_CLEARABLE) : bd.drive.faults;
   const bool calibrating = bd.drive.state == POUR_DRIVE_CALIBRATING;
   if (calibrating) {
     /* The offsets measured (again, after a clear of CURRENT_OFFSET): the gates off and the brake engaged
@@ -127,13 +128,13 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   const bool fresh = ctl->have_trusted && state->seq != bd.guard_seq;
   bd.guard_seq = state->seq;
   pour_protect_output_t p;
-  /* The protection clears only what the core cleared (a clear it refuses, in an active stop, keeps both). */
+  /* A clear the core would refuse (the e-stop, a link fault, the active stop) keeps both latched. */
   pour_guard_tick(&bd.guard, sampled ? &s : NULL, loop_faults, state->theta_urad, fresh, bd.calibration_valid,
-                  bd.clear, &p);
+                  clear, &p);
 
   pour_hal_drive_mask(true);
-  if (bd.clear && p.faults == 0u) {
-    (void)pour_drive_clear_faults(&bd.drive); /* what it keeps stays in bd.faults: the core latches it again */
+  if (clear && p.faults == 0u) {
+    (void)pour_drive_clear_faults(&bd.drive); /* what it keeps stays in the word: the core refuses the clear */
   }
   /* What a calibration clears does not trip (nor short) a drive that measures the motor or has just measured
    * it (the flow stores it this tick); a missing calibration alone not one that measures its offsets with the
@@ -156,7 +157,6 @@ void pour_board_drive_tick(pour_control_t *ctl, pour_control_input_t *in, pour_c
   pour_hal_drive_mask(false);
 
   pour_control_step(ctl, in, out);
-  bd.clear = in->clear_faults && out->faults == 0u;
   bool measuring = false;
   if (bd.calibration != NULL) {
     pour_hal_drive_mask(true);

@@ -25,7 +25,9 @@ uint8_t pour_calibration_flow_reason(pour_motor_cal_status_t status) {
 
 void pour_calibration_flow_sense(pour_calibration_flow_t *flow, pour_can_node_t *node, const pour_drive_t *drv,
                                  const pour_sensors_t *sample, bool fresh, uint8_t encoder_bits) {
-  if (fresh && sample->encoder < (1u << encoder_bits)) {
+  if (fresh && sample->encoder >= (1u << encoder_bits)) {
+    flow->sample_ms = UINT16_MAX; /* the latest sample is no sample: an older good one does not stand in */
+  } else if (fresh) {
     flow->sample_ms = 0u;
     flow->theta_urad = pour_sensors_theta_urad(sample->encoder, encoder_bits);
     flow->scale_rotating_g = sample->scale_rotating_g;

@@ -5,8 +5,8 @@
  * with the bucket held; a good result is stored through calibration_store, and the outcome goes on the bus
  * unasked: OK, WRITE_FAILED (the flash refused: nothing valid stored, RUN stays refused) or the reason the
  * sequence stopped. The sequence releases the brake for 3.1 s: a start is refused unless the latest sensor
- * sample (the rig's node, over the bus) is recent, shows the output near upright and the rotating bucket
- * empty. A second start while the sequence runs is answered MEASURING again and changes nothing. */
+ * sample (the rig's node, over the bus) is recent, in range, shows the output near upright and the
+ * rotating bucket empty: a count out of range in the latest sample refuses it, whatever came before. A second start while the sequence runs is answered MEASURING again and changes nothing. */
 #ifndef POUR_CALIBRATION_FLOW_H
 #define POUR_CALIBRATION_FLOW_H
 
@@ -30,7 +30,8 @@ typedef struct {
                                      (board_guard), which RUN needs */
   pour_calibration_t calibration; /* the stored calibration, when stored is POUR_CAL_OK */
   bool stored_now;                /* a measured calibration was stored this tick */
-  uint16_t sample_ms;             /* since the latest usable sensor sample [ms], saturating */
+  uint16_t sample_ms;             /* since the latest sensor sample [ms], saturating; UINT16_MAX: none, or the
+                                     latest carried a count out of range */
   int32_t theta_urad;             /* its output angle [µrad] */
   int32_t scale_rotating_g;       /* its rotating scale [g] */
 } pour_calibration_flow_t;
