@@ -108,20 +108,29 @@ pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params
   if (ctl == NULL || params == NULL || !pour_params_writable(ctl)) {
     return POUR_EINVAL;
   }
-  const pour_control_config_t old = ctl->config;
-  const pour_mode_t mode = ctl->mode;
-  const uint16_t faults = ctl->faults;
-  const uint32_t tick = ctl->tick;
+  /* What holds the axis survives the new configuration: a latched fault (only clear_faults ends it), the
+   * hold after an experiment (only a Reset or another experiment ends it) with the empty bucket it expects,
+   * the last trusted angle that a
+   * restart of the held axis must find again, the drive's trust, the command on the wire (no step) and the
+   * count of refusals the bus reports. */
+  const pour_control_t kept = *ctl;
   pour_status_t s = pour_control_init(ctl, &params->control, weights);
   if (s != POUR_OK) {
-    (void)pour_control_init(ctl, &old, weights); /* accepted before, so accepted again */
+    (void)pour_control_init(ctl, &kept.config, weights); /* accepted before, so accepted again */
     s = POUR_EINVAL;
   }
-  /* A fault stays latched through a new configuration: only clear_faults ends it. */
-  ctl->mode = mode;
-  ctl->faults = faults;
-  ctl->stopped = mode == POUR_MODE_FAULT;
-  ctl->tick = tick;
+  ctl->mode = kept.mode;
+  ctl->faults = kept.faults;
+  ctl->stopped = kept.mode == POUR_MODE_FAULT;
+  ctl->tick = kept.tick;
+  ctl->held = kept.held;
+  ctl->have_trusted = kept.have_trusted;
+  ctl->trusted_theta_urad = kept.trusted_theta_urad;
+  ctl->check_restart = kept.check_restart;
+  ctl->drive_untrusted = kept.drive_untrusted;
+  ctl->refused = kept.refused;
+  pour_estimator_expect_empty(&ctl->estimator, kept.estimator.empty_ok);
+  pour_safety_force(&ctl->safety, kept.safety.torque);
   return s;
 }
 

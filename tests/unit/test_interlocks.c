@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "pour/control.h"
+#include "pour/params.h"
 #include "pour/weights_compiled.h"
 #include "unity.h"
 
@@ -257,6 +258,48 @@ static void test_interlock_AnExperimentEndingOnItsFirstSampleHoldsTowardTheSafeT
   TEST_ASSERT_EQUAL_INT16(3000, out.torque);
 }
 
+/* A parameter write puts a new configuration in force through pour_control_init (pour_params_apply): it must
+ * not end the hold that an experiment's end left (only a Reset or another experiment does). */
+static void test_interlock_AParameterWriteKeepsTheHoldAfterAnExperiment(void) {
+  in.sensors.scale_rotating_g = 0;
+  step(false);
+  pour_control_experiment(&ctl, (uint8_t)POUR_EXPERIMENT_IDENTIFY);
+  in.sensors.encoder = count_at(config.safety.theta_max_urad + 1000); /* outside its range: it ends at once */
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  pour_params_t params;
+  pour_params_default(&params, &config, 1u);
+  params.control.safety.omega_max_urad_s = 1500000;
+  TEST_ASSERT_TRUE(pour_params_writable(&ctl));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_params_apply(&ctl, &params, &pour_weights_compiled));
+  in.sensors.encoder = count_at(0);
+  for (int t = 0; t < 50; ++t) {
+    step(true);
+    TEST_ASSERT_EQUAL_HEX16(0u, out.faults);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+    assert_held();
+  }
+}
+
+/* ... nor forget the angle the brake held: after a write in FAULT, the first sample after the clear must still
+ * lie within restart_jump_max of the last trusted angle, or it is BAD_INPUT. */
+static void test_interlock_AParameterWriteInFaultKeepsTheRestartCheck(void) {
+  fault_and_stop();
+  pour_params_t params;
+  pour_params_default(&params, &config, 1u);
+  params.control.safety.omega_max_urad_s = 1500000;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_params_apply(&ctl, &params, &pour_weights_compiled));
+  in.clear_faults = true;
+  step(false);
+  in.clear_faults = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  in.sensors.encoder = count_at(2 * config.restart_jump_max_urad); /* it moved under the brake */
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, out.mode);
+  TEST_ASSERT_BITS_HIGH(POUR_FAULT_BAD_INPUT, out.faults);
+  assert_held();
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_interlock_RunStartsOnlyWhenNoInputOfTheTickVetoesIt);
@@ -267,5 +310,7 @@ int main(void) {
   RUN_TEST(test_interlock_AnExperimentStartsOnlyFromACleanIdle);
   RUN_TEST(test_interlock_AnArmedExperimentKeepsEveryVetoOfRun);
   RUN_TEST(test_interlock_AnExperimentEndingOnItsFirstSampleHoldsTowardTheSafeTorque);
+  RUN_TEST(test_interlock_AParameterWriteKeepsTheHoldAfterAnExperiment);
+  RUN_TEST(test_interlock_AParameterWriteInFaultKeepsTheRestartCheck);
   return UNITY_END();
 }
