@@ -130,7 +130,8 @@ pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params
   ctl->drive_untrusted = kept.drive_untrusted;
   ctl->refused = kept.refused;
   pour_estimator_expect_empty(&ctl->estimator, kept.estimator.empty_ok);
-  pour_safety_force(&ctl->safety, kept.safety.torque);
+  const q15_t lim = ctl->config.safety.tau_limit; /* the command on the wire, within the new clamp */
+  pour_safety_force(&ctl->safety, kept.safety.torque > lim ? lim : (kept.safety.torque < -lim ? (q15_t)-lim : kept.safety.torque));
   return s;
 }
 

@@ -56,7 +56,9 @@ class ControlModel {
                                                                                    : mode_;
     const bool stopping = mode_ == POUR_MODE_FAULT && power_; // the last tick ran the active stop
     uint16_t kept = faults_;
-    const bool clear_refused = in.clear_faults && mode == POUR_MODE_FAULT && stopping;
+    // "A clear in a tick whose link fault or drive fault word is still set is refused and counted" (rule 4).
+    const bool level = in.link_fault || in.drive_faults != 0;
+    const bool clear_refused = in.clear_faults && mode == POUR_MODE_FAULT && (stopping || level);
     if (in.clear_faults && mode == POUR_MODE_FAULT && !clear_refused) {
       kept = 0;
       mode = POUR_MODE_IDLE;
@@ -70,9 +72,12 @@ class ControlModel {
     stale_ = in.sensors_fresh ? 0u : stale_ + 1u;
     if (in.sensors_fresh && new_seq && !raw_plausible(in.sensors))
       FUZZ_CHECK(out.faults & POUR_FAULT_BAD_INPUT, "an implausible sample did not latch BAD_INPUT");
-    if (in.link_fault && !in.clear_faults) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
-    if (in.drive_faults != 0 && !in.clear_faults)
-      FUZZ_CHECK(out.faults & POUR_FAULT_DRIVE, "a drive fault did not latch DRIVE");
+    if (in.link_fault) FUZZ_CHECK(out.faults & POUR_FAULT_LINK, "a link fault did not latch LINK");
+    if (in.drive_faults != 0) FUZZ_CHECK(out.faults & POUR_FAULT_DRIVE, "a drive fault did not latch DRIVE");
+    // "the core stays in FAULT, and a brake that held stays engaged" (rule 4), whatever else the tick says.
+    if (level)
+      FUZZ_CHECK(out.mode == POUR_MODE_FAULT && !(held_ && out.power), "a level fault with clear %d: mode %u power %d",
+                 in.clear_faults, out.mode, out.power);
     FUZZ_CHECK((out.faults & kept) == kept, "a latched fault cleared itself: %x -> %x", kept, out.faults);
     const uint16_t new_bits = static_cast<uint16_t>(out.faults & ~kept);
     FUZZ_CHECK((new_bits & ~POUR_FAULT_ALL) == 0 && !(new_bits & POUR_FAULT_ESTOP) && (in.link_fault || !(new_bits & POUR_FAULT_LINK)) &&
@@ -125,6 +130,16 @@ class ControlModel {
     held_ = (out.mode == POUR_MODE_FAULT || out.mode == POUR_MODE_ESTOP) && !out.power;
   }
 
+  // A parameter write put a new configuration in force (pour_params_apply): docs/can.md, "In FAULT the latched
+  // faults, the brake and the tick count stay through the new configuration"; the command on the wire stays,
+  // within the new clamp.
+ public:
+  void reconfigure(const pour_control_config_t &c) {
+    c_ = c;
+    torque_ = static_cast<q15_t>(std::clamp<int32_t>(torque_, -c.safety.tau_limit, c.safety.tau_limit));
+  }
+
+ private:
   // Between the last command and the safe torque, or between it and zero (the safe torque cut at a limit).
   bool on_the_way(int32_t x, int32_t from) const {
     const auto between = [&](int32_t to) { return std::min(from, to) <= x && x <= std::max(from, to); };

@@ -10,13 +10,21 @@
 // with both released and no assert came after it in the same tick; every clear not taken is counted, and the
 // heartbeat's Refused is the core's refusals plus those, mod 16; the 32-bit sample count runs on by the
 // frames' forward distance whatever commands came (a refused Reset changes nothing).
+// The port's side as the board composes it (board_loop.c, board_drive.c): the drive's fault word is a level
+// that only a clear the core would act on (pour_control_clear_acceptable, asked before the step) clears, once
+// its cause is gone; the calibration flow's interlock answers every CalibrationStart from the tick's latest
+// sample. docs/can.md: "a start is refused unless the latest sample is recent, upright and empty", "a count out
+// of range means REFUSED_NO_SENSORS"; docs/safety.md rule 4: "A clear in a tick whose link fault or drive fault
+// word is still set is refused and counted".
 #include <fuzzer/FuzzedDataProvider.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "control_model.h"
 
 extern "C" {
+#include "calibration_flow.h"
 #include "pour/can_node.h"
 #include "pour/weights_compiled.h"
 }
@@ -46,13 +54,47 @@ pour_can_frame_t fuzz_frame(FuzzedDataProvider &fdp, uint8_t node_id) {
       break;
     }
     default: {
-      static const uint8_t commands[] = {POUR_CAN_CMD_CLEAR_ERRORS, POUR_CAN_CMD_STOP, POUR_CAN_CMD_RESET};
-      st = pour_can_pack_command(node_id, commands[fdp.ConsumeIntegralInRange<int>(0, 2)], &f);
+      static const uint8_t commands[] = {POUR_CAN_CMD_CLEAR_ERRORS, POUR_CAN_CMD_STOP, POUR_CAN_CMD_RESET,
+                                         POUR_CAN_CMD_CALIBRATION_START};
+      st = pour_can_pack_command(node_id, commands[fdp.ConsumeIntegralInRange<int>(0, 3)], &f);
     }
   }
   if (st != POUR_OK) std::memset(&f, 0, sizeof f);
   if (kind == 3) f.id = static_cast<uint16_t>(f.id ^ (1u << fdp.ConsumeIntegralInRange<int>(0, 10))); // one bit off
   return f;
+}
+
+// The answer to this tick's CalibrationStart, judged from the documents: RUN and ESTOP refused by name; a start
+// may be MEASURING only if the latest sample is at most 20 ms old, in the encoder's range, within 5° of upright
+// (0 = upright, below upright wraps) and the rotating scale within ±200 g; else a named refusal. Angles within
+// 10 µrad of the 5° edge are not judged (the degrees-to-count rounding there is the firmware's choice).
+void check_calibration_answer(uint8_t status, uint8_t mode, const pour_can_sensors_t &s, uint32_t age, uint8_t bits,
+                              bool asked) {
+  if (!asked) return; // an unasked result (none here: the sequence never runs)
+  if (mode == POUR_MODE_RUN) {
+    FUZZ_CHECK(status == POUR_CAN_CAL_REFUSED_RUNNING, "a start in RUN answered %u", status);
+    return;
+  }
+  if (mode == POUR_MODE_ESTOP) {
+    FUZZ_CHECK(status == POUR_CAN_CAL_REFUSED_ESTOP, "a start in ESTOP answered %u", status);
+    return;
+  }
+  const double turn = std::ldexp(1.0, bits);
+  const bool in_range = age != UINT32_MAX && s.encoder < turn;
+  const double count = in_range ? (s.encoder >= turn / 2 ? s.encoder - turn : static_cast<double>(s.encoder)) : 0.0;
+  const double theta = std::fabs(count * 2.0 * M_PI * 1e6 / turn);
+  const bool recent = in_range && age <= 20u;
+  if (!recent) {
+    FUZZ_CHECK(status == POUR_CAN_CAL_REFUSED_NO_SENSORS, "start with no recent in-range sample (age %u, count %u) "
+               "answered %u", age, s.encoder, status);
+  } else if (theta > 87266 + 10) {
+    FUZZ_CHECK(status == POUR_CAN_CAL_REFUSED_NOT_UPRIGHT, "start at %.0f urad answered %u", theta, status);
+  } else if (theta < 87266 - 10 && (s.scale_rotating_g > 200 || s.scale_rotating_g < -200)) {
+    FUZZ_CHECK(status == POUR_CAN_CAL_REFUSED_NOT_EMPTY, "start with %d g answered %u", s.scale_rotating_g, status);
+  }
+  if (status == POUR_CAN_CAL_MEASURING)
+    FUZZ_CHECK(recent && theta <= 87266 + 10 && s.scale_rotating_g <= 200 && s.scale_rotating_g >= -200,
+               "MEASURING on a sample %u ms old, %.0f urad, %d g", age, theta, s.scale_rotating_g);
 }
 
 } // namespace
@@ -64,11 +106,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   ncfg.node_id = fdp.ConsumeIntegralInRange<uint8_t>(0, 63);
   ncfg.watchdog_ms = fdp.ConsumeIntegralInRange<uint16_t>(1, 200);
   ncfg.heartbeat_period_ms = fdp.ConsumeIntegralInRange<uint16_t>(1, 200);
+  ncfg.can_calibrate = true; // the board's node: it has a drive that measures the motor
   static pour_control_t ctl;
   static pour_can_node_t node;
   FUZZ_CHECK(pour_control_init(&ctl, &cfg, &pour_weights_compiled) == POUR_OK, "a valid config was refused");
   FUZZ_CHECK(pour_can_node_init(&node, &ncfg) == POUR_OK, "a valid node config was refused");
   ControlModel model(cfg, pour_weights_compiled.n_actions);
+  // The board's drive, its offsets measured on a quiet bus (it can calibrate), and the flow's interlock.
+  static pour_drive_t drv;
+  const pour_drive_config_t dcfg = pour_drive_default_config();
+  FUZZ_CHECK(pour_drive_init(&drv, &dcfg) == POUR_OK, "the drive's default config was refused");
+  const pour_drive_sample_t quiet{{dcfg.offset_nominal, dcfg.offset_nominal, dcfg.offset_nominal}, 0, 0};
+  pour_drive_output_t dout;
+  for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES; ++k) pour_drive_isr(&drv, &quiet, &dout);
+  static pour_calibration_flow_t flow;
+  pour_calibration_flow_init(&flow, POUR_CAL_OK, nullptr);
+  uint16_t word = 0;             // the drive's latched fault word
+  uint32_t latest_age = UINT32_MAX; // ms since the latest sample the node took (UINT32_MAX: none yet)
+  pour_can_sensors_t latest{};
   static const bool trace = std::getenv("POUR_FUZZ_TRACE") != nullptr; // replaying a crash: one line per tick
   // The e-stop's two sources as the frames and the line samples said them, and the model of pour_commands:
   // a clear pending (it arrived released), the clears dropped so far.
@@ -93,6 +148,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       have_count = true;
     };
     pour_can_sensors_t last{}; // the last Sensors frame the node accepted this tick
+    bool asked_calibration = false;
     if (fdp.ConsumeBool()) { // this tick's sample: mostly what the rig reads (a 17-bit encoder between a
                              // little below upright and the stop, scales within their limits), now and then not
       const bool sane = fdp.ConsumeIntegralInRange<int>(0, 7) != 0;
@@ -123,6 +179,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
       } else if (cmd == POUR_CAN_CMD_ESTOP && pour_can_unpack_estop(&f, &e) == POUR_CAN_RX_OK) {
         bus_level = e.assert_estop != 0u;
         if (bus_level) asserts();
+      } else if (cmd == POUR_CAN_CMD_CALIBRATION_START) {
+        asked_calibration = true;
       } else if (cmd == POUR_CAN_CMD_CLEAR_ERRORS) {
         if (bus_level || line_level) {
           ++dropped; // held: dropped where it arrives
@@ -154,9 +212,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (sampled) {
       FUZZ_CHECK(in.sensors.seq == count, "sample count %u, expected %u", in.sensors.seq, count);
     }
+    // The drive's word: a bit now and then, held until a clear the core would act on reaches the drive first
+    // and its cause is gone (board_drive.c's order).
+    const uint8_t drive_bits = fdp.ConsumeIntegral<uint8_t>();
+    if ((drive_bits & 0x0f) == 0) word = static_cast<uint16_t>(word | (1u << (drive_bits >> 4)));
+    if (in.clear_faults && (drive_bits & 0x10) == 0 && pour_control_clear_acceptable(&ctl, &in)) word = 0;
+    in.drive_faults = word;
+    in.drive_trusted = (drive_bits & 0x20) != 0;
     pour_control_output_t out{};
     pour_control_step(&ctl, &in, &out);
     model.check(in, out, ctl.state.theta_urad);
+    pour_calibration_flow_sense(&flow, &node, &drv, &in.sensors, in.sensors_fresh, cfg.sensors.encoder_bits);
+    (void)pour_can_node_take_calibration_start(&node); // the interlock is judged here; the sequence is not run
+    if (sampled) {
+      latest = last;
+      latest_age = 0;
+    } else if (latest_age != UINT32_MAX) {
+      ++latest_age;
+    }
     pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
     const uint8_t n_tx = pour_can_node_end_tick(&node, &out, fdp.ConsumeIntegral<uint8_t>(), tx);
     FUZZ_CHECK(n_tx >= 1 && n_tx <= POUR_CAN_NODE_MAX_TX, "%u frames", n_tx);
@@ -177,6 +250,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                       (cmd == POUR_CAN_CMD_CALIBRATION_RESULT &&
                        pour_can_unpack_calibration_result(&tx[k], &cal) == POUR_CAN_RX_OK);
       FUZZ_CHECK(ok, "frame %u (cmd 0x%02x) does not decode", k, cmd);
+      if (cmd == POUR_CAN_CMD_CALIBRATION_RESULT) check_calibration_answer(cal.status, out.mode, latest, latest_age,
+                                                                           cfg.sensors.encoder_bits, asked_calibration);
       if (cmd == POUR_CAN_CMD_HEARTBEAT)
         FUZZ_CHECK(hb.mode == out.mode && hb.refused == ((out.refused + dropped) & POUR_CAN_REFUSED_MAX),
                    "heartbeat mode %u refused %u; the core says %u, %u refused, %u clears dropped", hb.mode, hb.refused,
