@@ -148,7 +148,8 @@ pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control
  *   pour_control_shape(ctl, out);                the envelope, the controlled stop, the outputs
  * pour_control_step is exactly that with the fixed-point policy. A decision stays in force until the next. */
 
-/* Stage 1. Order: e-stop (ESTOP, whatever else the input says), link fault (FAULT), clear request, stop,
+/* Stage 1. Order: e-stop (ESTOP, whatever else the input says), link fault (FAULT), drive fault (FAULT), clear
+ * request (refused while the stop is active, the link fault is set or the drive's word is not 0), stop,
  * reset, input (a seq that does not advance makes the sample not fresh; the estimator turns a fresh one into
  * the state, restarted in IDLE so that a run starts from its first sample; an implausible sample or state:
  * BAD_INPUT), timeout (STALE_INPUT, with SEQ if repeated samples were refused; armed in RUN only), IDLE ->
