@@ -113,25 +113,40 @@ pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params
    * the last trusted angle that a
    * restart of the held axis must find again, the drive's trust, the command on the wire (no step) and the
    * count of refusals the bus reports. */
-  const pour_control_t kept = *ctl;
-  pour_status_t s = pour_control_init(ctl, &params->control, weights);
+  const pour_control_config_t old = ctl->config;
+  const pour_mode_t mode = ctl->mode;
+  const uint16_t faults = ctl->faults;
+  const uint32_t tick = ctl->tick;
+  const uint32_t refused = ctl->refused;
+  const bool held = ctl->held;
+  const bool empty_ok = ctl->estimator.empty_ok;
+  const bool have_trusted = ctl->have_trusted;
+  const int32_t trusted_theta_urad = ctl->trusted_theta_urad;
+  const bool check_restart = ctl->check_restart;
+  const bool drive_untrusted = ctl->drive_untrusted;
+  const q15_t on_wire = ctl->safety.torque;
+  /* A controller whose decisions come from outside (no weights) stays one, with its decision period. */
+  const uint16_t period = ctl->decision_period_ms;
+  pour_status_t s = weights != NULL ? pour_control_init(ctl, &params->control, weights)
+                                    : pour_control_init_external(ctl, &params->control, period);
   if (s != POUR_OK) {
-    (void)pour_control_init(ctl, &kept.config, weights); /* accepted before, so accepted again */
+    /* accepted before, so accepted again */
+    (void)(weights != NULL ? pour_control_init(ctl, &old, weights) : pour_control_init_external(ctl, &old, period));
     s = POUR_EINVAL;
   }
-  ctl->mode = kept.mode;
-  ctl->faults = kept.faults;
-  ctl->stopped = kept.mode == POUR_MODE_FAULT;
-  ctl->tick = kept.tick;
-  ctl->held = kept.held;
-  ctl->have_trusted = kept.have_trusted;
-  ctl->trusted_theta_urad = kept.trusted_theta_urad;
-  ctl->check_restart = kept.check_restart;
-  ctl->drive_untrusted = kept.drive_untrusted;
-  ctl->refused = kept.refused;
-  pour_estimator_expect_empty(&ctl->estimator, kept.estimator.empty_ok);
+  ctl->mode = mode;
+  ctl->faults = faults;
+  ctl->stopped = mode == POUR_MODE_FAULT;
+  ctl->tick = tick;
+  ctl->refused = refused;
+  ctl->held = held;
+  pour_estimator_expect_empty(&ctl->estimator, empty_ok);
+  ctl->have_trusted = have_trusted;
+  ctl->trusted_theta_urad = trusted_theta_urad;
+  ctl->check_restart = check_restart;
+  ctl->drive_untrusted = drive_untrusted;
   const q15_t lim = ctl->config.safety.tau_limit; /* the command on the wire, within the new clamp */
-  pour_safety_force(&ctl->safety, kept.safety.torque > lim ? lim : (kept.safety.torque < -lim ? (q15_t)-lim : kept.safety.torque));
+  pour_safety_force(&ctl->safety, on_wire > lim ? lim : (on_wire < -lim ? (q15_t)-lim : on_wire));
   return s;
 }
 

@@ -24,6 +24,8 @@ extern "C" {
 #include "board_drive.h"
 #include "brake_power_lines.h"
 #include "board_loop.h"
+#include "board_params.h"
+#include "params_store.h"
 #include "calibration_flow.h"
 #include "clock.h"
 #include "drive_without_cut.h"
@@ -63,6 +65,7 @@ struct Plant {
   bool slipping = false; // the coupling slips: the motor turns on at 2 rad/s of output, its torque lost
   double brake_since = 0.0, t = 0.0, theta = 0.0, omega = 0.0;
   std::vector<pour_can_frame_t> rx;         // what the host and the rig send this tick
+  std::vector<pour_can_frame_t> replies;    // ParamValue and ParamAck frames the board sent
   std::vector<pour_can_calibration_result_t> results; // every CalibrationResult the board sent
   uint8_t last_mode = 0xFFu;                // the last Heartbeat's mode
   // what the bucket did: periods with the brake released while the drive did not power the motor, and the
@@ -119,6 +122,8 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
   pour_can_heartbeat_t hb;
   if (pour_can_unpack_calibration_result(frame, &r) == POUR_CAN_RX_OK) plant.results.push_back(r);
   if (pour_can_unpack_heartbeat(frame, &hb) == POUR_CAN_RX_OK) plant.last_mode = hb.mode;
+  const uint8_t cmd = static_cast<uint8_t>(frame->id & POUR_CAN_CMD_MASK);
+  if (cmd == POUR_CAN_CMD_PARAM_VALUE || cmd == POUR_CAN_CMD_PARAM_ACK) plant.replies.push_back(*frame);
   return 1;
 }
 
@@ -137,6 +142,11 @@ pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
   return loaded_status;
 }
 const pour_flash_t *pour_hal_calibration_flash(void) { return &f; }
+// The parameters' page: a second erased page and register file in memory.
+static uint32_t params_regs[POUR_FLASH_N_REGS];
+static uint32_t params_page[POUR_FLASH_PAGE_BYTES / 4];
+static const pour_flash_t params_flash = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u};
+const pour_flash_t *pour_hal_params_flash(void) { return &params_flash; }
 int pour_hal_calibration_reason(void) { return (int)loaded_status; }
 }
 
@@ -153,7 +163,8 @@ void boot() {
   const pour_drive_config_t dc = pour_drive_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, static_cast<int32_t>(kTauMax * 1000), calibrated));
   pour_can_node_config_t nc = pour_can_node_default_config();
-  nc.identity.init_status = static_cast<int8_t>(calibrated ? POUR_OK : POUR_ECALIBRATION);
+  const pour_status_t params = pour_board_params_init(&ctl, nc.node_id);
+  nc.identity.init_status = static_cast<int8_t>(params != POUR_OK ? params : calibrated ? POUR_OK : POUR_ECALIBRATION);
   nc.can_calibrate = true;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &nc));
   pour_can_calibration_result_t r;
@@ -241,6 +252,9 @@ void tick(uint32_t ms, double ref) {
 
 void setUp(void) {
   flash_page_file_reset();
+  std::memset(params_regs, 0, sizeof params_regs);
+  std::memset(params_page, 0xFF, sizeof params_page);
+  plant.replies.clear();
   loaded_status = POUR_CAL_EMPTY;
   plant_reset();
 }
@@ -394,9 +408,92 @@ static void test_board_calibration_run_ASlippedCouplingIsClearedOnlyByACalibrati
   TEST_ASSERT_TRUE(plant.theta_max <= 10.0 * kPi / 180);
 }
 
+// What the host's bench tool sends (pour-bench config set / save / tare / zero): one request a tick.
+static pour_can_param_ack_t param_request(uint8_t cmd, uint8_t id, int32_t value, uint32_t ms, int32_t *echo) {
+  pour_can_frame_t fr;
+  if (cmd == POUR_CAN_CMD_PARAM_WRITE) {
+    const pour_can_param_t m = {id, value};
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_param(0, cmd, &m, &fr));
+  } else if (cmd == POUR_CAN_CMD_TARE) {
+    const pour_can_tare_t m = {static_cast<uint8_t>(value)};
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_tare(0, &m, &fr));
+  } else {
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_command(0, cmd, &fr));
+  }
+  plant.replies.clear();
+  plant.rx.push_back(fr);
+  tick(ms, 0.0);
+  TEST_ASSERT_EQUAL_UINT(1u, plant.replies.size()); /* answered in the tick it came, never a timeout */
+  pour_can_param_ack_t ack = {0u, 0u, 0xFFu};
+  pour_can_param_t v;
+  if (pour_can_unpack_param(&plant.replies[0], POUR_CAN_CMD_PARAM_VALUE, &v) == POUR_CAN_RX_OK) {
+    ack = {cmd, v.param_id, POUR_PARAM_OK};
+    *echo = v.value;
+  } else {
+    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_param_ack(&plant.replies[0], &ack));
+  }
+  return ack;
+}
+
+// A ParamWrite in IDLE is in force at once and echoed; ParamSave stores the set in page 62, refused BUSY while
+// the core runs; the next boot loads it (the calibration's page 63 untouched).
+static void test_board_params_AWriteASaveAndTheNextBootKeepIt(void) {
+  boot();
+  int32_t echo = 0;
+  for (uint32_t ms = 0; ms < 5; ++ms) tick(ms, 0.0);
+  pour_can_param_ack_t a = param_request(POUR_CAN_CMD_PARAM_WRITE, POUR_PARAM_ID_omega_max, 1500000, 5, &echo);
+  TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
+  TEST_ASSERT_EQUAL_INT32(1500000, echo);
+  TEST_ASSERT_EQUAL_INT32(1500000, ctl.config.safety.omega_max_urad_s);
+  a = param_request(POUR_CAN_CMD_PARAM_SAVE, 0, 0, 6, &echo);
+  TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
+  pour_params_t back;
+  pour_params_default(&back, &ctl.config, 0u);
+  back.control.safety.omega_max_urad_s = 0;
+  uint8_t bad = 0;
+  TEST_ASSERT_EQUAL_INT(POUR_PARAMS_BLOB_OK, pour_params_store_load(&params_flash, &back, &bad));
+  TEST_ASSERT_EQUAL_INT32(1500000, back.control.safety.omega_max_urad_s);
+  TEST_ASSERT_EQUAL_HEX32(0xFFFFFFFFu, page[0]); /* the calibration's page: still blank */
+  boot();
+  TEST_ASSERT_EQUAL_INT32(1500000, ctl.config.safety.omega_max_urad_s);
+  TEST_ASSERT_EQUAL_INT8(POUR_ECALIBRATION, node.config.identity.init_status); /* the params are fine */
+}
+
+// Tare and Zero take the latest raw reading as the offset; from the next tick the core sees it corrected.
+static void test_board_params_TareAndZeroCorrectWhatTheCoreSees(void) {
+  boot();
+  int32_t echo = 0;
+  for (uint32_t ms = 0; ms < 5; ++ms) tick(ms, 0.0);
+  pour_can_param_ack_t a = param_request(POUR_CAN_CMD_TARE, 0, POUR_CAN_TARE_TARGET, 5, &echo);
+  TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
+  TEST_ASSERT_EQUAL_INT32(10000, pour_board_params()->scale_target_tare_g); /* the rig's target scale reads 10 kg */
+  a = param_request(POUR_CAN_CMD_ZERO, 0, 0, 6, &echo);
+  TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
+  pour_sensors_t s = {0u, 5u, 0, 10000};
+  pour_board_params_correct(&s);
+  TEST_ASSERT_EQUAL_INT32(0, s.scale_target_g);
+}
+
+// A stored set that cannot be trusted (here a flipped bit: its CRC fails) is refused by name at boot: Identity
+// says POUR_EPARAMS (main.c then never drives the motor) and the defaults stay in force.
+static void test_board_params_ACorruptStoredSetIsRefusedByName(void) {
+  pour_params_t p;
+  const pour_control_config_t cc = pour_control_default_config();
+  pour_params_default(&p, &cc, 0u);
+  p.control.safety.omega_max_urad_s = 1500000;
+  TEST_ASSERT_EQUAL_INT(POUR_FLASH_OK, pour_params_store_save(&params_flash, &p));
+  params_page[3] ^= 0x10u;
+  boot();
+  TEST_ASSERT_EQUAL_INT8(POUR_EPARAMS, node.config.identity.init_status);
+  TEST_ASSERT_EQUAL_INT32(cc.safety.omega_max_urad_s, ctl.config.safety.omega_max_urad_s);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_board_calibration_run_UncalibratedToRunWithoutAReset);
+  RUN_TEST(test_board_params_AWriteASaveAndTheNextBootKeepIt);
+  RUN_TEST(test_board_params_TareAndZeroCorrectWhatTheCoreSees);
+  RUN_TEST(test_board_params_ACorruptStoredSetIsRefusedByName);
   RUN_TEST(test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot);
   RUN_TEST(test_board_calibration_run_ASlippedCouplingIsClearedOnlyByACalibration);
   return UNITY_END();

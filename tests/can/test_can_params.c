@@ -164,6 +164,11 @@ static void test_can_params_SaveReportsTheStorage(void) {
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, ask(&f, &reply));
   assert_ack(&reply, POUR_CAN_CMD_PARAM_SAVE, 0, POUR_PARAM_OK);
   TEST_ASSERT_EQUAL_INT(1, saves);
+  env.writable = false; /* RUN, ESTOP or the active stop: BUSY, nothing stored */
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_BUSY, ask(&f, &reply));
+  assert_ack(&reply, POUR_CAN_CMD_PARAM_SAVE, 0, POUR_PARAM_BUSY);
+  TEST_ASSERT_EQUAL_INT(1, saves);
+  env.writable = true;
   save_fails = true;
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_NO_STORAGE, ask(&f, &reply));
   env.save = NULL;

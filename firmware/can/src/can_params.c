@@ -47,8 +47,12 @@ pour_param_result_t pour_can_params_handle(uint8_t node_id, const pour_can_param
                                                 : reply_value(node_id, params, r->param_id, reply);
   }
   if (r->cmd == POUR_CAN_CMD_PARAM_SAVE) {
-    const bool saved = env->save != NULL && env->save(env->user, params) == POUR_OK;
-    return reply_ack(node_id, r, saved ? POUR_PARAM_OK : POUR_PARAM_NO_STORAGE, reply);
+    /* Only where a write is taken: on the board an erase stalls the flash the running loop executes from. */
+    pour_param_result_t saved = POUR_PARAM_NO_STORAGE;
+    if (env->save != NULL) {
+      saved = !env->writable ? POUR_PARAM_BUSY : (env->save(env->user, params) == POUR_OK ? POUR_PARAM_OK : POUR_PARAM_NO_STORAGE);
+    }
+    return reply_ack(node_id, r, saved, reply);
   }
   pour_params_t candidate = *params;
   pour_param_result_t res = POUR_PARAM_OK;

@@ -122,7 +122,8 @@ void pour_params_correct(const pour_params_t *params, pour_sensors_t *sample);
 /* True if the core takes a new configuration now: IDLE, or FAULT once the controlled stop is over. */
 bool pour_params_writable(const pour_control_t *ctl);
 
-/* Puts params->control in force in ctl (pour_control_init), which must be writable: IDLE stays IDLE; FAULT
+/* Puts params->control in force in ctl (pour_control_init; with weights NULL, pour_control_init_external with
+ * ctl's decision period), which must be writable: IDLE stays IDLE; FAULT
  * keeps its latched faults, the brake and the tick count. POUR_EINVAL (ctl unchanged in effect: the old
  * configuration is put back) if the core refuses the configuration or ctl is not writable. */
 pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params,

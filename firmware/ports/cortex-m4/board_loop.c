@@ -4,6 +4,7 @@
 #include <stdbool.h>
 
 #include "board_drive.h"
+#include "board_params.h"
 #include "calibration_flow.h"
 #include "clock.h"
 #include "hal_calibration.h"
@@ -48,12 +49,14 @@ void pour_board_loop_tick(pour_control_t *ctl, pour_can_node_t *node, uint32_t o
   pour_can_node_estop_line(node, pour_hal_estop_asserted());
   pour_control_input_t in;
   pour_can_node_begin_tick(node, &in);
+  pour_board_params_correct(&in.sensors); /* the encoder's zero, the scales' tares and factors */
   /* An ExperimentStart goes to the core before the tick; this tick's update answers it. */
   uint8_t kind = 0u;
   const bool asked = pour_can_node_take_experiment(node, &kind);
   if (asked) {
     pour_control_experiment(ctl, kind);
   }
+  pour_board_params_service(ctl, node); /* before the step, which then runs on the set in force */
   pour_control_output_t out;
   pour_board_drive_tick(ctl, &in, &out);
   pour_calibration_flow_sense(&flow, node, pour_board_drive_state(), &in.sensors, in.sensors_fresh,

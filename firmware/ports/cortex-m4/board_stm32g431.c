@@ -15,6 +15,7 @@
 
 #include "adc_inj.h"
 #include "board_af.h"
+#include "board_params.h"
 #include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
@@ -24,6 +25,7 @@
 #include "hal_drive_g4.h"
 #include "ocp.h"
 #include "opamp.h"
+#include "params_store.h"
 #include "pwm_tim1.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -243,6 +245,12 @@ pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
 }
 
 const pour_flash_t *pour_hal_calibration_flash(void) { return &calibration_flash; }
+
+/* The parameters: the page before the calibration's (params_store.h). */
+static const pour_flash_t params_flash = {
+    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_PARAMS_ADDR, POUR_FLASH_PARAMS_PAGE, WAIT_POLLS};
+
+const pour_flash_t *pour_hal_params_flash(void) { return &params_flash; }
 
 void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
   pour_calibration_can_result(calibration_status, &calibration, POUR_CAN_CAL_UNAVAILABLE, r);

@@ -11,6 +11,7 @@
 
 #include "board_drive.h"
 #include "board_loop.h"
+#include "board_params.h"
 #include "clock.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -94,8 +95,15 @@ PHASE bool start_up(pour_status_t *status_out) {
   if (status == POUR_OK) {
     status = drive_init();
   }
-  *status_out = status;
   pour_can_node_config_t nc = pour_can_node_default_config();
+  if (status == POUR_OK || status == POUR_ECALIBRATION) {
+    /* The stored parameters before the first tick (a stored node id too); a set that cannot be trusted is
+     * refused as a policy or a clock would be. */
+    const pour_status_t params = pour_board_params_init(&controller, nc.node_id);
+    status = params != POUR_OK ? params : status;
+    nc.node_id = pour_board_params()->node_id;
+  }
+  *status_out = status;
   nc.identity.weights_hash = pour_weights_compiled.content_hash;
   nc.identity.tau_max_cnm = (uint16_t)(pour_weights_compiled.tau_max_mnm / 10);
   nc.identity.init_status = (int8_t)status;

@@ -22,6 +22,8 @@
 #include <stdlib.h>
 
 #include "board_drive.h"
+#include "board_params.h"
+#include "params_store.h"
 #include "clock.h"
 #include "drive_without_cut.h"
 #include "hal_brake.h"
@@ -93,6 +95,17 @@ void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
 static uint32_t flash_regs[POUR_FLASH_N_REGS], flash_page[POUR_FLASH_PAGE_BYTES / 4u];
 const pour_flash_t *pour_hal_calibration_flash(void) {
   static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u};
+  return &f;
+}
+/* The parameters' page likewise, erased (never saved: the defaults). */
+static uint32_t params_regs[POUR_FLASH_N_REGS], params_page[POUR_FLASH_PAGE_BYTES / 4u];
+const pour_flash_t *pour_hal_params_flash(void) {
+  static const pour_flash_t f = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u};
+  static bool erased;
+  if (!erased) {
+    for (uint32_t i = 0; i < POUR_FLASH_PAGE_BYTES / 4u; ++i) params_page[i] = 0xFFFFFFFFu;
+    erased = true;
+  }
   return &f;
 }
 

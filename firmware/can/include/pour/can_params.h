@@ -24,7 +24,8 @@ typedef struct {
 
 /* Answers one request into *reply (ParamValue for an accepted read or write, else ParamAck with the result);
  * *params changes only when a write, tare or zero is accepted. Order of the checks: unknown id, range,
- * writable (BUSY), the set's rules, the core's. Returns the result. */
+ * writable (BUSY), the set's rules, the core's; a save: storage (NO_STORAGE), writable (BUSY). Returns the
+ * result. */
 pour_param_result_t pour_can_params_handle(uint8_t node_id, const pour_can_param_request_t *request,
                                            pour_params_t *params, const pour_can_params_env_t *env,
                                            pour_can_frame_t *reply);
