@@ -21,7 +21,7 @@ import numpy as np
 from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
-from pour.sim import envs, gym_env
+from pour.sim import envs
 from pour.train import trainer
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
@@ -57,6 +57,7 @@ def _greedy_metrics(job: tuple) -> dict[str, float]:
     layers) through the Gymnasium env, which runs the same simulator and firmware pipeline tick by tick."""
     kind, n_actions, period_ms, policy, seed = job
     if isinstance(policy, tuple):
+        from pour.sim import gym_env  # _run_policies made sure the gym extra is there
         key = ("env:" + kind, n_actions, period_ms)
         if key not in _SIMS:
             _SIMS[key] = gym_env.PourEnv(kind, n_actions, period_ms, 10.0)
@@ -81,6 +82,7 @@ def _run_policies(run: Path) -> tuple[tuple[str, int, int], dict[str, Any], list
             spec = (doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]))
         except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{run}/actor.json: not an MLP actor's description ({exc})") from None
+        cli.require("gymnasium", "gym")  # an MLP actor runs through the Gymnasium env
         hist = _mlp_layers(ck, "history_mlp_")
         if not hist:
             raise ValueError(f"{run}: its checkpoint has no MLP actor history (history_mlp_0...)")
