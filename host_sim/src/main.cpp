@@ -327,12 +327,12 @@ int run_experiment_cli(const Options &o, const poursim_config_t &cfg) {
     return 1;
   }
   const bool done = r.phase == POUR_EXPERIMENT_PHASE_DONE && r.faults == 0u;
-  std::printf("experiment %s: %u ticks logged to %s; %s (mode %s, faults 0x%04x)\n", o.experiment.c_str(), r.ticks,
+  std::printf("experiment %s: %u ticks logged to %s; %s (mode %s, faults %s)\n", o.experiment.c_str(), r.ticks,
               o.candump.c_str(),
               done ? "ran to its end, bucket held"
                    : (r.phase == POUR_EXPERIMENT_PHASE_OUT_OF_RANGE ? "ENDED EARLY: the angle left its range"
                                                                      : "ENDED EARLY: a fault or no end"),
-              pour_mode_name(r.mode), static_cast<unsigned>(r.faults));
+              pour_mode_name(r.mode), poursim::core_fault_names(r.faults).c_str());
   return done ? 0 : 1;
 }
 
@@ -472,7 +472,7 @@ int main(int argc, char **argv) {
     poursim::write_csv_header(csv);
   }
   Recorder first;
-  poursim_drive_telemetry_t drive_peak{}; // the full drive's worst over the episodes (drive = 1)
+  std::vector<poursim_drive_telemetry_t> drive; // the full drive's figures of each episode (drive = 1)
   for (int k = 0; k < o.episodes; ++k) {
     uint32_t seed = seed0 + static_cast<uint32_t>(k);
     Recorder rec;
@@ -494,20 +494,18 @@ int main(int argc, char **argv) {
     eps.push_back(e);
     poursim_drive_telemetry_t tel;
     poursim_drive_telemetry(world, &tel);
-    drive_peak.peak_current = std::max(drive_peak.peak_current, tel.peak_current);
-    drive_peak.peak_vbus = std::max(drive_peak.peak_vbus, tel.peak_vbus);
-    drive_peak.min_vbus = k == 0 ? tel.min_vbus : std::min(drive_peak.min_vbus, tel.min_vbus);
-    drive_peak.faults |= tel.faults;
+    drive.push_back(tel);
     if (!o.quiet) poursim::print_episode(per, k + 1, e);
     if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
     if (k == 0 && !o.render.empty()) first = std::move(rec);
   }
-  poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps);
-  if (cfg.drive == 1)
+  poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps, cfg.drive == 1 ? &drive : nullptr);
+  if (cfg.drive == 1) {
+    const poursim_drive_telemetry_t w = poursim::drive_worst(drive);
     std::fprintf(per, "drive (field-oriented, docs/motor.md): peak phase current %.1f A, peak bus %.2f V (lowest %.2f V), "
-                 "faults 0x%04x\n",
-                 drive_peak.peak_current, drive_peak.peak_vbus, drive_peak.min_vbus,
-                 static_cast<unsigned>(drive_peak.faults));
+                 "faults %s\n",
+                 w.peak_current, w.peak_vbus, w.min_vbus, poursim::drive_fault_names(w.faults).c_str());
+  }
   if (lcm_ctl != nullptr) {
     lcm_ctl->link().drain(50);
     std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());

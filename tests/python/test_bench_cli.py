@@ -33,28 +33,28 @@ def test_bad_command_lines_are_status_2(argv, needle):
 def test_a_bad_weights_file_is_status_2(tmp_path):
     bad = tmp_path / "weights.h"
     bad.write_text("not a header\n")
-    r = bench("--iface", "nosuchcan0", "--weights", str(bad), "clear")
+    r = bench("--channel", "nosuchcan0", "--weights", str(bad), "clear")
     assert r.returncode == 2, r.stderr
     assert r.stderr.startswith(f"pour-bench: error: --weights {bad}: "), r.stderr
-    r = bench("--iface", "nosuchcan0", "reset")
+    r = bench("--channel", "nosuchcan0", "reset")
     assert r.returncode == 2 and "'reset' can move the axis: give the policy you expect" in r.stderr, r.stderr
 
 
 def test_calibrate_moves_the_axis_so_it_needs_the_expected_policy():
-    r = bench("--iface", "nosuchcan0", "calibrate")
+    r = bench("--channel", "nosuchcan0", "calibrate")
     assert r.returncode == 2 and "'calibrate' can move the axis: give the policy you expect" in r.stderr, r.stderr
-    r = bench("--iface", "nosuchcan0", "--expect-hash", "1", "calibrate", "--seconds", "0")
+    r = bench("--channel", "nosuchcan0", "--expect-hash", "1", "calibrate", "--seconds", "0")
     assert r.returncode == 2 and "not a number of seconds" in r.stderr, r.stderr
 
 
 def test_a_bus_that_cannot_open_says_which():
-    r = bench("--iface", "nosuchcan0", "scan")
+    r = bench("--channel", "nosuchcan0", "scan")
     assert r.returncode == 1
     assert "pour-bench: error: cannot open CAN bus socketcan:nosuchcan0" in r.stderr, r.stderr
 
 
 def test_config_list_names_the_dbc_parameters_without_a_bus():
-    r = bench("--iface", "nosuchcan0", "config", "list")
+    r = bench("--channel", "nosuchcan0", "config", "list")
     assert r.returncode == 0, r.stderr
     assert "  4 omega_max" in r.stdout and " 22 scale_target_tare" in r.stdout, r.stdout
 
@@ -169,7 +169,8 @@ class _FakeNode:
     the DBC gives them) to each CalibrationRead, after an unasked outcome of a measurement that is not the
     answer. Every frame it receives is kept."""
 
-    def __init__(self, channel: str, answer: dict) -> None:
+    def __init__(self, channel: str, answer: dict, drive: dict | None = None, mode: str = "RUN",
+                 faults: dict | None = None) -> None:
         import threading
 
         import can
@@ -178,6 +179,7 @@ class _FakeNode:
         self.db = bn.load_dbc()
         self.bus = can.Bus(interface="virtual", channel=channel)
         self.answer = answer
+        self.drive, self.mode, self.faults = drive, mode, faults or {}
         self.received: list[str] = []
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self.run, daemon=True)
@@ -198,7 +200,9 @@ class _FakeNode:
         counter = 0
         while not self.stop.is_set():
             self.send("Identity", WeightsHash=0x1234, TauMax=20.0, FwVersion=dbc.protocol_version(self.db.version))
-            self.send("Heartbeat", Mode="RUN", Counter=counter % 256)
+            self.send("Heartbeat", Mode=self.mode, Counter=counter % 256, **self.faults)
+            if self.drive is not None:  # with every heartbeat, as a controller with a drive of its own sends it
+                self.send("DriveTelemetry", **self.drive)
             counter += 1
             msg = self.bus.recv(0.02)
             if msg is None:
@@ -235,8 +239,76 @@ def test_calibration_reads_the_stored_block_without_asking_or_moving(answer, sta
     monkeypatch.setattr("sys.stdin", None)
     channel = f"calread{status}{answer['Stored']}"
     with _FakeNode(channel, answer) as node:
-        rc = bench_cli.main(["--interface", "virtual", "--iface", channel, "calibration"])
+        rc = bench_cli.main(["--interface", "virtual", "--channel", channel, "calibration"])
     out = capsys.readouterr()
     assert rc == status, out
     assert needle in (out.out if status == 0 else out.err), out
     assert node.received == ["CalibrationRead"]
+
+
+@pytest.mark.parametrize("drive, needle", [
+    (dict(Id=0.25, Iq=-3.5, Vbus=23.875, DriveFault_Overcurrent=1, DriveFault_I2t=1),
+     "node 0: drive faults Overcurrent, I2t, Iq -3.500 A, Id 0.250 A, bus 23.88 V"),
+    (dict(Id=0.0, Iq=1.25, Vbus=24.0), "node 0: drive faults none, Iq 1.250 A, Id 0.000 A, bus 24.00 V"),
+    (None, "node 0: no DriveTelemetry (a controller without a drive of its own)"),
+])
+def test_faults_names_the_drives_faults_from_its_telemetry(drive, needle, capsys):
+    """pour-bench faults against a node on a python-can virtual bus that sends DriveTelemetry (scaled by the
+    DBC: Iq 0.002 A, Vbus 0.001 V a count) with each heartbeat, or none."""
+    from pour.bench import cli as bench_cli
+    channel = f"drivefaults{len(needle)}"
+    with _FakeNode(channel, {}, drive=drive, mode="FAULT", faults=dict(Fault_Drive=1)):
+        rc = bench_cli.main(["--interface", "virtual", "--channel", channel, "faults"])
+    out = capsys.readouterr()
+    assert rc == 0, out
+    lines = out.out.splitlines()
+    assert lines[0].startswith("node 0: mode FAULT, faults Drive,") and lines[1] == needle, out.out
+
+
+def test_without_socketcan_the_error_points_to_the_no_can_hardware_doc(monkeypatch, capsys):
+    """A kernel without SocketCAN (Errno 97, EAFNOSUPPORT, as in a container): one line that says so and names
+    the doc section, which exists."""
+    import errno
+
+    import can
+
+    from pour.bench import cli as bench_cli
+    from conftest import SOURCE_DIR
+
+    def no_socketcan(*args, **kwargs):
+        raise OSError(errno.EAFNOSUPPORT, "Address family not supported by protocol")
+
+    monkeypatch.setattr(can, "Bus", no_socketcan)
+    assert bench_cli.main(["--channel", "vcan0", "scan"]) == 1
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("pour-bench: error: cannot open CAN bus socketcan:vcan0: [Errno 97]"), line
+    assert "this kernel has no SocketCAN" in line and 'docs/bench.md, "No CAN hardware"' in line, line
+    doc = (SOURCE_DIR / "docs" / "bench.md").read_text()
+    assert "\n## No CAN hardware\n" in doc and "ip link add dev vcan0 type vcan" in doc
+
+
+def test_every_subcommand_and_option_has_help():
+    import argparse
+
+    from pour.bench import cli as bench_cli
+
+    def walk(parser, path):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                helped = {a.dest for a in action._choices_actions if a.help}
+                for name, sub in action.choices.items():
+                    assert name in helped, f"{path} {name}: no help"
+                    yield from walk(sub, f"{path} {name}")
+            elif not isinstance(action, (argparse._HelpAction, argparse._VersionAction)):
+                yield path, action
+
+    actions = list(walk(bench_cli.parser(), "pour-bench"))
+    assert len(actions) > 20
+    missing = [f"{path} {a.option_strings or a.dest}" for path, a in actions if not a.help]
+    assert not missing, missing
+
+
+def test_bus_options_are_named_as_python_can_names_them():
+    from pour.bench import cli as bench_cli
+    opts = {o for a in bench_cli.parser()._actions for o in a.option_strings}
+    assert {"--channel", "--interface", "--node"} <= opts and "--iface" not in opts

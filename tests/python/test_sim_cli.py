@@ -294,3 +294,37 @@ def test_firmware_pour_is_bit_identical_across_runs(host_sim, tmp_path, source_d
         assert r.returncode == 0, r.stderr
         outs.append(out.read_bytes())
     assert outs[0] == outs[1] and len(outs[0]) > 100_000
+
+
+def test_drive_json_carries_the_peak_current_the_bus_range_and_the_faults_by_name(host_sim, source_dir):
+    """--set drive=1 --json: the summary's "drive" is the worst of the episodes' own "drive" objects, and the
+    text line (on stderr with --json) says the same figures."""
+    args = ("--policy", source_dir / "policy" / "weights.h", "--set", "drive=1", "--set", "episode_s=2",
+            "--episodes", 2)
+    r = host_sim(*args, "--json", "--quiet")
+    assert r.returncode == 0, r.stderr
+    s = json.loads(r.stdout)
+    per = [e["drive"] for e in s["per_episode"]]
+    assert len(per) == 2 and all(set(d) == {"peak_current_a", "peak_vbus_v", "min_vbus_v", "faults"} for d in per)
+    assert s["drive"]["peak_current_a"] == max(d["peak_current_a"] for d in per) > 1.0
+    assert s["drive"]["peak_vbus_v"] == max(d["peak_vbus_v"] for d in per)
+    assert s["drive"]["min_vbus_v"] == min(d["min_vbus_v"] for d in per)
+    assert 20.0 < s["drive"]["min_vbus_v"] <= s["drive"]["peak_vbus_v"] < 26.0  # the 24 V supply
+    assert s["drive"]["faults"] == [] and all(e["fault_names"] == [] for e in s["per_episode"])
+    line = r.stderr.strip().splitlines()[-1]
+    assert line == (f"drive (field-oriented, docs/motor.md): peak phase current {s['drive']['peak_current_a']:.1f} A, "
+                    f"peak bus {s['drive']['peak_vbus_v']:.2f} V (lowest {s['drive']['min_vbus_v']:.2f} V), "
+                    "faults none")
+
+
+def test_drive_json_names_an_injected_drive_fault(host_sim, source_dir):
+    s = summary(host_sim, "--policy", source_dir / "policy" / "weights.h", "--set", "drive=1", "--set",
+                "drive_fault=3", "--set", "episode_s=2")  # the encoder wired backwards
+    (e,) = s["per_episode"]
+    assert e["drive"]["faults"] == ["ENCODER_DIRECTION"] == s["drive"]["faults"]
+    assert e["fault_names"] == ["DRIVE"] and e["faults"] == 1 << 11 and s["faulted"] == 1
+
+
+def test_json_without_the_full_drive_has_no_drive_object(host_sim):
+    s = summary(host_sim, "--baseline", "hand", "--set", "episode_s=1")
+    assert "drive" not in s and "drive" not in s["per_episode"][0]

@@ -5,6 +5,7 @@ bars: inertia, friction and torque scale within 5 %, latency exact, scale delay 
 draws), weighs the fill from the tilt experiment's log (with water), and refuses every log or rig file it
 cannot use, saying why."""
 import json
+import os
 import subprocess
 import sys
 import tomllib
@@ -140,7 +141,7 @@ def test_an_experiment_a_fault_ended_is_refused(tmp_path):
     # torque holds, the controller latches Encoder (0x40) and ends it.
     argv = [HOST_SIM, "--experiment", "identify", "--candump", stuck, "--set", "friction_coulomb=8.0"]
     r = subprocess.run([str(a) for a in argv], capture_output=True, text=True, timeout=120)
-    assert r.returncode != 0 and "faults 0x0040" in r.stdout, r.stdout + r.stderr
+    assert r.returncode != 0 and "faults ENCODER" in r.stdout, r.stdout + r.stderr
     r = sysid(stuck, tmp_path / "rig.toml")
     assert r.returncode == 1 and "a fault ended the experiment" in r.stderr and "in phase 'sweep'" in r.stderr, \
         r.stderr
@@ -330,3 +331,46 @@ def test_the_flow_map_is_the_simulators_own_at_the_default(tmp_path):
     row = next(r for r in flow.CD_MAP if r[0] == 5)
     assert float(np.mean(cd)) == pytest.approx(row[1], abs=1e-4)
     assert float(np.std(cd, ddof=1)) == pytest.approx(row[2], abs=1e-4)
+
+
+def one_line_error(r: subprocess.CompletedProcess) -> str:
+    assert "Traceback" not in r.stderr, r.stderr
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith("pour-sysid: error: "), line
+    return line
+
+
+def test_without_the_simulator_library_it_is_one_line_and_exit_1(tmp_path, nominal_log):
+    lib = tmp_path / "no" / "libpoursim.so"
+    r = subprocess.run([str(SYSID), str(nominal_log), "--out", str(tmp_path / "rig.toml")], capture_output=True,
+                       text=True, timeout=120, env={**os.environ, "POUR_SIM_LIB": str(lib)})
+    assert r.returncode == 1
+    line = one_line_error(r)
+    assert "libpoursim.so not found" in line and str(lib) in line and "POUR_SIM_LIB" in line
+    assert not (tmp_path / "rig.toml").exists()
+
+
+@pytest.mark.parametrize("make, status, why", [
+    (lambda d: d / "missing.log", 2, "cannot read (No such file or directory)"),
+    (lambda d: d, 2, "cannot read (Is a directory)"),
+    (lambda d: (d / "text.log").write_text("not a log\n") and d / "text.log", 1, "not a candump -L log"),
+    (lambda d: (d / "bin.log").write_bytes(bytes(range(256)) * 8) and d / "bin.log", 1, "not a candump -L log"),
+])
+def test_a_log_it_cannot_use_is_one_line(tmp_path, make, status, why):
+    log = make(tmp_path)
+    r = sysid(log, tmp_path / "rig.toml")
+    assert r.returncode == status and why in one_line_error(r), r.stderr
+    assert not (tmp_path / "rig.toml").exists()
+
+
+@pytest.mark.parametrize("base, why", [("missing.toml", "No such file or directory"),
+                                       ("bad.toml", "Invalid value")])
+def test_a_base_rig_file_it_cannot_read_is_one_line_and_exit_2(tmp_path, nominal_log, base, why):
+    (tmp_path / "bad.toml").write_text("x = [\n")
+    r = sysid(nominal_log, tmp_path / "rig.toml", "--base", tmp_path / base)
+    assert r.returncode == 2 and why in one_line_error(r), r.stderr
+
+
+def test_an_out_path_it_cannot_write_is_one_line_and_exit_2(tmp_path, nominal_log):
+    r = sysid(nominal_log, tmp_path / "no" / "rig.toml")
+    assert r.returncode == 2 and "--out: folder" in one_line_error(r), r.stderr

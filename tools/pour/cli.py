@@ -4,8 +4,11 @@ stderr (tqdm), which --quiet turns off. Imports no subpackage."""
 from __future__ import annotations
 
 import argparse
+import importlib
+import os
 import sys
 from importlib import metadata
+from types import ModuleType
 from typing import Iterable, TypeVar
 
 from tqdm import tqdm
@@ -19,6 +22,23 @@ def version() -> str:
         return metadata.version("pour-tools")
     except metadata.PackageNotFoundError:
         return "unknown (pour-tools is not installed)"
+
+
+class MissingExtra(SystemExit):
+    """An optional extra is not installed: exits 1 with one line naming the extra to install."""
+
+
+def require(module: str, extra: str) -> ModuleType:
+    """module, imported where it is used; MissingExtra (one line: the program, the module, the extra) when it is
+    not installed. An ImportError from inside an installed module is not caught."""
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        if exc.name is None or exc.name.split(".")[0] != module.split(".")[0]:
+            raise
+        prog = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else "pour"
+        raise MissingExtra(f"{prog}: {module} is not installed: it comes with the {extra} extra "
+                           f"(pip install './tools[{extra}]')") from None
 
 
 class ArgumentParser(argparse.ArgumentParser):

@@ -43,7 +43,8 @@ def load() -> C.CDLL:
                 raise SimError(f"libpoursim at {path} failed to load: {e}") from e
             return _lib
     raise SimError("libpoursim.so not found (looked at: " + ", ".join(map(str, tried)) +
-                   "); build it with `cmake --workflow --preset host` or set POUR_SIM_LIB")
+                   "); reinstall the package from a checkout (pip install ./tools builds it in), build it with "
+                   "`cmake --workflow --preset host`, or set POUR_SIM_LIB")
 
 
 def _name(fn_name: str, value: int, ctype: type) -> str | None:

@@ -9,7 +9,7 @@ library built elsewhere).
 
 Data that has its one source in the checkout (the DBC, the generated LCM Python types) is found through
 data_file() and lcmtypes_python_dirs(): first in the package's own data/ folder, which a wheel carries
-(tools/setup.py copies and generates it at build time), then in the checkout and its build trees. Nothing
+(tools/CMakeLists.txt copies and generates it at build time), then in the checkout and its build trees. Nothing
 here imports the rest of the package.
 """
 from __future__ import annotations
@@ -27,6 +27,8 @@ PACKAGE_DATA = Path(__file__).resolve().parent / "data"
 # Each data file a wheel ships, by its name in PACKAGE_DATA, and the one source it is copied from.
 DATA_SOURCES = {"pour.dbc": Path("can") / "pour.dbc"}
 LCMTYPES_DIR = "lcmtypes"  # PACKAGE_DATA/lcmtypes/pour_lcm/pour/*.py in a wheel
+# The package's own libpoursim: a wheel's (tools/CMakeLists.txt builds it), absent from a checkout.
+PACKAGE_LIB = Path(__file__).resolve().parent / "lib" / "libpoursim.so"
 
 
 def build_dirs(build_dir: str | os.PathLike | None = None, any_preset: bool = False) -> list[Path]:
@@ -68,11 +70,11 @@ def binary(name: str, build_dir: str | os.PathLike | None = None) -> Path | None
 
 
 def sim_library_candidates() -> list[Path]:
-    """Where libpoursim is looked for, in order: $POUR_SIM_LIB alone when it is set, else lib/libpoursim.so of
-    every build tree (any preset)."""
+    """Where libpoursim is looked for, in order: $POUR_SIM_LIB alone when it is set, else the package's own
+    (a wheel's), then lib/libpoursim.so of every build tree (any preset)."""
     if os.environ.get("POUR_SIM_LIB"):
         return [Path(os.environ["POUR_SIM_LIB"])]
-    return candidates(SIM_LIB_REL, any_preset=True)
+    return [PACKAGE_LIB] + candidates(SIM_LIB_REL, any_preset=True)
 
 
 def data_file(name: str) -> Path:

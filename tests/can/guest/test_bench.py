@@ -25,7 +25,7 @@ LOCKSTEP = ("--lockstep", "--stall-ms", "5000")
 
 
 def bench(*argv: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "pour.bench.cli", "--iface", "vcan0", "--timeout", "2", *argv],
+    return subprocess.run([sys.executable, "-m", "pour.bench.cli", "--channel", "vcan0", "--timeout", "2", *argv],
                           capture_output=True, text=True, timeout=timeout)
 
 

@@ -68,8 +68,10 @@ def _seconds(text: str) -> float:
 
 def parser() -> argparse.ArgumentParser:
     ap = cli.ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0], epilog=EPILOG)
-    ap.add_argument("--iface", default="vcan0", help="CAN interface (python-can channel; default %(default)s)")
-    ap.add_argument("--interface", default="socketcan", help="python-can interface (default %(default)s)")
+    ap.add_argument("--channel", default="vcan0",
+                    help="the CAN bus, as python-can names it (socketcan: a network interface; default %(default)s)")
+    ap.add_argument("--interface", default="socketcan",
+                    help="python-can's interface, the kind of bus (socketcan, virtual, ...; default %(default)s)")
     ap.add_argument("--node", type=_node_id, default=0, help="controller node id, 0..63 (default 0)")
     ap.add_argument("--timeout", type=_seconds, default=bn.DEFAULT_TIMEOUT_S,
                     help="seconds to wait for an answer (default %(default)s)")
@@ -79,27 +81,28 @@ def parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="cmd", required=True, metavar="COMMAND")
     sub.add_parser("scan", help="list the nodes on the bus")
     sub.add_parser("info", help="identity and state of the node")
-    sub.add_parser("faults", help="mode and latched faults by name")
+    sub.add_parser("faults", help="mode and latched faults by name: the core's, and the drive's (DriveTelemetry)")
     sub.add_parser("clear", help="clear latched faults (MOVES: a run resumes)")
     p = sub.add_parser("estop", help="assert the e-stop (or --release it)")
-    p.add_argument("--release", action="store_true")
+    p.add_argument("--release", action="store_true", help="release the e-stop instead (the node goes to FAULT)")
     sub.add_parser("stop", help="end the run (RUN -> IDLE)")
     sub.add_parser("reset", help="start a new run from the power-on state (MOVES once samples flow)")
     p = sub.add_parser("config", help="parameters: get [NAME...], set NAME VALUE, save, list")
     csub = p.add_subparsers(dest="config_cmd", required=True, metavar="ACTION")
-    g = csub.add_parser("get")
+    g = csub.add_parser("get", help="read parameters from the node")
     g.add_argument("names", nargs="*", help="parameter names or ids (default: all)")
-    s = csub.add_parser("set")
-    s.add_argument("name")
-    s.add_argument("value", type=_int)
-    csub.add_parser("save")
+    s = csub.add_parser("set", help="write one parameter (IDLE or FAULT only; a refusal names its reason)")
+    s.add_argument("name", help="parameter name or id (config list)")
+    s.add_argument("value", type=_int, help="the value as the node stores it (a decimal integer)")
+    csub.add_parser("save", help="store the node's parameters (its params= file, flash on the board)")
     csub.add_parser("list", help="the parameter names this DBC knows")
     p = sub.add_parser("tare", help="tare the scales at their present reading")
-    p.add_argument("--scale", choices=["rotating", "target", "both"], default="both")
+    p.add_argument("--scale", choices=["rotating", "target", "both"], default="both",
+                   help="which load cell (default %(default)s)")
     sub.add_parser("zero", help="the encoder's present count becomes upright")
     p = sub.add_parser("log", help="record the bus as a candump -L log")
-    p.add_argument("output", type=Path)
-    p.add_argument("--seconds", type=_seconds, default=10.0)
+    p.add_argument("output", type=Path, help="the candump -L log to write (atomically)")
+    p.add_argument("--seconds", type=_seconds, default=10.0, help="record this long (default %(default)s)")
     p = sub.add_parser("plot", help="live plot: θ, θ̇, torque, scales, mode and faults (--png to save)")
     p.add_argument("--seconds", type=_seconds, default=3600.0, help="stop after this long (default: an hour)")
     p.add_argument("--window", type=_seconds, default=10.0, help="seconds shown (default %(default)s)")
@@ -155,6 +158,19 @@ def _print_state(st: bn.NodeState) -> None:
           f"rx_dropped {st.rx_dropped}, overruns {st.overruns}, refused {st.refused}")
 
 
+def _print_drive(n: bn.Node, timeout: float) -> None:
+    """The drive's faults by name, its currents and bus voltage, from a DriveTelemetry frame (one a heartbeat)."""
+    if n.state is None or n.state.drive is None:
+        try:
+            n.bench.wait_for(n.id, lambda name, s: name == "DriveTelemetry", min(timeout, bn.HEARTBEAT_WAIT_S),
+                             "with its drive's telemetry")
+        except bn.NodeTimeout:
+            pass
+    drive = n.state.drive if n.state is not None else None
+    print(f"node {n.id}: {drive.describe()}" if drive is not None
+          else f"node {n.id}: no DriveTelemetry (a controller without a drive of its own)")
+
+
 def _plot(a: argparse.Namespace) -> int:
     from pour.bench import plot
     if not 8 <= a.encoder_bits <= 24:
@@ -173,7 +189,7 @@ def _plot(a: argparse.Namespace) -> int:
         used = plot.run(plot.replay(a.replay, paced=not a.fast), db, a.node, a.seconds, a.encoder_bits, a.window,
                         a.png, not a.no_window, hold=True)
     else:
-        with bn.Bench(channel=a.iface, interface=a.interface) as bench:
+        with bn.Bench(channel=a.channel, interface=a.interface) as bench:
             used = plot.run(bench.frames(a.seconds), db, a.node, a.seconds, a.encoder_bits, a.window, a.png,
                             not a.no_window)
     print(f"pour-bench plot: {used} frames of node {a.node}" + (f", figure in {a.png}" if a.png else ""))
@@ -188,7 +204,7 @@ def run(a: argparse.Namespace) -> int:
     want = _expected_hash(a) if a.cmd in MOTION else None
     if a.cmd == "plot":
         return _plot(a)
-    with bn.Bench(channel=a.iface, interface=a.interface) as bench:
+    with bn.Bench(channel=a.channel, interface=a.interface) as bench:
         if a.cmd == "scan":
             for st in bench.scan(max(a.timeout, bn.HEARTBEAT_WAIT_S)).values():
                 ident = st.identity
@@ -207,8 +223,10 @@ def run(a: argparse.Namespace) -> int:
                 print(f"pour-bench: warning: firmware {i.fw_version} and this DBC (protocol {bench.protocol}) "
                       f"differ: some frames may be misread", file=sys.stderr)
             _print_state(st)
+            _print_drive(n, a.timeout)
         elif a.cmd == "faults":
             _print_state(n.info(a.timeout))
+            _print_drive(n, a.timeout)
         elif a.cmd == "estop":
             n.estop(not a.release)
             _print_state(n.wait_mode({"FAULT"} if a.release else {"ESTOP"}, a.timeout))

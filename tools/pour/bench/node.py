@@ -13,6 +13,7 @@ Every wait has a timeout; a node that does not answer raises NodeTimeout, which 
 """
 from __future__ import annotations
 
+import errno
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -121,6 +122,33 @@ class Identity:
 
 
 @dataclass
+class DriveTelemetry:
+    """The drive's last DriveTelemetry frame: the current loop's d and q currents [A], the bus voltage [V] and
+    its latched faults, by the DBC's names (Overcurrent, ...)."""
+    id_a: float
+    iq_a: float
+    vbus_v: float
+    faults: list[str]
+
+    def describe(self) -> str:
+        return (f"drive faults {', '.join(self.faults) or 'none'}, Iq {self.iq_a:.3f} A, Id {self.id_a:.3f} A, "
+                f"bus {self.vbus_v:.2f} V")
+
+
+def drive_fault_signals(db: cantools.database.can.Database) -> list[str]:
+    """DriveTelemetry's fault signals (DriveFault_*), in the DBC's order (bit 0 first)."""
+    return [s.name for s in db.get_message_by_name("DriveTelemetry").signals if s.name.startswith("DriveFault_")]
+
+
+def drive_telemetry(db: cantools.database.can.Database, sig: dict) -> DriveTelemetry:
+    """A DriveTelemetry frame's raw signals (Decoder.decode) in SI units, by the DBC's scales."""
+    m = db.get_message_by_name("DriveTelemetry")
+    scaled = {n: sig[n] * m.get_signal_by_name(n).scale for n in ("Id", "Iq", "Vbus")}
+    return DriveTelemetry(scaled["Id"], scaled["Iq"], scaled["Vbus"],
+                          [f.removeprefix("DriveFault_") for f in drive_fault_signals(db) if sig[f]])
+
+
+@dataclass
 class NodeState:
     """What a node last said of itself (monotonic times [s])."""
     node_id: int
@@ -135,6 +163,7 @@ class NodeState:
     heartbeats: int = 0
     counter_breaks: int = 0  # heartbeats whose counter repeated or went back: another node on this id
     identities: set[int] = field(default_factory=set)  # distinct policy hashes seen on this id
+    drive: DriveTelemetry | None = None  # the last DriveTelemetry (a node with a drive of its own sends one a heartbeat)
 
     def describe(self, now: float | None = None) -> str:
         now = time.monotonic() if now is None else now
@@ -179,6 +208,22 @@ class Decoder:
             return None
 
 
+# Where a user without CAN hardware is sent (docs/bench.md's section of that name).
+NO_CAN_DOC = 'docs/bench.md, "No CAN hardware"'
+
+
+def _no_bus_hint(e: Exception, channel: str) -> str:
+    """What to do when a bus does not open for want of SocketCAN or of the interface; "" otherwise."""
+    err = getattr(e, "errno", None)
+    if err == errno.EAFNOSUPPORT:
+        return (f": this kernel has no SocketCAN; without CAN hardware use a vcan interface or the user-mode "
+                f"Linux guest the tests use ({NO_CAN_DOC}), or --interface virtual")
+    if err in (errno.ENODEV, errno.ENXIO):
+        return (f": no interface {channel}; for a virtual one: ip link add dev {channel} type vcan && "
+                f"ip link set up {channel} ({NO_CAN_DOC})")
+    return ""
+
+
 class Bench:
     """One CAN bus. channel/interface are python-can's; bus: an open python-can bus instead."""
 
@@ -193,7 +238,7 @@ class Bench:
         try:
             self.bus = bus if bus is not None else can.Bus(interface=interface, channel=channel)
         except (OSError, can.CanError, ValueError) as e:
-            raise BenchError(f"cannot open CAN bus {interface}:{channel}: {e}") from e
+            raise BenchError(f"cannot open CAN bus {interface}:{channel}: {e}{_no_bus_hint(e, channel)}") from e
         self.states: dict[int, NodeState] = {}
         self._by_cmd = {m.frame_id: m for m in self.db.messages}
         self.decoder = Decoder(self.db)
@@ -247,6 +292,8 @@ class Bench:
             st.rx_dropped, st.overruns, st.refused = sig["RxDropped"], sig["Overruns"], sig["Refused"]
             st.t_heartbeat = now
             st.heartbeats += 1
+        elif name == "DriveTelemetry":
+            self.states.setdefault(node_id, NodeState(node_id)).drive = drive_telemetry(self.db, sig)
         elif name == "Identity":
             st = self.states.setdefault(node_id, NodeState(node_id))
             st.identity = Identity(sig["WeightsHash"], sig["TauMax"] * 0.01, sig["FwVersion"], sig["InitStatus"])

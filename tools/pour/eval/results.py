@@ -21,7 +21,8 @@ import numpy as np
 from pour import atomic, cli
 from pour.eval import evaluate
 from pour.policy import export, weights_h
-from pour.sim import envs, gym_env
+from pour.sim import envs
+from pour.sim.episode import FINISH_MAX_S, POURED_MIN_PCT, SPILLED_MAX_PCT
 from pour.train import trainer
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
@@ -30,7 +31,7 @@ FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from Seed
 def _row(name: str, how: str, poured: Sequence[float], spilled: Sequence[float], finish: Sequence[float],
          ret: Sequence[float], reversals: Sequence[float]) -> dict[str, Any]:
     poured, spilled, finish = np.asarray(poured), np.asarray(spilled), np.asarray(finish)
-    ok = (poured >= 95) & (spilled <= 3) & (finish >= 0) & (finish <= 8)
+    ok = (poured >= POURED_MIN_PCT) & (spilled <= SPILLED_MAX_PCT) & (finish >= 0) & (finish <= FINISH_MAX_S)
     return {"name": name, "how": how, "episodes": int(poured.size), "poured_pct": float(poured.mean()),
             "poured_pct_min": float(poured.min()), "spilled_pct": float(spilled.mean()),
             "spilled_pct_max": float(spilled.max()),
@@ -57,6 +58,7 @@ def _greedy_metrics(job: tuple) -> dict[str, float]:
     layers) through the Gymnasium env, which runs the same simulator and firmware pipeline tick by tick."""
     kind, n_actions, period_ms, policy, seed = job
     if isinstance(policy, tuple):
+        from pour.sim import gym_env  # _run_policies made sure the gym extra is there
         key = ("env:" + kind, n_actions, period_ms)
         if key not in _SIMS:
             _SIMS[key] = gym_env.PourEnv(kind, n_actions, period_ms, 10.0)
@@ -81,6 +83,7 @@ def _run_policies(run: Path) -> tuple[tuple[str, int, int], dict[str, Any], list
             spec = (doc["config"]["env"]["kind"], int(doc["n_actions"]), int(doc["decision_period_ms"]))
         except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{run}/actor.json: not an MLP actor's description ({exc})") from None
+        cli.require("gymnasium", "gym")  # an MLP actor runs through the Gymnasium env
         hist = _mlp_layers(ck, "history_mlp_")
         if not hist:
             raise ValueError(f"{run}: its checkpoint has no MLP actor history (history_mlp_0...)")
@@ -227,7 +230,8 @@ def init_row(config_path: str, n: int) -> dict[str, Any]:
 
 def markdown(rows: list[dict[str, Any]], n: int) -> str:
     lines = [f"Held-out seeds {FIRST_SEED}..{FIRST_SEED + n - 1} ({n} episodes of 10 s each per policy, "
-             "greedy). Targets: poured >= 95 %, spilled <= 3 %, finished within 8 s.", "",
+             f"greedy). Targets: poured >= {POURED_MIN_PCT:g} %, spilled <= {SPILLED_MAX_PCT:g} %, finished within "
+             f"{FINISH_MAX_S:g} s.", "",
              "| policy | poured % (mean / min) | spilled % (mean / max) | finish s (mean / max) | "
              "reversals per 10 s (mean / max) | return | episodes meeting all targets |",
              "|---|---|---|---|---|---|---|",

@@ -19,6 +19,11 @@ OMEGA_MAX_RAD_S = 4.0
 # The normalisation as a policy.json records it (pour.policy.export.write_policy).
 NORM = {"theta_min_rad": THETA_MIN_RAD, "theta_max_rad": THETA_MAX_RAD, "omega_max_rad_s": OMEGA_MAX_RAD_S}
 N_FEATURES = 6
+# The targets an episode meets to count as a success (the results table's, pour-results; the Gymnasium env's
+# info["is_success"]): poured at least this much of the liquid, spilled at most this much, finished in time.
+POURED_MIN_PCT = 95.0
+SPILLED_MAX_PCT = 3.0
+FINISH_MAX_S = 8.0
 
 
 class EnvError(RuntimeError):

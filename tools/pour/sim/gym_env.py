@@ -14,7 +14,10 @@ firmware's own pipeline (estimator, supervisor, envelope, controlled stop), as i
 holds the core's latched fault bits (0 while it runs). Observation: the five normalised
 state variables [θn, ωn, V_rotating, V_target, V_spill] in [0, 1] (float32). Reward: the per-tick
 reward K_target·V_target − K_spill·V_spill summed over the decision period. The 10 s episode ends by
-time limit (truncated=True); nothing terminates it earlier.
+time limit (truncated=True), or earlier when the core faults (terminated=True: the core has stopped the
+bucket and holds it; info["fault_names"] names the faults). The last step's info["is_success"] says whether
+the episode met the results table's targets (pour.sim.episode: poured >= 95 %, spilled <= 3 %, finished
+within 8 s) without a fault. Only the 'sim' backend renders (rgb_array); the toy plant has no scene.
 """
 from __future__ import annotations
 
@@ -24,8 +27,9 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from pour import libpoursim
 from pour.policy import linear
-from pour.sim import envs, gym_ids
+from pour.sim import envs, episode, gym_ids
 
 
 class PourEnv(gym.Env):
@@ -33,7 +37,9 @@ class PourEnv(gym.Env):
 
     reset(seed=s) runs the plant of seed s, exactly as host_sim --seed s does; reset() without a seed goes on
     with seeds drawn from the env's seeded generator. reset(options={"rig": {KEY: VALUE}}) sets simulator
-    config keys over the env's own options from that episode on (the same keys as host_sim --set)."""
+    config keys over the env's own options from that episode on (the same keys as host_sim --set). A reset
+    refused (an unknown option or key, a value out of range, a bad seed) changes nothing: the env goes on
+    as it was."""
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 100}
 
@@ -55,6 +61,8 @@ class PourEnv(gym.Env):
                                         self._options)
         self.render_mode = render_mode
         self.metadata = dict(self.metadata, render_fps=1000 // int(decision_period_ms))
+        if backend != "sim":
+            self.metadata["render_modes"] = []  # the toy plant has no scene to draw
         self.levels = linear.action_levels(int(n_actions))
         self.period = int(decision_period_ms)
         self.max_decisions = int(round(episode_s * 1000)) // self.period
@@ -72,25 +80,23 @@ class PourEnv(gym.Env):
         return np.asarray(self._plant.features()[:5], dtype=np.float32)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
-        super().reset(seed=seed)
+        # Everything is checked before anything changes: a refused reset leaves the env as it was.
         unknown = set(options or {}) - {"rig"}
         if unknown:
             raise envs.EnvError(f"reset options {sorted(unknown)}: the only option is 'rig' (simulator config keys)")
         rig = (options or {}).get("rig")
+        if rig is not None and not isinstance(rig, dict):
+            raise envs.EnvError(f"reset option rig = {rig!r}: expected a dict of simulator config keys")
+        if seed is not None and not (isinstance(seed, (int, np.integer)) and 0 <= int(seed) < 2**32):
+            raise envs.EnvError(f"seed {seed!r}: expected an integer 0 .. 2^32 - 1 (host_sim's --seed)")
         if rig:
-            if not isinstance(rig, dict):
-                raise envs.EnvError(f"reset option rig = {rig!r}: expected a dict of simulator config keys")
-            self._options.update(rig)
-            self._plant = envs.make_stepper(self._backend, self._n_actions, self.period, self._episode_s,
-                                            self._options)
+            merged = {**self._options, **rig}
+            plant = envs.make_stepper(self._backend, self._n_actions, self.period, self._episode_s, merged)
+            self._options, self._plant = merged, plant
+        super().reset(seed=seed)
         # A given seed is the plant's seed, as host_sim's --seed; without one the next seed comes from the
         # env's generator (seeded by the last reset with a seed), so a sequence of resets is reproducible.
-        if seed is not None:
-            if not 0 <= int(seed) < 2**32:
-                raise envs.EnvError(f"seed {seed}: expected 0 .. 2^32 - 1 (host_sim's --seed)")
-            plant_seed = int(seed)
-        else:
-            plant_seed = int(self.np_random.integers(0, 2**32 - 1))
+        plant_seed = int(seed) if seed is not None else int(self.np_random.integers(0, 2**32 - 1))
         self._plant.reset(plant_seed)
         self._k = 0
         self._started = True
@@ -103,12 +109,26 @@ class PourEnv(gym.Env):
             raise gym.error.InvalidAction(f"action {action!r} is not in {self.action_space}")
         reward = float(self._plant.advance(float(self.levels[int(action)]), self.period))
         self._k += 1
-        truncated = self._k >= self.max_decisions
-        if truncated:
-            self._started = False
+        faults = int(getattr(self._plant, "faults", 0))
+        terminated = faults != 0  # the core stopped the bucket: nothing the agent does changes it now
+        truncated = not terminated and self._k >= self.max_decisions
         info = {"v_target": float(self._plant.v_tgt), "v_spill": float(self._plant.v_spill),
-                "t_s": self._k * self.period * 1e-3, "faults": int(getattr(self._plant, "faults", 0))}
-        return self._obs(), reward, False, truncated, info
+                "t_s": self._k * self.period * 1e-3, "faults": faults}
+        if terminated:
+            info["fault_names"] = libpoursim.fault_names(faults)
+        if terminated or truncated:
+            self._started = False
+            info["is_success"] = self._success(faults)
+        return self._obs(), reward, terminated, truncated, info
+
+    def _success(self, faults: int) -> bool:
+        """The episode met the results table's targets (pour.sim.episode) without a fault."""
+        if faults:
+            return False
+        finish = float(self._plant.metrics()["finish_s"])
+        return (100.0 * float(self._plant.v_tgt) >= episode.POURED_MIN_PCT
+                and 100.0 * float(self._plant.v_spill) <= episode.SPILLED_MAX_PCT
+                and 0.0 <= finish <= episode.FINISH_MAX_S)
 
 
     def render(self) -> np.ndarray | None:

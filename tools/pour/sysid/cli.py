@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from pour import atomic, cli
+from pour.libpoursim import SimError
 from pour.sim import poursim
 from pour.sysid import fit as sf
 from pour.sysid import flow
@@ -28,8 +29,8 @@ from pour.sysid import rig as srig
 PROG = "pour-sysid"
 EPILOG = ("Exit status (the same meanings in every pour program): 0 done; 1 a log that cannot be fitted "
           "(truncated, of another node, with gaps, a refused or cut-short experiment, a parameter it does not "
-          "excite, a --tilt log without outflow over the lip); 2 bad input (the command line, the base rig "
-          "file).")
+          "excite, a --tilt log without outflow over the lip), no simulator library, a write that failed; 2 bad "
+          "input (the command line, the base rig file, a log that cannot be read).")
 
 NO_FILL = "fill_depth: not identified (no --tilt log with water): training keeps its config's fill and range"
 
@@ -128,6 +129,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, srig.RigError) as e:
         print(f"{PROG}: error: {e}", file=sys.stderr)
         return 2
+    except SimError as e:  # the simulator library holds the rig's defaults
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 1
     try:
         run = slog.read(a.log, a.node)
         fit = sf.fit_identify(run, base)
@@ -139,7 +143,10 @@ def main(argv: list[str] | None = None) -> int:
             cd, tilt = flow.fit_flow(tilt_run, {**base, "scale_delay_s": e["scale_delay_s"].value})
             e["flow_coefficient"] = cd
             e[flow.KEY] = flow.key_of(cd)
-    except slog.LogError as err:
+    except slog.LogUnreadable as err:
+        print(f"{PROG}: error: {err}", file=sys.stderr)
+        return 2
+    except (slog.LogError, SimError) as err:
         print(f"{PROG}: error: {err}", file=sys.stderr)
         return 1
     fitted = srig.Rig({k: e[k].value for k in srig.FITTED if k in e},
@@ -155,10 +162,14 @@ def main(argv: list[str] | None = None) -> int:
         header.append("uncertain beyond 5 %: " + ", ".join(flagged))
     if "fill_depth" not in e:
         header.append(NO_FILL)
-    srig.save(a.out, fitted, header)
-    if a.png is not None:
-        fit.series["theta_sim"] = simulate(run, fit, base)
-        figure(fit, a.png, tilt if a.tilt is not None else None)
+    try:
+        srig.save(a.out, fitted, header)
+        if a.png is not None:
+            fit.series["theta_sim"] = simulate(run, fit, base)
+            figure(fit, a.png, tilt if a.tilt is not None else None)
+    except OSError as err:
+        print(f"{PROG}: error: {err.filename or a.out}: cannot write ({err.strerror})", file=sys.stderr)
+        return 1
     if a.json:
         print(json.dumps({k: {"value": v.value, "sigma": v.sigma, "unit": v.unit} for k, v in e.items()}))
     else:

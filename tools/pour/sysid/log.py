@@ -23,6 +23,10 @@ class LogError(ValueError):
     """A log that cannot be fitted, and why."""
 
 
+class LogUnreadable(LogError):
+    """The log's file cannot be opened or read (missing, a folder, no permission)."""
+
+
 @dataclass
 class Run:
     """One tick per row, from the first tick of the experiment (RUN) to the last logged."""
@@ -53,7 +57,9 @@ def read(path: Path, node_id: int) -> Run:
     node, with gaps, or of a start the controller refused."""
     try:
         msgs = list(can.CanutilsLogReader(str(path)))
-    except (OSError, ValueError, IndexError) as e:
+    except OSError as e:
+        raise LogUnreadable(f"{path}: cannot read ({e.strerror})") from None
+    except (ValueError, IndexError) as e:
         raise LogError(f"{path}: not a candump -L log ({e}); truncated mid-line?") from e
     if not msgs:
         raise LogError(f"{path}: no frames")

@@ -17,6 +17,7 @@
 #define POUR_DRIVE_FAULT_CALIBRATION 0x0200u      /* no valid calibration (missing, bad CRC, old version) */
 #define POUR_DRIVE_FAULT_I2T 0x0400u              /* the motor's thermal (I²t) budget is spent */
 #define POUR_DRIVE_FAULT_ALL 0x07FFu
+#define POUR_DRIVE_FAULT_COUNT 11u /* bits 0 .. POUR_DRIVE_FAULT_COUNT - 1 of POUR_DRIVE_FAULT_ALL */
 
 /* What ClearErrors may clear (pour_drive_clear_faults): a fault whose cause the drive or the board judges
  * afresh once cleared. OVERCURRENT and PHASE: the loop checks every period again. HW_OVERCURRENT: the board
@@ -36,5 +37,10 @@
 
 #define POUR_DRIVE_FAULT_CLEARED_BY_CALIBRATION                                                               \
   (POUR_DRIVE_FAULT_CALIBRATION | POUR_DRIVE_FAULT_ENCODER_DIRECTION | POUR_DRIVE_FAULT_ENCODER_MISMATCH)
+
+#include <stdint.h>
+
+/* The name of one POUR_DRIVE_FAULT_* bit ("OVERCURRENT", ...), NULL for anything else. */
+const char *pour_drive_fault_name(uint32_t bit);
 
 #endif /* POUR_DRIVE_FAULTS_H */
