@@ -69,6 +69,8 @@ struct Plant {
   // largest |θ| [rad]
   long unpowered_released = 0;
   double theta_max = 0.0;
+  int model_count = 0; // the model's last encoder count (modulo its cpr)
+  uint16_t tim4 = 0;   // TIM4's 16-bit count
 } plant;
 
 bool drive_powers() {
@@ -89,8 +91,14 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_config_t &c = pour_board_drive_state()->config;
   for (int k = 0; k < 3; ++k) s->phase[k] = plant.sample.adc_phase[k];
   s->vbus = plant.sample.adc_vbus;
+  // TIM4 counts 16 bits (encoder_tim4.c: ARR 0xFFFF); the model's count wraps at the encoder's cpr: the
+  // timer's count follows the model's steps, taken the short way round
+  const int cpr = static_cast<int>(c.encoder_cpr);
+  const int step = ((static_cast<int>(plant.sample.encoder) - plant.model_count) % cpr + cpr + cpr / 2) % cpr - cpr / 2;
+  plant.model_count = plant.sample.encoder;
+  plant.tim4 = static_cast<uint16_t>(plant.tim4 + step);
   s->ntc = pour_ideal_adc_counts(&c, 1055u + 15u * 227u / 10u); // 40 °C
-  s->encoder = plant.sample.encoder;
+  s->encoder = plant.tim4;
   return true;
 }
 
@@ -168,6 +176,7 @@ void plant_reset() {
   plant.params = poursim::motor_params(pour_drive_default_config(), poursim_default_config());
   plant.model.reset(plant.params, 7, poursim::MotorFault::None);
   plant.sample = plant.model.sample();
+  plant.model_count = plant.tim4 = plant.sample.encoder;
   plant.rx.clear();
   plant.results.clear();
   plant.gates = Gates::Off;

@@ -1,20 +1,19 @@
 /* SPDX-License-Identifier: MIT */
-/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring, and which pin was checked against what): core
- * clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent watchdog, the LED, and
- * FDCAN1 behind hal_can. Registers and fields from stm32g431_regs.h's table (checked against ST's
- * description of the chip by tests/board/check_registers.py).
- *   PA15  e-stop input (the board's PWM-input pad): a normally-closed chain from 3.3 V holds it high;
- *         pull-down, so an open contact or a broken wire reads low = asserted
- *   PB12  brake release (the potentiometer pad), high = released; an external pull-down keeps the brake
- *         engaged through reset and while the MCU is unpowered
- *   PB8   power stage enable (J8's index pin, unused: the output encoder gives the absolute angle), high =
- *         on; external pull-down (it also holds BOOT0 low: boot from flash)
- *   PA11, PB9  FDCAN1 RX, TX (board_af.h); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
+/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring and each pin's reason; pour/board_facts.h: every pin
+ * and its source): core clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent
+ * watchdog, the option bytes' boot check, the LED, and FDCAN1 behind hal_can. Registers and fields from
+ * stm32g431_regs.h's table (checked against ST's description of the chip by tests/board/check_registers.py).
+ *   PB8   e-stop input (J8's Z, the board's 10 kΩ pull-up to 3.3 V, BOOT0): a normally-closed contact to ground
+ *         holds it low; an open contact or a broken wire reads high = asserted
+ *   PB3   brake release (the ST-LINK VCP's pad), high = released; an external 10 kΩ pull-down keeps the brake
+ *         engaged through reset, flashing (SWD leaves PB3 alone) and the ROM bootloader (which never drives it)
+ *   PA15  power stage enable (the PWM-input pad), high = on; an external 4.7 kΩ pull-down holds it under 0.52 V
+ *         against the JTDI pull-up the chip applies from reset until this firmware configures it
+ *   PA11, PB9  FDCAN1 RX, TX; PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
  *   PC6   LED (red), high = on */
 #include <stddef.h>
 
 #include "adc_inj.h"
-#include "board_af.h"
 #include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
@@ -24,6 +23,7 @@
 #include "hal_drive_g4.h"
 #include "ocp.h"
 #include "opamp.h"
+#include "pour/board_facts.h"
 #include "pwm_tim1.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -39,29 +39,31 @@
 #include "stm32g431_regs.h"
 
 #define RCC_R POUR_PERIPH(RCC)
-#define GPIOA_R POUR_PERIPH(GPIOA)
-#define GPIOB_R POUR_PERIPH(GPIOB)
-#define GPIOC_R POUR_PERIPH(GPIOC)
 #define CAN_TERMINATED true /* this node ends the bench's bus (the rig's sensor node is the other end) */
 #define WAIT_POLLS 100000u /* bound of every ready-flag wait: a flag that never comes is an error */
 
-static const pour_gpio_t estop = {GPIOA_R, 15u};
-static const pour_gpio_t brake = {GPIOB_R, 12u};
-static const pour_gpio_t power = {GPIOB_R, 8u};
-static const pour_gpio_t led = {GPIOC_R, 6u};
+/* A pin of pour/board_facts.h's table by its name: its port's registers (GPIOA + 0x400 per port) and number. */
+#define BOARD_PIN(name)                                                                                      \
+  {(volatile uint32_t *)(uintptr_t)(POUR_GPIOA_BASE + 0x400u * (uint32_t)POUR_BOARD_PIN_##name##_PORT),          \
+   (uint8_t)POUR_BOARD_PIN_##name##_PIN}
+static const pour_gpio_t estop = BOARD_PIN(ESTOP);
+static const pour_gpio_t brake = BOARD_PIN(BRAKE);
+static const pour_gpio_t power = BOARD_PIN(POWER);
+static const pour_gpio_t led = BOARD_PIN(LED);
 
-/* A pin and its alternate function, from board_af.h's table. */
+/* A pin and its alternate function, both from the table. */
 typedef struct {
   pour_gpio_t pin;
   uint8_t af;
 } af_pin_t;
-#define AF_PIN(owner, signal, port, pin, af) {{GPIO##port##_R, pin##u}, af##u},
-static const af_pin_t can_pins[] = {POUR_BOARD_AF_CAN(AF_PIN)};
-static const af_pin_t gates[] = {POUR_BOARD_AF_GATES(AF_PIN)};
-static const af_pin_t encoder_pins[] = {POUR_BOARD_AF_ENCODER(AF_PIN)};
+#define AF_PIN(name) {BOARD_PIN(name), (uint8_t)POUR_BOARD_PIN_##name##_AF}
+static const af_pin_t can_pins[] = {AF_PIN(CAN_RX), AF_PIN(CAN_TX)};
+static const af_pin_t gates[] = {AF_PIN(PWM_UH), AF_PIN(PWM_VH), AF_PIN(PWM_WH),
+                                 AF_PIN(PWM_UL), AF_PIN(PWM_VL), AF_PIN(PWM_WL)};
+static const af_pin_t encoder_pins[] = {AF_PIN(ENC_A), AF_PIN(ENC_B)};
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
-static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
-static const pour_gpio_t can_termination = {GPIOC_R, 14u};
+static const pour_gpio_t can_shutdown = BOARD_PIN(CAN_SHDN);
+static const pour_gpio_t can_termination = BOARD_PIN(CAN_TERM);
 
 static pour_ocp_t ocp;
 
@@ -108,10 +110,10 @@ bool pour_hal_power_on(void) { return pour_gpio_driven(power); }
 void pour_hal_estop_init(void) {
   ports_on();
   pour_gpio_output(led, false);
-  pour_gpio_input(estop, POUR_GPIO_PULL_DOWN);
+  pour_gpio_input(estop, POUR_GPIO_PULL_NONE); /* the board's 10 kΩ pull-up: open reads asserted */
 }
 
-bool pour_hal_estop_asserted(void) { return !pour_gpio_read(estop); }
+bool pour_hal_estop_asserted(void) { return pour_gpio_read(estop); }
 
 void pour_hal_watchdog_start(uint32_t timeout_ms) {
   volatile uint32_t *const iwdg = POUR_PERIPH(IWDG);
@@ -162,12 +164,12 @@ int pour_hal_can_receive(pour_can_frame_t *frame) { return pour_fdcan_receive(&f
 int pour_hal_can_transmit(const pour_can_frame_t *frame) { return pour_fdcan_transmit(&fdcan, frame); }
 
 /* The motor's power stage (hal_drive): the gates, the encoder and the converters' pins. */
-/* OPAMP inputs and outputs, the bus divider, the NTC: PA0..PA3, PA5..PA7, PB0..PB2, PB14. */
-static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R, 2u}, {GPIOA_R, 3u},
-                                          {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
-                                          {GPIOB_R, 1u}, {GPIOB_R, 2u}, {GPIOB_R, 14u}};
+/* OPAMP inputs and outputs, the bus divider, the NTC. */
+static const pour_gpio_t analog_pins[] = {BOARD_PIN(SHUNT_U), BOARD_PIN(SHUNT_U_M), BOARD_PIN(AMP_U), BOARD_PIN(SHUNT_V),
+                                          BOARD_PIN(SHUNT_V_M), BOARD_PIN(AMP_V),   BOARD_PIN(SHUNT_W), BOARD_PIN(SHUNT_W_M),
+                                          BOARD_PIN(AMP_W),   BOARD_PIN(VBUS),      BOARD_PIN(NTC)};
 #define ENCODER_FILTER 6u   /* f_DTS / 4, N = 6: 141 ns at 170 MHz */
-#define OPAMP_GAIN 0u /* the board's feedback network (opamp.h) */
+#define OPAMP_GAIN ((uint32_t)POUR_BOARD_PGA_GAIN) /* input/bias on VINM0 (opamp.h) */
 #define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
 
 

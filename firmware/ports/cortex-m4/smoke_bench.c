@@ -19,6 +19,8 @@
  * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
  * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
+
+#include "pour/board_facts.h"
 #include <stdlib.h>
 
 #include "board_drive.h"
@@ -47,7 +49,7 @@
 #define STATES_TO 170u
 #define PERIODS_PER_TICK 20u /* 20 kHz PWM under the 1 kHz loop */
 #define VBUS_MV 24000u
-#define NTC_MV 1055u /* 25 °C */
+#define NTC_MV ((uint32_t)POUR_BOARD_NTC_V0_MV) /* 25 °C */
 
 static uint32_t tick;
 static bool brake = true, power;
@@ -125,8 +127,8 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_t *drv = pour_board_drive_state();
   const pour_drive_output_t *o = pour_board_drive_output();
   const q15_t id = gates_on ? o->id_ref : 0, iq = gates_on ? o->iq_ref : 0; /* last period's references */
-  pour_ideal_phase_counts(drv, id, iq, motor_counts, drv->config.offset_nominal, s->phase);
-  s->vbus = pour_ideal_adc_counts(&drv->config, VBUS_MV * 1000u / drv->config.vbus_divider_milli);
+  pour_ideal_phase_counts(drv, id, iq, motor_counts, POUR_BOARD_OFFSET_NOMINAL_COUNTS, s->phase); /* the board's bias */
+  s->vbus = pour_ideal_adc_counts(&drv->config, VBUS_MV * 1000u / POUR_BOARD_VBUS_DIVIDER_MILLI);
   s->ntc = pour_ideal_adc_counts(&drv->config, NTC_MV);
   s->encoder = motor_counts;
   return true;
