@@ -21,6 +21,9 @@
 #include "poursim/poursim.h"
 
 extern "C" {
+#include "hal_watchdog.h"
+#include "iwdg.h"
+#include "stm32g431_regs.h"
 #include "board_drive.h"
 #include "brake_power_lines.h"
 #include "board_loop.h"
@@ -100,6 +103,18 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   s->ntc = pour_ideal_adc_counts(&c, 1055u + 15u * 227u / 10u); // 40 °C
   s->encoder = plant.tim4;
   return true;
+}
+
+// The IWDG as a register file, stretched as the board's flash hook does it (board_stm32g431.c): its shortest
+// timeout in force during the calibration's save, and after it.
+static uint32_t iwdg[4];
+static uint32_t timeout_at_save_us, timeout_after_us;
+static int timeouts_set;
+static void watchdog_stall(bool begin) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_iwdg_set(iwdg, begin ? POUR_WATCHDOG_FLASH_MS : POUR_WATCHDOG_TIMEOUT_MS, 10u));
+  const uint32_t shortest = pour_iwdg_timeout_us(iwdg[POUR_IWDG_PR], iwdg[POUR_IWDG_RLR], POUR_BOARD_LSI_MAX_HZ);
+  (begin ? timeout_at_save_us : timeout_after_us) = shortest;
+  timeouts_set++;
 }
 
 uint32_t pour_clock_crystal(void) { return 0u; } // the clock is no part of this plant: HSI16, as without a crystal
@@ -250,6 +265,7 @@ void tick(uint32_t ms, double ref) {
 
 void setUp(void) {
   flash_page_file_reset();
+  f.stall = watchdog_stall;
   loaded_status = POUR_CAL_EMPTY;
   plant_reset();
 }
@@ -336,6 +352,11 @@ static void test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot(
   }
   TEST_ASSERT_EQUAL_INT(2, (int)plant.results.size());
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, plant.results[1].status);
+  // the save ran with the watchdog armed for longer than the slowest page erase, at the fastest LSI, and
+  // went back to the loop's timeout after it
+  TEST_ASSERT_TRUE(timeouts_set >= 2);
+  TEST_ASSERT_TRUE(timeout_at_save_us > POUR_BOARD_FLASH_PAGE_ERASE_MAX_US);
+  TEST_ASSERT_UINT32_WITHIN(1000u, POUR_WATCHDOG_TIMEOUT_MS * 1000u, timeout_after_us);
   plant_reset(); // power cycled: the same flash page
   boot();
   TEST_ASSERT_EQUAL_INT8(POUR_OK, node.config.identity.init_status);

@@ -35,6 +35,7 @@
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
+#include "iwdg.h"
 #include "safe_outputs.h"
 #include "stm32g431_regs.h"
 
@@ -116,15 +117,14 @@ void pour_hal_estop_init(void) {
 bool pour_hal_estop_asserted(void) { return pour_gpio_read(estop); }
 
 void pour_hal_watchdog_start(uint32_t timeout_ms) {
-  volatile uint32_t *const iwdg = POUR_PERIPH(IWDG);
-  iwdg[POUR_IWDG_KR] = 0xCCCCu; /* start (LSI 32 kHz) */
-  iwdg[POUR_IWDG_KR] = 0x5555u; /* unlock PR and RLR */
-  iwdg[POUR_IWDG_PR] = POUR_VAL(IWDG, PR, PR, 0u); /* /4: 8 counts per ms */
-  iwdg[POUR_IWDG_RLR] = POUR_VAL(IWDG, RLR, RL, timeout_ms * 8u - 1u);
-  /* the new values reached the IWDG's clock domain */
-  (void)pour_regs_wait(&iwdg[POUR_IWDG_SR], POUR_MSK(IWDG, SR, PVU) | POUR_MSK(IWDG, SR, RVU) | POUR_MSK(IWDG, SR, WVU), 0u,
-                       WAIT_POLLS);
-  iwdg[POUR_IWDG_KR] = 0xAAAAu;
+  (void)pour_iwdg_set(POUR_PERIPH(IWDG), timeout_ms, WAIT_POLLS); /* values that never settle: the old ones hold */
+}
+
+void pour_hal_watchdog_set_timeout(uint32_t timeout_ms) { (void)pour_iwdg_set(POUR_PERIPH(IWDG), timeout_ms, WAIT_POLLS); }
+
+/* Around a flash page's erase and program: the watchdog outlasts the stall, then the loop's timeout again. */
+static void flash_stall(bool begin) {
+  pour_hal_watchdog_set_timeout(begin ? POUR_WATCHDOG_FLASH_MS : POUR_WATCHDOG_TIMEOUT_MS);
 }
 
 void pour_hal_watchdog_feed(void) { POUR_PERIPH(IWDG)[POUR_IWDG_KR] = 0xAAAAu; }
@@ -230,7 +230,7 @@ static pour_calibration_t calibration;
 static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
 
 static const pour_flash_t calibration_flash = {
-    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS};
+    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS, flash_stall};
 
 pour_status_t pour_hal_calibration_load(void) {
   calibration_status = pour_calibration_load(&calibration_flash, &calibration);

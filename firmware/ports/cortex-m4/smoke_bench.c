@@ -94,7 +94,7 @@ void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
 /* A page and the flash interface's registers in RAM (mps2-an386 has no flash controller). */
 static uint32_t flash_regs[POUR_FLASH_N_REGS], flash_page[POUR_FLASH_PAGE_BYTES / 4u];
 const pour_flash_t *pour_hal_calibration_flash(void) {
-  static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u};
+  static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u, NULL};
   return &f;
 }
 
