@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "adc_inj.h"
+#include "boot_check.h"
 #include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
@@ -84,6 +85,8 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
 }
 
 uint32_t pour_clock_crystal(void) { return crystal_hz; }
+
+pour_status_t pour_hal_boot_check(void) { return pour_boot_check_optr(POUR_PERIPH(FLASH)[POUR_FLASH_OPTR]); }
 
 static void ports_on(void) {
   clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, GPIOAEN) | POUR_MSK(RCC, AHB2ENR, GPIOBEN) |

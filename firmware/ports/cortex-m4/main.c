@@ -10,6 +10,7 @@
 #include <stdbool.h>
 
 #include "board_drive.h"
+#include "boot_check.h"
 #include "board_loop.h"
 #include "clock.h"
 #include "hal_brake.h"
@@ -87,6 +88,9 @@ PHASE bool start_up(pour_status_t *status_out) {
   pour_hal_timer_init(clock_hz);
 
   pour_status_t status = controller_init();
+  if (status == POUR_OK) {
+    status = pour_hal_boot_check(); /* option bytes that would boot the ROM bootloader: said, never run */
+  }
   if (status == POUR_OK) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
   }

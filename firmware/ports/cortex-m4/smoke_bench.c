@@ -20,6 +20,7 @@
  * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
 
+#include "boot_check.h"
 #include "pour/board_facts.h"
 #include <stdlib.h>
 
@@ -112,6 +113,7 @@ bool pour_hal_power_on(void) { return power; }
 void pour_hal_estop_init(void) {}
 bool pour_hal_estop_asserted(void) { return tick >= ESTOP_FROM && tick < ESTOP_TO; }
 void pour_hal_watchdog_start(uint32_t timeout_ms) { (void)timeout_ms; }
+pour_status_t pour_hal_boot_check(void) { return POUR_OK; } /* the bench has no option bytes */
 
 pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
   return clock_hz == MPS2_AN386_CLOCK_HZ && node_id == 0u ? POUR_OK : POUR_EINVAL;
