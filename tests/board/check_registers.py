@@ -47,6 +47,7 @@ class InputError(Exception):
 class Register:
     offset: int
     fields: dict[str, tuple[int, int]] = field(default_factory=dict)  # name -> (bit, width)
+    path: Path | None = None  # the file of its fields (and their enumerated values)
 
 
 @dataclass
@@ -113,11 +114,93 @@ def _parse_block(root: Path, module: str) -> dict[str, Register]:
             name, rtype = m.group(1), m.group(2)
             path = _field_file(root, module, rtype)
             fields = _parse_fields(path) if path else {}
-            regs.setdefault(name, Register(offset, fields))
+            regs.setdefault(name, Register(offset, fields, path))
             offset = None
     if not regs:
         raise InputError(f"{root / (module + '.rs')}: no register block found")
     return regs
+
+
+_READER_FN = r"^\s*pub fn {name}\(&self\) -> (\w+)_R\b"
+_READER_TYPE = r"^pub type {t}_R = crate::(?:Bit|Field)Reader<(\w+)>;"
+_READER_USE = r"^pub use (\w+)_R as {t}_R;"
+_VARIANT = re.compile(r"^\s*///(\d+): (.*)$")
+
+
+def field_meanings(path: Path, name: str) -> dict[int, str] | None:
+    """The enumerated values ST's description gives a field (value -> meaning), or None if it gives none."""
+    text = _read(path)
+    m = re.search(_READER_FN.format(name=re.escape(name)), text, re.M)
+    if not m:
+        return None
+    t = m.group(1)
+    for _ in range(4):
+        m = re.search(_READER_TYPE.format(t=re.escape(t)), text, re.M)
+        if m:
+            break
+        m = re.search(_READER_USE.format(t=re.escape(t)), text, re.M)
+        if not m:
+            return None
+        t = m.group(1)
+    else:
+        return None
+    enum = m.group(1)
+    start = text.find(f"pub enum {enum} {{")
+    if start < 0:
+        return None
+    meanings: dict[int, str] = {}
+    for line in text[start:].splitlines()[1:]:
+        if line.strip() == "}":
+            break
+        v = _VARIANT.match(line)
+        if v:
+            meanings[int(v.group(1))] = v.group(2).strip()
+    return meanings or None
+
+
+def load_intents(path: Path) -> dict[tuple[str, str, str], str]:
+    """(block, reg, field) -> the declared intent: a meaning from ST's enumerated values, "=N", or "status"."""
+    intents = {}
+    for n, line in enumerate(_read(path).splitlines(), 1):
+        if not line.strip() or line.startswith("#"):
+            continue
+        parts = [p.strip() for p in line.split("|")]
+        key = parts[0].split()
+        if len(parts) != 3 or len(key) != 3 or not parts[1] or len(parts[2]) < 5:
+            raise InputError(f"{path.name} line {n}: not 'BLOCK REG FIELD | intent | source': {line!r}")
+        intents[tuple(key)] = parts[1]
+    if not intents:
+        raise InputError(f"{path}: no intent")
+    return intents
+
+
+def compare_writes(crate: Crate, blocks_of: dict[str, list[str]], writes: list[tuple[str, str, str, int]],
+                   intents: dict[tuple[str, str, str], str]) -> list[str]:
+    """Each written field's value, decoded through ST's enumerated values, against the declared intent."""
+    problems = []
+    for block, reg, name, value in writes:
+        intent = intents.get((block, reg, name))
+        where = f"{block}.{reg}.{name} = {value}"
+        if intent is None:
+            problems.append(f"WRITE {where}: no declared intent")
+            continue
+        if intent == "status":
+            continue
+        modules = blocks_of.get(block, [])
+        theirs = crate.block(modules[0]).get(reg.lower()) if modules else None
+        meanings = field_meanings(theirs.path, name.lower()) if theirs and theirs.path else None
+        if intent.startswith("="):
+            if meanings is not None and value in meanings:
+                problems.append(f"WRITE {where}: ST names this value ({meanings[value]!r}): declare its meaning")
+            elif int(intent[1:], 0) != value:
+                problems.append(f"WRITE {where}: the intent is {intent[1:]}")
+        elif meanings is None:
+            problems.append(f"WRITE {where}: ST's description gives no meanings for this field: declare =N")
+        elif value not in meanings:
+            problems.append(f"WRITE {where}: no meaning in ST's description (intent {intent!r})")
+        elif meanings[value] != intent:
+            problems.append(f"WRITE {where} means {meanings[value]!r}, the intent is {intent!r}")
+    return problems
 
 
 def load_crate(crate_dir: Path) -> Crate:
@@ -178,11 +261,12 @@ def compare_pins(db: PinDatabase, pins: list[tuple[str, str, str, str, int]]) ->
     return problems
 
 
-def parse_table(text: str) -> tuple[dict, dict, list, list]:
+def parse_table(text: str) -> tuple[dict, dict, list, list, list]:
     periphs: dict[str, tuple[str, int]] = {}
     regs: dict[tuple[str, str], int] = {}
     fields: list[tuple[str, str, str, int, int]] = []
     pins: list[tuple[str, str, str, str, int]] = []
+    writes: list[tuple[str, str, str, int]] = []
     for n, line in enumerate(text.splitlines(), 1):
         parts = line.split()
         try:
@@ -192,22 +276,28 @@ def parse_table(text: str) -> tuple[dict, dict, list, list]:
                 regs[(parts[1], parts[2])] = int(parts[3], 0)
             elif parts[:1] == ["FIELD"] and len(parts) == 6:
                 fields.append((parts[1], parts[2], parts[3], int(parts[4], 0), int(parts[5], 0)))
+            elif parts[:1] == ["WRITE"] and len(parts) == 5:
+                writes.append((parts[1], parts[2], parts[3], int(parts[4], 0)))
             elif parts[:1] == ["PIN"] and len(parts) == 6:
                 pins.append((parts[1], parts[2], parts[3], parts[4], int(parts[5], 0)))
             elif parts:
                 raise ValueError
         except ValueError:
-            raise InputError(f"table line {n}: not PERIPH/REG/FIELD/PIN with numbers: {line!r}") from None
+            raise InputError(f"table line {n}: not PERIPH/REG/FIELD/PIN/WRITE with numbers: {line!r}") from None
     if not periphs:
         raise InputError("table: no PERIPH line")
-    return periphs, regs, fields, pins
+    return periphs, regs, fields, pins, writes
 
 
-def compare(crate: Crate, table: str, db: PinDatabase | None = None) -> tuple[list[str], int]:
-    """Mismatches (one line each) and the number of items checked (PIN lines against db, ST's pin database)."""
-    periphs, regs, fields, pins = parse_table(table)
+def compare(crate: Crate, table: str, db: PinDatabase | None = None,
+            intents: dict[tuple[str, str, str], str] | None = None) -> tuple[list[str], int]:
+    """Mismatches (one line each) and the number of items checked (PIN lines against db, ST's pin database;
+    WRITE lines against intents)."""
+    periphs, regs, fields, pins, writes = parse_table(table)
     if pins and db is None:
         raise InputError("table: PIN lines need ST's pin database (--metapac)")
+    if writes and intents is None:
+        raise InputError("table: WRITE lines need the declared intents (--intents)")
     problems: list[str] = []
     checked = 0
     blocks_of: dict[str, list[str]] = {}
@@ -249,6 +339,9 @@ def compare(crate: Crate, table: str, db: PinDatabase | None = None) -> tuple[li
     if pins:
         problems += compare_pins(db, pins)
         checked += len(pins)
+    if writes:
+        problems += compare_writes(crate, blocks_of, writes, intents)
+        checked += len(writes)
     return problems, checked
 
 
@@ -257,11 +350,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--crate", type=Path, required=True, help="the stm32g4 crate's directory (Cargo.toml there)")
     ap.add_argument("--table", type=Path, required=True, help="our table, as board_regtable prints it")
     ap.add_argument("--metapac", type=Path, help="the stm32-metapac crate's directory, for the PIN lines")
+    ap.add_argument("--intents", type=Path, help="the declared intent of each written field, for the WRITE lines")
     args = ap.parse_args(argv)
     try:
         crate = load_crate(args.crate)
         db = load_metapac(args.metapac) if args.metapac is not None else None
-        problems, checked = compare(crate, _read(args.table), db)
+        intents = load_intents(args.intents) if args.intents is not None else None
+        problems, checked = compare(crate, _read(args.table), db, intents)
     except InputError as e:
         print(f"check_registers: {e}", file=sys.stderr)
         return 2

@@ -58,8 +58,12 @@ def _with_metapac(metapac):
     METAPAC = metapac
 
 
-def run(crate: Path, table: Path, capsys, metapac: Path | None = None) -> tuple[int, str]:
-    status = check_registers.main(["--crate", str(crate), "--table", str(table), "--metapac", str(metapac or METAPAC)])
+INTENTS = HERE / "register_intents.txt"
+
+
+def run(crate: Path, table: Path, capsys, metapac: Path | None = None, intents: Path = INTENTS) -> tuple[int, str]:
+    status = check_registers.main(["--crate", str(crate), "--table", str(table), "--metapac", str(metapac or METAPAC),
+                                   "--intents", str(intents)])
     captured = capsys.readouterr()
     return status, captured.out + captured.err
 
@@ -91,6 +95,50 @@ def test_every_pin_the_port_uses_is_checked(table):
     board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board_stm32g431.c").read_text()
     used = set(re.findall(r"(?:BOARD_PIN|AF_PIN)\((\w+)\)", board_c)) - {"name"}
     assert used and used <= pins, used - pins
+
+
+def test_every_written_field_has_a_meaning_checked(table):
+    writes = [line for line in table.read_text().splitlines() if line.startswith("WRITE ")]
+    assert len(writes) >= 80
+    intents = check_registers.load_intents(INTENTS)
+    for w in writes:
+        assert tuple(w.split()[1:4]) in intents, w
+
+
+def test_a_wrong_mode_fails_by_its_meaning(crate, table, tmp_path, capsys):
+    """The op-amps as the port had them (VM_SEL VINM0: open loop), a PGA gain without the VINM0 bias, the
+    low sides on at a break: each decoded through ST's enumerated values and refused against the intent."""
+    text = table.read_text()
+    for good in ("WRITE OPAMP OPAMP1_CSR VM_SEL 2\n", "WRITE OPAMP OPAMP2_CSR PGA_GAIN 11\n", "WRITE TIM1 CR2 OIS2N 0\n"):
+        assert good in text, good
+    bad = tmp_path / "table.txt"
+    bad.write_text(text.replace("WRITE OPAMP OPAMP1_CSR VM_SEL 2\n", "WRITE OPAMP OPAMP1_CSR VM_SEL 0\n")
+                   .replace("WRITE OPAMP OPAMP2_CSR PGA_GAIN 11\n", "WRITE OPAMP OPAMP2_CSR PGA_GAIN 3\n")
+                   .replace("WRITE TIM1 CR2 OIS2N 0\n", "WRITE TIM1 CR2 OIS2N 1\n")
+                   .replace("WRITE TIM1 ARR ARR 4250\n", "WRITE TIM1 ARR ARR 4251\n")
+                   .replace("WRITE OPAMP OPAMP3_CSR PGA_GAIN 11\n", "WRITE OPAMP OPAMP3_CSR PGA_GAIN 7\n")
+                   + "WRITE TIM1 CR1 URS 1\n")
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert ("WRITE OPAMP.OPAMP1_CSR.VM_SEL = 0 means 'VINM0 connected to VINM input', the intent is "
+            "'Feedback resistor connected to VINM (PGA mode)'") in out
+    assert "WRITE OPAMP.OPAMP2_CSR.PGA_GAIN = 3 means 'Gain 16', the intent is 'Gain 16, input/bias connected" in out
+    assert "WRITE TIM1.CR2.OIS2N = 1 means 'OCxN=1 after a dead-time when MOE=0'" in out
+    assert "WRITE TIM1.ARR.ARR = 4251: the intent is 4250" in out
+    assert "WRITE OPAMP.OPAMP3_CSR.PGA_GAIN = 7: no meaning in ST's description" in out
+    assert "WRITE TIM1.CR1.URS = 1: no declared intent" in out
+
+
+def test_bad_intents_are_refused_with_a_reason(crate, table, tmp_path, capsys):
+    bad = tmp_path / "intents.txt"
+    bad.write_text("OPAMP OPAMP1_CSR VM_SEL | PGA\n")
+    status, out = run(crate, table, capsys, intents=bad)
+    assert status == 2 and "intents.txt line 1" in out
+    bad.write_text("# nothing\n")
+    status, out = run(crate, table, capsys, intents=bad)
+    assert status == 2 and "no intent" in out
+    status, out = run(crate, table, capsys, intents=tmp_path / "nowhere.txt")
+    assert status == 2 and "cannot read" in out
 
 
 def test_wrong_alternate_function_in_our_table_fails(crate, table, tmp_path, capsys):
