@@ -15,6 +15,8 @@ const char *pour_status_name(pour_status_t status) {
       return "POUR_ECORRUPT";
     case POUR_ECALIBRATION:
       return "POUR_ECALIBRATION";
+    case POUR_EBOOT:
+      return "POUR_EBOOT";
     case POUR_EPARAMS:
       return "POUR_EPARAMS";
   }

@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
+extern "C" {
+#include "pour/board_facts.h"
+}
+
 namespace poursim {
 
 MotorParams motor_params(const pour_drive_config_t &fw, const poursim_config_t &c) {
@@ -18,11 +22,14 @@ MotorParams motor_params(const pour_drive_config_t &fw, const poursim_config_t &
   p.deadtime_s = fw.deadtime_ns * 1e-9;
   p.supply_v = c.supply_voltage;
   p.bus_c = c.bus_capacitance;
-  p.shunt = fw.shunt_uohm * 1e-6;
-  p.amp_gain = fw.amp_gain_milli * 1e-3;
-  p.adc_vref = fw.adc_vref_mv * 1e-3;
-  p.adc_bias = fw.offset_nominal;
-  p.vbus_divider = fw.vbus_divider_milli * 1e-3;
+  // The board's analog chain as ST built it (pour/board_facts.h), not as the firmware believes it: a firmware
+  // whose offset, sign or divider disagrees with the board sees it here as it would on the bench. The sign
+  // rides on the gain: the amplifier's output falls as current flows into the motor.
+  p.shunt = POUR_BOARD_SHUNT_UOHM * 1e-6;
+  p.amp_gain = POUR_BOARD_CURRENT_SIGN * POUR_BOARD_INPUT_NETWORK_MILLI * 1e-3 * POUR_BOARD_PGA_GAIN;
+  p.adc_vref = POUR_BOARD_ADC_VREF_MV * 1e-3;
+  p.adc_bias = POUR_BOARD_BIAS_MV * 4096.0 / POUR_BOARD_ADC_VREF_MV;
+  p.vbus_divider = static_cast<double>(POUR_BOARD_VBUS_R_TOP_OHM + POUR_BOARD_VBUS_R_BOTTOM_OHM) / POUR_BOARD_VBUS_R_BOTTOM_OHM;
   p.encoder_cpr = static_cast<int>(fw.encoder_cpr);
   return p;
 }

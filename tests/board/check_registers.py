@@ -9,10 +9,12 @@ comments of the field readers and writers). Our side is the table that board_reg
 from the drivers' X-macro tables: lines "PERIPH <instance> <block> <base>", "REG <block> <reg> <offset>",
 "FIELD <block> <reg> <field> <bit> <width>".
 
-The board's alternate-function pins ("AF <owner> <signal> <pin> <af>", from board_af.h) are checked against
-the pin maps of the stm32g4xx-hal crate (--hal; generated from ST's STM32CubeMX database): the timers'
-channels in src/pwm.rs ("pins!" blocks: "TIM1: CH1(...): [gpio::PA8<AF6>, ...]") and FDCAN's in
-src/can.rs ("mod fdcan1 { ... tx: [PB9<AF9>, ...] rx: [...] }").
+Every pin the board uses ("PIN <name> <pin> <owner> <signal> <af>", from pour/board_facts.h; af -1: no
+alternate function) is checked against ST's pin database as the stm32-metapac crate carries it (--metapac;
+embassy's stm32-data, generated from ST's CubeMX files): src/chips/stm32g431cb/metadata.rs includes a shared
+metadata_NNNN.rs whose peripherals list "PeripheralPin { pin, signal, af }" rows and whose PINS list the
+package's pins. A GPIO pin must exist on the package; any other must be the named peripheral's signal on that
+pin with that alternate function (None for analog signals).
 
 Exit status 0 when every register and field we use matches, 1 with one line per mismatch, 2 on bad input.
 """
@@ -45,6 +47,7 @@ class InputError(Exception):
 class Register:
     offset: int
     fields: dict[str, tuple[int, int]] = field(default_factory=dict)  # name -> (bit, width)
+    path: Path | None = None  # the file of its fields (and their enumerated values)
 
 
 @dataclass
@@ -111,11 +114,93 @@ def _parse_block(root: Path, module: str) -> dict[str, Register]:
             name, rtype = m.group(1), m.group(2)
             path = _field_file(root, module, rtype)
             fields = _parse_fields(path) if path else {}
-            regs.setdefault(name, Register(offset, fields))
+            regs.setdefault(name, Register(offset, fields, path))
             offset = None
     if not regs:
         raise InputError(f"{root / (module + '.rs')}: no register block found")
     return regs
+
+
+_READER_FN = r"^\s*pub fn {name}\(&self\) -> (\w+)_R\b"
+_READER_TYPE = r"^pub type {t}_R = crate::(?:Bit|Field)Reader<(\w+)>;"
+_READER_USE = r"^pub use (\w+)_R as {t}_R;"
+_VARIANT = re.compile(r"^\s*///(\d+): (.*)$")
+
+
+def field_meanings(path: Path, name: str) -> dict[int, str] | None:
+    """The enumerated values ST's description gives a field (value -> meaning), or None if it gives none."""
+    text = _read(path)
+    m = re.search(_READER_FN.format(name=re.escape(name)), text, re.M)
+    if not m:
+        return None
+    t = m.group(1)
+    for _ in range(4):
+        m = re.search(_READER_TYPE.format(t=re.escape(t)), text, re.M)
+        if m:
+            break
+        m = re.search(_READER_USE.format(t=re.escape(t)), text, re.M)
+        if not m:
+            return None
+        t = m.group(1)
+    else:
+        return None
+    enum = m.group(1)
+    start = text.find(f"pub enum {enum} {{")
+    if start < 0:
+        return None
+    meanings: dict[int, str] = {}
+    for line in text[start:].splitlines()[1:]:
+        if line.strip() == "}":
+            break
+        v = _VARIANT.match(line)
+        if v:
+            meanings[int(v.group(1))] = v.group(2).strip()
+    return meanings or None
+
+
+def load_intents(path: Path) -> dict[tuple[str, str, str], str]:
+    """(block, reg, field) -> the declared intent: a meaning from ST's enumerated values, "=N", or "status"."""
+    intents = {}
+    for n, line in enumerate(_read(path).splitlines(), 1):
+        if not line.strip() or line.startswith("#"):
+            continue
+        parts = [p.strip() for p in line.split("|")]
+        key = parts[0].split()
+        if len(parts) != 3 or len(key) != 3 or not parts[1] or len(parts[2]) < 5:
+            raise InputError(f"{path.name} line {n}: not 'BLOCK REG FIELD | intent | source': {line!r}")
+        intents[tuple(key)] = parts[1]
+    if not intents:
+        raise InputError(f"{path}: no intent")
+    return intents
+
+
+def compare_writes(crate: Crate, blocks_of: dict[str, list[str]], writes: list[tuple[str, str, str, int]],
+                   intents: dict[tuple[str, str, str], str]) -> list[str]:
+    """Each written field's value, decoded through ST's enumerated values, against the declared intent."""
+    problems = []
+    for block, reg, name, value in writes:
+        intent = intents.get((block, reg, name))
+        where = f"{block}.{reg}.{name} = {value}"
+        if intent is None:
+            problems.append(f"WRITE {where}: no declared intent")
+            continue
+        if intent == "status":
+            continue
+        modules = blocks_of.get(block, [])
+        theirs = crate.block(modules[0]).get(reg.lower()) if modules else None
+        meanings = field_meanings(theirs.path, name.lower()) if theirs and theirs.path else None
+        if intent.startswith("="):
+            if meanings is not None and value in meanings:
+                problems.append(f"WRITE {where}: ST names this value ({meanings[value]!r}): declare its meaning")
+            elif int(intent[1:], 0) != value:
+                problems.append(f"WRITE {where}: the intent is {intent[1:]}")
+        elif meanings is None:
+            problems.append(f"WRITE {where}: ST's description gives no meanings for this field: declare =N")
+        elif value not in meanings:
+            problems.append(f"WRITE {where}: no meaning in ST's description (intent {intent!r})")
+        elif meanings[value] != intent:
+            problems.append(f"WRITE {where} means {meanings[value]!r}, the intent is {intent!r}")
+    return problems
 
 
 def load_crate(crate_dir: Path) -> Crate:
@@ -128,65 +213,60 @@ def load_crate(crate_dir: Path) -> Crate:
     return Crate(bases, root)
 
 
-_HAL_TIMER = re.compile(r"^\s*(TIM\d+):\s*$")
-_HAL_SIGNAL = re.compile(r"^\s*(CH\dN?|BRK2?)(?:\(\w+\))?:\s*\[")
-_HAL_PIN = re.compile(r"(P[A-G]\d+)<AF(\d+)>")
-_HAL_CAN_MOD = re.compile(r"^\s*mod (fdcan\d)\s*\{")
-_HAL_CAN_DIR = re.compile(r"^\s*(tx|rx):\s*\[")
+_METAPAC_INCLUDE = re.compile(r'include!\("\.\./(metadata_\d+\.rs)"\)')
+_METAPAC_PERIPH = re.compile(r'Peripheral \{\s*name: "(\w+)",(.*?)\n    \},\n', re.S)
+_METAPAC_PIN = re.compile(r'PeripheralPin \{\s*pin: "(\w+)",\s*signal: "(\w+)",\s*af: (?:None|Some\((\d+)\)),')
+_METAPAC_PACKAGE_PIN = re.compile(r'Pin \{ name: "(\w+)" \}')
 
 
-def load_hal_af(hal_dir: Path) -> dict[tuple[str, str, str], set[int]]:
-    """(owner, signal, pin) -> the alternate functions the HAL's pin maps give it."""
-    amap: dict[tuple[str, str, str], set[int]] = {}
-    owner = signal = None
-    for line in _read(hal_dir / "src" / "pwm.rs").splitlines():
-        m = _HAL_TIMER.match(line)
-        if m:
-            owner, signal = m.group(1), None
-            continue
-        m = _HAL_SIGNAL.match(line)
-        if m and owner:
-            signal = m.group(1)
-        if owner and signal:
-            for pin, af in _HAL_PIN.findall(line):
-                amap.setdefault((owner, signal, pin), set()).add(int(af))
-        if line.strip().startswith("]"):
-            signal = None
-    owner = signal = None
-    for line in _read(hal_dir / "src" / "can.rs").splitlines():
-        m = _HAL_CAN_MOD.match(line)
-        if m:
-            owner, signal = m.group(1).upper(), None
-            continue
-        m = _HAL_CAN_DIR.match(line)
-        if m and owner:
-            signal = m.group(1).upper()
-        if owner and signal:
-            for pin, af in _HAL_PIN.findall(line):
-                amap.setdefault((owner, signal, pin), set()).add(int(af))
-        if line.strip().startswith("]"):
-            signal = None
-    if not any(k[0].startswith("TIM") for k in amap) or not any(k[0].startswith("FDCAN") for k in amap):
-        raise InputError(f"{hal_dir}: no timer or FDCAN pin map found in src/pwm.rs, src/can.rs")
-    return amap
+@dataclass
+class PinDatabase:
+    chip_pins: set[str]
+    signals: dict[tuple[str, str, str], int | None]  # (peripheral, signal, pin) -> af (None: analog)
 
 
-def compare_af(amap: dict[tuple[str, str, str], set[int]], afs: list[tuple[str, str, str, int]]) -> list[str]:
+def load_metapac(crate_dir: Path, chip: str = "stm32g431cb") -> PinDatabase:
+    chips = crate_dir / "src" / "chips"
+    m = _METAPAC_INCLUDE.search(_read(chips / chip / "metadata.rs"))
+    if not m:
+        raise InputError(f"{chips / chip / 'metadata.rs'}: no included metadata file")
+    text = _read(chips / m.group(1))
+    signals: dict[tuple[str, str, str], int | None] = {}
+    for pm in _METAPAC_PERIPH.finditer(text):
+        for pin, signal, af in _METAPAC_PIN.findall(pm.group(2)):
+            signals[(pm.group(1), signal, pin)] = int(af) if af else None
+    start = text.find("static PINS")
+    chip_pins = set(_METAPAC_PACKAGE_PIN.findall(text[start:])) if start >= 0 else set()
+    if not signals or not chip_pins:
+        raise InputError(f"{chips / m.group(1)}: no peripheral pins or no package pins found")
+    return PinDatabase(chip_pins, signals)
+
+
+def compare_pins(db: PinDatabase, pins: list[tuple[str, str, str, str, int]]) -> list[str]:
     problems = []
-    for owner, signal, pin, af in afs:
-        theirs = amap.get((owner, signal, pin))
-        if theirs is None:
-            problems.append(f"AF {owner}.{signal} on {pin}: the HAL has no such pin for it")
-        elif af not in theirs:
-            problems.append(f"AF {owner}.{signal} on {pin}: AF{af}, the HAL's AF{'/AF'.join(map(str, sorted(theirs)))}")
+    for name, pin, owner, signal, af in pins:
+        if pin not in db.chip_pins:
+            problems.append(f"PIN {name}: {pin} is not a pin of the STM32G431CB's package")
+        elif owner == "GPIO":
+            continue
+        elif (owner, signal, pin) not in db.signals:
+            problems.append(f"PIN {name}: {owner} has no {signal} on {pin} in ST's pin database")
+        else:
+            theirs = db.signals[(owner, signal, pin)]
+            ours = None if af < 0 else af
+            if theirs != ours:
+                want = "none" if theirs is None else f"AF{theirs}"
+                got = "none" if ours is None else f"AF{ours}"
+                problems.append(f"PIN {name}: {owner}.{signal} on {pin} with {got}, ST's {want}")
     return problems
 
 
-def parse_table(text: str) -> tuple[dict, dict, list, list]:
+def parse_table(text: str) -> tuple[dict, dict, list, list, list]:
     periphs: dict[str, tuple[str, int]] = {}
     regs: dict[tuple[str, str], int] = {}
     fields: list[tuple[str, str, str, int, int]] = []
-    afs: list[tuple[str, str, str, int]] = []
+    pins: list[tuple[str, str, str, str, int]] = []
+    writes: list[tuple[str, str, str, int]] = []
     for n, line in enumerate(text.splitlines(), 1):
         parts = line.split()
         try:
@@ -196,22 +276,28 @@ def parse_table(text: str) -> tuple[dict, dict, list, list]:
                 regs[(parts[1], parts[2])] = int(parts[3], 0)
             elif parts[:1] == ["FIELD"] and len(parts) == 6:
                 fields.append((parts[1], parts[2], parts[3], int(parts[4], 0), int(parts[5], 0)))
-            elif parts[:1] == ["AF"] and len(parts) == 5:
-                afs.append((parts[1], parts[2], parts[3], int(parts[4], 0)))
+            elif parts[:1] == ["WRITE"] and len(parts) == 5:
+                writes.append((parts[1], parts[2], parts[3], int(parts[4], 0)))
+            elif parts[:1] == ["PIN"] and len(parts) == 6:
+                pins.append((parts[1], parts[2], parts[3], parts[4], int(parts[5], 0)))
             elif parts:
                 raise ValueError
         except ValueError:
-            raise InputError(f"table line {n}: not PERIPH/REG/FIELD/AF with numbers: {line!r}") from None
+            raise InputError(f"table line {n}: not PERIPH/REG/FIELD/PIN/WRITE with numbers: {line!r}") from None
     if not periphs:
         raise InputError("table: no PERIPH line")
-    return periphs, regs, fields, afs
+    return periphs, regs, fields, pins, writes
 
 
-def compare(crate: Crate, table: str, amap: dict | None = None) -> tuple[list[str], int]:
-    """Mismatches (one line each) and the number of items checked (AF lines against amap, the HAL's pins)."""
-    periphs, regs, fields, afs = parse_table(table)
-    if afs and amap is None:
-        raise InputError("table: AF lines need the HAL's pin maps (--hal)")
+def compare(crate: Crate, table: str, db: PinDatabase | None = None,
+            intents: dict[tuple[str, str, str], str] | None = None) -> tuple[list[str], int]:
+    """Mismatches (one line each) and the number of items checked (PIN lines against db, ST's pin database;
+    WRITE lines against intents)."""
+    periphs, regs, fields, pins, writes = parse_table(table)
+    if pins and db is None:
+        raise InputError("table: PIN lines need ST's pin database (--metapac)")
+    if writes and intents is None:
+        raise InputError("table: WRITE lines need the declared intents (--intents)")
     problems: list[str] = []
     checked = 0
     blocks_of: dict[str, list[str]] = {}
@@ -250,9 +336,12 @@ def compare(crate: Crate, table: str, amap: dict | None = None) -> tuple[list[st
                     f"{block}.{reg}.{name}: bits {bit}+{width}, ST's {got[0]}+{got[1]} ({module}.{reg.lower()})")
     for block in sorted({b for b, _ in regs} - set(blocks_of)):
         problems.append(f"{block}: registers listed but no PERIPH uses the block")
-    if afs:
-        problems += compare_af(amap, afs)
-        checked += len(afs)
+    if pins:
+        problems += compare_pins(db, pins)
+        checked += len(pins)
+    if writes:
+        problems += compare_writes(crate, blocks_of, writes, intents)
+        checked += len(writes)
     return problems, checked
 
 
@@ -260,12 +349,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--crate", type=Path, required=True, help="the stm32g4 crate's directory (Cargo.toml there)")
     ap.add_argument("--table", type=Path, required=True, help="our table, as board_regtable prints it")
-    ap.add_argument("--hal", type=Path, help="the stm32g4xx-hal crate's directory, for the AF lines")
+    ap.add_argument("--metapac", type=Path, help="the stm32-metapac crate's directory, for the PIN lines")
+    ap.add_argument("--intents", type=Path, help="the declared intent of each written field, for the WRITE lines")
     args = ap.parse_args(argv)
     try:
         crate = load_crate(args.crate)
-        amap = load_hal_af(args.hal) if args.hal is not None else None
-        problems, checked = compare(crate, _read(args.table), amap)
+        db = load_metapac(args.metapac) if args.metapac is not None else None
+        intents = load_intents(args.intents) if args.intents is not None else None
+        problems, checked = compare(crate, _read(args.table), db, intents)
     except InputError as e:
         print(f"check_registers: {e}", file=sys.stderr)
         return 2

@@ -20,6 +20,7 @@ static void flash_page_file_reset(void) {
   f.page = page;
   f.page_number = POUR_FLASH_CAL_PAGE;
   f.busy_polls = 10u;
+  f.stall = NULL;
 }
 
 #endif /* POUR_FLASH_PAGE_FILE_H */

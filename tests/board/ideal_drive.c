@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 #include "ideal_drive.h"
 
+#include "pour/board_facts.h"
 #include "pour/foc.h"
 
 #define HALF_SQRT3_Q15 28378
@@ -15,8 +16,8 @@ void pour_ideal_phase_counts(const pour_drive_t *drv, q15_t id, q15_t iq, uint16
   const int32_t b_part = (int32_t)(((int64_t)beta * HALF_SQRT3_Q15 + (1 << 14)) >> 15);
   const int32_t i[3] = {alpha, -alpha / 2 + b_part, -alpha / 2 - b_part};
   for (int k = 0; k < 3; ++k) {
-    /* the inverse of pour_current_sense_convert: count = bias + i / gain, rounded */
-    const int64_t num = (int64_t)i[k] * 65536;
+    /* the board's amplifier (pour/board_facts.h): count = bias + sign x i / gain, rounded */
+    const int64_t num = (int64_t)i[k] * 65536 * POUR_BOARD_CURRENT_SIGN;
     const int64_t g = drv->sense.config.gain_q16;
     const int64_t n = bias + (num >= 0 ? (num + g / 2) / g : (num - g / 2) / g);
     counts[k] = (uint16_t)(n < 0 ? 0 : (n > 4095 ? 4095 : n));

@@ -11,7 +11,8 @@
 #include "pour/drive.h"
 
 /* The three shunt amplifiers' ADC counts of the currents id, iq (per-unit Q15) at the electrical angle of
- * encoder count `encoder`, around the bias `bias` [counts], as drv's configuration converts them. */
+ * encoder count `encoder`, around the bias `bias` [counts], through drv's gain with the board's sign
+ * (pour/board_facts.h: the count falls as current flows into the motor). */
 void pour_ideal_phase_counts(const pour_drive_t *drv, q15_t id, q15_t iq, uint16_t encoder, uint16_t bias,
                              uint16_t counts[3]);
 

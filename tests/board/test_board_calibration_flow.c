@@ -63,7 +63,7 @@ static void tick(pour_mode_t mode) {
   for (uint8_t k = 0; k < n; ++k) {
     if (n_sent < 4 && pour_can_unpack_calibration_result(&tx[k], &sent[n_sent]) == POUR_CAN_RX_OK) ++n_sent;
   }
-  const pour_drive_sample_t s = {{2048, 2048, 2048}, 1554, 0};
+  const pour_drive_sample_t s = {{2553, 2553, 2553}, 2867, 0}; /* the board's bias; 24 V */
   pour_drive_output_t o;
   for (int p = 0; p < 20; ++p) {
     pour_drive_isr(&drv, &s, &o);

@@ -21,6 +21,9 @@
 #include "poursim/poursim.h"
 
 extern "C" {
+#include "hal_watchdog.h"
+#include "iwdg.h"
+#include "stm32g431_regs.h"
 #include "board_drive.h"
 #include "brake_power_lines.h"
 #include "board_loop.h"
@@ -72,6 +75,8 @@ struct Plant {
   // largest |θ| [rad]
   long unpowered_released = 0;
   double theta_max = 0.0;
+  int model_count = 0; // the model's last encoder count (modulo its cpr)
+  uint16_t tim4 = 0;   // TIM4's 16-bit count
 } plant;
 
 bool drive_powers() {
@@ -92,9 +97,27 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_config_t &c = pour_board_drive_state()->config;
   for (int k = 0; k < 3; ++k) s->phase[k] = plant.sample.adc_phase[k];
   s->vbus = plant.sample.adc_vbus;
+  // TIM4 counts 16 bits (encoder_tim4.c: ARR 0xFFFF); the model's count wraps at the encoder's cpr: the
+  // timer's count follows the model's steps, taken the short way round
+  const int cpr = static_cast<int>(c.encoder_cpr);
+  const int step = ((static_cast<int>(plant.sample.encoder) - plant.model_count) % cpr + cpr + cpr / 2) % cpr - cpr / 2;
+  plant.model_count = plant.sample.encoder;
+  plant.tim4 = static_cast<uint16_t>(plant.tim4 + step);
   s->ntc = pour_ideal_adc_counts(&c, 1055u + 15u * 227u / 10u); // 40 °C
-  s->encoder = plant.sample.encoder;
+  s->encoder = plant.tim4;
   return true;
+}
+
+// The IWDG as a register file, stretched as the board's flash hook does it (board_stm32g431.c): its shortest
+// timeout in force during the calibration's save, and after it.
+static uint32_t iwdg[4];
+static uint32_t timeout_at_save_us, timeout_after_us;
+static int timeouts_set;
+static void watchdog_stall(bool begin) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_iwdg_set(iwdg, begin ? POUR_WATCHDOG_FLASH_MS : POUR_WATCHDOG_TIMEOUT_MS, 10u));
+  const uint32_t shortest = pour_iwdg_timeout_us(iwdg[POUR_IWDG_PR], iwdg[POUR_IWDG_RLR], POUR_BOARD_LSI_MAX_HZ);
+  (begin ? timeout_at_save_us : timeout_after_us) = shortest;
+  timeouts_set++;
 }
 
 uint32_t pour_clock_crystal(void) { return 0u; } // the clock is no part of this plant: HSI16, as without a crystal
@@ -145,7 +168,7 @@ const pour_flash_t *pour_hal_calibration_flash(void) { return &f; }
 // The parameters' page: a second erased page and register file in memory.
 static uint32_t params_regs[POUR_FLASH_N_REGS];
 static uint32_t params_page[POUR_FLASH_PAGE_BYTES / 4];
-static const pour_flash_t params_flash = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u};
+static pour_flash_t params_flash = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u, nullptr};
 const pour_flash_t *pour_hal_params_flash(void) { return &params_flash; }
 int pour_hal_calibration_reason(void) { return (int)loaded_status; }
 }
@@ -179,6 +202,7 @@ void plant_reset() {
   plant.params = poursim::motor_params(pour_drive_default_config(), poursim_default_config());
   plant.model.reset(plant.params, 7, poursim::MotorFault::None);
   plant.sample = plant.model.sample();
+  plant.model_count = plant.tim4 = plant.sample.encoder;
   plant.rx.clear();
   plant.results.clear();
   plant.gates = Gates::Off;
@@ -252,6 +276,8 @@ void tick(uint32_t ms, double ref) {
 
 void setUp(void) {
   flash_page_file_reset();
+  f.stall = watchdog_stall;
+  params_flash.stall = watchdog_stall;
   std::memset(params_regs, 0, sizeof params_regs);
   std::memset(params_page, 0xFF, sizeof params_page);
   plant.replies.clear();
@@ -341,6 +367,11 @@ static void test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot(
   }
   TEST_ASSERT_EQUAL_INT(2, (int)plant.results.size());
   TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, plant.results[1].status);
+  // the save ran with the watchdog armed for longer than the slowest page erase, at the fastest LSI, and
+  // went back to the loop's timeout after it
+  TEST_ASSERT_TRUE(timeouts_set >= 2);
+  TEST_ASSERT_TRUE(timeout_at_save_us > POUR_BOARD_FLASH_PAGE_ERASE_MAX_US);
+  TEST_ASSERT_UINT32_WITHIN(1000u, POUR_WATCHDOG_TIMEOUT_MS * 1000u, timeout_after_us);
   plant_reset(); // power cycled: the same flash page
   boot();
   TEST_ASSERT_EQUAL_INT8(POUR_OK, node.config.identity.init_status);
@@ -445,8 +476,11 @@ static void test_board_params_AWriteASaveAndTheNextBootKeepIt(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
   TEST_ASSERT_EQUAL_INT32(1500000, echo);
   TEST_ASSERT_EQUAL_INT32(1500000, ctl.config.safety.omega_max_urad_s);
+  timeouts_set = 0;
   a = param_request(POUR_CAN_CMD_PARAM_SAVE, 0, 0, 6, &echo);
   TEST_ASSERT_EQUAL_UINT8(POUR_PARAM_OK, a.result);
+  TEST_ASSERT_EQUAL_INT(2, timeouts_set); /* the watchdog stretched around the erase, and back */
+  TEST_ASSERT_TRUE(timeout_at_save_us > timeout_after_us);
   pour_params_t back;
   pour_params_default(&back, &ctl.config, 0u);
   back.control.safety.omega_max_urad_s = 0;

@@ -58,7 +58,7 @@ static void convert(uint16_t u, uint16_t v, uint16_t w, uint16_t count) {
   adc1[POUR_ADC_JDR1] = u;
   adc2[POUR_ADC_JDR1] = v;
   adc1[POUR_ADC_JDR2] = w;
-  adc1[POUR_ADC_JDR3] = 1554u; /* 24 V through the 19.17 divider */
+  adc1[POUR_ADC_JDR3] = 2867u; /* 24 V through the board's 10.389 divider */
   adc1[POUR_ADC_JDR4] = 1309u; /* 25 °C */
   tim4[POUR_TIM4_CNT] = count;
   adc1[POUR_ADC_ISR] = JEOC_JEOS;
@@ -76,7 +76,7 @@ static void isr_acknowledged(void) {
 
 static void calibrate(void) {
   for (int k = 0; k < POUR_CURRENT_SENSE_CAL_SAMPLES; ++k) {
-    convert(2048u, 2050u, 2046u, 0u);
+    convert(2553u, 2555u, 2551u, 0u);
     isr_acknowledged();
     TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCER]); /* the gates off while the offsets are measured */
   }
@@ -93,10 +93,10 @@ static void test_drive_isr_WithoutTheEndOfSequenceNothingIsRead(void) {
 
 static void test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares(void) {
   calibrate();
-  const uint16_t offsets[3] = {2048u, 2050u, 2046u};
+  const uint16_t offsets[3] = {2553u, 2555u, 2551u};
   TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, pour_board_drive_state()->sense.offset, 3);
   /* At zero current and no reference the bridge runs at half duty: each compare mid-period. */
-  convert(2048u, 2050u, 2046u, 100u);
+  convert(2553u, 2555u, 2551u, 100u);
   isr_acknowledged();
   const pour_drive_output_t *o = pour_board_drive_output();
   TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]);
@@ -107,7 +107,7 @@ static void test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares(void) {
   TEST_ASSERT_EQUAL_UINT16(100u, pour_board_drive_state()->last_encoder); /* TIM4's count reached the loop */
   /* U 200 counts above its offset, V and W sharing the return: the loop answers, its compares follow. */
   for (int n = 0; n < 5; ++n) {
-    convert(2248u, 1950u, 1946u, 100u);
+    convert(2753u, 2455u, 2451u, 100u);
     isr_acknowledged();
   }
   TEST_ASSERT_TRUE(o->id != 0 || o->iq != 0);
@@ -119,7 +119,7 @@ static void test_drive_isr_ReadsTheDataRegistersAndWritesTheCompares(void) {
 
 static void test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares(void) {
   calibrate();
-  convert(4095u, 2050u, 0u, 0u); /* beyond the 45 A software limit on U and W */
+  convert(4095u, 2555u, 0u, 0u); /* beyond the 45 A software limit on U and W */
   tim1[POUR_TIM1_EGR] = 0u;
   isr_acknowledged();
   TEST_ASSERT_BITS_HIGH(POUR_DRIVE_FAULT_OVERCURRENT, pour_board_drive_state()->faults);
@@ -128,7 +128,7 @@ static void test_drive_isr_ATrippedLoopShortsThePhasesThroughTheCompares(void) {
   TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR3]);
   TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* the low sides on, all period */
   TEST_ASSERT_EQUAL_HEX32(1u, tim1[POUR_TIM1_EGR]);           /* now, not at the next update */
-  convert(2048u, 2050u, 2046u, 0u); /* the current gone: still shorted, latched */
+  convert(2553u, 2555u, 2551u, 0u); /* the current gone: still shorted, latched */
   isr_acknowledged();
   TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, pour_board_drive_state()->state);
@@ -162,14 +162,14 @@ static void board_tick(bool clear) {
   pour_board_drive_tick(&ctl, &in, &out);
 }
 
-/* ms milliseconds of 20 periods, phase U's amplifier at u counts (2048: its nominal bias), a tick after each
+/* ms milliseconds of 20 periods, phase U's amplifier at u counts (2553: the board's bias), a tick after each
  * with a ClearErrors at the first if asked; counts the periods with the gates on while the drive measured
  * its offsets, and the ticks with the brake released. */
 static int gates_on_measuring, released;
 static void run_ms(int ms, uint16_t u, bool clear_first) {
   for (int t = 0; t < ms; ++t) {
     for (int k = 0; k < 20; ++k) {
-      convert(u, 2050u, 2046u, 0u);
+      convert(u, 2555u, 2551u, 0u);
       isr_acknowledged();
       const bool measuring = pour_board_drive_state()->state == POUR_DRIVE_CALIBRATING;
       gates_on_measuring += measuring && tim1[POUR_TIM1_CCER] != 0u ? 1 : 0;
@@ -179,31 +179,31 @@ static void run_ms(int ms, uint16_t u, bool clear_first) {
   }
 }
 
-/* A broken amplifier at start-up (U 400 counts off its bias, beyond the 160 accepted): CURRENT_OFFSET, the
+/* A broken amplifier at start-up (U 400 counts off its bias, beyond the 100 accepted): CURRENT_OFFSET, the
  * phases shorted. A ClearErrors measures the offsets again with the gates off and the brake engaged. */
 static void broken_amplifier_cleared(void) {
   const pour_control_config_t cc = pour_control_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
   gates_on_measuring = released = 0;
-  run_ms(20, 2448u, false);
+  run_ms(20, 2953u, false);
   const pour_drive_t *drv = pour_board_drive_state();
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv->state);
   TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, pour_board_drive_faults());
   TEST_ASSERT_EQUAL_HEX32(CCER_BRIDGE, tim1[POUR_TIM1_CCER]); /* shorted */
   TEST_ASSERT_EQUAL_HEX32(0u, tim1[POUR_TIM1_CCR1]);
   TEST_ASSERT_EQUAL_INT(0, armed);
-  run_ms(1, 2448u, true); /* the board hands the clear to the drive before the core's step, in the same tick */
+  run_ms(1, 2953u, true); /* the board hands the clear to the drive before the core's step, in the same tick */
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_CALIBRATING, drv->state);
   TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, drv->faults); /* latched until they pass */
 }
 
 static void test_drive_isr_AClearMeasuresTheOffsetsAgainAndClearsThemInRange(void) {
   broken_amplifier_cleared();
-  run_ms(20, 2048u, false); /* the amplifier reads its bias again: 256 periods, 12.8 ms */
+  run_ms(20, 2553u, false); /* the amplifier reads its bias again: 256 periods, 12.8 ms */
   const pour_drive_t *drv = pour_board_drive_state();
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_RUN, drv->state);
   TEST_ASSERT_EQUAL_HEX16(0u, pour_board_drive_faults());
-  const uint16_t offsets[3] = {2048u, 2050u, 2046u};
+  const uint16_t offsets[3] = {2553u, 2555u, 2551u};
   TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, drv->sense.offset, 3);
   TEST_ASSERT_EQUAL_INT(1, armed); /* the cut armed on the new offsets */
   TEST_ASSERT_EQUAL_UINT16_ARRAY(offsets, armed_on, 3);
@@ -214,7 +214,7 @@ static void test_drive_isr_AClearMeasuresTheOffsetsAgainAndClearsThemInRange(voi
 
 static void test_drive_isr_AClearWithTheAmplifierStillBrokenKeepsItLatched(void) {
   broken_amplifier_cleared();
-  run_ms(20, 2448u, false);
+  run_ms(20, 2953u, false);
   const pour_drive_t *drv = pour_board_drive_state();
   TEST_ASSERT_EQUAL_INT(POUR_DRIVE_FAULTED, drv->state);
   TEST_ASSERT_EQUAL_HEX16(POUR_DRIVE_FAULT_CURRENT_OFFSET, pour_board_drive_faults());

@@ -26,6 +26,7 @@
 #include "brake_power_lines.h"
 #include "hal_drive.h"
 #include "ideal_drive.h"
+#include "pour/board_facts.h"
 #include "pour/control.h"
 #include "unity.h"
 
@@ -81,9 +82,10 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_output_t *o = pour_board_drive_output();
   const bool on = gates() == GATES_ON;
   pour_ideal_phase_counts(pour_board_drive_state(), on ? o->id_ref : 0, on ? o->iq_ref : 0, motor_count(),
-                          drive_config.offset_nominal, s->phase);
-  s->vbus = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(plant.vbus_v * 1e6 / drive_config.vbus_divider_milli));
-  s->ntc = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(1055.0 + (plant.temp_c - 25.0) * 22.7));
+                          POUR_BOARD_OFFSET_NOMINAL_COUNTS, s->phase); /* the board's chain, not the firmware's idea */
+  s->vbus = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(plant.vbus_v * 1e6 / POUR_BOARD_VBUS_DIVIDER_MILLI));
+  s->ntc = pour_ideal_adc_counts(&drive_config, (uint32_t)lround(POUR_BOARD_NTC_V0_MV + (plant.temp_c - 25.0) *
+                                                                                  POUR_BOARD_NTC_DV_DT_UV_PER_C * 1e-3));
   s->encoder = motor_count();
   return true;
 }

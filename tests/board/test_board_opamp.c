@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* OPAMP1..3 as PGAs against a register file: the gain codes, PGA mode, high speed, output on the pin. */
+/* OPAMP1..3 as PGAs against a register file: the gain codes with the input/bias on VINM0, PGA mode, high
+ * speed, output on the pin; the board's gain from pour/board_facts.h. */
 #include <string.h>
 
 #include "opamp.h"
+#include "pour/board_facts.h"
 #include "unity.h"
 
 static uint32_t regs[POUR_OPAMP_N_REGS];
@@ -13,19 +15,24 @@ void tearDown(void) {}
 
 static void test_opamp_init_SetsAllThreeAsPgasOfTheGain(void) {
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, 16u));
-  const uint32_t want = 1u | (2u << 5) | (1u << 7) | (3u << 14); /* OPAEN, VM_SEL PGA, OPAHSM, gain 16 */
+  /* OPAEN, VM_SEL PGA, OPAHSM, PGA_GAIN 0b01011: gain 16, input/bias on VINM0 (RM0440) */
+  const uint32_t want = 1u | (2u << 5) | (1u << 7) | (11u << 14);
   TEST_ASSERT_EQUAL_HEX32(want, regs[POUR_OPAMP_OPAMP1_CSR]);
   TEST_ASSERT_EQUAL_HEX32(want, regs[POUR_OPAMP_OPAMP2_CSR]);
   TEST_ASSERT_EQUAL_HEX32(want, regs[POUR_OPAMP_OPAMP3_CSR]);
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, 2u));
-  TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_OPAMP_OPAMP1_CSR] & (0x1Fu << 14));
+  TEST_ASSERT_EQUAL_HEX32(8u << 14, regs[POUR_OPAMP_OPAMP1_CSR] & (0x1Fu << 14));
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, 64u));
-  TEST_ASSERT_EQUAL_HEX32(5u << 14, regs[POUR_OPAMP_OPAMP3_CSR] & (0x1Fu << 14));
+  TEST_ASSERT_EQUAL_HEX32(13u << 14, regs[POUR_OPAMP_OPAMP3_CSR] & (0x1Fu << 14));
 }
 
-static void test_opamp_init_GainZeroUsesTheBoardsNetwork(void) {
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, 0u));
-  TEST_ASSERT_EQUAL_HEX32(1u | (1u << 7), regs[POUR_OPAMP_OPAMP2_CSR]); /* OPAEN, VM_SEL VINM0, OPAHSM */
+/* The old open loop (VM_SEL VINM0 with no feedback network on the board: the ADC reads a rail) is refused. */
+static void test_opamp_init_NeverLeavesTheAmplifierOpenLoop(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_opamp_init(regs, 0u));
+  TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_OPAMP_OPAMP2_CSR]);
+  TEST_ASSERT_EQUAL_INT(16, POUR_BOARD_PGA_GAIN);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_opamp_init(regs, POUR_BOARD_PGA_GAIN));
+  TEST_ASSERT_EQUAL_HEX32(2u, (regs[POUR_OPAMP_OPAMP2_CSR] >> 5) & 3u); /* VM_SEL: PGA */
 }
 
 static void test_opamp_init_RefusesAGainItCannotSet(void) {
@@ -39,7 +46,7 @@ static void test_opamp_init_RefusesAGainItCannotSet(void) {
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_opamp_init_SetsAllThreeAsPgasOfTheGain);
-  RUN_TEST(test_opamp_init_GainZeroUsesTheBoardsNetwork);
+  RUN_TEST(test_opamp_init_NeverLeavesTheAmplifierOpenLoop);
   RUN_TEST(test_opamp_init_RefusesAGainItCannotSet);
   return UNITY_END();
 }

@@ -35,12 +35,12 @@ static void test_pwm_init_IsCentreAlignedComplementaryWithTheTriggerAtTheTop(voi
   /* PWM mode 1 with preload on CH1..CH4 */
   TEST_ASSERT_EQUAL_HEX32((6u << 4) | (1u << 3) | (6u << 12) | (1u << 11), regs[POUR_TIM1_CCMR1_OUTPUT]);
   TEST_ASSERT_EQUAL_HEX32((6u << 4) | (1u << 3) | (6u << 12) | (1u << 11), regs[POUR_TIM1_CCMR2_OUTPUT]);
-  /* TRGO2 = OC4REF; idle levels: low sides on */
-  TEST_ASSERT_EQUAL_HEX32((7u << 20) | (1u << 9) | (1u << 11) | (1u << 13), regs[POUR_TIM1_CR2]);
+  /* TRGO2 = OC4REF; idle levels: all six off (OISx = OISxN = 0, ST's for this board) */
+  TEST_ASSERT_EQUAL_HEX32(7u << 20, regs[POUR_TIM1_CR2]);
   TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_TIM1_CCER]); /* all six off */
   TEST_ASSERT_EQUAL_HEX32((1u << 1) | (1u << 2) | (1u << 4), regs[POUR_TIM1_AF1]); /* COMP1, 2, 4 */
-  /* DTG 800 ns = 136 clocks = (64 + 4) x 2, OSSI, OSSR, BKE, BKP, no AOE, MOE, BKF 2 */
-  TEST_ASSERT_EQUAL_HEX32((0x80u | 4u) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 13) | (1u << 15) | (2u << 16),
+  /* DTG 800 ns = 136 clocks = (64 + 4) x 2, OSSI, OSSR, BKE, BKP, no AOE, MOE, BKF 6 (141 ns) */
+  TEST_ASSERT_EQUAL_HEX32((0x80u | 4u) | (1u << 10) | (1u << 11) | (1u << 12) | (1u << 13) | (1u << 15) | (6u << 16),
                           regs[POUR_TIM1_BDTR]);
   TEST_ASSERT_FALSE(pour_pwm_enabled(&pwm));
 }
@@ -76,7 +76,7 @@ static void test_pwm_enable_SwitchesTheBridgeChannels(void) {
   TEST_ASSERT_FALSE(pour_pwm_enabled(&pwm));
 }
 
-static void test_pwm_break_LeavesThePhasesShortedUntilCleared(void) {
+static void test_pwm_break_LeavesTheBridgeOffUntilCleared(void) {
   const uint16_t c[3] = {2000u, 2000u, 2000u};
   pour_pwm_set_compares(&pwm, c);
   pour_pwm_enable(&pwm, true);
@@ -110,7 +110,7 @@ int main(void) {
   RUN_TEST(test_pwm_init_RefusesBadConfig);
   RUN_TEST(test_pwm_set_compares_ClampsToThePeriod);
   RUN_TEST(test_pwm_enable_SwitchesTheBridgeChannels);
-  RUN_TEST(test_pwm_break_LeavesThePhasesShortedUntilCleared);
+  RUN_TEST(test_pwm_break_LeavesTheBridgeOffUntilCleared);
   RUN_TEST(test_pwm_short_low_sides_ZeroesTheComparesNow);
   return UNITY_END();
 }

@@ -9,6 +9,7 @@
 
 #include <stdint.h>
 
+#include "pour/board_facts.h"
 #include "pour/drive.h"
 
 #define POUR_DRIVE_SCRIPT_PERIODS 1000u
@@ -36,7 +37,7 @@ static inline int pour_drive_script_run(pour_drive_golden_t out[POUR_DRIVE_SCRIP
   pour_drive_output_t o;
   for (int n = 0; n < POUR_CURRENT_SENSE_CAL_SAMPLES; ++n) {
     const uint16_t noise = (uint16_t)(pour_drive_script_rng(&rng) % 5u);
-    const pour_drive_sample_t s = {{(uint16_t)(2046u + noise), 2049u, (uint16_t)(2050u - noise)}, 1554u, 0u};
+    const pour_drive_sample_t s = {{(uint16_t)(2551u + noise), 2554u, (uint16_t)(2555u - noise)}, 2867u, 0u}; /* the board's bias; 24 V */
     pour_drive_isr(&drv, &s, &o);
   }
   if (drv.state != POUR_DRIVE_RUN) return -1;
@@ -48,10 +49,10 @@ static inline int pour_drive_script_run(pour_drive_golden_t out[POUR_DRIVE_SCRIP
     const int32_t ia = (int32_t)(pour_drive_script_rng(&rng) % 201u) - 100;
     const int32_t ib = (int32_t)(pour_drive_script_rng(&rng) % 201u) - 100;
     pour_drive_sample_t s;
-    s.adc_phase[0] = (uint16_t)(2048 + ia);
-    s.adc_phase[1] = (uint16_t)(2048 + ib);
-    s.adc_phase[2] = (uint16_t)(2048 - ia - ib);
-    s.adc_vbus = (uint16_t)(1522u + pour_drive_script_rng(&rng) % 123u);
+    s.adc_phase[0] = (uint16_t)(POUR_BOARD_OFFSET_NOMINAL_COUNTS + ia); /* around the board's bias */
+    s.adc_phase[1] = (uint16_t)(POUR_BOARD_OFFSET_NOMINAL_COUNTS + ib);
+    s.adc_phase[2] = (uint16_t)(POUR_BOARD_OFFSET_NOMINAL_COUNTS - ia - ib);
+    s.adc_vbus = (uint16_t)(2808u + pour_drive_script_rng(&rng) % 227u); /* 23.4 .. 25.3 V through 10.389 */
     s.encoder = (uint16_t)(pour_drive_script_rng(&rng) & 4095u);
     pour_drive_isr(&drv, &s, &o);
     for (int p = 0; p < 3; ++p) out[k].compare[p] = o.compare[p];

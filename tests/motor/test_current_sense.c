@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: MIT */
+#include "pour/board_facts.h"
 #include "pour/current_sense.h"
 #include "unity.h"
 
@@ -37,10 +38,12 @@ static void test_current_sense_ConvertsThroughGainAndOffset(void) {
   const uint16_t adc[3] = {2048 + 100, 2048, 2048 - 2048};
   q15_t i[3];
   pour_current_sense_convert(&cs, adc, i);
-  /* 100 counts · 986000/65536 = 1504.5 LSB (2.94 A) */
-  TEST_ASSERT_EQUAL_INT16(1505, i[0]);
+  /* 100 counts · 986000/65536 = 1504.5 LSB (2.94 A), of the board's sign: a count above the offset is current
+   * out of the motor (pour/board_facts.h) */
+  TEST_ASSERT_EQUAL_INT(-1, POUR_BOARD_CURRENT_SIGN);
+  TEST_ASSERT_EQUAL_INT16(-1505, i[0]);
   TEST_ASSERT_EQUAL_INT16(0, i[1]);
-  TEST_ASSERT_EQUAL_INT16(-30812, i[2]);
+  TEST_ASSERT_EQUAL_INT16(30813, i[2]); /* +30812.5, rounded up */
 }
 
 static void test_current_sense_SaturatesInsteadOfWrapping(void) {
@@ -50,8 +53,8 @@ static void test_current_sense_SaturatesInsteadOfWrapping(void) {
   const uint16_t adc[3] = {4095, 0, 2048};
   q15_t i[3];
   pour_current_sense_convert(&cs, adc, i);
-  TEST_ASSERT_EQUAL_INT16(32767, i[0]);
-  TEST_ASSERT_EQUAL_INT16(-32768, i[1]);
+  TEST_ASSERT_EQUAL_INT16(-32768, i[0]);
+  TEST_ASSERT_EQUAL_INT16(32767, i[1]);
 }
 
 static void test_current_sense_InitRefusesBadConfig(void) {

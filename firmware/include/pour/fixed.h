@@ -20,7 +20,8 @@ typedef enum {
   POUR_EFORMAT = -3, /* weights with an unsupported Q format or format version */
   POUR_ECORRUPT = -4,    /* weights whose content hash does not match */
   POUR_ECALIBRATION = -5, /* no valid drive calibration (none stored, corrupt, an older format, out of range) */
-  POUR_EPARAMS = -6       /* stored parameters corrupt, of another layout, out of range, or refused by the core */
+  POUR_EBOOT = -6,        /* the option bytes would boot the ROM bootloader (B-G431B-ESC1: nSWBOOT0, nBOOT0) */
+  POUR_EPARAMS = -7       /* stored parameters corrupt, of another layout, out of range, or refused by the core */
 } pour_status_t;
 
 /* Name of a status value, for logs and error messages. */

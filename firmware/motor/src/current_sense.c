@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "pour/board_facts.h"
+
 #define ADC_MAX 4095
 
 pour_status_t pour_current_sense_init(pour_current_sense_t *cs, const pour_current_sense_config_t *config) {
@@ -31,8 +33,10 @@ int pour_current_sense_calibrate(pour_current_sense_t *cs, const uint16_t adc[3]
 
 void pour_current_sense_convert(const pour_current_sense_t *cs, const uint16_t adc[3], q15_t i[3]) {
   for (int k = 0; k < 3; ++k) {
-    /* |count| < 2^16 and gain < 2^31: |x| < 2^47, so x >> 16 fits int32 before the Q15 saturation */
-    const int64_t x = (int64_t)((int32_t)adc[k] - (int32_t)cs->offset[k]) * cs->config.gain_q16;
+    /* The board's amplifier falls as current flows into the motor (POUR_BOARD_CURRENT_SIGN). |count| < 2^16 and
+     * gain < 2^31: |x| < 2^47, so x >> 16 fits int32 before the Q15 saturation. */
+    const int32_t counts = (int32_t)adc[k] - (int32_t)cs->offset[k];
+    const int64_t x = (int64_t)(POUR_BOARD_CURRENT_SIGN < 0 ? -counts : counts) * cs->config.gain_q16;
     i[k] = pour_sat_q15((int32_t)((x + (1 << 15)) >> 16));
   }
 }

@@ -4,6 +4,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "pour/board_facts.h"
+
 #define I_BASE POUR_DRIVE_I_BASE_MA
 #define V_BASE POUR_DRIVE_V_BASE_MV
 #define VMAX_OF_BUS_Q15 17784 /* 0.94/√3: the min–max range less the dead-time and duty-ceiling margins */
@@ -16,7 +18,7 @@ pour_drive_config_t pour_drive_default_config(void) {
   memset(&c, 0, sizeof c);
   c.pwm_hz = 20000;
   c.timer_clock_hz = 170000000;
-  c.deadtime_ns = 800;
+  c.deadtime_ns = POUR_BOARD_DEADTIME_NS;
   /* maxon EC 45 flat 70 W, 24 V (docs/motor.md): a star winding's phase is half the terminal values */
   c.r_phase_uohm = 286500; /* half the 0.573 Ω terminal resistance (phase to phase) */
   c.ld_nh = 150500;        /* half the 0.301 mH terminal inductance (iron-core, surface magnets: Ld = Lq) */
@@ -36,12 +38,12 @@ pour_drive_config_t pour_drive_default_config(void) {
   c.regen_full_mv = 25000;
   c.flux_brake_ma = 20000;
   c.regen_enabled = 1;
-  c.shunt_uohm = 3000;
-  c.amp_gain_milli = 9140;
-  c.adc_vref_mv = 3300;
-  c.offset_nominal = 2048;
-  c.offset_tolerance = 160;
-  c.vbus_divider_milli = 19170;
+  c.shunt_uohm = POUR_BOARD_SHUNT_UOHM; /* the analog chain: pour/board_facts.h */
+  c.amp_gain_milli = POUR_BOARD_AMP_GAIN_MILLI;
+  c.adc_vref_mv = POUR_BOARD_ADC_VREF_MV;
+  c.offset_nominal = POUR_BOARD_OFFSET_NOMINAL_COUNTS;
+  c.offset_tolerance = POUR_BOARD_OFFSET_TOLERANCE_COUNTS;
+  c.vbus_divider_milli = POUR_BOARD_VBUS_DIVIDER_MILLI;
   c.encoder_cpr = 4096;
   c.encoder_offset = 0;
   c.phase_sum_ma = 4000;

@@ -3,6 +3,8 @@
 
 #include <stddef.h>
 
+#include "pour/board_facts.h"
+
 #include "hal_brake.h"
 #include "hal_drive.h"
 
@@ -12,9 +14,9 @@ pour_guard_config_t pour_guard_default_config(void) {
   pour_guard_config_t c;
   c.adc_vref_mv = 3300u;
   c.vbus_divider_milli = 19170u;
-  c.ntc_mv_at_t0 = 1055;
+  c.ntc_mv_at_t0 = POUR_BOARD_NTC_V0_MV; /* pour/board_facts.h: which of ST's two profiles, and why */
   c.ntc_t0_mdegc = 25000;
-  c.ntc_uv_per_degc = 22700;
+  c.ntc_uv_per_degc = POUR_BOARD_NTC_DV_DT_UV_PER_C;
   c.encoder_cpr = 4096u;
   c.gear_ratio = 20u;
   return c;

@@ -1,21 +1,21 @@
 /* SPDX-License-Identifier: MIT */
-/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring, and which pin was checked against what): core
- * clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent watchdog, the LED, and
- * FDCAN1 behind hal_can. Registers and fields from stm32g431_regs.h's table (checked against ST's
- * description of the chip by tests/board/check_registers.py).
- *   PA15  e-stop input (the board's PWM-input pad): a normally-closed chain from 3.3 V holds it high;
- *         pull-down, so an open contact or a broken wire reads low = asserted
- *   PB12  brake release (the potentiometer pad), high = released; an external pull-down keeps the brake
- *         engaged through reset and while the MCU is unpowered
- *   PB8   power stage enable (J8's index pin, unused: the output encoder gives the absolute angle), high =
- *         on; external pull-down (it also holds BOOT0 low: boot from flash)
- *   PA11, PB9  FDCAN1 RX, TX (board_af.h); PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
+/* The ST B-G431B-ESC1 board (docs/bringup.md: the wiring and each pin's reason; pour/board_facts.h: every pin
+ * and its source): core clock (crystal, PLL, 170 MHz), the brake, power and e-stop lines, the independent
+ * watchdog, the option bytes' boot check, the LED, and FDCAN1 behind hal_can. Registers and fields from
+ * stm32g431_regs.h's table (checked against ST's description of the chip by tests/board/check_registers.py).
+ *   PB8   e-stop input (J8's Z, the board's 10 kΩ pull-up to 3.3 V, BOOT0): a normally-closed contact to ground
+ *         holds it low; an open contact or a broken wire reads high = asserted
+ *   PB3   brake release (the ST-LINK VCP's pad), high = released; an external 10 kΩ pull-down keeps the brake
+ *         engaged through reset, flashing (SWD leaves PB3 alone) and the ROM bootloader (which never drives it)
+ *   PA15  power stage enable (the PWM-input pad), high = on; an external 4.7 kΩ pull-down holds it under 0.52 V
+ *         against the JTDI pull-up the chip applies from reset until this firmware configures it
+ *   PA11, PB9  FDCAN1 RX, TX; PC11 transceiver shutdown, low = on; PC14 bus termination, high = on
  *   PC6   LED (red), high = on */
 #include <stddef.h>
 
 #include "adc_inj.h"
-#include "board_af.h"
 #include "board_params.h"
+#include "boot_check.h"
 #include "calibration_store.h"
 #include "clock.h"
 #include "encoder_tim4.h"
@@ -26,6 +26,7 @@
 #include "ocp.h"
 #include "opamp.h"
 #include "params_store.h"
+#include "pour/board_facts.h"
 #include "pwm_tim1.h"
 #include "hal_brake.h"
 #include "hal_calibration.h"
@@ -37,33 +38,36 @@
 #include "hal_motor.h"
 #include "hal_power.h"
 #include "hal_watchdog.h"
+#include "iwdg.h"
 #include "safe_outputs.h"
 #include "stm32g431_regs.h"
 
 #define RCC_R POUR_PERIPH(RCC)
-#define GPIOA_R POUR_PERIPH(GPIOA)
-#define GPIOB_R POUR_PERIPH(GPIOB)
-#define GPIOC_R POUR_PERIPH(GPIOC)
 #define CAN_TERMINATED true /* this node ends the bench's bus (the rig's sensor node is the other end) */
 #define WAIT_POLLS 100000u /* bound of every ready-flag wait: a flag that never comes is an error */
 
-static const pour_gpio_t estop = {GPIOA_R, 15u};
-static const pour_gpio_t brake = {GPIOB_R, 12u};
-static const pour_gpio_t power = {GPIOB_R, 8u};
-static const pour_gpio_t led = {GPIOC_R, 6u};
+/* A pin of pour/board_facts.h's table by its name: its port's registers (GPIOA + 0x400 per port) and number. */
+#define BOARD_PIN(name)                                                                                      \
+  {(volatile uint32_t *)(uintptr_t)(POUR_GPIOA_BASE + 0x400u * (uint32_t)POUR_BOARD_PIN_##name##_PORT),          \
+   (uint8_t)POUR_BOARD_PIN_##name##_PIN}
+static const pour_gpio_t estop = BOARD_PIN(ESTOP);
+static const pour_gpio_t brake = BOARD_PIN(BRAKE);
+static const pour_gpio_t power = BOARD_PIN(POWER);
+static const pour_gpio_t led = BOARD_PIN(LED);
 
-/* A pin and its alternate function, from board_af.h's table. */
+/* A pin and its alternate function, both from the table. */
 typedef struct {
   pour_gpio_t pin;
   uint8_t af;
 } af_pin_t;
-#define AF_PIN(owner, signal, port, pin, af) {{GPIO##port##_R, pin##u}, af##u},
-static const af_pin_t can_pins[] = {POUR_BOARD_AF_CAN(AF_PIN)};
-static const af_pin_t gates[] = {POUR_BOARD_AF_GATES(AF_PIN)};
-static const af_pin_t encoder_pins[] = {POUR_BOARD_AF_ENCODER(AF_PIN)};
+#define AF_PIN(name) {BOARD_PIN(name), (uint8_t)POUR_BOARD_PIN_##name##_AF}
+static const af_pin_t can_pins[] = {AF_PIN(CAN_RX), AF_PIN(CAN_TX)};
+static const af_pin_t gates[] = {AF_PIN(PWM_UH), AF_PIN(PWM_VH), AF_PIN(PWM_WH),
+                                 AF_PIN(PWM_UL), AF_PIN(PWM_VL), AF_PIN(PWM_WL)};
+static const af_pin_t encoder_pins[] = {AF_PIN(ENC_A), AF_PIN(ENC_B)};
 #define COUNT(a) (sizeof(a) / sizeof((a)[0]))
-static const pour_gpio_t can_shutdown = {GPIOC_R, 11u};
-static const pour_gpio_t can_termination = {GPIOC_R, 14u};
+static const pour_gpio_t can_shutdown = BOARD_PIN(CAN_SHDN);
+static const pour_gpio_t can_termination = BOARD_PIN(CAN_TERM);
 
 static pour_ocp_t ocp;
 
@@ -83,6 +87,8 @@ pour_status_t pour_clock_init(uint32_t *core_clock_hz) {
 }
 
 uint32_t pour_clock_crystal(void) { return crystal_hz; }
+
+pour_status_t pour_hal_boot_check(void) { return pour_boot_check_optr(POUR_PERIPH(FLASH)[POUR_FLASH_OPTR]); }
 
 static void ports_on(void) {
   clock_on(POUR_RCC_AHB2ENR, POUR_MSK(RCC, AHB2ENR, GPIOAEN) | POUR_MSK(RCC, AHB2ENR, GPIOBEN) |
@@ -110,21 +116,20 @@ bool pour_hal_power_on(void) { return pour_gpio_driven(power); }
 void pour_hal_estop_init(void) {
   ports_on();
   pour_gpio_output(led, false);
-  pour_gpio_input(estop, POUR_GPIO_PULL_DOWN);
+  pour_gpio_input(estop, POUR_GPIO_PULL_NONE); /* the board's 10 kΩ pull-up: open reads asserted */
 }
 
-bool pour_hal_estop_asserted(void) { return !pour_gpio_read(estop); }
+bool pour_hal_estop_asserted(void) { return pour_gpio_read(estop); }
 
 void pour_hal_watchdog_start(uint32_t timeout_ms) {
-  volatile uint32_t *const iwdg = POUR_PERIPH(IWDG);
-  iwdg[POUR_IWDG_KR] = 0xCCCCu; /* start (LSI 32 kHz) */
-  iwdg[POUR_IWDG_KR] = 0x5555u; /* unlock PR and RLR */
-  iwdg[POUR_IWDG_PR] = POUR_VAL(IWDG, PR, PR, 0u); /* /4: 8 counts per ms */
-  iwdg[POUR_IWDG_RLR] = POUR_VAL(IWDG, RLR, RL, timeout_ms * 8u - 1u);
-  /* the new values reached the IWDG's clock domain */
-  (void)pour_regs_wait(&iwdg[POUR_IWDG_SR], POUR_MSK(IWDG, SR, PVU) | POUR_MSK(IWDG, SR, RVU) | POUR_MSK(IWDG, SR, WVU), 0u,
-                       WAIT_POLLS);
-  iwdg[POUR_IWDG_KR] = 0xAAAAu;
+  (void)pour_iwdg_set(POUR_PERIPH(IWDG), timeout_ms, WAIT_POLLS); /* values that never settle: the old ones hold */
+}
+
+void pour_hal_watchdog_set_timeout(uint32_t timeout_ms) { (void)pour_iwdg_set(POUR_PERIPH(IWDG), timeout_ms, WAIT_POLLS); }
+
+/* Around a flash page's erase and program: the watchdog outlasts the stall, then the loop's timeout again. */
+static void flash_stall(bool begin) {
+  pour_hal_watchdog_set_timeout(begin ? POUR_WATCHDOG_FLASH_MS : POUR_WATCHDOG_TIMEOUT_MS);
 }
 
 void pour_hal_watchdog_feed(void) { POUR_PERIPH(IWDG)[POUR_IWDG_KR] = 0xAAAAu; }
@@ -164,12 +169,12 @@ int pour_hal_can_receive(pour_can_frame_t *frame) { return pour_fdcan_receive(&f
 int pour_hal_can_transmit(const pour_can_frame_t *frame) { return pour_fdcan_transmit(&fdcan, frame); }
 
 /* The motor's power stage (hal_drive): the gates, the encoder and the converters' pins. */
-/* OPAMP inputs and outputs, the bus divider, the NTC: PA0..PA3, PA5..PA7, PB0..PB2, PB14. */
-static const pour_gpio_t analog_pins[] = {{GPIOA_R, 0u}, {GPIOA_R, 1u}, {GPIOA_R, 2u}, {GPIOA_R, 3u},
-                                          {GPIOA_R, 5u}, {GPIOA_R, 6u}, {GPIOA_R, 7u}, {GPIOB_R, 0u},
-                                          {GPIOB_R, 1u}, {GPIOB_R, 2u}, {GPIOB_R, 14u}};
+/* OPAMP inputs and outputs, the bus divider, the NTC. */
+static const pour_gpio_t analog_pins[] = {BOARD_PIN(SHUNT_U), BOARD_PIN(SHUNT_U_M), BOARD_PIN(AMP_U), BOARD_PIN(SHUNT_V),
+                                          BOARD_PIN(SHUNT_V_M), BOARD_PIN(AMP_V),   BOARD_PIN(SHUNT_W), BOARD_PIN(SHUNT_W_M),
+                                          BOARD_PIN(AMP_W),   BOARD_PIN(VBUS),      BOARD_PIN(NTC)};
 #define ENCODER_FILTER 6u   /* f_DTS / 4, N = 6: 141 ns at 170 MHz */
-#define OPAMP_GAIN 0u /* the board's feedback network (opamp.h) */
+#define OPAMP_GAIN ((uint32_t)POUR_BOARD_PGA_GAIN) /* input/bias on VINM0 (opamp.h) */
 #define ADC_REGULATOR_WAIT 4000u /* >= 20 µs at 170 MHz (>= 4 cycles a pass) */
 
 
@@ -230,7 +235,7 @@ static pour_calibration_t calibration;
 static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
 
 static const pour_flash_t calibration_flash = {
-    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS};
+    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS, flash_stall};
 
 pour_status_t pour_hal_calibration_load(void) {
   calibration_status = pour_calibration_load(&calibration_flash, &calibration);
@@ -247,8 +252,8 @@ pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
 const pour_flash_t *pour_hal_calibration_flash(void) { return &calibration_flash; }
 
 /* The parameters: the page before the calibration's (params_store.h). */
-static const pour_flash_t params_flash = {
-    POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_PARAMS_ADDR, POUR_FLASH_PARAMS_PAGE, WAIT_POLLS};
+static const pour_flash_t params_flash = {POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_PARAMS_ADDR,
+                                          POUR_FLASH_PARAMS_PAGE, WAIT_POLLS, flash_stall};
 
 const pour_flash_t *pour_hal_params_flash(void) { return &params_flash; }
 

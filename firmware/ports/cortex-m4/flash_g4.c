@@ -67,6 +67,9 @@ int pour_flash_write_page(const pour_flash_t *f, const uint32_t *words, uint32_t
       words == NULL || n_words % 2u != 0u || n_words > POUR_FLASH_PAGE_BYTES / 4u) {
     return POUR_FLASH_BAD_ARGS;
   }
+  if (f->stall != NULL) {
+    f->stall(true);
+  }
   int result = begin(f);
   if (result == 0) {
     result = erase(f);
@@ -74,13 +77,14 @@ int pour_flash_write_page(const pour_flash_t *f, const uint32_t *words, uint32_t
   if (result == 0) {
     result = program(f, words, n_words);
   }
-  if (lock(f, result) != 0) {
-    return POUR_FLASH_FAILED;
-  }
-  for (uint32_t i = 0; i < n_words; ++i) {
+  result = lock(f, result) != 0 ? POUR_FLASH_FAILED : POUR_FLASH_OK;
+  for (uint32_t i = 0; i < n_words && result == POUR_FLASH_OK; ++i) {
     if (f->page[i] != words[i]) {
-      return POUR_FLASH_FAILED;
+      result = POUR_FLASH_FAILED;
     }
   }
-  return POUR_FLASH_OK;
+  if (f->stall != NULL) {
+    f->stall(false);
+  }
+  return result;
 }

@@ -6,6 +6,7 @@
 #ifndef POUR_FLASH_G4_H
 #define POUR_FLASH_G4_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "regs.h"
@@ -39,6 +40,9 @@ typedef struct {
   volatile uint32_t *page;   /* the page's first word (erase and program target) */
   uint32_t page_number;      /* PNB of that page */
   uint32_t busy_polls;       /* bound of each wait for BSY, > 0 */
+  /* Called with true before the erase and false after the read-back, or NULL: the single-bank G431 stalls
+   * every fetch for up to 24.5 ms of erase, so the board stretches its watchdog across it (hal_watchdog.h). */
+  void (*stall)(bool begin);
 } pour_flash_t;
 
 /* Results of an erase or a program. */
@@ -47,7 +51,7 @@ typedef struct {
 #define POUR_FLASH_BAD_ARGS (-2)
 
 /* Replaces the page's content: unlock, erase (checked blank), program n_words (even: double words, at
- * most a page) from words, lock, read back. */
+ * most a page) from words, lock, read back; f->stall (if any) around it all. */
 int pour_flash_write_page(const pour_flash_t *f, const uint32_t *words, uint32_t n_words);
 
 #endif /* POUR_FLASH_G4_H */

@@ -10,6 +10,7 @@
 #include <stdbool.h>
 
 #include "board_drive.h"
+#include "boot_check.h"
 #include "board_loop.h"
 #include "board_params.h"
 #include "clock.h"
@@ -27,7 +28,6 @@
 #include "pour/control.h"
 #include "pour/weights_compiled.h"
 
-#define WATCHDOG_TIMEOUT_MS 10u /* ten missed ticks: the loop is gone, reset (brake engaged meanwhile) */
 
 static pour_control_t controller;
 static pour_can_node_t can_node;
@@ -85,10 +85,13 @@ PHASE bool start_up(pour_status_t *status_out) {
   pour_hal_estop_init();
   uint32_t clock_hz = 0u;
   const pour_status_t clock_status = pour_clock_init(&clock_hz);
-  pour_hal_watchdog_start(WATCHDOG_TIMEOUT_MS);
+  pour_hal_watchdog_start(POUR_WATCHDOG_TIMEOUT_MS);
   pour_hal_timer_init(clock_hz);
 
   pour_status_t status = controller_init();
+  if (status == POUR_OK) {
+    status = pour_hal_boot_check(); /* option bytes that would boot the ROM bootloader: said, never run */
+  }
   if (status == POUR_OK) {
     status = clock_status; /* without its clock the loop would still run, but not as measured: refuse */
   }

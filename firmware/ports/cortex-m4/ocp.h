@@ -1,8 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /* Hardware overcurrent protection: COMP1, COMP2 and COMP4 watch the shunt signals of phases U, V, W at the
- * op-amps' inputs (PA1, PA7, PB0) against thresholds from DAC3 (internal, no pin), and their outputs feed
- * TIM1's break input (pwm_tim1.c), which cuts the PWM with no software in the path. The threshold is the
- * shunt's bias, measured from the current offsets at start-up, plus trip current x shunt. */
+ * op-amps' inputs (PA1, PA7, PB0: before the PGA's x16, after the board's network) against thresholds from DAC3
+ * (internal, no pin), and their outputs feed TIM1's break input (pwm_tim1.c), which cuts the PWM with no
+ * software in the path. The threshold is the input's bias (the measured ADC offset / the PGA's gain) plus the
+ * trip current x shunt x the network's attenuation (pour/board_facts.h, ST's project for this board the same).
+ * The input rises with current out of the phase into the low side (the ADC reading rises: the board's sign),
+ * the direction a short of a phase to the bus drives through a conducting low side. */
 #ifndef POUR_OCP_H
 #define POUR_OCP_H
 
@@ -48,7 +51,8 @@ POUR_REGS_DECLARE(OCP);
 typedef struct {
   uint32_t vref_mv;       /* ADC and DAC full scale [mV] */
   uint32_t shunt_uohm;    /* phase shunt [µΩ] */
-  uint32_t amp_gain_milli; /* amplifier gain [1/1000] (the ADC sees the bias and shunt voltage x gain) */
+  uint32_t pga_gain;       /* the op-amp's gain from its input (the comparator's) to the ADC, 2 .. 64 */
+  uint32_t network_milli; /* the board's attenuation from the shunt to the op-amp's input [1/1000], 1 .. 1000 */
   uint32_t trip_ma;       /* phase current that trips the break [mA] */
   uint32_t ready_polls;   /* bound of the wait for the DAC's ready flags */
 } pour_ocp_config_t;
@@ -58,10 +62,12 @@ typedef struct {
   uint16_t threshold[3]; /* DAC codes of phases U, V, W (U: DAC3 CH1; V, W share CH2: the larger bias) */
 } pour_ocp_t;
 
-/* B-G431B-ESC1: 3.3 V, 3 mΩ, gain 9.14, trip at 40 A (the board's peak; the software limit is lower). */
+/* B-G431B-ESC1 (pour/board_facts.h): 3.3 V, 3 mΩ, network 0.571, PGA x16, trip at the board's 40 A peak (the
+ * software limit is lower). */
 pour_ocp_config_t pour_ocp_default_config(void);
 
-/* DAC code for a trip at config->trip_ma above a zero-current ADC reading of offset_counts. */
+/* DAC code for a trip at config->trip_ma from a zero-current ADC reading of offset_counts: offset / PGA gain
+ * plus trip x shunt x network, in counts of vref, rounded; 4096 if beyond full scale. */
 uint16_t pour_ocp_threshold_code(const pour_ocp_config_t *config, uint16_t offset_counts);
 
 /* Thresholds from the three measured offsets [ADC counts], DAC3 on, the comparators on, non-inverted, their

@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* OPAMP1..3, the phase shunts' amplifiers (B-G431B-ESC1: VINP0 on PA1, PA7, PB0 with the board's bias
- * network; outputs on their pins PA2, PA6, PB1 into the ADCs), high-speed mode. Either as programmable-gain
- * amplifiers (internal gain 2 .. 64) or with the board's own feedback network on VINM0 (PA3, PA5, PB2):
- * ST's motor-control profile of this board uses a gain of 9.14, which no internal gain gives, so the
- * board's default is the external network (pour_opamp_init with gain 0). */
+/* OPAMP1..3, the phase shunts' amplifiers (B-G431B-ESC1, pour/board_facts.h: VINP0 on PA1, PA7, PB0 carries the
+ * shunt through the board's network, VINM0 on PA3, PA5, PB2 its foot; outputs on PA2, PA6, PB1 into the ADCs):
+ * internal programmable-gain amplifiers whose gain network's foot is VINM0 ("input/bias on VINM0"), as ST's
+ * own project for this board sets them (x16 there: 9.14 from the shunt with the network's 0.571), in
+ * high-speed mode (FOC-Stim's choice for this board; ST's project uses normal speed). */
 #ifndef POUR_OPAMP_H
 #define POUR_OPAMP_H
 
@@ -27,8 +27,8 @@
 POUR_REGS_DECLARE(OPAMP);
 #define POUR_OPAMP_N_REGS (0x24 / 4)
 
-/* Configures and enables the three with their outputs on the pins: gain 0, the external network on VINM0;
- * gain 2, 4, 8, 16, 32 or 64, non-inverting PGAs. POUR_EINVAL for another gain. */
+/* Configures and enables the three with their outputs on the pins: non-inverting PGAs of gain 2, 4, 8, 16, 32
+ * or 64 with the input/bias on VINM0. POUR_EINVAL for another gain. */
 pour_status_t pour_opamp_init(volatile uint32_t *regs, uint32_t gain);
 
 #endif /* POUR_OPAMP_H */

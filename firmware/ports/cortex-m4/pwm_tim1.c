@@ -16,7 +16,7 @@ pour_pwm_config_t pour_pwm_default_config(void) {
   c.timer_clock_hz = 170000000u;
   c.pwm_hz = 20000u;
   c.deadtime_ns = 800u;
-  c.break_filter = 2u;
+  c.break_filter = 6u; /* f_DTS / 4, N = 6: 141 ns, the length of ST's filter for this board (BKF 4 at CKD / 2) */
   return c;
 }
 
@@ -64,9 +64,10 @@ pour_status_t pour_pwm_init(pour_pwm_t *pwm, volatile uint32_t *regs, const pour
                               POUR_VAL(TIM1, CCMR1_OUTPUT, OC2M, OCM_PWM1) | POUR_MSK(TIM1, CCMR1_OUTPUT, OC2PE);
   r[POUR_TIM1_CCMR2_OUTPUT] = POUR_VAL(TIM1, CCMR2_OUTPUT, OC3M, OCM_PWM1) | POUR_MSK(TIM1, CCMR2_OUTPUT, OC3PE) |
                               POUR_VAL(TIM1, CCMR2_OUTPUT, OC4M, OCM_PWM1) | POUR_MSK(TIM1, CCMR2_OUTPUT, OC4PE);
-  /* Idle levels (MOE clear after a break, OSSI): high sides off, low sides on. */
-  r[POUR_TIM1_CR2] = POUR_VAL(TIM1, CR2, MMS2, MMS2_OC4REF) | POUR_MSK(TIM1, CR2, OIS1N) |
-                     POUR_MSK(TIM1, CR2, OIS2N) | POUR_MSK(TIM1, CR2, OIS3N);
+  /* Idle levels (MOE clear after a break, OSSI): all six off, OISx = OISxN = 0, as ST sets them for this board
+   * (pour/board_facts.h): with a failed high side or a phase shorted to the bus, low sides switched on by the
+   * hardware would short the bus itself. */
+  r[POUR_TIM1_CR2] = POUR_VAL(TIM1, CR2, MMS2, MMS2_OC4REF);
   r[POUR_TIM1_CCER] = 0u; /* with MOE and OSSR set: all six at their inactive level, off */
   /* The comparators of phases U, V, W (COMP1, COMP2, COMP4) into the break, active high; no automatic
    * restart (AOE clear): a trip stays until ClearErrors. */
@@ -88,14 +89,14 @@ void pour_pwm_set_compares(pour_pwm_t *pwm, const uint16_t compare[3]) {
 }
 
 /* Off is the channels disabled under a set MOE (OSSR: their inactive level), not MOE cleared: a cleared
- * MOE means the break, whose idle levels short the phases. */
+ * MOE means the break, whose idle levels are all off until the break is cleared. */
 void pour_pwm_enable(pour_pwm_t *pwm, bool on) { pwm->regs[POUR_TIM1_CCER] = on ? CCER_BRIDGE : 0u; }
 
 void pour_pwm_short_low_sides(pour_pwm_t *pwm) {
   const uint16_t zero[3] = {0u, 0u, 0u};
   pour_pwm_set_compares(pwm, zero);
   pwm->regs[POUR_TIM1_EGR] = POUR_MSK(TIM1, EGR, UG); /* now, not at the next period */
-  pour_pwm_enable(pwm, true); /* after a break MOE stays clear: the idle levels already short the phases */
+  pour_pwm_enable(pwm, true); /* after a break MOE stays clear: the bridge stays off, the brake holds */
 }
 
 bool pour_pwm_break_fired(const pour_pwm_t *pwm) { return (pwm->regs[POUR_TIM1_SR] & POUR_MSK(TIM1, SR, BIF)) != 0u; }

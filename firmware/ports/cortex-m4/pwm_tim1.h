@@ -3,8 +3,8 @@
  * top of the count as the trigger (TRGO2) of the ADCs' injected conversions, so the phase currents are
  * sampled at the centre of the low-side conduction. The break input takes the overcurrent comparators
  * (ocp.c): a trip clears MOE in hardware within the comparator's and the break filter's delay, far less
- * than one PWM period, and the outputs go to their idle levels, all low sides on (the phases shorted:
- * damping, never coasting). Registers through pointers (a register file in tests/board/test_board_pwm.c). */
+ * than one PWM period, and the outputs go to their idle levels, all six off (ST's idle levels for this
+ * board: a short of a phase to the bus must not meet a conducting low side); the brake holds the axis. Registers through pointers (a register file in tests/board/test_board_pwm.c). */
 #ifndef POUR_PWM_TIM1_H
 #define POUR_PWM_TIM1_H
 
@@ -91,7 +91,7 @@ typedef struct {
   uint16_t period; /* ARR: counts from the bottom to the top of the centre-aligned count */
 } pour_pwm_t;
 
-/* B-G431B-ESC1: 170 MHz, 20 kHz, 800 ns dead time (the L6387 adds its own), break filter 2 samples. */
+/* B-G431B-ESC1: 170 MHz, 20 kHz, 800 ns dead time (pour/board_facts.h), break filter 6 samples at f_DTS / 4. */
 pour_pwm_config_t pour_pwm_default_config(void);
 
 /* The dead-time generator's DTG code for deadtime_ns at timer_clock_hz (rounded up: never shorter); -1 if
@@ -105,10 +105,11 @@ pour_status_t pour_pwm_init(pour_pwm_t *pwm, volatile uint32_t *regs, const pour
 void pour_pwm_set_compares(pour_pwm_t *pwm, const uint16_t compare[3]);
 
 /* true: the gates follow the compares; false: all six switches off. After a break neither: the idle levels
- * (phases shorted) hold until pour_pwm_clear_break. */
+ * (all six off) hold until pour_pwm_clear_break. */
 void pour_pwm_enable(pour_pwm_t *pwm, bool on);
 
-/* All three low sides on (compares 0, MOE set): the motor's phases shorted. */
+/* All three low sides on (compares 0) while MOE is set: the motor's phases shorted (a software fault's
+ * damping). After a break MOE stays clear and the bridge stays off. */
 void pour_pwm_short_low_sides(pour_pwm_t *pwm);
 
 /* true once the break input has fired (SR.BIF), until pour_pwm_clear_break. */

@@ -19,6 +19,9 @@
  * brake at the end; heartbeats and identity frames with the compiled-in policy hash; the watchdog fed every
  * healthy tick; the LED shown every tick with that tick's mode. */
 #include <stdio.h>
+
+#include "boot_check.h"
+#include "pour/board_facts.h"
 #include <stdlib.h>
 
 #include "board_drive.h"
@@ -49,7 +52,7 @@
 #define STATES_TO 170u
 #define PERIODS_PER_TICK 20u /* 20 kHz PWM under the 1 kHz loop */
 #define VBUS_MV 24000u
-#define NTC_MV 1055u /* 25 °C */
+#define NTC_MV ((uint32_t)POUR_BOARD_NTC_V0_MV) /* 25 °C */
 
 static uint32_t tick;
 static bool brake = true, power;
@@ -94,13 +97,13 @@ void pour_hal_calibration_result(pour_can_calibration_result_t *r) {
 /* A page and the flash interface's registers in RAM (mps2-an386 has no flash controller). */
 static uint32_t flash_regs[POUR_FLASH_N_REGS], flash_page[POUR_FLASH_PAGE_BYTES / 4u];
 const pour_flash_t *pour_hal_calibration_flash(void) {
-  static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u};
+  static const pour_flash_t f = {flash_regs, flash_page, POUR_FLASH_CAL_PAGE, 10u, NULL};
   return &f;
 }
 /* The parameters' page likewise, erased (never saved: the defaults). */
 static uint32_t params_regs[POUR_FLASH_N_REGS], params_page[POUR_FLASH_PAGE_BYTES / 4u];
 const pour_flash_t *pour_hal_params_flash(void) {
-  static const pour_flash_t f = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u};
+  static const pour_flash_t f = {params_regs, params_page, POUR_FLASH_PARAMS_PAGE, 10u, NULL};
   static bool erased;
   if (!erased) {
     for (uint32_t i = 0; i < POUR_FLASH_PAGE_BYTES / 4u; ++i) params_page[i] = 0xFFFFFFFFu;
@@ -123,6 +126,7 @@ bool pour_hal_power_on(void) { return power; }
 void pour_hal_estop_init(void) {}
 bool pour_hal_estop_asserted(void) { return tick >= ESTOP_FROM && tick < ESTOP_TO; }
 void pour_hal_watchdog_start(uint32_t timeout_ms) { (void)timeout_ms; }
+pour_status_t pour_hal_boot_check(void) { return POUR_OK; } /* the bench has no option bytes */
 
 pour_status_t pour_hal_can_init(uint32_t clock_hz, uint8_t node_id) {
   return clock_hz == MPS2_AN386_CLOCK_HZ && node_id == 0u ? POUR_OK : POUR_EINVAL;
@@ -138,8 +142,8 @@ bool pour_hal_drive_sample(pour_hal_drive_sample_t *s) {
   const pour_drive_t *drv = pour_board_drive_state();
   const pour_drive_output_t *o = pour_board_drive_output();
   const q15_t id = gates_on ? o->id_ref : 0, iq = gates_on ? o->iq_ref : 0; /* last period's references */
-  pour_ideal_phase_counts(drv, id, iq, motor_counts, drv->config.offset_nominal, s->phase);
-  s->vbus = pour_ideal_adc_counts(&drv->config, VBUS_MV * 1000u / drv->config.vbus_divider_milli);
+  pour_ideal_phase_counts(drv, id, iq, motor_counts, POUR_BOARD_OFFSET_NOMINAL_COUNTS, s->phase); /* the board's bias */
+  s->vbus = pour_ideal_adc_counts(&drv->config, VBUS_MV * 1000u / POUR_BOARD_VBUS_DIVIDER_MILLI);
   s->ntc = pour_ideal_adc_counts(&drv->config, NTC_MV);
   s->encoder = motor_counts;
   return true;

@@ -27,6 +27,7 @@
   R(RCC, CCIPR, 0x88)                                                                                          \
   R(PWR, CR5, 0x80)                                                                                            \
   R(FLASH, ACR, 0x00)                                                                                          \
+  R(FLASH, OPTR, 0x20)                                                                                         \
   R(IWDG, KR, 0x00)                                                                                            \
   R(IWDG, PR, 0x04)                                                                                            \
   R(IWDG, RLR, 0x08)                                                                                           \
@@ -84,6 +85,9 @@
   F(FLASH, ACR, PRFTEN, 8, 1)                                                                                  \
   F(FLASH, ACR, ICEN, 9, 1)                                                                                    \
   F(FLASH, ACR, DCEN, 10, 1)                                                                                   \
+  F(FLASH, OPTR, N_BOOT1, 23, 1)                                                                               \
+  F(FLASH, OPTR, N_SWBOOT0, 26, 1)                                                                             \
+  F(FLASH, OPTR, N_BOOT0, 27, 1)                                                                               \
   F(IWDG, KR, KEY, 0, 16)                                                                                      \
   F(IWDG, PR, PR, 0, 3)                                                                                        \
   F(IWDG, RLR, RL, 0, 12)                                                                                      \

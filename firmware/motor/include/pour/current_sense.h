@@ -33,7 +33,8 @@ pour_status_t pour_current_sense_init(pour_current_sense_t *cs, const pour_curre
  * POUR_DRIVE_FAULT_CURRENT_OFFSET). */
 int pour_current_sense_calibrate(pour_current_sense_t *cs, const uint16_t adc[3]);
 
-/* Three ADC counts → three phase currents (Q15 per-unit, saturated): (count − offset)·gain, rounded. */
+/* Three ADC counts → three phase currents (Q15 per-unit, saturated), positive into the motor: the board's
+ * sign (pour/board_facts.h: offset − count on the B-G431B-ESC1) × (count − offset)·gain, rounded. */
 void pour_current_sense_convert(const pour_current_sense_t *cs, const uint16_t adc[3], q15_t i[3]);
 
 #endif /* POUR_CURRENT_SENSE_H */
