@@ -4,6 +4,8 @@
 #   scripts/bench.sh              all sections but fuzz
 #   scripts/bench.sh core         only the named sections (see SECTIONS below)
 #   scripts/bench.sh fuzz 60      the fuzz targets, 60 s each (default 300)
+#   scripts/bench.sh suite        ./scripts/test.sh's wall time by preset (build, tests), warm or cold as found
+#   scripts/bench.sh suite-all    the same for ./scripts/test.sh --all
 set -uo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ROOT"
@@ -394,7 +396,25 @@ print("%d/%d lines (%.1f %%)" % (t["covered"], t["count"], t["percent"]))' || ec
   echo "   findings in all: $findings (inputs in build/host-fuzz/bench/<target>/)"
 }
 
-SECTIONS=(core motor lcm sim can weights fuzz)
+# --- section: suite, suite-all — the test suite's wall time ------------------------------------------
+# Runs ./scripts/test.sh (or --all) and prints its table of wall time by preset (configure and build, then
+# ctest -j) with the machine's load. Bar: the quick suite <= 10 min on 2 cores once built; --all well under
+# CI's 90 min.
+bench_suite_run() {
+  local log rc
+  log=$(mktemp)
+  echo "== suite: ./scripts/test.sh $* ($(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg)) =="
+  ./scripts/test.sh "$@" >"$log" 2>&1
+  rc=$?
+  sed -n '/^wall time by preset/,$p' "$log" | sed 's/^/   /'
+  [ "$rc" = 0 ] || echo "   (the suite failed, exit $rc; its log: $log)"
+  [ "$rc" = 0 ] && rm -f "$log"
+  return "$rc"
+}
+bench_suite() { bench_suite_run; }
+bench_suite-all() { bench_suite_run --all; }
+
+SECTIONS=(core motor lcm sim can weights fuzz suite suite-all)
 wanted=()
 for a in "$@"; do
   # `fuzz 600`: the number is the seconds each fuzz target runs.
@@ -404,7 +424,7 @@ for a in "$@"; do
     wanted+=("$a")
   fi
 done
-[ ${#wanted[@]} -gt 0 ] || wanted=(core motor lcm sim can weights) # fuzz only when asked: it runs for minutes
+[ ${#wanted[@]} -gt 0 ] || wanted=(core motor lcm sim can weights) # fuzz and suite only when asked: minutes
 status=0
 for s in "${wanted[@]}"; do
   if [[ " ${SECTIONS[*]} " != *" $s "* ]]; then

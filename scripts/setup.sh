@@ -1,12 +1,11 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs everything pour needs on Debian 12 (bookworm): apt packages, a pinned Python venv in .venv,
-# the Unity test framework in .deps/unity, and ST's register description of the STM32G4 (the stm32g4 and
-# stm32g4xx-hal crates, in cargo's home). Idempotent: a second run checks and changes nothing.
+# the Unity test framework in .deps/unity, and ST's descriptions of the STM32G4 (the stm32g4, stm32g4xx-hal
+# and stm32-metapac crates, in .deps/stm32g4). Idempotent: a second run checks and changes nothing.
 #   ./scripts/setup.sh              all of that
-#   ./scripts/setup.sh --build      what the build and the README's commands need: not the two crates, which
-#                                   only a test reads (scripts/build.sh, scripts/demo.sh; Debian 12's own cargo
-#                                   fetches them through crates.io's git index, a long download)
+#   ./scripts/setup.sh --build      what the build and the README's commands need: not the three crates,
+#                                   which only the tests read (scripts/build.sh, scripts/demo.sh)
 #   ./scripts/setup.sh --with-sb3   and the optional Stable-Baselines3 extra in .venv (stable-baselines3 and
 #                                   torch from tools/requirements-sb3.lock, about 2.9 GB: pour.examples.sb3_ppo)
 set -euo pipefail
@@ -39,8 +38,6 @@ APT_PACKAGES=(
   ca-certificates xz-utils
   openocd
 )
-# cargo fetches the stm32g4 crate; a machine that has one (rustup's) keeps it, a bare one gets Debian's.
-command -v cargo >/dev/null || APT_PACKAGES+=(cargo)
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then
@@ -115,42 +112,32 @@ if [ ! -f "$UNITY_DIR/unity.c" ]; then
 fi
 
 # ST's register description of the STM32G4 (the stm32g4 crate: stm32-rs's svd2rust output of ST's SVD
-# files), which tests/board/check_registers.py compares the port's register tables with, and the
-# stm32g4xx-hal crate, whose pin maps (generated from ST's STM32CubeMX database) it checks the board's
-# alternate functions against. Fetched by cargo into its home from the crate registry, pinned by version
-# (scripts/stm32g4/Cargo.toml) and by the sha256 of each crate file, which cargo checks on download
-# against the lock written here; never copied into the repo. .deps/stm32g4/crate-dir and hal-dir name the
-# unpacked sources.
+# files), which tests/board/check_registers.py compares the port's register tables with; the stm32g4xx-hal
+# crate, whose pin maps (generated from ST's STM32CubeMX database) it checks the board's alternate functions
+# against; and the stm32-metapac crate, ST's CubeMX pin data per package (src/chips/stm32g431cb/), for the
+# board's pin check. Each .crate file comes over HTTPS from the crate registry's download endpoint, pinned by
+# version and sha256 (scripts/lib/fetch_crate.py: no cargo, no git index), and is unpacked under
+# .deps/stm32g4/NAME-VERSION; never copied into the repo. The marker files crate-dir, hal-dir and
+# metapac-dir hold each unpacked crate's absolute path; NAME-VERSION.sha256 records the pin it was
+# checked against, so a changed pin fetches again.
 SVD_CRATES=("stm32g4 0.16.0 97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d crate-dir src/stm32g431/mod.rs"
-            "stm32g4xx-hal 0.1.0 6402921e7994d834b5717593270b821dfb601d83ea7eeb4ebd6b2b3fe730f793 hal-dir src/pwm.rs")
-SVD_WORK=.deps/stm32g4
-svd_ok=1
-for entry in "${SVD_CRATES[@]}"; do
-  read -r _ _ _ marker probe <<<"$entry"
-  dir=$(cat "$SVD_WORK/$marker" 2>/dev/null || true)
-  [ -n "$dir" ] && [ -f "$dir/$probe" ] || svd_ok=0
-done
-cmp -s scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml" || svd_ok=0
-if [ "$WITH_CRATE" = 1 ] && [ "$svd_ok" = 0 ]; then
-  log "stm32g4: fetching the stm32g4 and stm32g4xx-hal crates with cargo"
-  mkdir -p "$SVD_WORK/src"
-  cp scripts/stm32g4/Cargo.toml "$SVD_WORK/Cargo.toml"
-  cp scripts/stm32g4/src/lib.rs "$SVD_WORK/src/lib.rs"
-  (cd "$SVD_WORK" && cargo generate-lockfile -q && cargo fetch -q --locked)
+            "stm32g4xx-hal 0.1.0 6402921e7994d834b5717593270b821dfb601d83ea7eeb4ebd6b2b3fe730f793 hal-dir src/pwm.rs"
+            "stm32-metapac 21.0.0 e74b78632cea498cfb28386a29f8bfae7476d6570a78733eb5fecbee66c2f4ce metapac-dir src/chips/stm32g431cb/pac.rs")
+SVD_WORK=$ROOT/.deps/stm32g4
+if [ "$WITH_CRATE" = 1 ]; then
+  mkdir -p "$SVD_WORK"
   for entry in "${SVD_CRATES[@]}"; do
     read -r name ver sha marker probe <<<"$entry"
-    got=$(awk -v name="$name" -v ver="$ver" '
-      /^\[\[package\]\]/ { n = ""; v = "" }
-      /^name = / { n = $3; gsub(/"/, "", n) }
-      /^version = / { v = $3; gsub(/"/, "", v) }
-      /^checksum = / { c = $3; gsub(/"/, "", c); if (n == name && v == ver) print c }' "$SVD_WORK/Cargo.lock")
-    [ "$got" = "$sha" ] || { log "stm32g4: $name $ver has sha256 '$got', pinned $sha"; exit 1; }
-    dir=$(cd "$SVD_WORK" && cargo metadata -q --offline --locked --format-version 1 | "$PY" -c '
-import json, os, sys
-meta = json.load(sys.stdin)
-print(next(os.path.dirname(p["manifest_path"]) for p in meta["packages"] if p["name"] == sys.argv[1]))' "$name")
-    [ -f "$dir/$probe" ] || { log "stm32g4: no $probe under '$dir'"; exit 1; }
-    echo "$dir" > "$SVD_WORK/$marker"
+    dir=$SVD_WORK/$name-$ver
+    if [ "$(cat "$SVD_WORK/$marker" 2>/dev/null)" = "$dir" ] && [ -f "$dir/$probe" ] \
+       && [ "$(cat "$SVD_WORK/$name-$ver.sha256" 2>/dev/null)" = "$sha" ]; then
+      continue
+    fi
+    log "crates: fetching $name $ver from the crate registry"
+    got=$("$PY" scripts/lib/fetch_crate.py "$name" "$ver" "$sha" "$SVD_WORK") || exit 1
+    [ "$got" = "$dir" ] && [ -f "$dir/$probe" ] || { log "crates: no $probe under '$got'"; exit 1; }
+    echo "$sha" > "$SVD_WORK/$name-$ver.sha256.part" && mv "$SVD_WORK/$name-$ver.sha256.part" "$SVD_WORK/$name-$ver.sha256"
+    echo "$dir" > "$SVD_WORK/$marker.part" && mv "$SVD_WORK/$marker.part" "$SVD_WORK/$marker"
   done
 fi
 

@@ -1,1 +1,0 @@
-// Never built: the crate exists so that cargo fetches stm32g4 (see Cargo.toml).
