@@ -59,10 +59,10 @@ def test_config_list_names_the_dbc_parameters_without_a_bus():
     assert "  4 omega_max" in r.stdout and " 22 scale_target_tare" in r.stdout, r.stdout
 
 
-def candump_log(path, node: int = 0, samples: int = 300) -> None:
+def candump_log(path, node: int = 0, samples: int = 300, drive: bool = False) -> None:
     """A candump -L log of one pour's frames for node, packed by the DBC: the encoder turning 1 count per
     sample, torque at 25 % of a 20 N·m tau_max, a heartbeat and identity every 100 samples (RUN, then
-    FAULT with StaleInput)."""
+    FAULT with StaleInput), and with drive a DriveTelemetry beside each heartbeat."""
     import cantools
 
     from pour.can import dbc
@@ -85,6 +85,10 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
             frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
                   Overruns=0, Counter=k // 100, Refused=0)
             frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
+            if drive:  # Iq 2 A, bus 24 V; the drive's overcurrent latched with the late heartbeat
+                frame(t, "DriveTelemetry", Id=0, Iq=1000, Vbus=24000, Crystal=6, **{
+                    s.name: int(late and s.name == "DriveFault_Overcurrent")
+                    for s in db.get_message_by_name("DriveTelemetry").signals if s.name.startswith("DriveFault_")})
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -96,6 +100,29 @@ def test_plot_of_a_log_draws_the_node_and_saves_a_png(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "pour-bench plot: 606 frames of node 0" in r.stdout, r.stdout  # 300 samples, 300 torques, 3 + 3
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_of_a_log_with_drive_telemetry_draws_iq_the_bus_and_the_drives_faults(tmp_path, monkeypatch):
+    from pour.bench import node as bn
+    from pour.bench import plot
+    log = tmp_path / "run.log"
+    candump_log(log, drive=True)
+    drawn = {}
+    update = plot.Figure.update
+
+    def keep(self, s):
+        update(self, s)
+        drawn.update(iq=list(self.l_iq.get_ydata()), vbus=list(self.l_vbus.get_ydata()),
+                     faults=self.fault_text.get_text(), note=self.drive_text.get_text())
+
+    monkeypatch.setattr(plot.Figure, "update", keep)
+    used = plot.run(plot.replay(log, paced=False), bn.load_dbc(), 0, 60.0, 17, 100.0, tmp_path / "p.png", False)
+    assert used == 609  # 300 samples, 300 torques, 3 heartbeats, 3 identities, 3 drive telemetries
+    assert drawn["iq"] == [2.0, 2.0, 2.0] and drawn["vbus"] == [24.0, 24.0, 24.0] and drawn["note"] == ""
+    assert "drive Overcurrent 0.2-0.2 s" in drawn["faults"] and "StaleInput 0.2-0.2 s" in drawn["faults"]
+    candump_log(log)
+    plot.run(plot.replay(log, paced=False), bn.load_dbc(), 0, 60.0, 17, 100.0, tmp_path / "p.png", False)
+    assert drawn["iq"] == [] and drawn["note"].startswith("no DriveTelemetry from this node")
 
 
 def test_plot_series_theta_rate_torque_and_faults():
