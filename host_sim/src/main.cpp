@@ -72,7 +72,7 @@ const char *kUsage =
     "  --realtime          with --lcm: pace at 1 kHz wall clock, use the latest torque, count misses\n"
     "  --lcm-timeout-ms T  with --lcm in lockstep: give up after T ms without an answer (default 2000)\n"
     "  --candump LOG       with --experiment: the log to write\n"
-    "  --node-id N         with --experiment: the controller's CAN node id (default 0)\n"
+    "  --node N            with --experiment: the controller's CAN node id (default 0)\n"
     "  --list-config       every config key with its unit, range and default\n"
     "  --help, --version   this text; the version\n"
     "Options take their value as --key VALUE or --key=VALUE (--lcm: --lcm=URL, --lcm URL or --lcm alone).\n"
@@ -210,7 +210,7 @@ const option kOptions[] = {
     {"quiet", no_argument, nullptr, kOptQuiet},
     {"experiment", required_argument, nullptr, kOptExperiment},
     {"candump", required_argument, nullptr, kOptCandump},
-    {"node-id", required_argument, nullptr, kOptNodeId},
+    {"node", required_argument, nullptr, kOptNodeId},
     {nullptr, 0, nullptr, 0},
 };
 
@@ -283,7 +283,7 @@ int parse_args(int argc, char **argv, Options &o) {
       o.candump = v;
       break;
     case kOptNodeId:
-      if (!parse_long(v, 0, 63, n)) return usage_error("--node-id wants an integer 0..63, got '%s'", v);
+      if (!parse_long(v, 0, 63, n)) return usage_error("--node wants an integer 0..63, got '%s'", v);
       o.node_id = static_cast<int>(n);
       break;
     case ':': return usage_error("%s needs a value", a);

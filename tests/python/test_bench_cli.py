@@ -4,6 +4,7 @@ tests/can/guest/test_bench.py): a bad command line is 2, a bus that cannot open 
 names the problem."""
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -20,7 +21,12 @@ def bench(*argv: str) -> subprocess.CompletedProcess:
     (["--node", "x", "info"], "'x' is not a decimal integer"),
     (["--timeout", "0", "info"], "not a number of seconds"),
     (["--expect-hash", "0xnothex", "clear"], "not a 32-bit policy hash"),
-    (["config", "set", "omega_max", "1.5"], "'1.5' is not a decimal integer"),
+    (["config", "set", "--raw", "omega_max", "1.5"], "VALUE: '1.5' is not a decimal integer"),
+    (["config", "set", "omega_max", "fast"], "VALUE: 'fast' is not a number (in rad/s"),
+    (["config", "set", "omega_max", "1000"], "omega_max = 1000 rad/s is outside 1e-06 .. 100 rad/s"),
+    (["config", "set", "encoder_bits", "30"], "encoder_bits = 30 bits is outside"),
+    (["config", "set", "nosuch", "1"], "no parameter 'nosuch'"),
+    (["config", "restore", "nosuch.json"], "nosuch.json: cannot read (No such file or directory)"),
     (["config", "set", "omega_max"], "the following arguments are required: value"),
     (["frobnicate"], "invalid choice: 'frobnicate'"),
     ([], "the following arguments are required: COMMAND"),
@@ -59,10 +65,10 @@ def test_config_list_names_the_dbc_parameters_without_a_bus():
     assert "  4 omega_max" in r.stdout and " 22 scale_target_tare" in r.stdout, r.stdout
 
 
-def candump_log(path, node: int = 0, samples: int = 300) -> None:
+def candump_log(path, node: int = 0, samples: int = 300, drive: bool = False) -> None:
     """A candump -L log of one pour's frames for node, packed by the DBC: the encoder turning 1 count per
     sample, torque at 25 % of a 20 N·m tau_max, a heartbeat and identity every 100 samples (RUN, then
-    FAULT with StaleInput)."""
+    FAULT with StaleInput), and with drive a DriveTelemetry beside each heartbeat."""
     import cantools
 
     from pour.can import dbc
@@ -85,6 +91,10 @@ def candump_log(path, node: int = 0, samples: int = 300) -> None:
             frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
                   Overruns=0, Counter=k // 100, Refused=0)
             frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
+            if drive:  # Iq 2 A, bus 24 V; the drive's overcurrent latched with the late heartbeat
+                frame(t, "DriveTelemetry", Id=0, Iq=1000, Vbus=24000, Crystal=6, **{
+                    s.name: int(late and s.name == "DriveFault_Overcurrent")
+                    for s in db.get_message_by_name("DriveTelemetry").signals if s.name.startswith("DriveFault_")})
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -96,6 +106,29 @@ def test_plot_of_a_log_draws_the_node_and_saves_a_png(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "pour-bench plot: 606 frames of node 0" in r.stdout, r.stdout  # 300 samples, 300 torques, 3 + 3
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_of_a_log_with_drive_telemetry_draws_iq_the_bus_and_the_drives_faults(tmp_path, monkeypatch):
+    from pour.bench import node as bn
+    from pour.bench import plot
+    log = tmp_path / "run.log"
+    candump_log(log, drive=True)
+    drawn = {}
+    update = plot.Figure.update
+
+    def keep(self, s):
+        update(self, s)
+        drawn.update(iq=list(self.l_iq.get_ydata()), vbus=list(self.l_vbus.get_ydata()),
+                     faults=self.fault_text.get_text(), note=self.drive_text.get_text())
+
+    monkeypatch.setattr(plot.Figure, "update", keep)
+    used = plot.run(plot.replay(log, paced=False), bn.load_dbc(), 0, 60.0, 17, 100.0, tmp_path / "p.png", False)
+    assert used == 609  # 300 samples, 300 torques, 3 heartbeats, 3 identities, 3 drive telemetries
+    assert drawn["iq"] == [2.0, 2.0, 2.0] and drawn["vbus"] == [24.0, 24.0, 24.0] and drawn["note"] == ""
+    assert "drive Overcurrent 0.2-0.2 s" in drawn["faults"] and "StaleInput 0.2-0.2 s" in drawn["faults"]
+    candump_log(log)
+    plot.run(plot.replay(log, paced=False), bn.load_dbc(), 0, 60.0, 17, 100.0, tmp_path / "p.png", False)
+    assert drawn["iq"] == [] and drawn["note"].startswith("no DriveTelemetry from this node")
 
 
 def test_plot_series_theta_rate_torque_and_faults():
@@ -180,6 +213,8 @@ class _FakeNode:
         self.bus = can.Bus(interface="virtual", channel=channel)
         self.answer = answer
         self.drive, self.mode, self.faults = drive, mode, faults or {}
+        self.params: dict[int, int] = {}  # a parameter store answering ParamRead and ParamWrite
+        self.writes: list[tuple[int, int]] = []
         self.received: list[str] = []
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self.run, daemon=True)
@@ -209,9 +244,25 @@ class _FakeNode:
                 continue
             name = self.db.get_message_by_frame_id(msg.arbitration_id).name
             self.received.append(name)
+            if name in ("ParamRead", "ParamWrite"):
+                self.param(name, self.db.decode_message(msg.arbitration_id, msg.data, scaling=False,
+                                                        decode_choices=False))
             if name == "CalibrationRead":
                 self.send("CalibrationResult", Status="NO_ENCODER", Stored="EMPTY")
                 self.send("CalibrationResult", **self.answer)
+
+    def param(self, name: str, sig: dict) -> None:
+        """The controller's answers: the value (ParamValue), or a ParamAck refusing a set whose theta_min is
+        not below its theta_max (INCONSISTENT), as pour_params_check judges it."""
+        pid = sig["ParamId"]
+        if name == "ParamWrite":
+            trial = {**self.params, pid: sig["Value"]}
+            if trial.get(2, -1) >= trial.get(3, 1):
+                self.send("ParamAck", Request="ParamWrite", ParamId=pid, Result="INCONSISTENT")
+                return
+            self.params = trial
+            self.writes.append((pid, sig["Value"]))
+        self.send("ParamValue", ParamId=pid, Value=self.params.get(pid, 0))
 
     def __enter__(self) -> "_FakeNode":
         self.thread.start()
@@ -312,3 +363,56 @@ def test_bus_options_are_named_as_python_can_names_them():
     from pour.bench import cli as bench_cli
     opts = {o for a in bench_cli.parser()._actions for o in a.option_strings}
     assert {"--channel", "--interface", "--node"} <= opts and "--iface" not in opts
+
+
+def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
+    """Against a node on a python-can virtual bus that stores what it is written: get and set read and take SI
+    units (the firmware table's urad/s as rad/s); a dump holds every parameter; a restore writes them all
+    back, a write the node refuses as inconsistent (theta_min above the theta_max then in force) after the
+    others."""
+    from pour.bench import cli as bench_cli
+    from pour.bench import params as bp
+    channel = "params-si"
+    with _FakeNode(channel, {}, mode="IDLE") as node:
+        node.params.update({prm.id: prm.min for prm in bp.table().values()})  # every value in range
+        node.params.update({2: -50000, 3: 2356194, 4: 1500000, 14: 4000})
+        base = ["--interface", "virtual", "--channel", channel]
+        assert bench_cli.main(base + ["config", "get", "omega_max", "stop_timeout"]) == 0
+        out = capsys.readouterr().out.splitlines()
+        assert out == ["omega_max 1.5 rad/s (range 1e-06 .. 100 rad/s; raw 1500000 urad/s)",
+                       "stop_timeout 4 s (range 0.001 .. 65.535 s; raw 4000 ms)"], out
+        assert bench_cli.main(base + ["config", "get", "--raw", "omega_max"]) == 0
+        assert capsys.readouterr().out == "omega_max 1500000\n"
+        assert bench_cli.main(base + ["config", "set", "omega_max", "2.25"]) == 0
+        assert capsys.readouterr().out.startswith("omega_max 2.25 rad/s (")
+        assert node.params[4] == 2250000
+        dump = tmp_path / "node0.json"
+        assert bench_cli.main(base + ["config", "dump", str(dump)]) == 0
+        assert f"{dump}: 28 parameters of node 0" in capsys.readouterr().out
+        saved = bp.load_dump(dump, bp.table())
+        assert saved["omega_max"] == 2250000 and saved["theta_max"] == 2356194 and len(saved) == 28
+        # Another set in force: theta_max below the dump's theta_min, so writing theta_min first is refused.
+        node.params.update({2: -600000, 3: -500000, 4: 1000})
+        doc = json.loads(dump.read_text())
+        doc["params"]["theta_min"]["raw"] = -400000
+        dump.write_text(json.dumps(doc))
+        node.writes.clear()
+        assert bench_cli.main(base + ["config", "restore", str(dump)]) == 0
+        assert "28 parameters restored" in capsys.readouterr().out
+        assert node.params[2] == -400000 and node.params[3] == 2356194 and node.params[4] == 2250000
+        assert [pid for pid, _ in node.writes].index(2) > [pid for pid, _ in node.writes].index(3)
+
+
+@pytest.mark.parametrize("text, why", [
+    ("{", "not a config dump"),
+    ('{"format": "other"}', "not a config dump"),
+    ('{"format": "pour-bench config dump 1", "params": {"omega_mx": {"raw": 1}}}', "no parameter 'omega_mx'"),
+    ('{"format": "pour-bench config dump 1", "params": {"omega_max": {"raw": 1.5}}}', "no integer \"raw\""),
+    ('{"format": "pour-bench config dump 1", "params": {"encoder_bits": {"raw": 30}}}', "encoder_bits = 30 bits is outside"),
+    ('{"format": "pour-bench config dump 1", "params": {"omega_max": {"raw": 5, "unit": "mrad/s"}}}', "is in 'mrad/s'"),
+])
+def test_a_dump_it_cannot_use_is_refused_before_the_bus_opens(tmp_path, text, why):
+    dump = tmp_path / "d.json"
+    dump.write_text(text)
+    r = bench("--channel", "nosuchcan0", "config", "restore", str(dump))
+    assert r.returncode == 2 and why in r.stderr and len(r.stderr.splitlines()) == 1, r.stderr

@@ -363,7 +363,7 @@ def test_dbc_for_node_shifts_every_id(db):
 
 @pytest.mark.parametrize("bad", ["64", "-1", "x", "1.5"])
 def test_dbc_generator_rejects_bad_node_ids(bad, tmp_path):
-    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node-id", bad, "-o", str(tmp_path / "x.dbc")],
+    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node", bad, "-o", str(tmp_path / "x.dbc")],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 2
     assert "pour-can-dbc: error:" in out.stderr
@@ -371,7 +371,7 @@ def test_dbc_generator_rejects_bad_node_ids(bad, tmp_path):
 
 
 def test_dbc_generator_writes_a_loadable_file(tmp_path):
-    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node-id", "0x3", "-o", str(tmp_path / "n3.dbc")],
+    out = subprocess.run([sys.executable, "-m", "pour.can.dbc", "--node", "0x3", "-o", str(tmp_path / "n3.dbc")],
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     db3 = cantools.database.load_file(str(tmp_path / "n3.dbc"))

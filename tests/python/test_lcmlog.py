@@ -250,3 +250,16 @@ def test_lost_samples_are_warned_about(tmp_path):
     sensor_log(path, [(0, 0.0, (1.0, 0.0), {}), (1, 0.5, (0.9, 0.1), {}), (2, 1.0, (0.5, 0.5), {})])
     r = subprocess.run([sys.executable, "-m", "pour.lcm.logfile", path], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
+
+
+def test_the_controllers_faults_are_printed_by_name(monkeypatch):
+    from pour import libpoursim
+    from pour.lcm import logfile
+    assert logfile._fault_text(0) == "none"
+    assert logfile._fault_text(0x0002 | 0x0800) == "ESTOP, DRIVE (0x0802)"
+
+    def no_library(faults):
+        raise libpoursim.SimError("libpoursim.so not found")
+
+    monkeypatch.setattr(libpoursim, "fault_names", no_library)
+    assert logfile._fault_text(0x0002) == "0x0002 (names: libpoursim not found)"

@@ -114,7 +114,7 @@ def test_log_of_another_node_is_refused(tmp_path, nominal_log):
     assert r.returncode == 1 and "no frames of node 5" in r.stderr, r.stderr
     assert "nodes in the log: 0" in r.stderr
     other = tmp_path / "node3.log"
-    experiment(other, "identify", 1, None, "--node-id", "3")
+    experiment(other, "identify", 1, None, "--node", "3")
     assert sysid(other, tmp_path / "rig.toml", "--node", "3").returncode == 0
 
 
@@ -186,7 +186,7 @@ def test_bad_rig_files_are_refused(tmp_path, nominal_log, text, why):
 @pytest.mark.parametrize("argv, why", [
     (["--experiment", "wobble", "--candump", "x.log"], "--experiment wants identify or tilt"),
     (["--experiment", "identify"], "--experiment and --candump go together"),
-    (["--experiment", "identify", "--candump", "x.log", "--node-id", "64"], "--node-id wants an integer 0..63"),
+    (["--experiment", "identify", "--candump", "x.log", "--node", "64"], "--node wants an integer 0..63"),
 ])
 def test_host_sim_experiment_usage_errors(tmp_path, argv, why):
     r = subprocess.run([str(HOST_SIM)] + argv, capture_output=True, text=True, cwd=tmp_path, timeout=30)

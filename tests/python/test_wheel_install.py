@@ -111,7 +111,7 @@ def test_every_entry_point_answers_help_and_version(installed):
 
 def test_can_tools_read_the_packaged_dbc(installed):
     bin_dir, work, env = installed
-    r = run([bin_dir / "pour-can-dbc", "--node-id", "1"], cwd=work, env=env)
+    r = run([bin_dir / "pour-can-dbc", "--node", "1"], cwd=work, env=env)
     assert r.returncode == 0, r.stderr
     assert "This file is for node id 1." in r.stdout and "BO_ 33 Heartbeat" in r.stdout  # cmd 1 of node 1
     r = run([bin_dir / "pour-can-bus-load"], cwd=work, env=env)

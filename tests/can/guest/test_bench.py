@@ -75,12 +75,12 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
         # Commands the controller refuses say so (the heartbeat's Refused count), and change nothing.
         assert "refused Stop in ESTOP" in refused("stop")
         assert "refused ClearErrors in ESTOP" in refused("--weights", str(WEIGHTS), "--yes", "clear")
-        assert "BUSY" in refused("config", "set", "omega_max", "1500000")
+        assert "BUSY" in refused("config", "set", "--raw", "omega_max", "1500000")
         assert "mode FAULT" in ok("estop", "--release")
-        assert ok("config", "set", "omega_max", "1500000") == "omega_max 1500000\n"
-        assert ok("config", "set", "stop_timeout", "4000") == "stop_timeout 4000\n"
-        assert "OUT_OF_RANGE" in refused("config", "set", "encoder_bits", "30")
-        assert "INCONSISTENT" in refused("config", "set", "theta_min", "2400000")  # above theta_max
+        assert ok("config", "set", "--raw", "omega_max", "1500000") == "omega_max 1500000\n"
+        assert ok("config", "set", "--raw", "stop_timeout", "4000") == "stop_timeout 4000\n"
+        assert "OUT_OF_RANGE" in refused("config", "set", "--raw", "encoder_bits", "30")
+        assert "INCONSISTENT" in refused("config", "set", "--raw", "theta_min", "2400000")  # above theta_max
         assert "no parameter 'nosuch'" in refused("config", "get", "nosuch")
         assert "parameters saved" in ok("config", "save")
         assert params.stat().st_size > 0
@@ -101,7 +101,7 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
         assert "parameter request 0x0a (parameter 4) refused: busy (not in IDLE or FAULT)" in log, log
         assert "parameter request 0x0a (parameter 16) refused: out of range" in log, log
         ctl = Controller(*LOCKSTEP, io=f"can:vcan0,params={params}")
-        out = ok("config", "get", "omega_max", "stop_timeout", "encoder_bits")
+        out = ok("config", "get", "--raw", "omega_max", "stop_timeout", "encoder_bits")
         assert out == "omega_max 1500000\nstop_timeout 4000\nencoder_bits 17\n", out
         out = ok("--weights", str(WEIGHTS), "--yes", "clear")
         assert "faults none" in out, out

@@ -13,6 +13,8 @@ from pathlib import Path
 
 from pour import atomic, cli
 from pour.bench import node as bn
+from pour.bench import params as bp
+from pour.libpoursim import SimError
 from pour.policy import weights_h
 
 PROG = "pour-bench"
@@ -87,15 +89,22 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--release", action="store_true", help="release the e-stop instead (the node goes to FAULT)")
     sub.add_parser("stop", help="end the run (RUN -> IDLE)")
     sub.add_parser("reset", help="start a new run from the power-on state (MOVES once samples flow)")
-    p = sub.add_parser("config", help="parameters: get [NAME...], set NAME VALUE, save, list")
+    p = sub.add_parser("config", help="parameters in SI units: get [NAME...], set NAME VALUE, dump FILE, restore FILE, "
+                                      "save, list")
     csub = p.add_subparsers(dest="config_cmd", required=True, metavar="ACTION")
-    g = csub.add_parser("get", help="read parameters from the node")
+    g = csub.add_parser("get", help="read parameters from the node, in SI units with their ranges")
     g.add_argument("names", nargs="*", help="parameter names or ids (default: all)")
+    g.add_argument("--raw", action="store_true", help="print the integers the node stores (NAME VALUE), no units")
     s = csub.add_parser("set", help="write one parameter (IDLE or FAULT only; a refusal names its reason)")
     s.add_argument("name", help="parameter name or id (config list)")
-    s.add_argument("value", type=_int, help="the value as the node stores it (a decimal integer)")
+    s.add_argument("value", help="the value in SI units (config get shows them), or with --raw the stored integer")
+    s.add_argument("--raw", action="store_true", help="VALUE is the integer the node stores, in its firmware unit")
+    d = csub.add_parser("dump", help="every parameter of the node into a JSON file (raw values and SI readings)")
+    d.add_argument("file", type=Path, help="the JSON file to write (atomically)")
+    r = csub.add_parser("restore", help="write every parameter of a dump back (the whole file checked first)")
+    r.add_argument("file", type=Path, help="a config dump (pour-bench config dump)")
     csub.add_parser("save", help="store the node's parameters (its params= file, flash on the board)")
-    csub.add_parser("list", help="the parameter names this DBC knows")
+    csub.add_parser("list", help="the parameter names this DBC knows, with their units and ranges")
     p = sub.add_parser("tare", help="tare the scales at their present reading")
     p.add_argument("--scale", choices=["rotating", "target", "both"], default="both",
                    help="which load cell (default %(default)s)")
@@ -196,11 +205,88 @@ def _plot(a: argparse.Namespace) -> int:
     return 0
 
 
+def _param_table() -> dict[str, bp.Param]:
+    try:
+        return bp.table()
+    except SimError as e:
+        raise bn.BenchError(f"the parameters' units and ranges come from libpoursim: {e}") from e
+
+
+def _param(table: dict[str, bp.Param], n: bn.Node, name_or_id: str) -> bp.Param:
+    name = n.bench.param_names.get(n.param_id(name_or_id), str(name_or_id))
+    if name not in table:
+        raise bn.BenchError(f"no parameter '{name_or_id}' in the firmware's table")
+    return table[name]
+
+
+def _config_value(a: argparse.Namespace, table: dict[str, bp.Param]) -> tuple[str, int, bp.Param | None]:
+    """config set's parameter name and raw value, checked before the bus opens (UsageError: exit 2)."""
+    if a.raw:
+        return a.name, _int_arg(a.value, "VALUE"), None
+    names = bn.param_names(bn.load_dbc())
+    name = names.get(int(a.name), a.name) if a.name.isdigit() else a.name
+    if name not in table:
+        raise UsageError(f"no parameter '{a.name}' (config list names them)")
+    try:
+        value = float(a.value)
+    except ValueError:
+        raise UsageError(f"VALUE: '{a.value}' is not a number (in {table[name].si_unit or 'its unit'}; "
+                         f"--raw for the stored integer)") from None
+    try:
+        return name, table[name].from_si(value), table[name]
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+
+
+def _config_restore(a: argparse.Namespace, n: bn.Node, values: dict[str, int]) -> None:
+    # The node judges the set as a whole (theta_min < theta_max, ...): a write refused as INCONSISTENT waits
+    # for the others and is tried again; any other refusal ends the restore.
+    pending = list(values.items())
+    while pending:
+        deferred = []
+        for name, raw in pending:
+            try:
+                n.set(name, raw, a.timeout)
+            except bn.ParamRefused as e:
+                if e.result != "INCONSISTENT":
+                    raise
+                deferred.append((name, raw))
+        if len(deferred) == len(pending):
+            name, raw = deferred[0]
+            n.set(name, raw, a.timeout)  # raises the node's refusal, named
+        pending = deferred
+    print(f"node {n.id}: {len(values)} parameters restored from {a.file} (config save stores them)")
+
+
+def _int_arg(text: str, what: str) -> int:
+    try:
+        return _int(text)
+    except argparse.ArgumentTypeError as e:
+        raise UsageError(f"{what}: {e}") from None
+
+
 def run(a: argparse.Namespace) -> int:
     if a.cmd == "config" and a.config_cmd == "list":
+        table = _param_table()
         for pid, name in bn.param_names(bn.load_dbc()).items():
-            print(f"{pid:3d} {name}")
+            prm = table.get(name)
+            print(f"{pid:3d} {name}" + (f"  [{prm.range_text()}]" if prm else ""))
         return 0
+    table: dict[str, bp.Param] = {}
+    if a.cmd == "config" and not getattr(a, "raw", False) and a.config_cmd != "save":
+        table = _param_table()
+    if a.cmd == "config" and a.config_cmd == "set":
+        set_name, set_raw, set_param = _config_value(a, table)
+    if a.cmd == "config" and a.config_cmd == "restore":
+        try:
+            restore = bp.load_dump(a.file, table)
+        except bp.ParamFileError as e:
+            raise UsageError(str(e)) from e
+    if a.cmd == "config" and a.config_cmd == "dump":
+        try:
+            atomic.check_output_path(a.file, "dump FILE")
+        except ValueError as e:
+            raise UsageError(str(e)) from e
     want = _expected_hash(a) if a.cmd in MOTION else None
     if a.cmd == "plot":
         return _plot(a)
@@ -242,9 +328,17 @@ def run(a: argparse.Namespace) -> int:
             if a.config_cmd == "get":
                 names = a.names or [name for _, name in sorted(bench.param_names.items())]
                 for name in names:
-                    print(f"{name} {n.get(name, a.timeout)}")
+                    raw = n.get(name, a.timeout)
+                    print(f"{name} {raw}" if a.raw else _param(table, n, name).describe(raw))
             elif a.config_cmd == "set":
-                print(f"{a.name} {n.set(a.name, a.value, a.timeout)}")
+                now = n.set(set_name, set_raw, a.timeout)
+                print(set_param.describe(now) if set_param is not None else f"{set_name} {now}")
+            elif a.config_cmd == "dump":
+                raw = {name: n.get(pid, a.timeout) for pid, name in sorted(bench.param_names.items())}
+                bp.dump(a.file, n.id, raw, table)
+                print(f"{a.file}: {len(raw)} parameters of node {n.id}")
+            elif a.config_cmd == "restore":
+                _config_restore(a, n, restore)
             else:
                 n.save(a.timeout)
                 print(f"node {n.id}: parameters saved")

@@ -2,7 +2,7 @@
 """The pour CAN protocol's DBC (can/pour.dbc, written for node 0) and its variant for any node id.
 
 Ids follow the ODrive rule: ``id = (node_id << 5) | cmd``, node_id 0..63, cmd 0..31. ``pour-can-dbc
---node-id N`` writes the DBC of node N, so that ``candump -L can0 | python -m cantools decode FILE``
+--node N`` writes the DBC of node N, so that ``candump -L can0 | python -m cantools decode FILE``
 decodes a controller configured with that node id.
 """
 from __future__ import annotations
@@ -69,11 +69,11 @@ def dbc_for_node(node_id: int, source: Path | None = None) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-can-dbc", description=__doc__.splitlines()[0])
-    ap.add_argument("--node-id", required=True, help="controller node id, 0..63")
+    ap.add_argument("--node", required=True, help="controller node id, 0..63")
     ap.add_argument("-o", "--out", "--output", dest="output", help="file to write (default: standard output)")
     args = ap.parse_args(argv)
     try:
-        node_id = int(args.node_id, 0)
+        node_id = int(args.node, 0)
         text = dbc_for_node(node_id)
     except (ValueError, OSError) as e:
         print(f"pour-can-dbc: error: {e}", file=sys.stderr)

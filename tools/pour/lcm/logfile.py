@@ -319,6 +319,17 @@ def analyse(path: Path, out_dir: Path | None, reward=None, encoder_bits: int = s
     return summary
 
 
+def _fault_text(faults: int) -> str:
+    """The core's fault word by name (pour_fault_name), with its hex; the hex alone without libpoursim."""
+    if not faults:
+        return "none"
+    try:
+        from pour import libpoursim
+        return f"{', '.join(libpoursim.fault_names(faults))} (0x{faults:04x})"
+    except libpoursim.SimError:
+        return f"0x{faults:04x} (names: libpoursim not found)"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     ap = cli.ArgumentParser(prog="pour-lcmlog", description=__doc__.split("\n\n")[0])
     ap.add_argument("log", type=Path, help="LCM log file (lcm-logger)")
@@ -378,7 +389,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"plant from {eps[0]['source']}")
     if "controller" in s:
         c = s["controller"]
-        print(f"controller: mode {c['mode']}  faults 0x{c['faults']:04x}  overruns {c['overruns']}"
+        print(f"controller: mode {c['mode']}  faults {_fault_text(c['faults'])}  overruns {c['overruns']}"
               f"  dropped {c['messages_dropped']}  step max {c['step_time_max_ns']} ns  weights {c['weights_hash']}")
     if a.out:
         print(f"plots: {a.out / 'traces.png'}, {a.out / 'latency.png'}; summary: {a.out / 'summary.json'}")
