@@ -124,6 +124,7 @@ def _parse_block(root: Path, module: str) -> dict[str, Register]:
 _READER_FN = r"^\s*pub fn {name}\(&self\) -> (\w+)_R\b"
 _READER_TYPE = r"^pub type {t}_R = crate::(?:Bit|Field)Reader<(\w+)>;"
 _READER_USE = r"^pub use (\w+)_R as {t}_R;"
+_READER_ELSEWHERE = r"^pub use (?:super|crate::stm32g431::(\w+))::(\w+)::{t}_R;"
 _VARIANT = re.compile(r"^\s*///(\d+): (.*)$")
 
 
@@ -138,6 +139,12 @@ def field_meanings(path: Path, name: str) -> dict[int, str] | None:
         m = re.search(_READER_TYPE.format(t=re.escape(t)), text, re.M)
         if m:
             break
+        other = re.search(_READER_ELSEWHERE.format(t=re.escape(t)), text, re.M)
+        if other:  # a reader another register's file declares (AFRH's AFRL's, GPIOB's GPIOA's)
+            module, reg = other.group(1), other.group(2)
+            path = path.parent / f"{reg}.rs" if module is None else path.parents[1] / module / f"{reg}.rs"
+            text = _read(path)
+            continue
         m = re.search(_READER_USE.format(t=re.escape(t)), text, re.M)
         if not m:
             return None
@@ -186,7 +193,8 @@ def compare_writes(crate: Crate, blocks_of: dict[str, list[str]], writes: list[t
             continue
         if intent == "status":
             continue
-        modules = blocks_of.get(block, [])
+        modules = blocks_of.get(block) or ([crate.bases[CRATE_NAME.get(block, block)][0]]
+                                           if CRATE_NAME.get(block, block) in crate.bases else [])  # an instance
         theirs = crate.block(modules[0]).get(reg.lower()) if modules else None
         meanings = field_meanings(theirs.path, name.lower()) if theirs and theirs.path else None
         if intent.startswith("="):

@@ -1,63 +1,25 @@
 /* SPDX-License-Identifier: MIT */
 /* The crystal timed against HSI16 and used, against register files a second thread keeps moving as the chip
- * would: CFGR.SWS follows CFGR.SW, LPTIM1 reports ARROK once enabled and counts HSI16 through its prescaler
- * once started, SysTick counts down at HCLK (the core's clock / 2 while the crystal is timed). Both counters
- * follow one emulated time, the host's monotonic clock slowed 10 times and advanced at most 1 us per step of
- * the thread: the ratio of their counts is that of the two oscillators, and a thread descheduled on a loaded
- * machine stalls the chip's time rather than making it jump. Host only: a POSIX thread plays the chip. */
+ * would (clock_chip.h). Host only: a POSIX thread plays the chip. */
 #define _POSIX_C_SOURCE 200112L /* clock_gettime under -std=c99 */
 #include <pthread.h>
 #include <string.h>
-#include <time.h>
 
 #include "clock.h"
+#include "clock_chip.h"
 #include "stm32g431_regs.h"
 #include "unity.h"
-
-#define SLOWDOWN 10u
-#define STEP_MAX_NS 1000u
 
 static volatile uint32_t rcc[0x100 / 4], pwr[0x100 / 4], flash[0x100 / 4], lptim[0x40 / 4], systick[0x10 / 4];
 static const pour_clock_hw_t hw = {rcc, pwr, flash, lptim, systick};
 static volatile int running; /* the test's flag to the chip thread (set before it starts, cleared to end it) */
-static uint64_t crystal_mhz_x10; /* the emulated crystal [0.1 MHz] */
-
-static uint64_t host_ns(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
-}
+static clock_chip_t chip_state = {rcc, lptim, systick, 0u, 0u, 0u, 0u, 0u};
 
 static void *chip(void *arg) {
   (void)arg;
-  uint64_t last = host_ns(), now = 0u, lptim_start = 0u, systick_start = 0u; /* the chip's times [ns] */
+  clock_chip_start(&chip_state);
   while (running) {
-    const uint64_t host = host_ns(), step = (host - last) / SLOWDOWN;
-    last = host;
-    now += step < STEP_MAX_NS ? step : STEP_MAX_NS;
-    const uint32_t cfgr = rcc[POUR_RCC_CFGR];
-    const uint32_t sw = POUR_GET(RCC, CFGR, SW, cfgr);
-    if (POUR_GET(RCC, CFGR, SWS, cfgr) != sw) { /* written only on a switch, while the code only polls */
-      rcc[POUR_RCC_CFGR] = (cfgr & ~POUR_MSK(RCC, CFGR, SWS)) | POUR_VAL(RCC, CFGR, SWS, sw);
-    }
-    const uint32_t cr = lptim[POUR_LPTIM_CR];
-    if ((cr & POUR_MSK(LPTIM, CR, ENABLE)) != 0u && lptim[POUR_LPTIM_ARR] != 0u) {
-      lptim[POUR_LPTIM_ISR] |= POUR_MSK(LPTIM, ISR, ARROK);
-    }
-    if ((cr & POUR_MSK(LPTIM, CR, CNTSTRT)) == 0u) {
-      lptim_start = 0u;
-    } else {
-      lptim_start = lptim_start != 0u ? lptim_start : now;
-      const uint64_t presc = 1u << POUR_GET(LPTIM, CFGR, PRESC, lptim[POUR_LPTIM_CFGR]);
-      lptim[POUR_LPTIM_CNT] = (uint32_t)((now - lptim_start) * 16u / 1000u / presc) & 0xFFFFu; /* HSI16 */
-    }
-    if ((systick[POUR_SYST_CSR] & POUR_SYST_CSR_ENABLE) == 0u || sw != 2u) {
-      systick_start = 0u;
-    } else {
-      systick_start = systick_start != 0u ? systick_start : now;
-      const uint64_t ticks = (now - systick_start) * crystal_mhz_x10 / 20000u; /* crystal / 2 */
-      systick[POUR_SYST_CVR] = (uint32_t)(0u - ticks) & POUR_SYST_MAX;
-    }
+    clock_chip_step(&chip_state);
   }
   return NULL;
 }
@@ -68,7 +30,7 @@ static uint32_t hz, crystal;
 static pour_clock_source_t source;
 
 static void start_chip(uint32_t mhz_x10) {
-  crystal_mhz_x10 = mhz_x10;
+  chip_state.crystal_mhz_x10 = mhz_x10;
   running = 1;
   TEST_ASSERT_EQUAL_INT(0, pthread_create(&thread, NULL, chip, NULL));
 }

@@ -200,3 +200,87 @@ def test_bad_input_is_refused_with_a_reason(crate, table, tmp_path, capsys):
     bad.write_text("PERIPH NOPE NOPE 0x1\n")
     status, out = run(crate, bad, capsys)
     assert status == 1 and "NOPE: no such peripheral" in out
+
+
+def _mutated(table: Path, tmp_path: Path, swaps: dict[str, str]) -> Path:
+    text = table.read_text()
+    for good, bad in swaps.items():
+        assert good + "\n" in text, good
+        text = text.replace(good + "\n", bad + "\n")
+    out = tmp_path / "table.txt"
+    out.write_text(text)
+    return out
+
+
+def test_a_wrong_adc_sample_time_or_trigger_fails(crate, table, tmp_path, capsys):
+    """U sampled for 2.5 cycles instead of ST's 6.5, the bus for 6.5 instead of 47.5, a falling-edge trigger."""
+    bad = _mutated(table, tmp_path, {"WRITE ADC1 SMPR1 SMP3 1": "WRITE ADC1 SMPR1 SMP3 0",
+                                     "WRITE ADC1 SMPR1 SMP1 4": "WRITE ADC1 SMPR1 SMP1 1",
+                                     "WRITE ADC2 JSQR JEXTEN 1": "WRITE ADC2 JSQR JEXTEN 2",
+                                     "WRITE ADC1 JSQR JSQ2 12": "WRITE ADC1 JSQR JSQ2 18"})
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert "WRITE ADC1.SMPR1.SMP3 = 0 means '2.5 ADC clock cycles', the intent is '6.5 ADC clock cycles'" in out
+    assert "WRITE ADC1.SMPR1.SMP1 = 1 means '6.5 ADC clock cycles', the intent is '47.5 ADC clock cycles'" in out
+    assert "WRITE ADC2.JSQR.JEXTEN = 2 means 'Trigger detection on the falling edge'" in out
+    assert "WRITE ADC1.JSQR.JSQ2 = 18: the intent is 12" in out
+
+
+def test_a_wrong_clock_fails(crate, table, tmp_path, capsys):
+    """The PLL from HSI16 instead of the crystal, three flash wait states at 170 MHz, range 1 normal."""
+    bad = _mutated(table, tmp_path, {"WRITE RCC PLLCFGR PLLSRC 3": "WRITE RCC PLLCFGR PLLSRC 2",
+                                     "WRITE FLASH ACR LATENCY 4": "WRITE FLASH ACR LATENCY 3",
+                                     "WRITE PWR CR5 R1MODE 0": "WRITE PWR CR5 R1MODE 1"})
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert "WRITE RCC.PLLCFGR.PLLSRC = 2 means 'HSI16 sent to PLL input', the intent is 'HSE sent to PLL input'" in out
+    assert "WRITE FLASH.ACR.LATENCY = 3 means 'Three Wait States (Vcore Boost 1 (<= 136MHz)" in out
+    assert "WRITE PWR.CR5.R1MODE = 1: the intent is 0" in out
+
+
+def test_a_pin_in_the_wrong_mode_fails(crate, table, tmp_path, capsys):
+    """A gate pin left an output instead of TIM1's alternate function, a shunt input digital, the power enable
+    driven high at start-up, an encoder pin on AF1."""
+    bad = _mutated(table, tmp_path, {"WRITE GPIOA MODER MODER8 2": "WRITE GPIOA MODER MODER8 1",
+                                     "WRITE GPIOA MODER MODER1 3": "WRITE GPIOA MODER MODER1 0",
+                                     "WRITE GPIOA ODR ODR15 0": "WRITE GPIOA ODR ODR15 1",
+                                     "WRITE GPIOB AFRL AFRL6 2": "WRITE GPIOB AFRL AFRL6 1"})
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert "WRITE GPIOA.MODER.MODER8 = 1 means 'General purpose output mode', the intent is 'Alternate function mode'" in out
+    assert "WRITE GPIOA.MODER.MODER1 = 0 means 'Input mode (reset state)', the intent is 'Analog mode'" in out
+    assert "WRITE GPIOA.ODR.ODR15 = 1 means 'Set output to logic high'" in out
+    assert "WRITE GPIOB.AFRL.AFRL6 = 1 means 'AF1', the intent is 'AF2'" in out
+
+
+def test_a_wrong_watchdog_prescaler_fails(crate, table, tmp_path, capsys):
+    """LSI / 8 doubles the 10 ms timeout; a reload one count short."""
+    bad = _mutated(table, tmp_path, {"WRITE IWDG PR PR 0": "WRITE IWDG PR PR 1",
+                                     "WRITE IWDG RLR RL 84": "WRITE IWDG RLR RL 83"})
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    assert "WRITE IWDG.PR.PR = 1 means 'Divider /8', the intent is 'Divider /4'" in out
+    assert "WRITE IWDG.RLR.RL = 83: the intent is 84" in out
+
+
+def test_a_wrong_fdcan_mode_fails(crate, table, tmp_path, capsys):
+    """FD frames on, bus monitoring, a prescaler that gives 1.13 Mbit/s, non-matching frames accepted."""
+    bad = _mutated(table, tmp_path, {"WRITE FDCAN CCCR FDOE 0": "WRITE FDCAN CCCR FDOE 1",
+                                     "WRITE FDCAN CCCR MON 0": "WRITE FDCAN CCCR MON 1",
+                                     "WRITE FDCAN NBTP NBRP 9": "WRITE FDCAN NBTP NBRP 8",
+                                     "WRITE FDCAN RXGFC ANFS 2": "WRITE FDCAN RXGFC ANFS 0"})
+    status, out = run(crate, bad, capsys)
+    assert status == 1
+    for field, want in (("CCCR.FDOE = 1", 0), ("CCCR.MON = 1", 0), ("NBTP.NBRP = 8", 9), ("RXGFC.ANFS = 0", 2)):
+        assert f"WRITE FDCAN.{field}: the intent is {want}" in out
+
+
+def test_every_pin_the_board_sets_up_is_decoded(table):
+    """The pins with GPIO WRITE lines are the pins board_stm32g431.c sets up, no more (the rest stay at reset)."""
+    text = table.read_text()
+    pins = {line.split()[2]: line.split()[1] for line in text.splitlines() if line.startswith("PIN ")}
+    moder = [w.split() for w in text.splitlines() if w.startswith("WRITE GPIO") and w.split()[2] == "MODER"]
+    written = {"P" + w[1][4] + w[3][len("MODER"):] for w in moder}
+    board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board_stm32g431.c").read_text()
+    used = set(re.findall(r"(?:BOARD_PIN|AF_PIN)\((\w+)\)", board_c)) - {"name"}
+    assert {pins[p] for p in written} == used
