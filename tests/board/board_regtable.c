@@ -96,7 +96,7 @@ static int clock_writes(const char *reg, const char *field) {
 
 /* The GPIO ports, each pin set up as board_stm32g431.c does from the board's table: a GPIO OUT pin an output
  * driven to its level, a GPIO IN pin an input without pull, a pin with an alternate function that function,
- * any other (the converters' inputs and outputs) analog. BSRR's writes land in ODR, as on the chip. */
+ * any other (the converters' inputs and outputs) analog; TIM1's gate pins at high speed. BSRR's writes land in ODR, as on the chip. */
 static volatile uint32_t gpio[3][0x400 / 4];
 /* The outputs' levels at start-up (board_stm32g431.c): the brake engaged (low), the power stage off (low),
  * the LED off, the CAN transceiver awake (SHDN low) and terminated (CAN_TERMINATED). */
@@ -130,6 +130,9 @@ static void setup_pin(const char *name, unsigned port, unsigned pin, const char 
   } else if (strcmp(owner, "GPIO") == 0) {
     pour_gpio_input(g, POUR_GPIO_PULL_NONE);
   } else if (af >= 0) {
+    if (strcmp(owner, "TIM1") == 0) {
+      pour_gpio_speed(g, POUR_GPIO_SPEED_HIGH);
+    }
     pour_gpio_alternate(g, (uint32_t)af);
   } else {
     pour_gpio_analog(g);
@@ -149,6 +152,7 @@ static void print_pin(const char *name, const char *letter, unsigned port, unsig
     printf("WRITE GPIO%s OTYPER OT%u %lu\n", letter, pin, (unsigned long)((r[POUR_GPIO_OTYPER] >> pin) & 1u));
     printf("WRITE GPIO%s ODR ODR%u %lu\n", letter, pin, (unsigned long)((r[POUR_GPIO_ODR] >> pin) & 1u));
   } else if (af >= 0) {
+    printf("WRITE GPIO%s OSPEEDR OSPEEDR%u %lu\n", letter, pin, (unsigned long)((r[POUR_GPIO_OSPEEDR] >> (2u * pin)) & 3u));
     const uint32_t afr = pin < 8u ? r[POUR_GPIO_AFRL] : r[POUR_GPIO_AFRH];
     printf("WRITE GPIO%s %s %s%u %lu\n", letter, pin < 8u ? "AFRL" : "AFRH", pin < 8u ? "AFRL" : "AFRH", pin,
            (unsigned long)((afr >> (4u * (pin % 8u))) & 15u));

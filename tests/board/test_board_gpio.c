@@ -47,6 +47,15 @@ static void test_gpio_alternate_UsesAfrlBelowPin8AndAfrhFrom8(void) {
   TEST_ASSERT_EQUAL_HEX32(0xFFFFFFFFu & ~(1u << 22) & ~(1u << 12), port[POUR_GPIO_MODER]); /* 10 for both */
 }
 
+static void test_gpio_speed_SetsOnlyThatPinsSpeed(void) {
+  port[POUR_GPIO_OSPEEDR] = 0x0C000000u; /* port A's reset value: PA13 very high */
+  pour_gpio_speed((pour_gpio_t){port, 8u}, POUR_GPIO_SPEED_HIGH);
+  pour_gpio_speed((pour_gpio_t){port, 15u}, POUR_GPIO_SPEED_HIGH);
+  TEST_ASSERT_EQUAL_HEX32(0x0C000000u | (2u << 16) | (2u << 30), port[POUR_GPIO_OSPEEDR]);
+  pour_gpio_speed((pour_gpio_t){port, 15u}, POUR_GPIO_SPEED_LOW);
+  TEST_ASSERT_EQUAL_HEX32(0x0C000000u | (2u << 16), port[POUR_GPIO_OSPEEDR]);
+}
+
 static void test_gpio_driven_ReadsTheOutputLatch(void) {
   const pour_gpio_t g = {port, 8u};
   TEST_ASSERT_FALSE(pour_gpio_driven(g));
@@ -61,6 +70,7 @@ int main(void) {
   RUN_TEST(test_gpio_output_DrivesTheLevelThenTheMode);
   RUN_TEST(test_gpio_input_SetsThePullAndInputMode);
   RUN_TEST(test_gpio_alternate_UsesAfrlBelowPin8AndAfrhFrom8);
+  RUN_TEST(test_gpio_speed_SetsOnlyThatPinsSpeed);
   RUN_TEST(test_gpio_driven_ReadsTheOutputLatch);
   return UNITY_END();
 }

@@ -100,6 +100,10 @@ def test_every_pin_the_port_uses_is_checked(table):
 def test_every_written_field_has_a_meaning_checked(table):
     writes = [line for line in table.read_text().splitlines() if line.startswith("WRITE ")]
     assert len(writes) >= 80
+    blocks = {w.split()[1] for w in writes}
+    for needed in ("OPAMP", "TIM1", "TIM4", "COMP", "DAC", "ADC1", "ADC2", "ADC12", "RCC", "PWR", "FLASH", "IWDG",
+                   "LPTIM", "FDCAN", "GPIOA", "GPIOB", "GPIOC"):
+        assert needed in blocks, needed  # every peripheral the port's drivers write is decoded
     intents = check_registers.load_intents(INTENTS)
     for w in writes:
         assert tuple(w.split()[1:4]) in intents, w
@@ -240,17 +244,19 @@ def test_a_wrong_clock_fails(crate, table, tmp_path, capsys):
 
 def test_a_pin_in_the_wrong_mode_fails(crate, table, tmp_path, capsys):
     """A gate pin left an output instead of TIM1's alternate function, a shunt input digital, the power enable
-    driven high at start-up, an encoder pin on AF1."""
+    driven high at start-up, an encoder pin on AF1, a gate pin at low speed (the port's old value)."""
     bad = _mutated(table, tmp_path, {"WRITE GPIOA MODER MODER8 2": "WRITE GPIOA MODER MODER8 1",
                                      "WRITE GPIOA MODER MODER1 3": "WRITE GPIOA MODER MODER1 0",
                                      "WRITE GPIOA ODR ODR15 0": "WRITE GPIOA ODR ODR15 1",
-                                     "WRITE GPIOB AFRL AFRL6 2": "WRITE GPIOB AFRL AFRL6 1"})
+                                     "WRITE GPIOB AFRL AFRL6 2": "WRITE GPIOB AFRL AFRL6 1",
+                                     "WRITE GPIOC OSPEEDR OSPEEDR13 2": "WRITE GPIOC OSPEEDR OSPEEDR13 0"})
     status, out = run(crate, bad, capsys)
     assert status == 1
     assert "WRITE GPIOA.MODER.MODER8 = 1 means 'General purpose output mode', the intent is 'Alternate function mode'" in out
     assert "WRITE GPIOA.MODER.MODER1 = 0 means 'Input mode (reset state)', the intent is 'Analog mode'" in out
     assert "WRITE GPIOA.ODR.ODR15 = 1 means 'Set output to logic high'" in out
     assert "WRITE GPIOB.AFRL.AFRL6 = 1 means 'AF1', the intent is 'AF2'" in out
+    assert "WRITE GPIOC.OSPEEDR.OSPEEDR13 = 0 means 'Low speed', the intent is 'High speed'" in out
 
 
 def test_a_wrong_watchdog_prescaler_fails(crate, table, tmp_path, capsys):

@@ -208,7 +208,8 @@ pour_status_t pour_hal_drive_init(void) {
     return POUR_EINVAL;
   }
   for (unsigned i = 0; i < COUNT(gates); ++i) {
-    pour_gpio_alternate(gates[i].pin, gates[i].af); /* the timer, all six off, takes the pins */
+    pour_gpio_speed(gates[i].pin, POUR_GPIO_SPEED_HIGH); /* [mcsdk] HAL_TIM_MspPostInit GPIO_SPEED_FREQ_HIGH */
+    pour_gpio_alternate(gates[i].pin, gates[i].af);      /* the timer, all six off, takes the pins */
   }
   for (unsigned i = 0; i < COUNT(encoder_pins); ++i) {
     pour_gpio_alternate(encoder_pins[i].pin, encoder_pins[i].af);

@@ -46,6 +46,11 @@ void pour_gpio_alternate(pour_gpio_t g, uint32_t af) {
   mode(g, POUR_GPIO_MODE_AF);
 }
 
+void pour_gpio_speed(pour_gpio_t g, uint32_t speed) {
+  set_field(&g.port[POUR_GPIO_OSPEEDR], (uint32_t)POUR_GPIO_OSPEEDR_OSPEEDR0_WIDTH * g.pin,
+            (uint32_t)POUR_GPIO_OSPEEDR_OSPEEDR0_WIDTH, speed);
+}
+
 void pour_gpio_analog(pour_gpio_t g) {
   pull(g, POUR_GPIO_PULL_NONE);
   mode(g, POUR_GPIO_MODE_ANALOG);

@@ -21,6 +21,9 @@ void pour_gpio_input(pour_gpio_t g, uint32_t pull);
 /* Alternate function af (0 .. 15), no pull. */
 void pour_gpio_alternate(pour_gpio_t g, uint32_t af);
 
+/* Output speed (POUR_GPIO_SPEED_*): the edge rate of an output or an alternate function's output. */
+void pour_gpio_speed(pour_gpio_t g, uint32_t speed);
+
 /* Analog (ADC, OPAMP and comparator inputs), no pull. */
 void pour_gpio_analog(pour_gpio_t g);
 

@@ -39,6 +39,7 @@
   R(LPTIM, CNT, 0x1C)                                                                                          \
   R(GPIO, MODER, 0x00)                                                                                         \
   R(GPIO, OTYPER, 0x04)                                                                                        \
+  R(GPIO, OSPEEDR, 0x08)                                                                                       \
   R(GPIO, PUPDR, 0x0C)                                                                                         \
   R(GPIO, IDR, 0x10)                                                                                           \
   R(GPIO, ODR, 0x14)                                                                                           \
@@ -103,6 +104,8 @@
   F(GPIO, MODER, MODER0, 0, 2)                                                                                 \
   F(GPIO, MODER, MODER15, 30, 2)                                                                               \
   F(GPIO, OTYPER, OT0, 0, 1)                                                                                   \
+  F(GPIO, OSPEEDR, OSPEEDR0, 0, 2)                                                                             \
+  F(GPIO, OSPEEDR, OSPEEDR15, 30, 2)                                                                           \
   F(GPIO, PUPDR, PUPDR0, 0, 2)                                                                                 \
   F(GPIO, PUPDR, PUPDR15, 30, 2)                                                                               \
   F(GPIO, IDR, IDR0, 0, 1)                                                                                     \
@@ -127,5 +130,8 @@ POUR_REGS_DECLARE(CHIP);
 #define POUR_GPIO_PULL_NONE 0u
 #define POUR_GPIO_PULL_UP 1u
 #define POUR_GPIO_PULL_DOWN 2u
+/* Output speeds (OSPEEDR), RM0440: 0 low (the reset value of most pins) .. 3 very high. */
+#define POUR_GPIO_SPEED_LOW 0u
+#define POUR_GPIO_SPEED_HIGH 2u
 
 #endif /* POUR_STM32G431_REGS_H */
