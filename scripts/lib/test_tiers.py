@@ -22,7 +22,8 @@ def labels_of(preset: str) -> list[set[str]]:
     """The label set of each test that `ctest --preset preset` would run."""
     res = subprocess.run(["ctest", "--preset", preset, "--show-only=json-v1"], capture_output=True, text=True)
     if res.returncode != 0:
-        raise RuntimeError(f"ctest --preset {preset} cannot list its tests: {res.stderr.strip()[:200]}")
+        first = (res.stderr.strip().splitlines() or ["no message"])[0]
+        raise RuntimeError(f"ctest --preset {preset} cannot list its tests: {first[:200]}")
     tests = json.loads(res.stdout).get("tests", [])
     out = []
     for test in tests:
