@@ -4,8 +4,9 @@
 # the Unity test framework in .deps/unity, and ST's descriptions of the STM32G4 (the stm32g4, stm32g4xx-hal
 # and stm32-metapac crates, in .deps/stm32g4). Idempotent: a second run checks and changes nothing.
 #   ./scripts/setup.sh              all of that
-#   ./scripts/setup.sh --build      what the build and the README's commands need: not the three crates,
-#                                   which only the tests read (scripts/build.sh, scripts/demo.sh)
+#   ./scripts/setup.sh --build      what the build and the README's commands need: not the three crates nor
+#                                   the user-mode Linux kernel, which only the tests use (scripts/build.sh,
+#                                   scripts/demo.sh)
 #   ./scripts/setup.sh --with-sb3   and the optional Stable-Baselines3 extra in .venv (stable-baselines3 and
 #                                   torch from tools/requirements-sb3.lock, about 2.9 GB: pour.examples.sb3_ppo)
 set -euo pipefail
@@ -35,7 +36,7 @@ APT_PACKAGES=(
   can-utils iproute2 kmod patchelf
   default-jdk-headless default-jre fonts-dejavu-core xvfb xauth x11-apps
   python3 python3-venv python3-dev python3-tk libglib2.0-0
-  ca-certificates xz-utils
+  ca-certificates xz-utils curl
   openocd
 )
 
@@ -141,7 +142,10 @@ if [ "$WITH_CRATE" = 1 ]; then
   done
 fi
 
-# The user-mode Linux kernel of the SocketCAN tests (scripts/lib/uml.sh says why not Debian 12's).
-scripts/lib/uml.sh
+# The user-mode Linux kernel of the SocketCAN tests (scripts/lib/uml.sh says why not Debian 12's): the tests
+# only, as the crates.
+if [ "$WITH_CRATE" = 1 ]; then
+  scripts/lib/uml.sh
+fi
 
 log "ok"
