@@ -182,6 +182,11 @@ static q15_t hold_safe(pour_control_t *ctl) {
   return pour_safety_hold(&ctl->safety, torque);
 }
 
+/* FAULT with the active stop under way (it has acted, and is not over). */
+static bool stop_running(const pour_control_t *ctl) {
+  return ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+}
+
 static void count_refused(pour_control_t *ctl) {
   if (ctl->refused != UINT32_MAX) {
     ctl->refused++;
@@ -335,7 +340,7 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
    * tick whose link or drive fault is still asserted is refused too: it would release the brake toward a
    * transport or a drive that is still faulted (the level latches its bit again, but only after a first
    * sample had already started a run). */
-  const bool stopping = ctl->mode == POUR_MODE_FAULT && ctl->stop_ms > 0u && !ctl->stopped;
+  const bool stopping = stop_running(ctl);
   if (in->clear_faults && (stopping || in->link_fault || in->drive_faults != 0u)) {
     count_refused(ctl);
   } else if (in->clear_faults && ctl->mode == POUR_MODE_FAULT) {
@@ -445,7 +450,7 @@ bool pour_control_clear_acceptable(const pour_control_t *ctl, const pour_control
     return false;
   }
   /* The e-stop released this tick turns ESTOP into FAULT with its stop over (update_stage). */
-  return ctl->mode == POUR_MODE_ESTOP || (ctl->mode == POUR_MODE_FAULT && (ctl->stop_ms == 0u || ctl->stopped));
+  return ctl->mode == POUR_MODE_ESTOP || (ctl->mode == POUR_MODE_FAULT && !stop_running(ctl));
 }
 
 STAGE void decide_stage(pour_control_t *ctl) {

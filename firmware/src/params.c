@@ -103,6 +103,11 @@ bool pour_params_writable(const pour_control_t *ctl) {
   return ctl->mode == POUR_MODE_IDLE || (ctl->mode == POUR_MODE_FAULT && ctl->stopped);
 }
 
+static pour_status_t reinit(pour_control_t *ctl, const pour_control_config_t *config,
+                            const pour_policy_weights_t *weights, uint16_t period) {
+  return weights != NULL ? pour_control_init(ctl, config, weights) : pour_control_init_external(ctl, config, period);
+}
+
 pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params,
                                 const pour_policy_weights_t *weights) {
   if (ctl == NULL || params == NULL || !pour_params_writable(ctl)) {
@@ -110,9 +115,8 @@ pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params
   }
   /* What holds the axis survives the new configuration: a latched fault (only clear_faults ends it), the
    * hold after an experiment (only a Reset or another experiment ends it) with the empty bucket it expects,
-   * the last trusted angle that a
-   * restart of the held axis must find again, the drive's trust, the command on the wire (no step) and the
-   * count of refusals the bus reports. */
+   * the last trusted angle that a restart of the held axis must find again, the drive's trust, the command
+   * on the wire (no step) and the count of refusals the bus reports. */
   const pour_control_config_t old = ctl->config;
   const pour_mode_t mode = ctl->mode;
   const uint16_t faults = ctl->faults;
@@ -127,11 +131,9 @@ pour_status_t pour_params_apply(pour_control_t *ctl, const pour_params_t *params
   const q15_t on_wire = ctl->safety.torque;
   /* A controller whose decisions come from outside (no weights) stays one, with its decision period. */
   const uint16_t period = ctl->decision_period_ms;
-  pour_status_t s = weights != NULL ? pour_control_init(ctl, &params->control, weights)
-                                    : pour_control_init_external(ctl, &params->control, period);
+  pour_status_t s = reinit(ctl, &params->control, weights, period);
   if (s != POUR_OK) {
-    /* accepted before, so accepted again */
-    (void)(weights != NULL ? pour_control_init(ctl, &old, weights) : pour_control_init_external(ctl, &old, period));
+    (void)reinit(ctl, &old, weights, period); /* accepted before, so accepted again */
     s = POUR_EINVAL;
   }
   ctl->mode = mode;
