@@ -7,6 +7,8 @@ resolved; the parameter table in docs/can.md and the DBC's ParamId value lists (
   param_table.py check [--header H]        the declaration alone
   param_table.py docs (--check | --write)  docs/can.md's table between its marker comments
   param_table.py dbc --check               every VAL_ ... ParamId list in can/pour.dbc
+  param_table.py fields [--bridge F]       the simulator bridge's field paths (POURSIM_FW_FIELD) against
+                                           every leaf of pour_control_config_t, and POUR_PARAMS's fields
 
 Exit 0 when all is well, 1 with one line per problem (naming the rows involved), 2 on bad usage."""
 from __future__ import annotations
@@ -140,6 +142,64 @@ def dbc(rows: list[dict]) -> int:
     return bad
 
 
+STRUCT = re.compile(r"typedef\s+struct\s*\{(.*?)\}\s*(\w+)\s*;", re.S)
+MEMBER = re.compile(r"^\s*(?:const\s+)?(\w+)\s+(\w+)\s*(\[[^\]]*\])?\s*;", re.M)
+
+
+def structs(include: Path = HEADER.parent) -> dict[str, list[tuple[str, str]]]:
+    """typedef struct {...} name_t; of the firmware's headers: name -> [(type, member)]."""
+    out: dict[str, list[tuple[str, str]]] = {}
+    for h in sorted(include.glob("*.h")):
+        text = re.sub(r"/\*.*?\*/", "", h.read_text(), flags=re.S)
+        for m in STRUCT.finditer(text):
+            out[m.group(2)] = [(t, n) for t, n, _ in MEMBER.findall(m.group(1))]
+    return out
+
+
+def leaves(all_structs: dict, name: str, prefix: str = "") -> list[str]:
+    paths = []
+    for ctype, member in all_structs[name]:
+        if ctype in all_structs:
+            paths += leaves(all_structs, ctype, f"{prefix}{member}.")
+        else:
+            paths.append(prefix + member)
+    return paths
+
+
+def bridge_file() -> Path | None:
+    """The host_sim source that lists the bridge's field paths (wherever the simulator's rooms put it)."""
+    for f in sorted((ROOT / "host_sim").rglob("*.cpp")):
+        if "POURSIM_FW_FIELD(safety." in f.read_text(errors="replace"):
+            return f
+    return None
+
+
+def fields(rows: list[dict], bridge: Path | None) -> int:
+    st = structs()
+    want = leaves(st, "pour_control_config_t")
+    problems = []
+    if bridge is None:
+        problems.append("no host_sim source lists POURSIM_FW_FIELD(...) paths")
+    else:
+        got = re.findall(r"(?<!#define )POURSIM_FW_FIELD\(([\w.]+)\)", bridge.read_text())
+        name = bridge.relative_to(ROOT) if bridge.is_relative_to(ROOT) else bridge
+        for path in want:
+            if path not in got:
+                problems.append(f"{name}: pour_control_config_t.{path} has no POURSIM_FW_FIELD")
+        for path in got:
+            if path not in want:
+                problems.append(f"{name}: POURSIM_FW_FIELD({path}) is no field of pour_control_config_t")
+        for path in sorted({p for p in got if got.count(p) > 1}):
+            problems.append(f"{name}: POURSIM_FW_FIELD({path}) is listed twice")
+    params = leaves(st, "pour_params_t")
+    for r in rows:
+        if r["field"] not in params:
+            problems.append(f"params.h: {r['name']} lives in {r['field']}, no field of pour_params_t")
+    for p in problems:
+        print(p, file=sys.stderr)
+    return 1 if problems else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -150,6 +210,7 @@ def main(argv: list[str] | None = None) -> int:
     g.add_argument("--check", action="store_true")
     g.add_argument("--write", action="store_true")
     sub.add_parser("dbc").add_argument("--check", action="store_true", required=True)
+    sub.add_parser("fields").add_argument("--bridge", type=Path, default=None)
     args = ap.parse_args(argv)
     header = getattr(args, "header", HEADER)
     try:
@@ -161,6 +222,8 @@ def main(argv: list[str] | None = None) -> int:
         return docs(rows, args.write)
     if args.cmd == "dbc":
         return dbc(rows)
+    if args.cmd == "fields":
+        return fields(rows, args.bridge or bridge_file())
     return 0
 
 

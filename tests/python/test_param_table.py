@@ -66,3 +66,30 @@ def test_a_bad_declaration_is_refused_naming_its_rows(tmp_path, old, new, messag
 def test_a_missing_header_is_one_line(tmp_path):
     r = run("check", "--header", str(tmp_path / "none.h"))
     assert r.returncode == 1 and r.stderr.startswith("error: ") and len(r.stderr.splitlines()) == 1, r.stderr
+
+
+def test_the_bridge_lists_every_field_of_the_cores_config():
+    r = run("fields")
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+
+
+def _bridge() -> Path:
+    for f in sorted((ROOT / "host_sim").rglob("*.cpp")):
+        if "POURSIM_FW_FIELD(safety." in f.read_text():
+            return f
+    raise AssertionError("no bridge source")
+
+
+@pytest.mark.parametrize("old,new,message", [
+    ("POURSIM_FW_FIELD(supervisor.window_ms), ", "",
+     "pour_control_config_t.supervisor.window_ms has no POURSIM_FW_FIELD"),
+    ("POURSIM_FW_FIELD(seed),", "POURSIM_FW_FIELD(seed), POURSIM_FW_FIELD(safety.omega_max),",
+     "POURSIM_FW_FIELD(safety.omega_max) is no field of pour_control_config_t"),
+], ids=["a field left out", "a path that is no field"])
+def test_a_bridge_that_drifts_is_named(tmp_path, old, new, message):
+    text = _bridge().read_text()
+    assert text.count(old) == 1, old
+    bad = tmp_path / "core_api.cpp"
+    bad.write_text(text.replace(old, new))
+    r = run("fields", "--bridge", str(bad))
+    assert r.returncode == 1 and r.stderr.strip().splitlines() == [f"{bad}: {message}"], r.stderr
