@@ -86,6 +86,7 @@ void Adc::reset() {
   for (auto& j : jdr_) j = 0;
   regulator_on_s_ = -1.0;
   cal_done_ = ready_at_ = UINT64_MAX;
+  ready_ = false;
   seq_len_ = seq_next_ = 0;
   time_.reset();
 }
@@ -157,6 +158,7 @@ void Adc::advance() {
   }
   if (ready_at_ <= now) {
     isr_ |= 1u << ISR_ADRDY;
+    ready_ = true;
     ready_at_ = UINT64_MAX;
   }
   while (seq_next_ < seq_len_ && seq_end_[seq_next_] <= now) {
@@ -241,11 +243,12 @@ bool Adc::write32(uint32_t off, uint32_t v) {
       if (bit(v, CR_ADDIS) && bit(cr_, CR_ADEN)) {
         if (conv) { link_->stop(me + ": ADDIS while a conversion is on (RM0440 21.4.9: stop it first)"); return true; }
         cr_ &= ~(1u << CR_ADEN);
-        isr_ &= ~(1u << ISR_ADRDY);
+        ready_ = false;
       }
       if (bit(v, CR_JADSTART) && !bit(cr_, CR_JADSTART)) {
-        if (!bit(cr_, CR_ADEN) || !bit(isr_, ISR_ADRDY) || bit(cr_, CR_ADDIS)) {
-          link_->stop(me + ": JADSTART set before ADRDY (RM0440 21.4.20: only with ADEN = 1 and ADDIS = 0)");
+        // The ADC is ready once ADRDY has come (the flag itself may have been cleared by software since).
+        if (!bit(cr_, CR_ADEN) || !ready_ || bit(cr_, CR_ADDIS)) {
+          link_->stop(me + ": JADSTART set before the ADC is ready (RM0440 21.4.20: only with ADEN = 1, ADRDY come, ADDIS = 0)");
           return true;
         }
         cr_ |= 1u << CR_JADSTART;

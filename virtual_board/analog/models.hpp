@@ -175,6 +175,7 @@ class Adc : public Peripheral {
   uint32_t jdr_[4] = {0, 0, 0, 0};
   double regulator_on_s_ = -1.0;  // time ADVREGEN was set; <0: off
   uint64_t cal_done_ = UINT64_MAX, ready_at_ = UINT64_MAX;
+  bool ready_ = false;  // ADRDY has come since ADEN
   // The injected sequence in flight: each rank's end-of-conversion cycle.
   uint32_t seq_jsqr_ = 0;
   int seq_len_ = 0, seq_next_ = 0;

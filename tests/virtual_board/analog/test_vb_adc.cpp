@@ -42,6 +42,19 @@ int main() {
     CHECK(any_stop_contains(b, "ADEN set during calibration"), "stops: %s",
           b.link.stops.empty() ? "(none)" : b.link.stops[0].c_str());
   }
+  {  // JADSTART before ADRDY: the ADC is still starting (tSTAB)
+    Board b;
+    b.w("ADC12_COMMON", C_CCR, 3u << 16);
+    b.w("ADC1", A_CR, 0u);
+    b.w("ADC1", A_CR, 1u << 28);
+    b.run_s(25e-6);
+    b.w("ADC1", A_CR, (1u << 28) | (1u << 31));
+    b.run_s(20e-6);
+    b.w("ADC1", A_CR, (1u << 28) | 1u);
+    b.w("ADC1", A_CR, (1u << 28) | 1u | (1u << 3));
+    CHECK(any_stop_contains(b, "JADSTART set before the ADC is ready"), "stops: %s",
+          b.link.stops.empty() ? "(none)" : b.link.stops[0].c_str());
+  }
   {  // ADVREGEN in deep power-down
     Board b;
     b.w("ADC2", A_CR, (1u << 29) | (1u << 28));
