@@ -172,11 +172,14 @@ void Adc::advance() {
 
 uint64_t Adc::next_event() const {
   uint64_t t = std::min(cal_done_, ready_at_);
-  if (seq_next_ < seq_len_) t = std::min(t, seq_end_[seq_next_]);
+  // Each rank's end is an event when JEOCIE asks for its interrupt; otherwise only the sequence's end (the
+  // flags and JDRx of the ranks between are caught up before each read).
+  if (seq_next_ < seq_len_) t = std::min(t, bit(ier_, ISR_JEOC) ? seq_end_[seq_next_] : seq_end_[seq_len_ - 1]);
   return t;
 }
 
 bool Adc::read32(uint32_t off, uint32_t* v) {
+  if (off == ISR || off == CR || (off >= JDR1 && off <= JDR4)) advance();  // as of now
   switch (off) {
     case ISR: *v = isr_; return true;
     case IER: *v = ier_; return true;

@@ -10,6 +10,7 @@
 #define POUR_VB_ANALOG_HPP
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -57,6 +58,10 @@ class Plant {
     tim1_ = tim1; tim4_ = tim4; comps_ = comps; opamps_ = opamps;
   }
   void reset();
+  // The load on the shaft beyond the options' constant one, e.g. host_sim's bucket through the gear: torque
+  // at the motor [N m] from time [s], shaft angle [rad] and speed [rad/s]; called once per PWM period.
+  using Load = std::function<double(double t, double theta_m, double omega_m)>;
+  void set_load(Load load) { load_ = std::move(load); }
   // Run whole PWM periods of the motor model up to the link's time (the duties from TIM1's active compares).
   void step_to_cycle(const BoardLink* link);
   // The cycle at which the next period starts (for the board's next_event).
@@ -98,6 +103,7 @@ class Plant {
   Comps* comps_ = nullptr;
   Opamps* opamps_ = nullptr;
   uint64_t sample_cycle_ = 0;
+  Load load_;
   double t_ = 0.0, omega_ = 0.0, theta_ = 0.0, torque_ = 0.0;
   uint64_t periods_ = 0;
   uint64_t last_cycles_ = 0;

@@ -155,7 +155,8 @@ void Plant::step_to_cycle(const BoardLink* link) {
     torque_ = impl_->model.period(d, on, w);
     theta_ += w * ts;
     if (!o_.locked_rotor) {
-      const double acc = (torque_ - o_.viscous_nms * omega_ - o_.load_torque_nm) / impl_->inertia;
+      const double extra = load_ ? load_(t_, theta_, omega_) : 0.0;
+      const double acc = (torque_ - o_.viscous_nms * omega_ - o_.load_torque_nm - extra) / impl_->inertia;
       omega_ += acc * ts;
     }
     ++periods_;

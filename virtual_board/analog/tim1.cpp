@@ -241,7 +241,9 @@ void Tim1::advance() {
 }
 
 uint64_t Tim1::next_event() const {
-  uint64_t t = std::min(next_half_, next_trgo2_);
+  // The update events are an event for the board only when their interrupt is enabled: the preload's
+  // transfer and UIF are caught up on each advance() and before each read of the timer's registers.
+  uint64_t t = bit(dier_, DIER_UIE) ? std::min(next_half_, next_trgo2_) : next_trgo2_;
   if (plant_ != nullptr && link_ != nullptr) t = std::min(t, plant_->next_step_cycle(link_));
   return t;
 }
@@ -277,6 +279,7 @@ void Tim1::raise_irqs() {
 }
 
 bool Tim1::read32(uint32_t off, uint32_t* v) {
+  if (off == SR) advance();  // UIF and BIF as of now
   switch (off) {
     case CR1: *v = cr1_ | (counting_up() ? 0u : 1u << 4u); return true;  // DIR read-only in centre-aligned
     case CR2: *v = cr2_; return true;

@@ -86,6 +86,13 @@ int main() {
     const double w_again = spin(kPi / 2, 0.2, &again);
     CHECK(w_again == w_fwd && again == fwd, "the same seed repeats exactly");
   }
+  {  // A load from outside (host_sim's bucket, for the board): with the bridge off it turns the shaft back.
+    Board b;
+    b.set.plant->set_load([](double, double, double) { return 0.02; });
+    tim1_pwm(b, 0, 0, 0, false);
+    b.run_s(20e-3);
+    CHECK(b.set.plant->omega() < -1.0, "the load drives the shaft backward: %.2f rad/s", b.set.plant->omega());
+  }
   {  // Encoder stuck: the count stops while the rotor turns.
     vb::AnalogOptions o;
     o.fault_encoder_stuck = true;

@@ -48,6 +48,23 @@ int main() {
     CHECK(b.set.tim1->deadtime_ticks() == 136u, "DTG 0x84: 136 ticks = 800 ns");
   }
   {
+    // The update interrupt (TIM1_UP, table 97 position 25): each over- and underflow in centre-aligned mode
+    // with RCR = 0, every second one with RCR = 1 (RM0440 28.3.3).
+    for (uint32_t rcr : {0u, 1u}) {
+      Board b;
+      b.w("TIM1", 0x30, rcr);
+      tim1_pwm(b, 0, 0, 0);
+      b.w("TIM1", T1_DIER, 1u);
+      int rises = 0;
+      for (int n = 0; n < 40; ++n) {
+        b.run_s(2.5e-6);
+        if (b.link.irq[vb::IRQ_TIM1_UP]) { ++rises; b.w("TIM1", T1_SR, ~1u); }
+      }
+      // 100 us = 2 periods: 4 update events with RCR = 0, 2 with RCR = 1
+      CHECK(rises == (rcr == 0u ? 4 : 2), "RCR %u: %d update interrupts in two periods", rcr, rises);
+    }
+  }
+  {
     // BDTR DTG's other ranges (RM0440 28.6.21): 0b10xxxxxx: (64 + x) x 2.
     Board b;
     b.w("TIM1", T1_BDTR, 0x80u | 5u);
