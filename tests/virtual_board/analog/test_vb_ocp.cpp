@@ -31,6 +31,19 @@ int main() {
     b.w("DAC3", 0x3C, 0u);
     CHECK(!b.link.stops.empty(), "MODE1 written with EN1 set stops the board");
   }
+  {  // RM0440 22.7.15 DAC_MCR HFSEL: above 160 MHz of AHB clock it must be 10. Strict, the board stops.
+    vb::AnalogOptions o;
+    o.strict_dac_hfsel = true;
+    Board b(o);
+    b.w("DAC3", 0x3C, 3u);
+    b.w("DAC3", 0x00, 1u);
+    CHECK(!b.link.stops.empty() && b.link.stops[0].find("HFSEL = 0") != std::string::npos,
+          "EN1 at 170 MHz with HFSEL 0 stops: %s", b.link.stops.empty() ? "(none)" : b.link.stops[0].c_str());
+    Board ok(o);
+    ok.w("DAC3", 0x3C, 3u | (2u << 14));
+    ok.w("DAC3", 0x00, 1u);
+    CHECK(ok.link.stops.empty(), "HFSEL 10: no stop");
+  }
   // Threshold for 40 A out of the phase into the low side (the shunt's positive voltage):
   //   0.1285625 + 0.571 x 0.003 x 40 = 0.1970825 V -> x 4096 / 3.3 = 244.6 -> 245.
   const uint32_t thr = 245;

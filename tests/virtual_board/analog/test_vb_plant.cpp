@@ -75,6 +75,8 @@ int main() {
     const double code = b.r("ADC1", A_JDR1);
     const double i_adc = (2553.0 - code) * 3.3 / 4096.0 / (16.0 * 0.571 * 0.003);
     CHECK(std::fabs(i_adc - i) < 0.03 * std::fabs(i), "ADC reads %.3f A of %.3f A (code %.0f)", i_adc, i, code);
+    std::printf("stall: I_U %.3f A, V/R %.3f A (%.2f %%), ADC1 JDR1 %.0f -> %.3f A, Vbus %.3f V, R %.4f Ohm\n", i, expect,
+                100.0 * (i - expect) / expect, code, i_adc, vb, r);
   }
   {
     int32_t fwd = 0, back = 0;
@@ -82,6 +84,7 @@ int main() {
     const double w_back = spin(-kPi / 2, 0.2, &back);
     CHECK(w_fwd > 50.0 && fwd > 0, "90 degrees ahead spins forward: %.1f rad/s, %d counts", w_fwd, fwd);
     CHECK(w_back < -50.0 && back < 0, "90 degrees behind spins backward: %.1f rad/s, %d counts", w_back, back);
+    std::printf("spin 0.2 s: forward %.1f rad/s (%d counts), backward %.1f rad/s (%d counts)\n", w_fwd, fwd, w_back, back);
     int32_t again = 0;
     const double w_again = spin(kPi / 2, 0.2, &again);
     CHECK(w_again == w_fwd && again == fwd, "the same seed repeats exactly");
