@@ -105,7 +105,7 @@ class Tim1 : public Peripheral {
   int nsinks_ = 0;
 
   uint32_t cr1_ = 0, cr2_ = 0, smcr_ = 0, dier_ = 0, sr_ = 0, ccmr1_ = 0, ccmr2_ = 0, ccmr3_ = 0, ccer_ = 0;
-  uint32_t psc_ = 0, arr_ = 0xFFFFu, rcr_ = 0, bdtr_ = 0, dtr2_ = 0, ecr_ = 0, tisel_ = 0, af1_ = 1u, af2_ = 1u;
+  uint32_t psc_ = 0, arr_ = 0xFFFFu, rcr_ = 0, bdtr_ = 0, dtr2_ = 0, ecr_ = 0, tisel_ = 0, af1_ = 0, af2_ = 0;
   uint32_t or1_ = 0, dcr_ = 0;
   std::array<uint32_t, 6> ccr_{};         // preload registers
   std::array<uint32_t, 6> ccr_active_{};  // shadows
@@ -269,7 +269,7 @@ class Tim4 : public Peripheral {
   bool write32(uint32_t off, uint32_t v);
   void count(int64_t n);
   uint32_t cr1_ = 0, cr2_ = 0, smcr_ = 0, dier_ = 0, sr_ = 0, ccmr1_ = 0, ccmr2_ = 0, ccer_ = 0, cnt_ = 0;
-  uint32_t psc_ = 0, arr_ = 0xFFFFu, ccr_[4] = {0, 0, 0, 0}, ecr_ = 0, tisel_ = 0, af1_ = 0, af2_ = 0, dcr_ = 0;
+  uint32_t psc_ = 0, arr_ = 0xFFFFFFFFu, ccr_[4] = {0, 0, 0, 0}, ecr_ = 0, tisel_ = 0, af1_ = 0, af2_ = 0, dcr_ = 0;
   int64_t half_ = 0;  // x2 modes: an odd edge waiting for its pair
 };
 

@@ -38,11 +38,13 @@ uint32_t ocm(uint32_t ccmr1, uint32_t ccmr2, uint32_t ccmr3, int ch) {
 }  // namespace
 
 void Tim1::reset() {
-  // SVD reset values: 0 everywhere but ARR 0xFFFF and AF1 / AF2 0x00000001 (BKINE, BK2INE).
+  // The stm32g4 crate's SVD reset values: 0 everywhere but ARR 0xFFFF. (RM0440's TIM1_AF1 / AF2 tables give
+  // BKINE / BK2INE set at reset, as I read them; the SVD gives 0 and the brief asks for the SVD: 0 here. Either
+  // way the BKIN pin is not routed on this board, so the break sources are the comparators alone.)
   cr1_ = cr2_ = smcr_ = dier_ = sr_ = ccmr1_ = ccmr2_ = ccmr3_ = ccer_ = 0;
   psc_ = rcr_ = bdtr_ = dtr2_ = ecr_ = tisel_ = or1_ = dcr_ = 0;
   arr_ = 0xFFFFu;
-  af1_ = af2_ = 1u;
+  af1_ = af2_ = 0u;
   ccr_.fill(0);
   ccr_active_.fill(0);
   arr_active_ = 0xFFFFu;

@@ -21,17 +21,19 @@ enum : uint32_t {
 }  // namespace
 
 void Tim4::reset() {
-  // SVD: 0 everywhere but ARR 0xFFFF (TIM3 / TIM4 are 16-bit on the G4).
+  // SVD (the crate's TIM3 block, which TIM4 shares): 0 everywhere but ARR 0xFFFFFFFF. The counter itself is
+  // 16-bit (RM0440 29.1: TIM3 / TIM4 16-bit): it wraps at ARR's low half.
   cr1_ = cr2_ = smcr_ = dier_ = sr_ = ccmr1_ = ccmr2_ = ccer_ = cnt_ = psc_ = ecr_ = tisel_ = af1_ = af2_ = dcr_ = 0;
-  arr_ = 0xFFFFu;
+  arr_ = 0xFFFFFFFFu;
   for (auto& c : ccr_) c = 0;
   half_ = 0;
 }
 
 void Tim4::count(int64_t n) {
-  const int64_t top = static_cast<int64_t>(arr_) + 1;
+  const int64_t arr16 = static_cast<int64_t>(arr_ & 0xFFFFu);
+  const int64_t top = arr16 + 1;
   int64_t c = static_cast<int64_t>(cnt_) + n;
-  if (c > static_cast<int64_t>(arr_) || c < 0) {
+  if (c > arr16 || c < 0) {
     sr_ |= 1u;  // UIF at each wrap (UDIS clear)
     c = ((c % top) + top) % top;
   }

@@ -7,7 +7,7 @@ using namespace vbt;
 
 int main() {
   Board b;
-  CHECK(b.r("TIM4", 0x2C) == 0xFFFFu, "ARR reset 0xFFFF");
+  CHECK(b.r("TIM4", 0x2C) == 0xFFFFFFFFu, "ARR reset 0xFFFFFFFF (the crate's SVD)");
   CHECK(b.r("TIM4", 0x24) == 0u, "CNT reset 0");
   b.w("TIM4", 0x08, 3u);                     // SMS 011: both inputs' edges
   b.w("TIM4", 0x18, 1u | (1u << 8));         // CC1S = CC2S = 01
