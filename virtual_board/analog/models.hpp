@@ -187,7 +187,7 @@ class Adc : public Peripheral {
 // OPAMP1..3 (RM0440 section 25), base 0x40010300.
 class Opamps : public Peripheral {
  public:
-  Opamps() : Peripheral("OPAMP", 0x40010300u, 0x400u) {}
+  Opamps() : Peripheral("OPAMP", 0x40010300u, 0x100u) {}  // RM0440 table 4: 0x4001 0300 .. 03FF
   bool read(uint32_t offset, unsigned width, uint32_t* value) override;
   bool write(uint32_t offset, unsigned width, uint32_t value) override;
   void reset() override;
@@ -232,7 +232,7 @@ class Dac3 : public Peripheral {
 // COMP1..4 (RM0440 section 24), base 0x40010200; outputs into TIM1's break (TIM1_AF1 BKCMPxE).
 class Comps : public Peripheral {
  public:
-  Comps() : Peripheral("COMP", 0x40010200u, 0x400u) {}
+  Comps() : Peripheral("COMP", 0x40010200u, 0x100u) {}  // RM0440 table 4: 0x4001 0200 .. 02FF
   bool read(uint32_t offset, unsigned width, uint32_t* value) override;
   bool write(uint32_t offset, unsigned width, uint32_t value) override;
   void reset() override;

@@ -14,6 +14,9 @@ int main() {
   CHECK(b.r("OPAMP", 0x00) == 0u && b.r("OPAMP", 0x08) == 0u, "CSR reset 0");
   uint32_t v = 0;
   CHECK(!b.set.opamp->read(0x0C, 4, &v), "OPAMP4 is not on the STM32G431: refused");
+  // The windows of RM0440 table 4 (bases as in the stm32g4 crate): COMP and OPAMP 256 bytes each, adjacent.
+  CHECK(b.set.comp->base() == 0x40010200u && b.set.comp->base() + b.set.comp->size() == b.set.opamp->base(),
+        "COMP's window ends where OPAMP's begins");
   double out = 0.0;
   CHECK(!b.set.opamp->output(0, &out), "disabled: no output");
   b.w("OPAMP", 0x00, OPAMP_PGA16);
