@@ -62,17 +62,6 @@ bool Adc12Common::write32(uint32_t off, uint32_t v) {
   return false;
 }
 
-bool Adc12Common::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Adc12Common::write(uint32_t offset, unsigned width, uint32_t value) {
-  if (width != 4u) return false;
-  return write32(offset, value);
-}
-
 void Adc::reset() {
   // SVD reset values: CR 0x20000000 (DEEPPWD), CFGR 0x80000000 (JQDIS), TR1 0x0FFF0000, TR2 / TR3 0x00FF0000.
   isr_ = ier_ = cfgr2_ = smpr1_ = smpr2_ = dr_ = jsqr_ = awd2cr_ = awd3cr_ = difsel_ = gcomp_ = 0;
@@ -284,18 +273,6 @@ bool Adc::write32(uint32_t off, uint32_t v) {
       if (off >= OFR1 && off <= OFR4) { ofr_[(off - OFR1) / 4u] = v; return true; }
       return false;  // DR and JDRx are read-only: a write is not a register the model covers
   }
-}
-
-bool Adc::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-
-bool Adc::write(uint32_t offset, unsigned width, uint32_t value) {
-  if (width != 4u) return false;  // RM0440 21.7: the ADC's registers are accessed by words
-  return write32(offset, value);
 }
 
 }  // namespace vb

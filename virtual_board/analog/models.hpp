@@ -52,13 +52,31 @@ class TimeBase {
   double seconds_ = 0.0;
 };
 
-// ---------------------------------------------------------------------------------------------------------
-// TIM1 (advanced-control timer, RM0440 section 28). Base 0x40012C00.
-class Tim1 : public Peripheral {
+// One model's registers as 32-bit words: read32 / write32 by aligned offset; narrow accesses (access.hpp)
+// merged here, once for every model.
+class RegPeripheral : public Peripheral {
  public:
-  Tim1() : Peripheral("TIM1", 0x40012C00u, 0x400u) {}
+  RegPeripheral(std::string name, uint32_t base, uint32_t size, bool words_only)
+      : Peripheral(std::move(name), base, size), words_only_(words_only) {}
   bool read(uint32_t offset, unsigned width, uint32_t* value) override;
   bool write(uint32_t offset, unsigned width, uint32_t value) override;
+
+ protected:
+  virtual bool read32(uint32_t off, uint32_t* v) = 0;
+  virtual bool write32(uint32_t off, uint32_t v) = 0;
+  // The word a narrow write merges into: the register as read, but for the write-to-clear and the
+  // event-generation registers, whose other lanes must write their no-effect value.
+  virtual uint32_t merge_base(uint32_t /*off*/, uint32_t current) const { return current; }
+
+ private:
+  bool words_only_;
+};
+
+// ---------------------------------------------------------------------------------------------------------
+// TIM1 (advanced-control timer, RM0440 section 28). Base 0x40012C00.
+class Tim1 : public RegPeripheral {
+ public:
+  Tim1() : RegPeripheral("TIM1", 0x40012C00u, 0x400u, false) {}
   void reset() override;
   void advance() override;
   uint64_t next_event() const override;
@@ -84,8 +102,9 @@ class Tim1 : public Peripheral {
   uint64_t period_start_cycle() const { return start_ + static_cast<uint64_t>(periods_done_) * cycles_per_period(); }
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
+  uint32_t merge_base(uint32_t off, uint32_t current) const override;
   uint64_t cycles_per_period() const;
   uint64_t tick_cycles() const { return static_cast<uint64_t>(psc_active_) + 1u; }
   void update_event(bool software);
@@ -122,27 +141,23 @@ class Tim1 : public Peripheral {
 
 // ---------------------------------------------------------------------------------------------------------
 // ADC1, ADC2 (RM0440 section 21) and their common registers ADC12_COMMON (base 0x50000300).
-class Adc12Common : public Peripheral {
+class Adc12Common : public RegPeripheral {
  public:
-  Adc12Common() : Peripheral("ADC12_COMMON", 0x50000300u, 0x100u) {}
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Adc12Common() : RegPeripheral("ADC12_COMMON", 0x50000300u, 0x100u, true) {}
   void reset() override { ccr_ = 0; }
   // HCLK cycles per ADC clock cycle; 0 when CKMODE selects the asynchronous clock (not modelled).
   uint32_t hclk_per_adc_clock() const;
   uint32_t ccr() const { return ccr_; }
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   uint32_t ccr_ = 0;
 };
 
-class Adc : public Peripheral {
+class Adc : public RegPeripheral {
  public:
-  Adc(int index, uint32_t base) : Peripheral(index == 1 ? "ADC1" : "ADC2", base, 0x100u), index_(index) {}
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Adc(int index, uint32_t base) : RegPeripheral(index == 1 ? "ADC1" : "ADC2", base, 0x100u, true), index_(index) {}
   void reset() override;
   void advance() override;
   uint64_t next_event() const override;
@@ -158,8 +173,8 @@ class Adc : public Peripheral {
   uint64_t conversion_cycles(uint32_t channel) const;
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   void update_irq();
   uint32_t sample(uint32_t channel);
   uint32_t sample_at(uint32_t channel, uint64_t cycle);
@@ -185,11 +200,9 @@ class Adc : public Peripheral {
 
 // ---------------------------------------------------------------------------------------------------------
 // OPAMP1..3 (RM0440 section 25), base 0x40010300.
-class Opamps : public Peripheral {
+class Opamps : public RegPeripheral {
  public:
-  Opamps() : Peripheral("OPAMP", 0x40010300u, 0x100u) {}  // RM0440 table 4: 0x4001 0300 .. 03FF
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Opamps() : RegPeripheral("OPAMP", 0x40010300u, 0x100u, false) {}  // RM0440 table 4: 0x4001 0300 .. 03FF
   void reset() override;
   void connect(Plant* plant) { plant_ = plant; }
   // The output pin's voltage of OPAMPk (k = 0..2); false when the op-amp is disabled (nothing drives the pin).
@@ -197,19 +210,17 @@ class Opamps : public Peripheral {
   uint32_t csr(int k) const { return csr_[static_cast<size_t>(k)]; }
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   Plant* plant_ = nullptr;
   std::array<uint32_t, 3> csr_{}, tcmr_{};
 };
 
 // ---------------------------------------------------------------------------------------------------------
 // DAC3 (RM0440 section 22), base 0x50001000: internal channels only (the comparators' thresholds).
-class Dac3 : public Peripheral {
+class Dac3 : public RegPeripheral {
  public:
-  Dac3() : Peripheral("DAC3", 0x50001000u, 0x400u) {}
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Dac3() : RegPeripheral("DAC3", 0x50001000u, 0x400u, false) {}
   void reset() override;
   void advance() override;
   uint64_t next_event() const override;
@@ -219,8 +230,8 @@ class Dac3 : public Peripheral {
   uint32_t mcr() const { return mcr_; }
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   Comps* comps_ = nullptr;
   bool strict_hfsel_ = false;
   uint32_t cr_ = 0, dhr1_ = 0, dhr2_ = 0, dor1_ = 0, dor2_ = 0, sr_ = 0, ccr_ = 0, mcr_ = 0;
@@ -230,11 +241,9 @@ class Dac3 : public Peripheral {
 
 // ---------------------------------------------------------------------------------------------------------
 // COMP1..4 (RM0440 section 24), base 0x40010200; outputs into TIM1's break (TIM1_AF1 BKCMPxE).
-class Comps : public Peripheral {
+class Comps : public RegPeripheral {
  public:
-  Comps() : Peripheral("COMP", 0x40010200u, 0x100u) {}  // RM0440 table 4: 0x4001 0200 .. 02FF
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Comps() : RegPeripheral("COMP", 0x40010200u, 0x100u, false) {}  // RM0440 table 4: 0x4001 0200 .. 02FF
   void reset() override;
   void connect(Plant* plant, Dac3* dac, Tim1* tim1, Opamps* opamps) { plant_ = plant; dac_ = dac; tim1_ = tim1; opamps_ = opamps; }
   // Re-evaluate every comparator (inputs moved); tells TIM1 when an output changed.
@@ -242,8 +251,8 @@ class Comps : public Peripheral {
   bool output(int k) const { return out_[static_cast<size_t>(k)]; }  // k = 0..3 for COMP1..4, after POL
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   Plant* plant_ = nullptr;
   Dac3* dac_ = nullptr;
   Tim1* tim1_ = nullptr;
@@ -254,19 +263,18 @@ class Comps : public Peripheral {
 
 // ---------------------------------------------------------------------------------------------------------
 // TIM4 (general-purpose timer, RM0440 section 29), base 0x40000800, as the encoder's counter.
-class Tim4 : public Peripheral {
+class Tim4 : public RegPeripheral {
  public:
-  Tim4() : Peripheral("TIM4", 0x40000800u, 0x400u) {}
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  Tim4() : RegPeripheral("TIM4", 0x40000800u, 0x400u, false) {}
   void reset() override;
   // The plant's quadrature edges since the last call (x4: every edge of A and B; sign: A leads B = up).
   void edges(int64_t x4_edges);
   uint32_t cnt() const { return cnt_; }
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
+  uint32_t merge_base(uint32_t off, uint32_t current) const override;
   void count(int64_t n);
   uint32_t cr1_ = 0, cr2_ = 0, smcr_ = 0, dier_ = 0, sr_ = 0, ccmr1_ = 0, ccmr2_ = 0, ccer_ = 0, cnt_ = 0;
   uint32_t psc_ = 0, arr_ = 0xFFFFFFFFu, ccr_[4] = {0, 0, 0, 0}, ecr_ = 0, tisel_ = 0, af1_ = 0, af2_ = 0, dcr_ = 0;
@@ -275,18 +283,16 @@ class Tim4 : public Peripheral {
 
 // ---------------------------------------------------------------------------------------------------------
 // LPTIM1 (RM0440 section 33), base 0x40007C00: the clock check's independent counter.
-class Lptim1 : public Peripheral {
+class Lptim1 : public RegPeripheral {
  public:
-  explicit Lptim1(double kernel_hz) : Peripheral("LPTIM1", 0x40007C00u, 0x400u), kernel_hz_(kernel_hz) {}
-  bool read(uint32_t offset, unsigned width, uint32_t* value) override;
-  bool write(uint32_t offset, unsigned width, uint32_t value) override;
+  explicit Lptim1(double kernel_hz) : RegPeripheral("LPTIM1", 0x40007C00u, 0x400u, true), kernel_hz_(kernel_hz) {}
   void reset() override;
   void advance() override;
   uint64_t next_event() const override;
 
  private:
-  bool read32(uint32_t off, uint32_t* v);
-  bool write32(uint32_t off, uint32_t v);
+  bool read32(uint32_t off, uint32_t* v) override;
+  bool write32(uint32_t off, uint32_t v) override;
   uint32_t count_now();
   double kernel_hz_;
   TimeBase time_;

@@ -69,18 +69,6 @@ bool Opamps::write32(uint32_t off, uint32_t v) {
   return false;
 }
 
-bool Opamps::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Opamps::write(uint32_t offset, unsigned width, uint32_t value) {
-  const uint32_t a = offset & ~3u;
-  if (width < 4u) { uint32_t cur = 0; if (!read32(a, &cur)) return false; value = lane_merge(cur, offset, width, value); }
-  return write32(a, value);
-}
-
 // ----------------------------------------------------------------------------------------------- DAC3
 namespace {
 enum : uint32_t {
@@ -225,18 +213,6 @@ bool Dac3::write32(uint32_t off, uint32_t v) {
   }
 }
 
-bool Dac3::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Dac3::write(uint32_t offset, unsigned width, uint32_t value) {
-  const uint32_t a = offset & ~3u;
-  if (width < 4u) { uint32_t cur = 0; if (!read32(a, &cur)) return false; value = lane_merge(cur, offset, width, value); }
-  return write32(a, value);
-}
-
 // ----------------------------------------------------------------------------------------------- COMP
 void Comps::reset() {
   csr_.fill(0);  // SVD: COMP_CxCSR reset 0
@@ -306,18 +282,6 @@ bool Comps::write32(uint32_t off, uint32_t v) {
   c = v & ~(1u << 30u);
   evaluate();
   return true;
-}
-
-bool Comps::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Comps::write(uint32_t offset, unsigned width, uint32_t value) {
-  const uint32_t a = offset & ~3u;
-  if (width < 4u) { uint32_t cur = 0; if (!read32(a, &cur)) return false; value = lane_merge(cur, offset, width, value); }
-  return write32(a, value);
 }
 
 }  // namespace vb

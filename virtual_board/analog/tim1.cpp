@@ -250,6 +250,12 @@ uint64_t Tim1::next_event() const {
   return t;
 }
 
+uint32_t Tim1::merge_base(uint32_t off, uint32_t current) const {
+  if (off == SR) return 0xFFFFFFFFu;  // rc_w0: the other lanes write 1, no effect
+  if (off == EGR) return 0u;          // an event only where a 1 is written
+  return current;
+}
+
 void Tim1::break_inputs_changed() {
   // RM0440 28.3.19: the break input is the OR of the enabled sources, each through its polarity
   // (AF1 BKCMPxP), then BKP gives the active level.
@@ -387,25 +393,6 @@ bool Tim1::write32(uint32_t off, uint32_t v) {
     case DCR: dcr_ = v; return true;
     default: return false;
   }
-}
-
-bool Tim1::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-
-bool Tim1::write(uint32_t offset, unsigned width, uint32_t value) {
-  const uint32_t a = offset & ~3u;
-  if (width < 4u) {
-    uint32_t cur = 0;
-    if (!read32(a, &cur)) return false;
-    if (a == SR) cur = 0xFFFFFFFFu;  // rc_w0: the other lanes write 1, no effect
-    if (a == EGR) cur = 0;
-    value = lane_merge(cur, offset, width, value);
-  }
-  return write32(a, value);
 }
 
 }  // namespace vb

@@ -42,6 +42,12 @@ void Tim4::count(int64_t n) {
   if (link_ != nullptr) link_->set_irq(IRQ_TIM4, (sr_ & dier_ & 1u) != 0u);
 }
 
+uint32_t Tim4::merge_base(uint32_t off, uint32_t current) const {
+  if (off == T_SR) return 0xFFFFFFFFu;
+  if (off == T_EGR) return 0u;
+  return current;
+}
+
 void Tim4::edges(int64_t x4) {
   if (!bit(cr1_, 0u) || x4 == 0) return;  // CEN
   const uint32_t sms = field(smcr_, 0u, 3u) | (field(smcr_, 16u, 1u) << 3u);
@@ -116,23 +122,6 @@ bool Tim4::write32(uint32_t off, uint32_t v) {
       if (off >= T_CCR1 && off <= T_CCR4) { ccr_[(off - T_CCR1) / 4u] = v & 0xFFFFu; return true; }
       return false;
   }
-}
-
-bool Tim4::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Tim4::write(uint32_t offset, unsigned width, uint32_t value) {
-  const uint32_t a = offset & ~3u;
-  if (width < 4u) {
-    uint32_t cur = 0;
-    if (!read32(a, &cur)) return false;
-    if (a == T_SR) cur = 0xFFFFFFFFu;
-    value = lane_merge(cur, offset, width, value);
-  }
-  return write32(a, value);
 }
 
 // --------------------------------------------------------------------------------------------- LPTIM1
@@ -227,17 +216,6 @@ bool Lptim1::write32(uint32_t off, uint32_t v) {
     case L_OR: or_ = v; return true;
     default: return false;  // ISR and CNT are read-only
   }
-}
-
-bool Lptim1::read(uint32_t offset, unsigned width, uint32_t* value) {
-  uint32_t w = 0;
-  if (!read32(offset & ~3u, &w)) return false;
-  *value = lane_read(w, offset, width);
-  return true;
-}
-bool Lptim1::write(uint32_t offset, unsigned width, uint32_t value) {
-  if (width != 4u) return false;
-  return write32(offset, value);
 }
 
 }  // namespace vb

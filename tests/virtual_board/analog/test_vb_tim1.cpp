@@ -65,6 +65,15 @@ int main() {
     }
   }
   {
+    // Narrow accesses: a half-word to TIM1 (RM0440 28.6: half-word and word), refused by the ADC (words only).
+    Board b;
+    CHECK(b.set.tim1->write(T1_CCR1, 2, 0x1234u), "half-word write to CCR1");
+    uint32_t v = 0;
+    CHECK(b.set.tim1->read(T1_CCR1, 2, &v) && v == 0x1234u, "half-word read back: 0x%x", v);
+    CHECK(b.set.tim1->read(T1_ARR + 1, 1, &v) && v == 0xFFu, "a byte of ARR: 0x%x", v);
+    CHECK(!b.set.adc1->write(A_CR, 2, 0u), "a half-word write to the ADC is refused");
+  }
+  {
     // BDTR DTG's other ranges (RM0440 28.6.21): 0b10xxxxxx: (64 + x) x 2.
     Board b;
     b.w("TIM1", T1_BDTR, 0x80u | 5u);
