@@ -2,6 +2,7 @@
 // The Plant's rotor through the gear to host_sim's bucket world (world_coupling.hpp).
 #include "world_coupling.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace vb {
@@ -43,9 +44,19 @@ void WorldCoupling::set_brake(bool engaged) {
 WorldSensors WorldCoupling::sensors() const {
   WorldSensors s;
   s.step = obs_.step;
+  s.encoder = obs_.encoder;
   s.scale_rotating_g = obs_.scale_rotating_g;
   s.scale_target_g = obs_.scale_target_g;
   return s;
+}
+
+bool WorldCoupling::sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const {
+  auto grams = [](int32_t g) {
+    return static_cast<int16_t>(std::max<int32_t>(-POUR_CAN_SCALE_MAX_G, std::min<int32_t>(POUR_CAN_SCALE_MAX_G, g)));
+  };
+  const pour_can_sensors_t m = {static_cast<uint8_t>(obs_.step & 0xFFu), obs_.encoder, grams(obs_.scale_rotating_g),
+                                grams(obs_.scale_target_g)};
+  return pour_can_pack_sensors(node_id, &m, frame) == POUR_OK;
 }
 
 uint64_t WorldCoupling::trajectory_hash() const { return world_ != nullptr ? poursim_trajectory_hash(world_) : 0u; }

@@ -23,6 +23,10 @@
 #include "analog.hpp"
 #include "poursim/poursim.h"
 
+extern "C" {  // the C header carries no linkage of its own
+#include "pour/can_codec.h"
+}
+
 namespace vb {
 
 struct WorldCouplingOptions {
@@ -35,9 +39,11 @@ struct WorldCouplingOptions {
   bool brake = false;             // the holding brake engaged from the start
 };
 
-// The scales as the host reads them (poursim_obs_t's load cells, tared empty) with the step they are for.
+// What the host reads from the rig and sends the board in Sensors frames (poursim_obs_t: the output shaft's
+// absolute encoder and the two load cells, tared empty), with the step they are for.
 struct WorldSensors {
   uint32_t step = 0;
+  uint32_t encoder = 0;
   int32_t scale_rotating_g = 0;
   int32_t scale_target_g = 0;
 };
@@ -56,6 +62,9 @@ class WorldCoupling {
 
   const poursim_obs_t& obs() const { return obs_; }
   WorldSensors sensors() const;
+  // The latest sample as the host's Sensors frame for `node_id` (pour/can_codec.h; the scales saturated to
+  // the frame's +-POUR_CAN_SCALE_MAX_G as host_sim's experiment log sends them); false if it does not pack.
+  bool sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const;
   double bucket_theta() const { return obs_.theta; }   // [rad], 0 upright, + toward the target
   double poured() const { return obs_.v_target; }      // fraction of the liquid in the target
   double spilled() const { return obs_.v_spill; }

@@ -24,6 +24,8 @@ struct Run {
   uint64_t hash = 0;
   uint32_t steps = 0;
   vb::WorldSensors sensors;
+  pour_can_frame_t frame{};
+  bool packed = false;
   bool ok = false;
 };
 
@@ -74,6 +76,7 @@ Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
   r.hash = world.trajectory_hash();
   r.steps = world.steps();
   r.sensors = world.sensors();
+  r.packed = world.sensors_frame(1u, &r.frame);
   return r;
 }
 }  // namespace
@@ -88,6 +91,14 @@ int main() {
     CHECK(std::fabs(r.shaft / 20.0 - r.theta_end) < 0.02, "the shaft follows through the gear: %.4f vs %.4f rad",
           r.shaft / 20.0, r.theta_end);
     CHECK(r.sensors.scale_target_g > 0, "the target's scale reads the poured liquid: %d g", r.sensors.scale_target_g);
+    pour_can_sensors_t m{};
+    CHECK(r.packed && pour_can_unpack_sensors(&r.frame, &m) == POUR_CAN_RX_OK, "the Sensors frame packs and unpacks");
+    CHECK(m.encoder == r.sensors.encoder && m.scale_target_g == r.sensors.scale_target_g &&
+              m.scale_rotating_g == r.sensors.scale_rotating_g && m.seq_low == (r.sensors.step & 0xFFu),
+          "the frame carries the sample: encoder %u / %u, target %d / %d g", m.encoder, r.sensors.encoder, m.scale_target_g,
+          r.sensors.scale_target_g);
+    const double enc_rad = static_cast<double>(r.sensors.encoder) * 2.0 * kPi / (1u << poursim_default_config().encoder_bits);
+    CHECK(std::fabs(enc_rad - r.theta_end) < 0.01, "the output encoder reads the tilt: %.4f vs %.4f rad", enc_rad, r.theta_end);
     std::printf("pour: theta %.3f rad (max %.3f), remaining %.3f of %.3f, poured %.3f, spilled %.3f, shaft/N %.4f rad, "
                 "scales %d g / %d g at step %u\n",
                 r.theta_end, r.theta_max, r.remaining, r.remaining0, r.poured, r.spilled, r.shaft / 20.0,
@@ -99,6 +110,12 @@ int main() {
     CHECK(r.theta_max < 1.0 * kPi / 180.0, "held: |theta| max %.5f rad", r.theta_max);
     CHECK(r.remaining > r.remaining0 - 0.01, "nothing poured: %.3f of %.3f", r.remaining, r.remaining0);
     std::printf("brake: |theta| max %.2e rad over 1 s, remaining %.3f\n", r.theta_max, r.remaining);
+  }
+  {  // The positive torque against the engaged brake (40 N m, twice the drive's peak): still held.
+    const Run r = run(0.12, 1.0, true, 1u);
+    CHECK(r.ok, "the world ran");
+    CHECK(r.theta_max < 1.0 * kPi / 180.0, "held against the motor: |theta| max %.5f rad", r.theta_max);
+    std::printf("brake against the torque: |theta| max %.2e rad over 1 s\n", r.theta_max);
   }
   {  // The same seed repeats exactly; another differs.
     const Run a = run(0.12, 0.5, false, 7u), b = run(0.12, 0.5, false, 7u), c = run(0.12, 0.5, false, 8u);
