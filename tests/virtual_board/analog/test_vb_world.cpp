@@ -29,7 +29,8 @@ struct Run {
   bool ok = false;
 };
 
-// `amplitude` of the vector (0: all three compares at 0, every low side on), `seconds` of it.
+// `amplitude` of the vector (negative: 90 degrees behind the rotor; 0: all three compares at 0, every low side
+// on), `seconds` of it.
 Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
   vb::AnalogOptions o;
   o.seed = seed;
@@ -47,14 +48,14 @@ Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
   b.w("TIM4", 0x08, 3u);
   b.w("TIM4", 0x18, 1u | (1u << 8));
   b.w("TIM4", 0x00, 1u);
-  if (amplitude > 0.0) tim1_pwm(b, ARR_20KHZ / 2, ARR_20KHZ / 2, ARR_20KHZ / 2);
+  if (amplitude != 0.0) tim1_pwm(b, ARR_20KHZ / 2, ARR_20KHZ / 2, ARR_20KHZ / 2);
   else tim1_pwm(b, 0, 0, 0);
   const int cpr = b.set.plant->encoder_cpr(), pp = b.set.plant->pole_pairs();
   const int periods = static_cast<int>(seconds * 20000.0);
   int32_t total = 0;
   uint16_t last = 0;
   for (int n = 0; n < periods && world.ok(); ++n) {
-    if (amplitude > 0.0) {
+    if (amplitude != 0.0) {
       const uint16_t c = static_cast<uint16_t>(b.r("TIM4", 0x24));
       total += static_cast<int16_t>(static_cast<uint16_t>(c - last));
       last = c;
@@ -103,6 +104,12 @@ int main() {
                 "scales %d g / %d g at step %u\n",
                 r.theta_end, r.theta_max, r.remaining, r.remaining0, r.poured, r.spilled, r.shaft / 20.0,
                 r.sensors.scale_rotating_g, r.sensors.scale_target_g, r.sensors.step);
+  }
+  {  // The vector behind the rotor: a negative torque, the bucket goes to its lower stop (-5 deg).
+    const Run r = run(-0.12, 0.5, false, 1u);
+    const double lo = poursim_default_config().theta_min;
+    CHECK(r.ok && std::fabs(r.theta_end - lo) < 0.01, "at the lower stop: %.4f rad (stop %.4f)", r.theta_end, lo);
+    std::printf("negative torque: theta %.4f rad, the stop at %.4f rad\n", r.theta_end, lo);
   }
   {  // Zero duties, the brake engaged: held within 1 degree for 1 s.
     const Run r = run(0.0, 1.0, true, 1u);
