@@ -8,6 +8,16 @@
 namespace vb {
 
 WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
+  if (!(std::isfinite(o.stiffness_nm_per_rad) && o.stiffness_nm_per_rad > 0.0)) {
+    error_ = "world coupling: stiffness_nm_per_rad must be a finite number > 0";
+    plant_ = nullptr;
+    return;
+  }
+  if (!(std::isfinite(o.damping_nms) && o.damping_nms >= 0.0)) {
+    error_ = "world coupling: damping_nms must be a finite number >= 0";
+    plant_ = nullptr;
+    return;
+  }
   poursim_config_t c = poursim_default_config();
   c.seed = o.seed;
   c.drive = 0;                    // the ideal drive as a torque source: the motor is the plant's
@@ -20,7 +30,8 @@ WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plan
   char err[POURSIM_ERR_LEN] = "";
   world_ = poursim_create(&c, err, sizeof err);
   if (world_ == nullptr) {
-    error_ = err;
+    error_ = std::string("world coupling: ") + err;
+    plant_ = nullptr;
     return;
   }
   const poursim_config_t* ep = poursim_episode_config(world_);

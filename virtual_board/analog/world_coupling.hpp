@@ -50,7 +50,9 @@ struct WorldSensors {
 
 class WorldCoupling {
  public:
-  // Creates and resets the world; false from ok() with error() saying why (a config or settle failure).
+  // Creates and resets the world and installs the plant's load; on bad options (stiffness not > 0, damping
+  // < 0, either not finite) or a world that does not settle, ok() is false, error() says why in one line
+  // and the plant keeps no load.
   WorldCoupling(const WorldCouplingOptions& o, Plant* plant);
   ~WorldCoupling();
   WorldCoupling(const WorldCoupling&) = delete;

@@ -132,6 +132,23 @@ int main() {
     std::printf("determinism: seed 7 hash %016llx twice, seed 8 %016llx\n", static_cast<unsigned long long>(a.hash),
                 static_cast<unsigned long long>(c.hash));
   }
+  {  // Bad options: a one-line error, no world, the plant left without a load.
+    const double bad[][2] = {{0.0, 4.4}, {-1.0, 4.4}, {NAN, 4.4}, {2000.0, -1.0}, {2000.0, INFINITY}};
+    for (const auto& kd : bad) {
+      vb::AnalogOptions o;
+      Board b(o);
+      vb::WorldCouplingOptions wo;
+      wo.stiffness_nm_per_rad = kd[0];
+      wo.damping_nms = kd[1];
+      vb::WorldCoupling world(wo, b.set.plant.get());
+      const std::string& e = world.error();
+      CHECK(!world.ok() && !e.empty() && e.find('\n') == std::string::npos &&
+                (e.find(kd[0] > 0.0 ? "damping_nms" : "stiffness_nm_per_rad") != std::string::npos),
+            "k %g, c %g: error '%s'", kd[0], kd[1], e.c_str());
+      b.run_s(2e-3);  // the plant runs on without the world
+      CHECK(world.steps() == 0u, "no world stepped");
+    }
+  }
   if (failures == 0) std::printf("ok\n");
   return failures == 0 ? 0 : 1;
 }
