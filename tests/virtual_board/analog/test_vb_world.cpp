@@ -21,6 +21,7 @@ void compares(Board& b, const double d[3]) {
 struct Run {
   double theta_max = 0.0, theta_end = 0.0, remaining0 = 0.0, remaining = 0.0, poured = 0.0, spilled = 0.0;
   double shaft = 0.0;
+  double t_leaves = -1.0, peak_gear_nm = 0.0;  // first time 1 % of the liquid is out [s]; peak |gear torque|
   uint64_t hash = 0;
   uint32_t steps = 0;
   vb::WorldSensors sensors;
@@ -66,6 +67,8 @@ Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
     }
     b.run_s(50e-6);
     r.theta_max = std::fmax(r.theta_max, std::fabs(world.bucket_theta()));
+    r.peak_gear_nm = std::fmax(r.peak_gear_nm, std::fabs(world.gear_torque()));
+    if (r.t_leaves < 0.0 && world.remaining() < r.remaining0 - 0.01) r.t_leaves = world.obs().t;
   }
   r.ok = world.ok();
   if (!r.ok) std::printf("world: %s\n", world.error().c_str());
@@ -100,9 +103,11 @@ int main() {
           r.sensors.scale_target_g);
     const double enc_rad = static_cast<double>(r.sensors.encoder) * 2.0 * kPi / (1u << poursim_default_config().encoder_bits);
     CHECK(std::fabs(enc_rad - r.theta_end) < 0.01, "the output encoder reads the tilt: %.4f vs %.4f rad", enc_rad, r.theta_end);
-    std::printf("pour: theta %.3f rad (max %.3f), remaining %.3f of %.3f, poured %.3f, spilled %.3f, shaft/N %.4f rad, "
+    // The motor's peak 1.35 N m x N 20 (config_fields.h motor_peak_torque's note), with 20 % for the gear's spring.
+    CHECK(r.peak_gear_nm < 1.35 * 20.0 * 1.2, "the gear carries at most about the motor's peak x N: %.2f N m", r.peak_gear_nm);
+    std::printf("pour: 1 %% out at t = %.3f s, peak gear torque %.2f N m; theta %.3f rad (max %.3f), remaining %.3f of %.3f, poured %.3f, spilled %.3f, shaft/N %.4f rad, "
                 "scales %d g / %d g at step %u\n",
-                r.theta_end, r.theta_max, r.remaining, r.remaining0, r.poured, r.spilled, r.shaft / 20.0,
+                r.t_leaves, r.peak_gear_nm, r.theta_end, r.theta_max, r.remaining, r.remaining0, r.poured, r.spilled, r.shaft / 20.0,
                 r.sensors.scale_rotating_g, r.sensors.scale_target_g, r.sensors.step);
   }
   {  // The vector behind the rotor: a negative torque, the bucket goes to its lower stop (-5 deg).
