@@ -170,7 +170,10 @@ if [ "$WITH_CRATE" = 1 ]; then
     crates=("$CARGO_WORK"/home/registry/cache/*/"$name-$ver.crate")
     shopt -u nullglob
     [ ${#crates[@]} = 1 ] || { log "crates: cargo's cache holds ${#crates[@]} files $name-$ver.crate, not one"; exit 1; }
-    got=$("$PY" scripts/lib/unpack_crate.py "$name" "$ver" "$sha" "${crates[0]}" "$SVD_WORK") || exit 1
+    # cargo keeps a cached .crate file without checking it again: a refused one is removed with its cache.
+    got=$("$PY" scripts/lib/unpack_crate.py "$name" "$ver" "$sha" "${crates[0]}" "$SVD_WORK") \
+      || { log "crates: $name $ver refused; removing .deps/cargo, so that the next run fetches afresh"
+           rm -rf "$CARGO_WORK"; exit 1; }
     [ "$got" = "$dir" ] && [ -f "$dir/$probe" ] || { log "crates: no $probe under '$got'"; exit 1; }
     echo "$sha" > "$SVD_WORK/$name-$ver.sha256.part" && mv "$SVD_WORK/$name-$ver.sha256.part" "$SVD_WORK/$name-$ver.sha256"
     echo "$dir" > "$SVD_WORK/$marker.part" && mv "$SVD_WORK/$marker.part" "$SVD_WORK/$marker"

@@ -81,8 +81,8 @@ def unpack(name: str, version: str, sha256: str, crate: Path, dest: Path) -> Pat
         with os.fdopen(fd, "wb") as out:
             got = _copy(crate, out)
         if got != sha256:
-            raise UnpackError(f"{name} {version}: sha256 {got} of {crate} differs from the pinned {sha256};"
-                              " refused")
+            raise UnpackError(f"{name} {version}: sha256 {got} of {crate.name} differs from the pinned"
+                              f" {sha256}; refused")
         tmp = Path(tempfile.mkdtemp(prefix=f".{top}.", suffix=".unpack", dir=dest))
         try:
             with tarfile.open(part, "r:gz") as tar:
