@@ -23,6 +23,8 @@ _PERIPH = re.compile(r"pub type (\w+) = crate::Periph<(\w+)::RegisterBlock, (0x[
 _DOC = re.compile(r"^\s*///(0x[0-9a-f]+)(?:\.\.(0x[0-9a-f]+))? - ")
 _ACCESSOR = re.compile(r"^\s*pub const fn (\w+)\(&self(?:, n: usize)?\) -> &(\w+)")
 _REG_TYPE = re.compile(r"pub type (\w+) = crate::Reg<(\w+)::\w+>;")
+_REEXPORT = re.compile(r"pub use crate::stm32g431::(\w+)::([a-z]\w*);")
+_REEXPORT_TYPE = re.compile(r"pub use crate::stm32g431::(\w+)::([A-Z]\w*);")
 _UX = re.compile(r"impl crate::RegisterSpec for \w+ \{\s*type Ux = u(8|16|32);")
 _RESET = re.compile(r"const RESET_VALUE: u(?:8|16|32) = (0x[0-9a-f_]+|\d+);")
 
@@ -42,6 +44,11 @@ def registers(root: Path, module: str) -> list[tuple[str, int, int, int]]:
     """(name, offset, width in bytes, reset value) of each register of a module, arrays expanded."""
     text = read(root / f"{module}.rs")
     types = {t: m for t, m in _REG_TYPE.findall(text)}
+    # A register shared with another block is re-exported from it ("pub use crate::stm32g431::gpioa::bsrr;").
+    owners = {sub: mod for mod, sub in _REEXPORT.findall(text)}
+    for mod, t in _REEXPORT_TYPE.findall(text):
+        types.setdefault(t, t.lower())
+        owners.setdefault(t.lower(), mod)
     out: list[tuple[str, int, int, int]] = []
     seen: set[int] = set()
     doc: tuple[int, int | None] | None = None
@@ -58,7 +65,8 @@ def registers(root: Path, module: str) -> list[tuple[str, int, int, int]]:
         doc = None
         if rtype not in types:
             continue  # a cluster (a nested register block): not used by the models
-        spec = read(root / module / f"{types[rtype]}.rs")
+        sub = types[rtype]
+        spec = read(root / owners.get(sub, module) / f"{sub}.rs")
         ux = _UX.search(spec)
         width = int(ux.group(1)) // 8 if ux else 4
         rv = _RESET.search(spec)
