@@ -1,0 +1,150 @@
+# SPDX-License-Identifier: MIT
+"""pour_virtual_board on the flashed image and on small hand-written images (assembled here with the
+cross toolchain): the heartbeat, the watchdog, the flash erase against the watchdog, and bad input.
+
+POUR_VB (the program) and POUR_ELF (build/cortex-m4's pour_firmware.elf) come from tests/virtual_board/CMakeLists.txt.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+VB = os.environ["POUR_VB"]
+ELF = os.environ["POUR_ELF"]
+CC = shutil.which("arm-none-eabi-gcc")
+
+
+def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([VB, *args], capture_output=True, text=True, timeout=timeout)
+
+
+def image(tmp_path: Path, body: str, origin: int = 0x08000000) -> str:
+    """A Cortex-M4 image: the vector table (SP at the top of SRAM, reset to `start`), then body."""
+    assert CC, "arm-none-eabi-gcc is needed (scripts/setup.sh's toolchain)"
+    src = tmp_path / "t.S"
+    src.write_text(
+        ".syntax unified\n.thumb\n.section .text\n.word 0x20008000\n.word start + 1\n.thumb_func\nstart:\n" + body + "\n.ltorg\n"
+    )
+    out = tmp_path / "t.elf"
+    subprocess.run([CC, "-mcpu=cortex-m4", "-mthumb", "-nostdlib", f"-Wl,-Ttext=0x{origin:08x}", "-Wl,-e,start",
+                    "-o", str(out), str(src)], check=True, capture_output=True)
+    return str(out)
+
+
+def test_flashed_image_boots_to_heartbeat():
+    r = run("--elf", ELF, "--placeholder-analog", "--until-heartbeat", "--seconds", "5", "--print-can")
+    assert r.returncode == 0, r.stderr
+    assert "sha256 " in r.stderr
+    ids = {line.split()[3] for line in r.stdout.splitlines() if " tx " in line}
+    assert "001" in ids, r.stdout  # Heartbeat of node 0 (can/pour.dbc BO_ 1)
+    assert "heartbeat at" in r.stdout
+
+
+def test_missed_watchdog_refresh_resets_the_chip():
+    r = run("--elf", ELF, "--placeholder-analog", "--seconds", "3", "--stall-core-at", "500", "--stall-core-ms", "300",
+            "--stop-on-reset")
+    assert r.returncode == 0, r.stderr
+    assert "reset at" in r.stderr and "IWDG: no refresh" in r.stderr, r.stderr
+
+
+def test_healthy_run_has_no_reset():
+    r = run("--elf", ELF, "--placeholder-analog", "--seconds", "3", "--stop-on-reset", "--bench")
+    assert r.returncode == 0, r.stderr
+    assert "reset at" not in r.stderr
+    assert " 0 resets" in r.stdout
+
+
+def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
+    # IWDG at LSI / 4 with RLR 99: 12.5 ms at 32 kHz, then a page erase (24.47 ms max): the chip resets inside it.
+    body = """
+    ldr r0, =0x40003000
+    ldr r1, =0xCCCC
+    str r1, [r0]
+    ldr r1, =0x5555
+    str r1, [r0]
+    movs r1, #0
+    str r1, [r0, #4]
+    movs r1, #99
+    str r1, [r0, #8]
+    ldr r0, =0x40022000
+    ldr r1, =0x45670123
+    str r1, [r0, #8]
+    ldr r1, =0xCDEF89AB
+    str r1, [r0, #8]
+    ldr r1, =(1 << 1) | (63 << 3)
+    str r1, [r0, #0x14]
+    ldr r1, =(1 << 1) | (63 << 3) | (1 << 16)
+    str r1, [r0, #0x14]
+1:  b 1b
+"""
+    r = run("--elf", image(tmp_path, body), "--seconds", "1", "--stop-on-reset")
+    assert "shorter than the flash page erase" in r.stderr, r.stderr
+    assert "IWDG: no refresh" in r.stderr
+
+
+def test_read_of_peripheral_without_model_stops_with_pc_address_name(tmp_path):
+    r = run("--elf", image(tmp_path, "ldr r0, =0x40015400\nldr r1, [r0]\n1: b 1b"), "--seconds", "1")
+    assert r.returncode == 1
+    assert "0x40015400" in r.stderr and "SAI" in r.stderr and "pc 0x0800" in r.stderr, r.stderr
+
+
+def test_unmapped_address_stops(tmp_path):
+    r = run("--elf", image(tmp_path, "ldr r0, =0x60000000\nldr r1, [r0]\n1: b 1b"), "--seconds", "1")
+    assert r.returncode == 1
+    assert "unmapped address 0x60000000" in r.stderr and "pc 0x0800" in r.stderr, r.stderr
+
+
+def test_uncovered_register_of_modelled_peripheral_stops(tmp_path):
+    r = run("--elf", image(tmp_path, "ldr r0, =0x40021000\nldr r1, [r0, #0x14]\n1: b 1b"), "--seconds", "1")
+    assert r.returncode == 1
+    assert "offset 0x014 of RCC" in r.stderr, r.stderr
+
+
+def test_host_elf_refused_by_name():
+    r = run("--elf", VB)  # this program: a 64-bit x86 ELF
+    assert r.returncode == 2
+    assert r.stderr.count("\n") == 1 and "not the STM32G431 image: not a 32-bit little-endian ELF" in r.stderr
+
+
+def test_32_bit_elf_of_another_machine_refused(tmp_path):
+    p = tmp_path / "x86.elf"
+    data = bytearray(Path(image(tmp_path, "1: b 1b")).read_bytes())
+    data[18:20] = (3).to_bytes(2, "little")  # e_machine EM_386
+    p.write_bytes(bytes(data))
+    r = run("--elf", str(p))
+    assert r.returncode == 2 and "not an ARM ELF (e_machine 3)" in r.stderr, r.stderr
+
+
+def test_image_without_vector_table_refused(tmp_path):
+    r = run("--elf", image(tmp_path, "1: b 1b", origin=0x08001000))
+    assert r.returncode == 2 and "no vector table at 0x08000000" in r.stderr, r.stderr
+
+
+def test_image_for_another_memory_map_refused(tmp_path):
+    r = run("--elf", image(tmp_path, "1: b 1b", origin=0x00000000))
+    assert r.returncode == 2 and "outside the 128 KB flash" in r.stderr, r.stderr
+
+
+def test_not_an_elf_refused(tmp_path):
+    p = tmp_path / "x.bin"
+    p.write_bytes(b"\x00" * 100)
+    r = run("--elf", str(p))
+    assert r.returncode == 2 and "not an ELF file" in r.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--seconds", "x"], "bad number for --seconds"),
+    (["--seconds", "-1"], "--seconds must be"),
+    (["--estop", "maybe"], "--estop must be open or closed"),
+    (["--ecc-page", "5"], "--ecc-page must be 62 or 63"),
+    (["--frobnicate"], "unknown option --frobnicate"),
+    (["--elf", "/nonexistent.elf"], "cannot read /nonexistent.elf"),
+])
+def test_bad_options(args, message):
+    r = run(*args)
+    assert r.returncode == 2
+    assert r.stderr.startswith("pour_virtual_board: ") and message in r.stderr and r.stderr.count("\n") == 1
