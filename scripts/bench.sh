@@ -261,7 +261,7 @@ candump -L vcan0 > $guest/candump.log &
 dump=\$!
 \$B/bin/pour_controller --io can:vcan0 --lockstep --stall-ms 5000 > $guest/ctl.txt 2>&1 &
 ctl=\$!
-\$B/bin/can_bridge --iface vcan0 --lcm \$U > $guest/bridge.txt 2>&1 &
+\$B/bin/can_bridge --channel vcan0 --lcm \$U > $guest/bridge.txt 2>&1 &
 br=\$!
 sleep 0.5
 t0=\$(date +%s.%N)

@@ -148,7 +148,10 @@ static int parse_long(const char *opt, const char *s, long lo, long hi, long *ou
 }
 
 static void usage(FILE *f) {
-  fprintf(f, "usage: can_bridge --iface IFACE [--lcm URL] [--node N] [--n-actions A] [--duration S]\n"
+  fprintf(f, "usage: can_bridge --channel CHANNEL [--interface socketcan] [--lcm URL] [--node N] [--n-actions A]\n"
+             "                  [--duration S]\n"
+             "  --channel, --interface: the SocketCAN interface (vcan0, can0) and the backend, as python-can and\n"
+             "  pour-bench name them; socketcan is the only backend\n"
              "  POUR_SENSORS, POUR_COMMAND (LCM) -> Sensors, Estop, Stop, ClearErrors, Reset (CAN, can/pour.dbc)\n"
              "  Torque, Heartbeat (CAN)        -> POUR_TORQUE, POUR_STATUS (LCM)\n"
              "  the torque scale [N.m] and policy hash come from the controller's Identity frame\n"
@@ -165,10 +168,12 @@ int main(int argc, char **argv) {
   const char *url = NULL;
   long duration_s = 0;
   pour_bridge_config_t cfg = pour_bridge_default_config();
-  enum { OPT_IFACE = 256, OPT_LCM, OPT_NODE, OPT_N_ACTIONS, OPT_DURATION, OPT_VERSION };
+  enum { OPT_CHANNEL = 256, OPT_INTERFACE, OPT_IFACE, OPT_LCM, OPT_NODE, OPT_N_ACTIONS, OPT_DURATION, OPT_VERSION };
   static const struct option options[] = {
       {"help", no_argument, NULL, 'h'},
       {"version", no_argument, NULL, OPT_VERSION},
+      {"channel", required_argument, NULL, OPT_CHANNEL},
+      {"interface", required_argument, NULL, OPT_INTERFACE},
       {"iface", required_argument, NULL, OPT_IFACE},
       {"lcm", required_argument, NULL, OPT_LCM},
       {"node", required_argument, NULL, OPT_NODE},
@@ -188,9 +193,18 @@ int main(int argc, char **argv) {
     case OPT_VERSION:
       printf("can_bridge %s\n", POUR_VERSION);
       return 0;
-    case OPT_IFACE:
+    case OPT_CHANNEL:
       iface = optarg;
       break;
+    case OPT_INTERFACE:
+      if (strcmp(optarg, "socketcan") != 0) {
+        fprintf(stderr, "can_bridge: --interface '%s': only socketcan is supported\n", optarg);
+        return 2;
+      }
+      break;
+    case OPT_IFACE:
+      fprintf(stderr, "can_bridge: --iface is now --channel (python-can's name): --channel %s\n", optarg);
+      return 2;
     case OPT_LCM:
       url = optarg;
       break;
@@ -218,7 +232,7 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (iface == NULL) {
-    fprintf(stderr, "can_bridge: --iface IFACE is required (e.g. --iface vcan0)\n");
+    fprintf(stderr, "can_bridge: --channel CHANNEL is required (e.g. --channel vcan0)\n");
     return 2;
   }
   static app_t app;

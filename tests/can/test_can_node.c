@@ -288,6 +288,40 @@ static void receive_command(uint8_t cmd) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
 }
 
+/* A bench with no host stream: commands alone never arm the watchdog, so the e-stop, its release and the clear
+ * leave an idle node IDLE (docs/bringup.md step 5), however long the bus then stays silent; the first sample
+ * arms it, and then silence trips it. */
+static void test_can_node_CommandsAloneNeverArmTheWatchdog(void) {
+  pour_control_output_t out;
+  pour_can_frame_t f;
+  static const struct { uint8_t assert_estop; uint8_t mode; } steps[] = {
+      {1u, POUR_MODE_ESTOP}, {0u, POUR_MODE_FAULT}};
+  for (unsigned i = 0; i < 2u; ++i) {
+    const pour_can_estop_t e = {.assert_estop = steps[i].assert_estop};
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_estop(cfg.node_id, &e, &f));
+    TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
+    for (unsigned t = 0; t < 20u; ++t) {
+      TEST_ASSERT_TRUE(pour_can_node_watchdog(&node, 1u) == false);
+      core_tick(&out);
+    }
+    TEST_ASSERT_EQUAL_UINT8(steps[i].mode, out.mode);
+  }
+  receive_command(POUR_CAN_CMD_CLEAR_ERRORS);
+  for (unsigned t = 0; t < 500u; ++t) {
+    TEST_ASSERT_FALSE(pour_can_node_watchdog(&node, 1u));
+    core_tick(&out);
+  }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_EQUAL_HEX16(0u, out.faults);
+  TEST_ASSERT_TRUE(out.brake);
+  send_sample(1, 0);
+  for (unsigned t = 0; t <= cfg.watchdog_ms; ++t) {
+    (void)pour_can_node_watchdog(&node, 1u);
+  }
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_HEX16(POUR_FAULT_LINK, out.faults & POUR_FAULT_LINK);
+}
+
 /* The Linux port's watchdog runs on the wall clock: it can trip while samples still arrive (a slow guest in
  * lockstep). Then the core itself goes to FAULT, and ClearErrors lets the torque back only through the slew
  * limit (it used to jump from 0 to the core's hidden command, 32767, in one tick). */
@@ -864,6 +898,7 @@ int main(void) {
   RUN_TEST(test_can_node_DriveTelemetryFollowsEveryHeartbeatOnceSet);
   RUN_TEST(test_can_node_DriveFaultFaultsTheCoreAndTheHeartbeatNamesIt);
   RUN_TEST(test_can_node_SilenceTripsWatchdogAfterTimeout);
+  RUN_TEST(test_can_node_CommandsAloneNeverArmTheWatchdog);
   RUN_TEST(test_can_node_WatchdogFaultsTheCoreAndClearRampsThroughSlew);
   RUN_TEST(test_can_node_EstopWinsOverWatchdogSafeTorque);
   RUN_TEST(test_can_node_SeqWrapIsTheNextSampleNotANewRun);

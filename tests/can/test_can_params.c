@@ -145,6 +145,10 @@ static void test_can_params_WriteAppliesOrRefusesWithItsId(void) {
   TEST_ASSERT_EQUAL_INT32(1200000, ctl.config.safety.omega_max_urad_s); /* in force in the core */
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, write_param(POUR_PARAM_ID_encoder_bits, 7, &reply));
   assert_ack(&reply, POUR_CAN_CMD_PARAM_WRITE, POUR_PARAM_ID_encoder_bits, POUR_PARAM_OUT_OF_RANGE);
+  /* 100 rad/s fits the int32 and the old table: the safety case's 2 rad/s refuses it on the node. */
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, write_param(POUR_PARAM_ID_omega_max, 99999999, &reply));
+  assert_ack(&reply, POUR_CAN_CMD_PARAM_WRITE, POUR_PARAM_ID_omega_max, POUR_PARAM_OUT_OF_RANGE);
+  TEST_ASSERT_EQUAL_INT32(1200000, ctl.config.safety.omega_max_urad_s); /* the core keeps what it had */
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_UNKNOWN_ID, write_param(99, 1, &reply));
   assert_ack(&reply, POUR_CAN_CMD_PARAM_WRITE, 99, POUR_PARAM_UNKNOWN_ID);
   /* In range, but the core refuses theta_min >= theta_max: nothing changes. */

@@ -24,6 +24,7 @@
 extern "C" {
 #include "pour/can_node.h"
 #include "pour/control.h"
+#include "pour/faults.h"
 #include "pour/weights_compiled.h"
 }
 #include "poursim/poursim.h"
@@ -283,9 +284,10 @@ int main(int argc, char **argv) {
   // The nominal pour, for the extra spill and the worst moment of a fault: its fastest tick.
   const Scenario nominal = {"nominal", Fault::kNone, 0, 3.0, false};
   const Result ref = run(nominal, seed, base);
-  std::printf("nominal pour (seed %u): poured %.1f %%, spilled %.1f %%, peak |θ̇| %.2f rad/s at %d ms, faults 0x%04x\n",
+  char names[POUR_FAULTS_TEXT_MAX];
+  std::printf("nominal pour (seed %u): poured %.1f %%, spilled %.1f %%, peak |θ̇| %.2f rad/s at %d ms, faults %s\n",
               static_cast<unsigned>(seed), ref.poured, ref.spilled, ref.peak_omega, ref.peak_omega_ms,
-              static_cast<unsigned>(ref.faults));
+              pour_faults_format(ref.faults, names, sizeof names));
   int failures = ref.detect_ms >= 0 || ref.band_violations > 0 ? 1 : 0;  // a nominal pour must not trip
   const std::vector<Scenario> scenarios = {
       {"reversed motor sign", Fault::kMotorReversed, 30, 3.0, false},
@@ -358,8 +360,8 @@ int main(int argc, char **argv) {
     std::snprintf(rest, sizeof rest, r.rest_ms >= 0 ? "%d ms" : "-", r.rest_ms);
     char onset[32];
     std::snprintf(onset, sizeof onset, r.onset_ms >= 0 ? "%d ms" : "-", r.onset_ms);
-    std::printf("| %s | %d ms | %s | %s | 0x%04x | %s | %.1f° .. %.1f° | %.1f %% | %s |\n", sc.name, sc.inject_ms,
-                onset, detect, static_cast<unsigned>(r.faults), rest, r.theta_min_deg, r.theta_max_deg, r.spilled,
+    std::printf("| %s | %d ms | %s | %s | %s | %s | %.1f° .. %.1f° | %.1f %% | %s |\n", sc.name, sc.inject_ms,
+                onset, detect, pour_faults_format(r.faults, names, sizeof names), rest, r.theta_min_deg, r.theta_max_deg, r.spilled,
                 r.ok ? "met" : ("MISSED:" + r.why).c_str());
     failures += r.ok ? 0 : 1;
   }

@@ -23,7 +23,7 @@ def bench(*argv: str) -> subprocess.CompletedProcess:
     (["--expect-hash", "0xnothex", "clear"], "not a 32-bit policy hash"),
     (["config", "set", "--raw", "omega_max", "1.5"], "VALUE: '1.5' is not a decimal integer"),
     (["config", "set", "omega_max", "fast"], "VALUE: 'fast' is not a number (in rad/s"),
-    (["config", "set", "omega_max", "1000"], "omega_max = 1000 rad/s is outside 1e-06 .. 100 rad/s"),
+    (["config", "set", "omega_max", "1000"], "omega_max = 1000 rad/s is outside 1e-06 .. 2 rad/s"),
     (["config", "set", "encoder_bits", "30"], "encoder_bits = 30 bits is outside"),
     (["config", "set", "nosuch", "1"], "no parameter 'nosuch'"),
     (["config", "restore", "nosuch.json"], "nosuch.json: cannot read (No such file or directory)"),
@@ -379,18 +379,18 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         base = ["--interface", "virtual", "--channel", channel]
         assert bench_cli.main(base + ["config", "get", "omega_max", "stop_timeout"]) == 0
         out = capsys.readouterr().out.splitlines()
-        assert out == ["omega_max 1.5 rad/s (range 1e-06 .. 100 rad/s; raw 1500000 urad/s)",
+        assert out == ["omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; raw 1500000 urad/s)",
                        "stop_timeout 4 s (range 0.001 .. 65.535 s; raw 4000 ms)"], out
         assert bench_cli.main(base + ["config", "get", "--raw", "omega_max"]) == 0
         assert capsys.readouterr().out == "omega_max 1500000\n"
-        assert bench_cli.main(base + ["config", "set", "omega_max", "2.25"]) == 0
-        assert capsys.readouterr().out.startswith("omega_max 2.25 rad/s (")
-        assert node.params[4] == 2250000
+        assert bench_cli.main(base + ["config", "set", "omega_max", "1.75"]) == 0
+        assert capsys.readouterr().out.startswith("omega_max 1.75 rad/s (")
+        assert node.params[4] == 1750000
         dump = tmp_path / "node0.json"
         assert bench_cli.main(base + ["config", "dump", str(dump)]) == 0
         assert f"{dump}: 28 parameters of node 0" in capsys.readouterr().out
         saved = bp.load_dump(dump, bp.table())
-        assert saved["omega_max"] == 2250000 and saved["theta_max"] == 2356194 and len(saved) == 28
+        assert saved["omega_max"] == 1750000 and saved["theta_max"] == 2356194 and len(saved) == 28
         # Another set in force: theta_max below the dump's theta_min, so writing theta_min first is refused.
         node.params.update({2: -600000, 3: -500000, 4: 1000})
         doc = json.loads(dump.read_text())
@@ -399,7 +399,7 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         node.writes.clear()
         assert bench_cli.main(base + ["config", "restore", str(dump)]) == 0
         assert "28 parameters restored" in capsys.readouterr().out
-        assert node.params[2] == -400000 and node.params[3] == 2356194 and node.params[4] == 2250000
+        assert node.params[2] == -400000 and node.params[3] == 2356194 and node.params[4] == 1750000
         assert [pid for pid, _ in node.writes].index(2) > [pid for pid, _ in node.writes].index(3)
 
 

@@ -85,13 +85,13 @@ def test_controller_refuses_a_parameter_set_the_core_refuses(tmp_path):
 
 
 @pytest.mark.parametrize("argv, needle", [
-    ([], "--iface IFACE is required"),
-    (["--iface", "vcan0", "--node", "64"], "--node needs an integer in [0, 63]"),
-    (["--iface", "vcan0", "--n-actions", "1"], "--n-actions needs an integer in [2, 16]"),
-    (["--iface", "vcan0", "--frobnicate"], "unknown option"),
-    (["--iface"], "--iface needs a value"),
-    (["--iface=vcan0", "--node=64"], "--node needs an integer in [0, 63]"),  # --key=value as --key value
-    (["--iface", "vcan0", "stray"], "unexpected argument 'stray'"),
+    ([], "--channel CHANNEL is required"),
+    (["--channel", "vcan0", "--node", "64"], "--node needs an integer in [0, 63]"),
+    (["--channel", "vcan0", "--n-actions", "1"], "--n-actions needs an integer in [2, 16]"),
+    (["--channel", "vcan0", "--frobnicate"], "unknown option"),
+    (["--channel"], "--channel needs a value"),
+    (["--channel=vcan0", "--node=64"], "--node needs an integer in [0, 63]"),  # --key=value as --key value
+    (["--channel", "vcan0", "stray"], "unexpected argument 'stray'"),
 ])
 def test_bridge_rejects_bad_arguments(argv, needle):
     r = run(exe("can_bridge"), *argv)
@@ -99,19 +99,30 @@ def test_bridge_rejects_bad_arguments(argv, needle):
     assert needle in r.stderr
 
 
-@pytest.mark.parametrize("iface", [["--iface", "nosuchcan0"], ["--iface=nosuchcan0"]])
+@pytest.mark.parametrize("iface", [["--channel", "nosuchcan0"], ["--channel=nosuchcan0"]])
 def test_bridge_without_the_interface_says_so(iface):
     r = run(exe("can_bridge"), *iface)
     assert r.returncode == 1
     assert "no CAN support" in r.stderr or "no such CAN interface" in r.stderr
 
 
-@pytest.mark.parametrize("argv", [["--iface", "nosuchcan0"], ["--iface=nosuchcan0", "--node=3"]])
+@pytest.mark.parametrize("argv", [["--channel", "nosuchcan0"], ["--channel=nosuchcan0", "--node=3"]])
 def test_controller_takes_the_bridges_can_flags(argv):
-    """pour_controller --iface IFACE [--node N] is its --io can:IFACE[,node=N]."""
+    """pour_controller --channel CHANNEL [--node N] is its --io can:CHANNEL[,node=N]."""
     r = run(exe("pour_controller"), *argv)
     assert r.returncode == 1
     assert "no CAN support" in r.stderr or "no such CAN interface" in r.stderr
+
+
+@pytest.mark.parametrize("program", ["can_bridge", "pour_controller"])
+def test_option_names_are_python_cans(program):
+    """--channel and --interface as python-can and pour-bench name them; the old --iface says what to type."""
+    r = run(exe(program), "--iface", "vcan0")
+    assert r.returncode == 2 and f"{program}: --iface is now --channel" in r.stderr and "--channel vcan0" in r.stderr
+    r = run(exe(program), "--channel", "vcan0", "--interface", "pcan")
+    assert r.returncode == 2 and "only socketcan is supported" in r.stderr, r.stderr
+    r = run(exe(program), "--help")
+    assert r.returncode == 0 and "--channel" in r.stdout and "--interface" in r.stdout and "--iface" not in r.stdout
 
 
 def test_bridge_help_names_the_channels():

@@ -31,12 +31,12 @@ def test_help_documents_the_exit_statuses(bin_dir, program):
 
 def test_node_ids_are_decimal_everywhere(bin_dir):
     # 064 is 52 in octal (a valid node) but 64 in decimal (out of range): both programs must refuse it.
-    r = _run(bin_dir / "can_bridge", "--iface", "nosuchcan0", "--node", "064")
+    r = _run(bin_dir / "can_bridge", "--channel", "nosuchcan0", "--node", "064")
     assert r.returncode == 2 and "--node needs an integer in [0, 63], got '064'" in r.stderr, r.stderr
     r = _run(bin_dir / "pour_controller", "--io", "can:nosuchcan0,node=064")
     assert r.returncode == 2 and "node needs an integer in [0, 63], got '064'" in r.stderr, r.stderr
     # 010 is node 10 for both: accepted, then the missing interface is a failure while running.
-    for argv in ([bin_dir / "can_bridge", "--iface", "nosuchcan0", "--node", "010"],
+    for argv in ([bin_dir / "can_bridge", "--channel", "nosuchcan0", "--node", "010"],
                  [bin_dir / "pour_controller", "--io", "can:nosuchcan0,node=010"]):
         r = _run(*argv)
         assert r.returncode == 1 and ("no CAN support" in r.stderr or "no such CAN interface" in r.stderr), r.stderr

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Property tests (Hypothesis) of the firmware core itself, driven through ctypes (pour.policy.core on libpoursim):
+"""Property tests (Hypothesis) of the firmware core itself, driven through ctypes (pour.core on libpoursim):
 after every tick the rules of docs/safety.md hold — clamp, slew, angle limits, the speed band, e-stop,
 latched faults, the input timeout, refused samples — for generated configs and input scripts.
 
@@ -16,7 +16,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pour.policy import core, weights_h
+from pour import core
+from pour.policy import weights_h
 from pour.sim import poursim
 
 PROFILE = settings(max_examples=300, derandomize=True, database=None, deadline=None,
@@ -29,14 +30,13 @@ CC = os.environ.get("CC") or shutil.which("cc") or "gcc"
 # --- the ctypes structures are the C headers' ----------------------------------------------------------
 
 def test_the_records_that_cross_the_c_api_have_c_sizes():
-    """Each plain record pour.policy.core and pour.sim.poursim mirror (a sample, a state, a tick's inputs and
-    outputs, the simulator's observations, policies, buffers, episodes and checks) has the size the library
-    was built with; the core's own state and configs are handles and opaque blocks, never mirrored."""
+    """Each plain record pour.core and pour.sim.poursim build from the library's table (a sample, a state, a
+    tick's inputs and outputs, the simulator's observations, policies, buffers, episodes and checks) has the
+    size the library was built with; the core's own state and configs are handles and opaque blocks, never mirrored."""
     lib = core.load()
-    records = dict(core.RECORDS)
-    records.update(poursim.RECORDS)
-    for cname, struct in records.items():
-        assert lib.poursim_sizeof(cname.encode()) == ctypes.sizeof(struct), cname
+    for module in (core, poursim):
+        for py_name, cname in module.RECORDS.items():
+            assert lib.poursim_sizeof(cname.encode()) == ctypes.sizeof(getattr(module, py_name)), cname
     assert lib.poursim_sizeof(b"pour_control_t") == 0  # not exported: Python never holds it
 
 

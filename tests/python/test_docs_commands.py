@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The README's and the docs' commands, run as a newcomer would after ./scripts/demo.sh, in a workspace of
+"""The docs' commands, run as a newcomer would after ./scripts/demo.sh, in a workspace of
 their own (outputs land there, not in the checkout; build/, .venv/, configs/ and policy/ are the
 checkout's, policy/ copied). Every command line of the blocks below is either run or listed in SKIPPED
 with the reason, so a new command in the docs has to be classified here.
@@ -87,7 +87,7 @@ def make_workspace(root: Path) -> Path:
 
 @pytest.fixture(scope="module")
 def ws(tmp_path_factory) -> Path:
-    """One for the training commands: the training doc's first commands are the README's, and a pour-train
+    """One for the training commands: the training notes' first commands are the guide's, and a pour-train
     on a finished run folder resumes it (nothing to train)."""
     return make_workspace(tmp_path_factory.mktemp("docs"))
 
@@ -111,9 +111,14 @@ def run_commands(ws: Path, commands: list[str]) -> list[str]:
     return ran
 
 
-def test_readme_training_block_runs_in_order(ws):
-    """README "Train your own policy": train both stages, export, evaluate, pour with the new header."""
-    commands = block_with(SOURCE_DIR / "README.md", "pour-train configs/train/pour11_stage1.toml")
+TRAINING = SOURCE_DIR / "docs" / "training.md"
+NOTES = SOURCE_DIR / "docs" / "notes" / "training-2026-12.md"
+
+
+def test_training_guide_block_runs_in_order(ws):
+    """docs/training.md "Train, export, evaluate": the chain's three runs, export, evaluate, pour with the new
+    header."""
+    commands = block_with(TRAINING, "pour-train configs/train/pour11_stage1.toml")
     ran = run_commands(ws, commands)
     assert len(ran) >= 5
     assert (ws / "runs" / "pour11" / "policy.json").is_file() and (ws / "results" / "robustness" / "robustness.md").is_file()
@@ -121,9 +126,9 @@ def test_readme_training_block_runs_in_order(ws):
 
 
 def test_training_doc_first_commands_run(ws):
-    """docs/training.md "Commands": everything before the convergence runs (which train 11 more runs and
-    feed pour-plots and pour-results: about 25 minutes)."""
-    commands = block_with(SOURCE_DIR / "docs" / "training.md", "pour-results --init")
+    """The training notes' "Commands behind the results": everything before the convergence runs (which train
+    11 more runs and feed pour-plots and pour-results: about 25 minutes)."""
+    commands = block_with(NOTES, "pour-results --init")
     first = commands[:next(i for i, c in enumerate(commands) if c.startswith("for "))]
     ran = run_commands(ws, first)
     assert any("pour-eval agree" in c for c in ran) and any("host_sim" in c for c in ran)
@@ -142,8 +147,8 @@ def test_bench_doc_one_command_pour_runs(tmp_path):
 
 def test_every_cheaper_and_skipped_entry_is_used():
     """No stale entries: each substitution and each skip matches a command of the blocks above."""
-    commands = (block_with(SOURCE_DIR / "README.md", "pour-train configs/train/pour11_stage1.toml")
-                + block_with(SOURCE_DIR / "docs" / "training.md", "pour-results --init"))
+    commands = (block_with(TRAINING, "pour-train configs/train/pour11_stage1.toml")
+                + block_with(NOTES, "pour-results --init"))
     for pattern, _, why in CHEAPER:
         assert any(re.search(pattern, c) for c in commands), why
     for prefix in SKIPPED:

@@ -148,6 +148,7 @@ def test_controller_estop_zeroes_torque_and_latches(controller):
         assert c.stop() == 0
     # The e-stop engaged the brake and cut the power once (hal_brake, hal_power of the Linux port).
     assert "brake_engagements 1 power_cuts 1" in c.out, c.out
+    assert "mode RUN faults none (0x0000)" in c.out, c.out  # the exit line names the mode and the faults
 
 
 def test_controller_drops_a_clear_sent_while_the_estop_is_held(controller):
@@ -200,7 +201,7 @@ def test_controller_real_time_ticks_without_states_and_counts(controller):
     (["--encoder-bits", "25"], "--encoder-bits needs an integer in [8, 24]"),
     (["--frobnicate"], "unknown option"),
     (["--seed=-3"], "--seed needs"),  # --key=value as --key value
-    (["--node", "3"], "--node goes with --iface"),
+    (["--node", "3"], "--node goes with --channel"),
     (["stray"], "unexpected argument 'stray'"),
 ])
 def test_controller_rejects_bad_arguments(controller, argv, needle):

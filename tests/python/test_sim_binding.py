@@ -177,13 +177,8 @@ def test_python_features_equal_the_c_normalisation_bit_for_bit():
         assert np.array_equal(linear.features(*state, *norm), poursim.features(*norm, *state))
 
 
-def test_every_ctypes_mirror_has_the_size_of_its_c_record():
+def test_every_record_class_has_the_size_of_its_c_record():
     lib = poursim.load_library()
-    mirrors = {"poursim_obs_t": poursim.ObsStruct, "poursim_reward_t": poursim.RewardStruct,
-               "poursim_policy_t": poursim.PolicyStruct, "poursim_rollout_buffers_t": poursim.BuffersStruct,
-               "poursim_episode_t": poursim.EpisodeStruct, "poursim_retention_t": poursim.RetentionStruct,
-               "poursim_slosh_t": poursim.SloshStruct, "poursim_drive_check_t": poursim.DriveCheckStruct,
-               "poursim_sensor_check_t": poursim.SensorCheckStruct}
-    for name, mirror in mirrors.items():
-        assert C.sizeof(mirror) == lib.poursim_sizeof(name.encode()), name
+    for py_name, c_name in poursim.RECORDS.items():
+        assert C.sizeof(getattr(poursim, py_name)) == lib.poursim_sizeof(c_name.encode()), c_name
     assert lib.poursim_sizeof(b"poursim_config_t") == 0  # a handle, never mirrored

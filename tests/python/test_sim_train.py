@@ -11,7 +11,8 @@ from gymnasium.utils.env_checker import check_env
 
 import pour.sim.gym_env
 from pour.eval import evaluate
-from pour.policy import core, weights_h
+from pour import core
+from pour.policy import weights_h
 from pour.sim import adapter, envs
 from pour.train import config as cfgmod
 from pour.train import trainer
@@ -54,7 +55,7 @@ def test_sim_gym_env_follows_the_gymnasium_conventions():
 
 
 def test_gym_steps_reproduce_the_c_rollout():
-    """Tick-by-tick stepping (the firmware's pipeline, in C through pour.policy.core) and the C whole-episode
+    """Tick-by-tick stepping (the firmware's pipeline, in C through pour.core) and the C whole-episode
     rollout agree exactly."""
     sim = envs.make_env("sim", 11, 10, 0.6)
     w = np.zeros((6, 11))

@@ -46,11 +46,39 @@ static void test_faults_mode_name_NamesEachMode(void) {
   TEST_ASSERT_NULL(pour_mode_name(255u));
 }
 
+static void test_faults_format_JoinsTheNamesInBitOrder(void) {
+  char buf[POUR_FAULTS_TEXT_MAX];
+  TEST_ASSERT_EQUAL_STRING("none", pour_faults_format(0u, buf, sizeof buf));
+  TEST_ASSERT_EQUAL_STRING("ESTOP", pour_faults_format(POUR_FAULT_ESTOP, buf, sizeof buf));
+  TEST_ASSERT_EQUAL_STRING("STALE_INPUT,SEQ", pour_faults_format(POUR_FAULT_SEQ | POUR_FAULT_STALE_INPUT, buf, sizeof buf));
+  TEST_ASSERT_EQUAL_STRING("LINK,BIT12,BIT15", pour_faults_format(POUR_FAULT_LINK | 0x9000u, buf, sizeof buf));
+}
+
+static void test_faults_format_EveryBitFitsTheDeclaredSize(void) {
+  char buf[POUR_FAULTS_TEXT_MAX + 8u];
+  memset(buf, 'x', sizeof buf);
+  pour_faults_format(0xFFFFu, buf, sizeof buf);
+  TEST_ASSERT_TRUE(strlen(buf) < POUR_FAULTS_TEXT_MAX);
+  TEST_ASSERT_EQUAL_STRING_LEN("STALE_INPUT,ESTOP,", buf, 18);
+}
+
+static void test_faults_format_CutsShortAndTerminates(void) {
+  char buf[8];
+  memset(buf, 'x', sizeof buf);
+  TEST_ASSERT_EQUAL_STRING("STALE_I", pour_faults_format(POUR_FAULT_STALE_INPUT, buf, sizeof buf));
+  char one[1] = {'x'};
+  TEST_ASSERT_EQUAL_STRING("", pour_faults_format(POUR_FAULT_ESTOP, one, sizeof one));
+  TEST_ASSERT_NULL(pour_faults_format(POUR_FAULT_ESTOP, NULL, 4u));
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_faults_name_NamesEveryBitOfTheMaskOnce);
   RUN_TEST(test_faults_name_SpellsTheMacros);
   RUN_TEST(test_faults_name_RefusesZeroAndSeveralBits);
   RUN_TEST(test_faults_mode_name_NamesEachMode);
+  RUN_TEST(test_faults_format_JoinsTheNamesInBitOrder);
+  RUN_TEST(test_faults_format_EveryBitFitsTheDeclaredSize);
+  RUN_TEST(test_faults_format_CutsShortAndTerminates);
   return UNITY_END();
 }

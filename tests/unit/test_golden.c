@@ -4,7 +4,7 @@
  * reference of them (pour.policy.fixedpoint), bit for bit. The stateful parts (the safety envelope with the
  * motion limits, the sensor estimator, whole control-step trajectories from raw sensor samples: modes,
  * faults, decision schedule) against what the C core itself did when the vectors were recorded (through
- * pour.policy.core): regression pins, on the host and the emulated Cortex-M4 alike;
+ * pour.core): regression pins, on the host and the emulated Cortex-M4 alike;
  * tests/python/test_core_properties.py checks them against docs/safety.md. */
 #include <string.h>
 

@@ -61,6 +61,30 @@ static void test_params_set_RefusesOutOfRangeAndUnknownIds(void) {
   TEST_ASSERT_EQUAL_INT32(-3141593, params.control.safety.theta_min_urad);
 }
 
+/* The envelope's ranges are the safety case's (docs/safety.md, "The motion envelope"), not the types': 100 rad/s
+ * fits an int32 and the old table's range, and is refused; the case's own limits pass. */
+static void test_params_set_RefusesAnEnvelopeBeyondTheSafetyCase(void) {
+  const pour_params_t before = params;
+  static const struct {
+    uint8_t id;
+    int32_t limit;
+  } k_cases[] = {
+      {POUR_PARAM_ID_omega_max, 2000000},       {POUR_PARAM_ID_omega_slack, 2000000},
+      {POUR_PARAM_ID_slow_omega, 2000000},      {POUR_PARAM_ID_stop_return_speed, 2000000},
+      {POUR_PARAM_ID_stop_rest_omega, 2000000}, {POUR_PARAM_ID_alpha_max, 3400000},
+      {POUR_PARAM_ID_governor_gain, 16384},     {POUR_PARAM_ID_stop_gain, 16384},
+  };
+  for (unsigned i = 0; i < sizeof k_cases / sizeof k_cases[0]; ++i) {
+    TEST_ASSERT_EQUAL_INT32(k_cases[i].limit, pour_param_info(k_cases[i].id)->max);
+    TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, k_cases[i].id, k_cases[i].limit + 1));
+  }
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, POUR_PARAM_ID_omega_max, 99999999));
+  TEST_ASSERT_EQUAL_MEMORY(&before, &params, sizeof params);
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_omega_max, 2000000));
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_governor_gain, 16384));
+  params = before;
+}
+
 static void test_params_check_RefusesAZeroPastTheEncodersRange(void) {
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_encoder_zero, 131071));
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_check(&params));
@@ -205,6 +229,7 @@ int main(void) {
   RUN_TEST(test_params_table_IsDenseAndEveryDefaultIsInRange);
   RUN_TEST(test_params_get_ReadsTheFieldsTheyLiveIn);
   RUN_TEST(test_params_set_RefusesOutOfRangeAndUnknownIds);
+  RUN_TEST(test_params_set_RefusesAnEnvelopeBeyondTheSafetyCase);
   RUN_TEST(test_params_check_RefusesAZeroPastTheEncodersRange);
   RUN_TEST(test_params_correct_AppliesZeroTareAndFactor);
   RUN_TEST(test_params_blob_RoundTrips);

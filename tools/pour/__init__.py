@@ -1,11 +1,12 @@
 """pour: offline tools for the soymilk-pouring controller.
 
-    pour.paths, pour.atomic, pour.libpoursim   shared: the build tree and the package data, atomic writes,
-                  libpoursim.so opened once
+    pour.paths, pour.atomic, pour.libpoursim, pour.records   shared: the build tree and the package data,
+                  atomic writes, libpoursim.so opened once, the ctypes records built from its layout table
+    pour.core     the firmware core through ctypes: its config, envelope, estimator and control pipeline
     pour.cli      shared: every program's --version and its progress bars (tqdm, off with --quiet)
     pour.policy   the policy as the firmware runs it: float softmax-linear (linear), its bit-exact
                   fixed-point reference (fixedpoint), weights.h (weights_h), policy.json -> weights.h
-                  (export), the firmware core through ctypes (core), golden vectors (golden)
+                  (export), golden vectors (golden)
     pour.sim      the simulator: libpoursim's binding (poursim), the episode record (episode), the trainer's
                   episode sources (envs, adapter) and the Gymnasium environment (gym_env)
     pour.train    REINFORCE: run config (config), gradients (reinforce), rollout executors (executors),
@@ -22,8 +23,9 @@
 A subpackage imports only those on its row (and the shared modules, which import no subpackage);
 tests/python/test_imports.py checks it:
 
-    pour.policy    -
-    pour.sim       policy
+    pour.core      -
+    pour.policy    core
+    pour.sim       policy, core
     pour.train     sim, policy, sysid
     pour.eval      train, sim, policy, sysid
     pour.lcm       eval, sim

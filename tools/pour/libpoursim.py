@@ -2,7 +2,7 @@
 """libpoursim.so, opened once for the whole package.
 
 One shared library holds the simulator (its entry points declared by pour.sim.poursim) and the firmware core
-(declared by pour.policy.core), so both bindings open it here and neither imports the other. pour.paths says
+(declared by pour.core), so both bindings open it here and neither imports the other. pour.paths says
 where it is looked for.
 """
 from __future__ import annotations

@@ -25,7 +25,7 @@ SIM_LIB_REL = Path("lib") / "libpoursim.so"
 # The package's data folder: filled in a built wheel, absent from a checkout (nothing there is a copy).
 PACKAGE_DATA = Path(__file__).resolve().parent / "data"
 # Each data file a wheel ships, by its name in PACKAGE_DATA, and the one source it is copied from.
-DATA_SOURCES = {"pour.dbc": Path("can") / "pour.dbc"}
+DATA_SOURCES = {"pour.dbc": Path("can") / "pour.dbc", "randomised.cfg": Path("configs") / "sim" / "randomised.cfg"}
 LCMTYPES_DIR = "lcmtypes"  # PACKAGE_DATA/lcmtypes/pour_lcm/pour/*.py in a wheel
 # The package's own libpoursim: a wheel's (tools/CMakeLists.txt builds it), absent from a checkout.
 PACKAGE_LIB = Path(__file__).resolve().parent / "lib" / "libpoursim.so"

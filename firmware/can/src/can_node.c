@@ -48,9 +48,10 @@ static void count(uint32_t *c) {
   }
 }
 
-/* A valid sample or command: feeds the watchdog, and arms it on the first one. */
+/* A valid sample or command feeds the watchdog; only a sample arms it. The watchdog guards the sample
+ * stream a pour runs on (RUN needs fresh samples), so an idle node that has never had one, a bench with no
+ * host stream, answers its e-stop and its clear without tripping; once samples have come, silence trips. */
 static void kick(pour_can_node_t *node) {
-  node->armed = true;
   node->ms_since_valid = 0;
 }
 
@@ -138,6 +139,7 @@ pour_can_rx_t pour_can_node_receive(pour_can_node_t *node, const pour_can_frame_
         return drop(node, rc);
       }
       take_sample(node, &m);
+      node->armed = true;
       kick(node);
       break;
     }

@@ -4,6 +4,7 @@
 #ifndef POUR_FAULTS_H
 #define POUR_FAULTS_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 typedef enum {
@@ -36,6 +37,11 @@ typedef enum {
 
 /* The name of one fault bit (a single POUR_FAULT_* value: "STALE_INPUT", ...), NULL for anything else. */
 const char *pour_fault_name(uint16_t bit);
+
+/* A fault word as its names joined by ',' ("none" for 0; bits without a name as "BIT<n>"), written into
+ * buf of size bytes and always terminated (cut short if it does not fit: POUR_FAULTS_TEXT_MAX holds all 16 bits). */
+const char *pour_faults_format(uint16_t faults, char *buf, size_t size);
+#define POUR_FAULTS_TEXT_MAX 128u
 
 /* The name of a mode ("IDLE", "RUN", "FAULT", "ESTOP"), NULL outside pour_mode_t. */
 const char *pour_mode_name(uint8_t mode);

@@ -17,6 +17,13 @@
 
 #define POUR_PARAM_FACTOR_ONE 1000000 /* a scale factor of 1.0 [ppm] */
 
+/* The safety case's ranges (docs/safety.md, "The motion envelope", "Defaults and why"), not the types': a
+ * write beyond them is refused (POUR_PARAM_OUT_OF_RANGE) on the node, over CAN and from flash. They are compiled
+ * in; widening one is a reviewed change of this file and a new firmware build, never a bus write. */
+#define POUR_PARAM_OMEGA_ENVELOPE_URAD_S 2000000   /* 2 rad/s: the hot-liquid limit, omega_max's default */
+#define POUR_PARAM_ALPHA_ENVELOPE_URAD_S2 3400000  /* 3.4 rad/s^2: omega_max in one 1.7 Hz slosh period */
+#define POUR_PARAM_GAIN_ENVELOPE 16384             /* 0.5 tau_max per rad/s: the stiffest stable governor */
+
 /* X(id, name, unit, min, max, C type, field of pour_params_t). Ids are the bus's (ParamId in can/pour.dbc,
  * whose value table names them alike; tests/python/test_can_dbc.py keeps the two equal). */
 #define POUR_PARAMS(X)                                                                                         \
@@ -25,17 +32,17 @@
   X(1, slew_per_tick, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.slew_per_tick)                            \
   X(2, theta_min, "urad", -3141593, 3141593, int32_t, control.safety.theta_min_urad)                         \
   X(3, theta_max, "urad", -3141593, 3141593, int32_t, control.safety.theta_max_urad)                         \
-  X(4, omega_max, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.omega_max_urad_s)        \
-  X(5, alpha_max, "urad/s2", 1000, 1000000000, int32_t, control.safety.alpha_max_urad_s2)                     \
-  X(6, omega_slack, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.omega_slack_urad_s)    \
-  X(7, governor_gain, "Q15/(rad/s)", 1, POUR_Q15_MAX, q15_t, control.safety.torque_per_rad_s)                 \
+  X(4, omega_max, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_max_urad_s)        \
+  X(5, alpha_max, "urad/s2", 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, int32_t, control.safety.alpha_max_urad_s2)                     \
+  X(6, omega_slack, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_slack_urad_s)    \
+  X(7, governor_gain, "Q15/(rad/s)", 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, control.safety.torque_per_rad_s)                 \
   /* the controlled stop (pour_stop_config_t) */                                                              \
   X(8, stop_torque_max, "Q15", 1, POUR_Q15_MAX, q15_t, control.stop.torque_max)                               \
-  X(9, stop_return_speed, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.stop.return_speed_urad_s) \
+  X(9, stop_return_speed, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.stop.return_speed_urad_s) \
   X(10, stop_return_gain, "1/s", 1, UINT16_MAX, uint16_t, control.stop.return_gain_per_s)                     \
-  X(11, stop_gain, "Q15/(rad/s)", 1, POUR_Q15_MAX, q15_t, control.stop.torque_per_rad_s)                      \
+  X(11, stop_gain, "Q15/(rad/s)", 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, control.stop.torque_per_rad_s)                      \
   X(12, stop_rest_theta, "urad", 1, 3141593, int32_t, control.stop.rest_theta_urad)                          \
-  X(13, stop_rest_omega, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.stop.rest_omega_urad_s)  \
+  X(13, stop_rest_omega, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.stop.rest_omega_urad_s)  \
   X(14, stop_timeout, "ms", 1, UINT16_MAX, uint16_t, control.stop.timeout_ms)                                 \
   /* the node and the encoder */                                                                              \
   X(15, node_id, "", 0, 63, uint8_t, node_id)                                                                 \
@@ -50,7 +57,7 @@
   X(22, scale_target_tare, "g", -32767, 32767, int32_t, scale_target_tare_g)                                 \
   /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */          \
   X(23, knee_theta, "urad", 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, control.safety.knee_theta_urad)           \
-  X(24, slow_omega, "urad/s", 1, POUR_SAFETY_OMEGA_MAX_URAD_S, int32_t, control.safety.slow_omega_urad_s)    \
+  X(24, slow_omega, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.slow_omega_urad_s)    \
   X(25, knee_decel, "urad/s2", 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, control.safety.knee_decel_urad_s2) \
   X(26, slow_torque_ff, "Q15", 0, POUR_Q15_MAX, q15_t, control.safety.slow_torque_ff)                         \
   X(27, slow_ki, "1/s", 0, UINT16_MAX, uint16_t, control.safety.slow_ki_per_s)

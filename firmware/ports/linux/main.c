@@ -14,6 +14,7 @@
 #ifdef POUR_SIM_DRIVE
 #include "sim_drive.h"
 #endif
+#include "pour/faults.h"
 #include "pour/weights_compiled.h"
 
 static volatile sig_atomic_t g_stop = 0;
@@ -32,7 +33,8 @@ static void usage(FILE *f) {
           "                         [,params=FILE]: parameters loaded from FILE at start, saved there on\n"
           "                         ParamSave (pour-bench config save); it overrides node= and the options\n"
           "  --lcm URL              the same as --io lcm:URL (the LCM URL's flag in every pour program)\n"
-          "  --iface IFACE [--node N]  the same as --io can:IFACE[,node=N] (as can_bridge spells them)\n"
+          "  --channel CHANNEL [--node N] [--interface socketcan]\n"
+          "                         the same as --io can:CHANNEL[,node=N] (python-can's and pour-bench's names)\n"
           "  --lockstep             one tick per sensor sample (deterministic: what host_sim --lcm runs\n"
           "                         unless --realtime)\n"
           "  --stall-ms N           lockstep: tick at 1 kHz on stale input after N ms without a sample (2000)\n"
@@ -120,7 +122,7 @@ static int open_io(const char *spec, pour_io_t *io, pour_linux_config_t *cfg) {
 
 /* Long options; the values of `val` past the ASCII range name the ones without a short form. */
 enum {
-  OPT_IO = 256, OPT_LCM, OPT_IFACE, OPT_NODE, OPT_LOCKSTEP, OPT_STALL_MS, OPT_DURATION, OPT_MAX_STATES,
+  OPT_IO = 256, OPT_LCM, OPT_CHANNEL, OPT_INTERFACE, OPT_IFACE, OPT_NODE, OPT_LOCKSTEP, OPT_STALL_MS, OPT_DURATION, OPT_MAX_STATES,
   OPT_INPUT_TIMEOUT_MS, OPT_ENCODER_BITS, OPT_SAMPLED, OPT_SEED, OPT_VERBOSE, OPT_VERSION
 };
 
@@ -129,6 +131,8 @@ static const struct option kOptions[] = {
     {"version", no_argument, NULL, OPT_VERSION},
     {"io", required_argument, NULL, OPT_IO},
     {"lcm", required_argument, NULL, OPT_LCM},
+    {"channel", required_argument, NULL, OPT_CHANNEL},
+    {"interface", required_argument, NULL, OPT_INTERFACE},
     {"iface", required_argument, NULL, OPT_IFACE},
     {"node", required_argument, NULL, OPT_NODE},
     {"lockstep", no_argument, NULL, OPT_LOCKSTEP},
@@ -171,9 +175,18 @@ int main(int argc, char **argv) {
       }
       io_spec = spec_buf;
       break;
-    case OPT_IFACE:
+    case OPT_CHANNEL:
       iface = optarg;
       break;
+    case OPT_INTERFACE:
+      if (strcmp(optarg, "socketcan") != 0) {
+        fprintf(stderr, "pour_controller: --interface '%s': only socketcan is supported\n", optarg);
+        return 2;
+      }
+      break;
+    case OPT_IFACE:
+      fprintf(stderr, "pour_controller: --iface is now --channel (python-can's name): --channel %s\n", optarg);
+      return 2;
     case OPT_NODE:
       node = optarg;
       break;
@@ -235,14 +248,14 @@ int main(int argc, char **argv) {
     return 2;
   }
   if (node != NULL && iface == NULL) {
-    fprintf(stderr, "pour_controller: --node goes with --iface IFACE\n");
+    fprintf(stderr, "pour_controller: --node goes with --channel CHANNEL\n");
     return 2;
   }
   if (iface != NULL) {
     const int len = node != NULL ? snprintf(spec_buf, sizeof spec_buf, "can:%s,node=%s", iface, node)
                                  : snprintf(spec_buf, sizeof spec_buf, "can:%s", iface);
     if (len >= (int)sizeof spec_buf) {
-      fprintf(stderr, "pour_controller: --iface/--node: longer than %u characters\n", (unsigned)sizeof spec_buf - 1u);
+      fprintf(stderr, "pour_controller: --channel/--node: longer than %u characters\n", (unsigned)sizeof spec_buf - 1u);
       return 2;
     }
     io_spec = spec_buf;
@@ -271,13 +284,15 @@ int main(int argc, char **argv) {
             pour_status_name((pour_status_t)rc));
     return 1;
   }
+  char faults_text[POUR_FAULTS_TEXT_MAX];
   printf("pour_controller: ticks %lld states %lld answers %lld duplicates %lld dropped %lld stale_ticks %lld "
          "overruns %lld late_mean_us %.1f late_max_us %lld step_max_ns %lld io_errors %lld resets %lld "
-         "mode %u faults 0x%04x brake_engagements %lld power_cuts %lld\n",
+         "mode %s faults %s (0x%04x) brake_engagements %lld power_cuts %lld\n",
          (long long)st.ticks, (long long)st.states_received, (long long)st.answers, (long long)st.duplicates,
          (long long)st.messages_dropped, (long long)st.stale_ticks, (long long)st.overruns,
          st.ticks > 0 ? (double)st.late_sum_us / (double)st.ticks : 0.0, (long long)st.late_max_us,
-         (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.resets, (unsigned)st.mode,
-         (unsigned)st.faults, (long long)st.brake_engagements, (long long)st.power_cuts);
+         (long long)st.step_time_max_ns, (long long)st.io_errors, (long long)st.resets,
+         pour_mode_name(st.mode) != NULL ? pour_mode_name(st.mode) : "?",
+         pour_faults_format(st.faults, faults_text, sizeof faults_text), (unsigned)st.faults, (long long)st.brake_engagements, (long long)st.power_cuts);
   return 0;
 }

@@ -53,7 +53,7 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
     params = tmp_path / "params.bin"
     policy_hash = weights_h.parse_weights_h(WEIGHTS).content_hash
     ctl = Controller(*LOCKSTEP, io=f"can:vcan0,params={params}")
-    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--channel", "vcan0", "--lcm", URL],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     plant = subprocess.Popen([str(BUILD_DIR / "bin" / "host_sim"), "--policy", str(WEIGHTS), "--lcm", URL,
                               "--lcm-timeout-ms", "60000", "--set", "episode_s=300"],
@@ -118,6 +118,21 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
         stop(bridge)
         ctl_out = stop(ctl.proc)
     assert "pour_controller: parameters from" in ctl_out, ctl_out
+
+
+def test_an_idle_node_without_a_stream_ends_idle():
+    """docs/bringup.md step 5 on a bench with no host stream: e-stop, release, clear, and IDLE lasts (the
+    command watchdog arms only on the first sample)."""
+    ctl = Controller()
+    try:
+        assert "mode ESTOP" in ok("estop")
+        assert "mode FAULT" in ok("estop", "--release")
+        ok("--weights", str(WEIGHTS), "--yes", "clear")
+        time.sleep(0.5)  # ten watchdog periods of silence
+        out = ok("faults")
+        assert "mode IDLE" in out and "faults none" in out, out
+    finally:
+        stop(ctl.proc)
 
 
 def test_a_bus_without_a_node_is_an_error():
@@ -190,7 +205,7 @@ def test_identify_runs_the_controllers_experiment_and_logs_it(tmp_path):
     angle range: it ends at its first tick with the bucket held, and pour-sysid says so of the log."""
     policy_hash = weights_h.parse_weights_h(WEIGHTS).content_hash
     ctl = Controller(*LOCKSTEP, io="can:vcan0")
-    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--channel", "vcan0", "--lcm", URL],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     plant = subprocess.Popen([str(BUILD_DIR / "bin" / "host_sim"), "--policy", str(WEIGHTS), "--lcm", URL,
                               "--lcm-timeout-ms", "60000", "--set", "episode_s=300"],

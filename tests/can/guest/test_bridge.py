@@ -73,7 +73,7 @@ class Host:
 def test_bridge_makes_a_can_controller_look_like_an_lcm_one():
     ctl = subprocess.Popen([str(BUILD_DIR / "bin" / "pour_controller"), "--io", "can:vcan0,heartbeat-ms=20",
                             "--lockstep"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--channel", "vcan0", "--lcm", URL],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     host = Host()
     try:

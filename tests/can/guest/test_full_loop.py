@@ -47,7 +47,7 @@ def test_lockstep_loop_over_can_is_bit_identical_to_in_process(tmp_path):
                             # The guest is slow between episodes (world reset): no stale ticks meanwhile.
                             "--stall-ms", "5000"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--channel", "vcan0", "--lcm", URL],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         bus.wait_for("Heartbeat", timeout=10.0)
@@ -86,7 +86,7 @@ def test_host_refuses_a_controller_with_another_policy_over_can(tmp_path):
     bus = Bus()
     ctl = subprocess.Popen([str(BUILD_DIR / "bin" / "pour_controller"), "--io", "can:vcan0", "--lockstep"],
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--iface", "vcan0", "--lcm", URL],
+    bridge = subprocess.Popen([str(BUILD_DIR / "bin" / "can_bridge"), "--channel", "vcan0", "--lcm", URL],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         bus.wait_for("Identity", timeout=10.0)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pour import atomic, libpoursim
+from pour import atomic, libpoursim, records
 
 # Firmware unit -> (SI unit, SI per firmware unit). Q15 torques are fractions of the node's full-scale torque
 # (Identity.TauMax), named as such.
@@ -83,15 +83,10 @@ class Param:
         return f"{self.name} {si} (range {self.range_text()}; raw {raw} {self.unit})".replace(" )", ")")
 
 
-class _Info(C.Structure):
-    _fields_ = [("id", C.c_uint8), ("name", C.c_char_p), ("unit", C.c_char_p), ("min", C.c_int32),
-                ("max", C.c_int32)]
-
-
 def table() -> dict[str, Param]:
     """Every parameter of the firmware's table, by name, in id order (SimError without libpoursim)."""
     fn = libpoursim.load().pour_param_info
-    fn.argtypes, fn.restype = [C.c_uint8], C.POINTER(_Info)
+    fn.argtypes, fn.restype = [C.c_uint8], C.POINTER(records.record("pour_param_info_t"))
     out: dict[str, Param] = {}
     for pid in range(256):
         row = fn(pid)

@@ -37,13 +37,11 @@ import numpy as np
 
 from pour import atomic, cli
 from pour.eval import evaluate, robustness
-from pour.sim import poursim
+from pour.sim import poursim, rigs
 from pour.train import executors
 
-# The ranges of issue 10 ("Training for robustness"): fill ±20 %, target and pivot ±2 cm, motor ±15 %;
-# bucket mass and liquid ±20 % and the scales' delay and noise ±50 % are this tool's choice.
-DEFAULT_RAND = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0.02, "rand_motor": 0.15,
-                "rand_bucket_mass": 0.2, "rand_liquid": 0.2, "rand_sensor": 0.5}
+# The ranges the policy is trained over: the training distribution's rig file (configs/sim/randomised.cfg).
+DEFAULT_RAND = rigs.load("randomised")
 FIRST_SEED = 3_000_000   # held out: training seeds come from SeedSequence streams
 FILL_STEP = 1e-4         # --repeats: relative fill step between repeats (1 mL of 10 L)
 MAX_REPEATS = 1000

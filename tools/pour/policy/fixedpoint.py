@@ -4,7 +4,7 @@
 Quantisation of the state, the policy's logits, the softmax, argmax and the seeded sampling: an independent
 implementation, written from docs/fixed-point.md, that the golden vectors (tools/pour/policy/golden.py) pin the C
 code against bit for bit. The stateful parts of the core (safety envelope, estimator, control step) have no
-Python copy: pour.policy.core calls the C code, and tests/python/test_core_properties.py checks it against
+Python copy: pour.core calls the C code, and tests/python/test_core_properties.py checks it against
 docs/safety.md. Integers are Python ints (no overflow); where C saturates, so does this code. Rounding is
 "half up" (floor(x + 1/2)) everywhere, as the C code's (x + half) >> shift and (2 n + d) // (2 d) give it.
 """

@@ -13,7 +13,7 @@ from typing import Mapping, Sequence, Union
 
 import numpy as np
 
-from pour import atomic, libpoursim
+from pour import atomic, libpoursim, records
 from pour.policy import fixedpoint as fp
 
 FORMAT = 1
@@ -216,16 +216,6 @@ def write_weights_h(path: PathLike, w_float: np.ndarray, levels: Sequence[float]
     return parse_weights_h(path)
 
 
-class WeightsFileStruct(ctypes.Structure):
-    """poursim_weights_file_t (host_sim/include/poursim/weights_file.h), the parsed record the C API fills."""
-    _fields_ = [(name, ctypes.c_int32) for name in ("format", "n_features", "n_actions", "w_frac_bits",
-                                                    "decision_period_ms", "theta_min_urad", "theta_max_urad",
-                                                    "omega_max_urad_s", "tau_max_mnm")] + [
-        ("content_hash", ctypes.c_uint32), ("w", ctypes.c_int16 * (N_FEATURES * fp.MAX_ACTIONS)),
-        ("levels", ctypes.c_int16 * fp.MAX_ACTIONS), ("has_float_reference", ctypes.c_int),
-        ("w_float", ctypes.c_float * (N_FEATURES * fp.MAX_ACTIONS))]
-
-
 _ERR_LEN = 256  # POURSIM_ERR_LEN
 
 
@@ -236,14 +226,14 @@ def _parser() -> ctypes.CDLL:
     except libpoursim.SimError as e:
         raise WeightsHError(f"reading a weights.h needs libpoursim's parser: {e}") from None
     lib.poursim_weights_parse.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p,
-                                          ctypes.POINTER(WeightsFileStruct), ctypes.c_char_p, ctypes.c_size_t]
-    lib.poursim_weights_load.argtypes = [ctypes.c_char_p, ctypes.POINTER(WeightsFileStruct), ctypes.c_char_p,
+                                          ctypes.POINTER(records.record("poursim_weights_file_t")), ctypes.c_char_p, ctypes.c_size_t]
+    lib.poursim_weights_load.argtypes = [ctypes.c_char_p, ctypes.POINTER(records.record("poursim_weights_file_t")), ctypes.c_char_p,
                                          ctypes.c_size_t]
     lib.poursim_weights_parse.restype = lib.poursim_weights_load.restype = ctypes.c_int
     return lib
 
 
-def _from_struct(f: WeightsFileStruct) -> WeightsH:
+def _from_struct(f: ctypes.Structure) -> WeightsH:
     n = f.n_actions
     w_q = np.array(f.w[:N_FEATURES * n], dtype=np.int16).reshape(N_FEATURES, n)
     w_float = None
@@ -256,7 +246,7 @@ def _from_struct(f: WeightsFileStruct) -> WeightsH:
 
 def parse_weights_h_bytes(data: bytes, name: str = "weights.h") -> WeightsH:
     """Parses and checks the text of a weights.h (name is used in messages); see parse_weights_h."""
-    lib, out, err = _parser(), WeightsFileStruct(), ctypes.create_string_buffer(_ERR_LEN)
+    lib, out, err = _parser(), records.record("poursim_weights_file_t")(), ctypes.create_string_buffer(_ERR_LEN)
     if lib.poursim_weights_parse(data, len(data), name.encode(), ctypes.byref(out), err, _ERR_LEN) != 0:
         raise WeightsHError(err.value.decode(errors="replace"))
     return _from_struct(out)
@@ -266,7 +256,14 @@ def parse_weights_h(path: PathLike) -> WeightsH:
     """Reads and checks a weights.h with libpoursim's loader, host_sim's own (docs/weights-h.md): every field
     present and in range, array shapes, content hash. Raises WeightsHError naming file, line and field (and
     saying so when the library is not built)."""
-    lib, out, err = _parser(), WeightsFileStruct(), ctypes.create_string_buffer(_ERR_LEN)
+    lib, out, err = _parser(), records.record("poursim_weights_file_t")(), ctypes.create_string_buffer(_ERR_LEN)
     if lib.poursim_weights_load(os.fsencode(path), ctypes.byref(out), err, _ERR_LEN) != 0:
         raise WeightsHError(err.value.decode(errors="replace"))
     return _from_struct(out)
+
+
+def __getattr__(name: str) -> type:
+    """WeightsFileStruct: poursim_weights_file_t, built from libpoursim's layout table (pour.records)."""
+    if name == "WeightsFileStruct":
+        return records.record("poursim_weights_file_t")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -3,7 +3,7 @@
 
 SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy inside the
 firmware's pipeline) and returns it as an Episode. SimStepper advances the world tick by tick for the
-Gymnasium environment through the same pipeline (pour.policy.core, from the same library), so a stepped
+Gymnasium environment through the same pipeline (pour.core, from the same library), so a stepped
 episode equals the C rollout's. Failures come out as
 EnvError, which the trainer reports; pour.libpoursim finds the library.
 """
@@ -15,7 +15,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from pour.policy import core, linear
+from pour import core
+from pour.policy import linear
 from pour.policy import fixedpoint as fp
 from pour.sim import episode, poursim
 
@@ -86,7 +87,7 @@ class SimEnv:
 
 
 class SimStepper:
-    """Tick-by-tick access for the Gymnasium environment through the firmware's own pipeline (pour.policy.core:
+    """Tick-by-tick access for the Gymnasium environment through the firmware's own pipeline (pour.core:
     pour_control_update, the agent's level as a request, pour_control_shape), on the firmware config for the
     simulated rig that poursim_rollout uses: the same estimator, supervisor, envelope and controlled stop, so a
     stepped episode equals the C rollout's tick for tick. The core's fault bits are in .faults."""

@@ -9,16 +9,12 @@ from typing import Any
 
 ENTRY_POINT = "pour.sim.gym_env:PourEnv"
 
-# The rig's spread that training randomises over (configs/train/pour11.toml's [env.options]), for
-# pour/PourRandomised-v0.
-RANDOMISED_RIG = {"rand_fill": 0.2, "rand_target_dx": 0.02, "rand_pivot_height": 0.02, "rand_motor": 0.15,
-                  "rand_bucket_mass": 0.2, "rand_liquid": 0.2, "rand_sensor": 0.5}
-
-# id -> PourEnv keyword arguments. max_episode_steps (MAX_EPISODE_STEPS): decisions in the default 10 s
-# episode at the default 10 ms period.
+# id -> PourEnv keyword arguments, "rig" naming the rig distribution (pour.sim.rigs: configs/sim/<rig>.cfg)
+# whose keys become the env's options; pour/PourRandomised-v0 is the one training randomises over.
+# max_episode_steps (MAX_EPISODE_STEPS): decisions in the default 10 s episode at the default 10 ms period.
 IDS: dict[str, dict[str, Any]] = {
     "pour/Pour-v0": {},
-    "pour/PourRandomised-v0": {"options": RANDOMISED_RIG},
+    "pour/PourRandomised-v0": {"rig": "randomised"},
     "pour/PourToy-v0": {"backend": "toy"},
 }
 MAX_EPISODE_STEPS = 1000
@@ -31,4 +27,13 @@ def register_all() -> None:
     for env_id, kwargs in IDS.items():
         if env_id not in gym.registry:
             gym.register(id=env_id, entry_point=ENTRY_POINT, max_episode_steps=MAX_EPISODE_STEPS,
-                         kwargs=dict(kwargs))
+                         kwargs=env_kwargs(kwargs))
+
+
+def env_kwargs(kwargs: dict[str, Any]) -> dict[str, Any]:
+    """PourEnv's keyword arguments of an IDS entry: its rig's keys (pour.sim.rigs) as the options."""
+    out = dict(kwargs)
+    if "rig" in out:
+        from pour.sim import rigs
+        out["options"] = rigs.load(out.pop("rig"))
+    return out

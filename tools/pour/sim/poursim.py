@@ -25,7 +25,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from pour import libpoursim
+from pour import libpoursim, records
 from pour.libpoursim import SimError  # the binding's error, raised by the loader too
 
 N_FEATURES = 6
@@ -37,91 +37,25 @@ REGIONS = ("rotating", "target", "spilled", "flight")
 _DP = C.POINTER(C.c_double)
 
 
-class ObsStruct(C.Structure):
-    _fields_ = [
-        ("step", C.c_uint32), ("t", C.c_double), ("theta", C.c_double), ("omega", C.c_double),
-        ("v_rotating", C.c_double), ("v_target", C.c_double), ("v_spill", C.c_double), ("v_flight", C.c_double),
-        ("torque", C.c_double), ("done", C.c_int),
-        ("motor_torque", C.c_double), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
-        ("scale_target_g", C.c_int32), ("drive_faults", C.c_uint32), ("drive_trusted", C.c_int),
-    ]
+# The plain records that cross the C API on purpose, by their C names; their ctypes classes are built from
+# libpoursim's own layout table (pour.records), none is written here. The config is a handle, not a record.
+RECORDS = {"ObsStruct": "poursim_obs_t", "RewardStruct": "poursim_reward_t", "PolicyStruct": "poursim_policy_t",
+           "BuffersStruct": "poursim_rollout_buffers_t", "EpisodeStruct": "poursim_episode_t",
+           "RetentionStruct": "poursim_retention_t", "SloshStruct": "poursim_slosh_t",
+           "DriveCheckStruct": "poursim_drive_check_t", "SensorCheckStruct": "poursim_sensor_check_t"}
+RETENTION_MAX = 181  # POURSIM_RETENTION_MAX (the table gives the arrays' length; this is for callers)
 
 
-class RewardStruct(C.Structure):
-    _fields_ = [("k_target", C.c_double), ("k_spill", C.c_double), ("gamma", C.c_double)]
+def _r(name: str) -> type:
+    """The ctypes class of a record, by its Python name here (ObsStruct) or its C name."""
+    return records.record(RECORDS.get(name, name))
 
 
-class PolicyStruct(C.Structure):
-    _fields_ = [
-        ("n_actions", C.c_int), ("decision_period", C.c_int), ("w", _DP), ("levels", _DP),
-        ("theta_min", C.c_double), ("theta_max", C.c_double), ("omega_max", C.c_double), ("greedy", C.c_int),
-        ("reward", RewardStruct), ("k_reversal", C.c_double),
-    ]
+def __getattr__(name: str) -> type:
+    if name in RECORDS:
+        return _r(name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
-
-class BuffersStruct(C.Structure):
-    _fields_ = [
-        ("capacity", C.c_int), ("features", _DP), ("actions", C.POINTER(C.c_int32)), ("rewards", _DP),
-        ("probs", _DP), ("step_capacity", C.c_int), ("step_rewards", _DP), ("step_theta", _DP),
-        ("step_torque", _DP),
-    ]
-
-
-class EpisodeStruct(C.Structure):
-    _fields_ = [
-        ("n_steps", C.c_int), ("n_decisions", C.c_int), ("poured", C.c_double), ("spilled", C.c_double),
-        ("remaining", C.c_double), ("finish_time", C.c_double), ("ret", C.c_double),
-        ("reward_sum", C.c_double), ("max_theta", C.c_double), ("liquid_l", C.c_double),
-        ("peak_omega", C.c_double), ("peak_alpha", C.c_double), ("reversals", C.c_int), ("faults", C.c_int),
-        ("fault_step", C.c_int),
-    ]
-
-
-RETENTION_MAX = 181
-
-
-class RetentionStruct(C.Structure):
-    _fields_ = [
-        ("n", C.c_int), ("theta", C.c_double * RETENTION_MAX), ("kept", C.c_double * RETENTION_MAX),
-        ("ideal", C.c_double * RETENTION_MAX), ("onset", C.c_double), ("ideal_onset", C.c_double),
-        ("rms_gap", C.c_double),
-    ]
-
-
-class SloshStruct(C.Structure):
-    _fields_ = [
-        ("freq", C.c_double), ("freq_theory", C.c_double), ("damping", C.c_double), ("amplitude", C.c_double),
-        ("noise", C.c_double), ("n", C.c_int),
-    ]
-
-
-class DriveCheckStruct(C.Structure):
-    _fields_ = [
-        ("latency_ticks", C.c_int), ("inertia_measured", C.c_double), ("inertia_expected", C.c_double),
-        ("inertia_bucket", C.c_double), ("breakaway_torque", C.c_double), ("terminal_load", C.c_double * 2),
-        ("terminal_speed", C.c_double * 2), ("terminal_expected", C.c_double * 2),
-        ("friction_speed", C.c_double * 5), ("friction_measured", C.c_double * 5),
-        ("friction_expected", C.c_double * 5),
-    ]
-
-
-class SensorCheckStruct(C.Structure):
-    _fields_ = [
-        ("encoder_max_error", C.c_double), ("encoder_at_stop", C.c_uint32), ("liquid_g", C.c_double),
-        ("rest_rotating_g", C.c_double), ("target_liquid_g", C.c_double), ("rest_target_g", C.c_double),
-        ("update_rate_hz", C.c_double), ("delay_s", C.c_double), ("delay_match", C.c_double),
-        ("noise_rms_g", C.c_double), ("noise_expected_g", C.c_double), ("impact_impulse_gs", C.c_double),
-        ("impact_expected_gs", C.c_double), ("impact_peak_g", C.c_double), ("impact_peak_reading_g", C.c_double),
-        ("hash_unchanged", C.c_int),
-    ]
-
-
-# The plain records that cross the C API on purpose, by their C names (poursim_sizeof checks each); the
-# config is a handle, not a record.
-RECORDS = {"poursim_obs_t": ObsStruct, "poursim_policy_t": PolicyStruct,
-           "poursim_rollout_buffers_t": BuffersStruct, "poursim_episode_t": EpisodeStruct,
-           "poursim_retention_t": RetentionStruct, "poursim_slosh_t": SloshStruct,
-           "poursim_drive_check_t": DriveCheckStruct, "poursim_sensor_check_t": SensorCheckStruct}
 
 _lib: C.CDLL | None = None
 
@@ -162,19 +96,19 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_config_write": ([C.c_void_p, C.c_char_p] + err, C.c_int),
         "poursim_create": ([C.c_void_p] + err, C.c_void_p),
         "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
-        "poursim_step": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
-        "poursim_step_servo": ([C.c_void_p, C.c_double, P(ObsStruct)], C.c_int),
+        "poursim_step": ([C.c_void_p, C.c_double, P(_r("ObsStruct"))], C.c_int),
+        "poursim_step_servo": ([C.c_void_p, C.c_double, P(_r("ObsStruct"))], C.c_int),
         "poursim_set_brake": ([C.c_void_p, C.c_int], C.c_int),
         "poursim_world_error": ([C.c_void_p], C.c_char_p),
         "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
         "poursim_measure_retention": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double,
-                                       P(RetentionStruct)] + err, C.c_int),
+                                       P(_r("RetentionStruct"))] + err, C.c_int),
         "poursim_measure_slosh": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
-                                   P(C.c_double), C.c_int, P(SloshStruct)] + err, C.c_int),
-        "poursim_observe": ([C.c_void_p, P(ObsStruct)], None),
+                                   P(C.c_double), C.c_int, P(_r("SloshStruct"))] + err, C.c_int),
+        "poursim_observe": ([C.c_void_p, P(_r("ObsStruct"))], None),
         "poursim_episode_config": ([C.c_void_p], C.c_void_p),
-        "poursim_measure_drive": ([C.c_void_p, P(DriveCheckStruct)] + err, C.c_int),
-        "poursim_measure_sensors": ([C.c_void_p, C.c_uint32, P(SensorCheckStruct)] + err, C.c_int),
+        "poursim_measure_drive": ([C.c_void_p, P(_r("DriveCheckStruct"))] + err, C.c_int),
+        "poursim_measure_sensors": ([C.c_void_p, C.c_uint32, P(_r("SensorCheckStruct"))] + err, C.c_int),
         "poursim_destroy": ([C.c_void_p], None),
         "poursim_particle_count": ([C.c_void_p], C.c_int),
         "poursim_particles": ([C.c_void_p, P(C.c_float), P(C.c_float), C.c_int], C.c_int),
@@ -182,12 +116,12 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_max_overlap": ([C.c_void_p], C.c_double),
         "poursim_max_wall_penetration": ([C.c_void_p], C.c_double),
         "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
-        "poursim_rollout": ([C.c_void_p, P(PolicyStruct), C.c_uint32, P(BuffersStruct), P(EpisodeStruct)], C.c_int),
+        "poursim_rollout": ([C.c_void_p, P(_r("PolicyStruct")), C.c_uint32, P(_r("BuffersStruct")), P(_r("EpisodeStruct"))], C.c_int),
         "poursim_version": ([], C.c_char_p),
         "poursim_sizeof": ([C.c_char_p], C.c_size_t),
-        "poursim_default_reward": ([], RewardStruct),
-        "poursim_reward_validate": ([P(RewardStruct)] + err, C.c_int),
-        "poursim_features": ([P(PolicyStruct), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
+        "poursim_default_reward": ([], _r("RewardStruct")),
+        "poursim_reward_validate": ([P(_r("RewardStruct"))] + err, C.c_int),
+        "poursim_features": ([P(_r("PolicyStruct")), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
                               P(C.c_double)], None),
         "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
     }
@@ -353,7 +287,7 @@ class Obs:
     drive_trusted: bool = True  # the drive still follows a torque
 
     @staticmethod
-    def from_struct(o: ObsStruct) -> "Obs":
+    def from_struct(o: C.Structure) -> "Obs":
         return Obs(o.step, o.t, o.theta, o.omega, o.v_rotating, o.v_target, o.v_spill, o.v_flight,
                    o.torque, bool(o.done), o.motor_torque,
                    int(o.encoder), int(o.scale_rotating_g), int(o.scale_target_g), int(o.drive_faults),
@@ -385,7 +319,7 @@ def reward_from(options: dict) -> Reward:
     d = default_reward()
     r = Reward(*(float(options.pop(k, getattr(d, k))) for k in ("k_target", "k_spill", "gamma")))
     e = _err()
-    if load_library().poursim_reward_validate(C.byref(RewardStruct(r.k_target, r.k_spill, r.gamma)), e, ERR_LEN):
+    if load_library().poursim_reward_validate(C.byref(_r("RewardStruct")(r.k_target, r.k_spill, r.gamma)), e, ERR_LEN):
         raise SimError(e.value.decode(errors="replace"), e.value.decode(errors="replace").split()[1])
     return r
 
@@ -403,7 +337,7 @@ class Policy:
     k_reversal: float = 0.0            # training's reward shaping: cost of each torque reversal
     reward: Reward | None = None       # None: libpoursim's default_reward()
 
-    def _struct(self) -> tuple[PolicyStruct, tuple[np.ndarray, np.ndarray]]:
+    def _struct(self) -> tuple[C.Structure, tuple[np.ndarray, np.ndarray]]:
         w = np.ascontiguousarray(self.w, dtype=np.float64)
         lv = np.ascontiguousarray(self.levels, dtype=np.float64)
         if w.ndim != 2 or w.shape[0] != N_FEATURES or not 2 <= w.shape[1] <= MAX_ACTIONS:
@@ -411,9 +345,9 @@ class Policy:
         if lv.shape != (w.shape[1],):
             raise SimError(f"policy levels has shape {lv.shape}, expected ({w.shape[1]},)")
         r = self.reward if self.reward is not None else default_reward()
-        s = PolicyStruct(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
+        s = _r("PolicyStruct")(w.shape[1], int(self.decision_period), w.ctypes.data_as(_DP), lv.ctypes.data_as(_DP),
                          self.theta_min, self.theta_max, self.omega_max, 1 if self.greedy else 0,
-                         RewardStruct(r.k_target, r.k_spill, r.gamma), float(self.k_reversal))
+                         _r("RewardStruct")(r.k_target, r.k_spill, r.gamma), float(self.k_reversal))
         return s, (w, lv)  # the arrays must outlive the call
 
 
@@ -453,14 +387,14 @@ class _Buffers:
         self.step_rewards = np.zeros(n_steps)
         self.step_theta = np.zeros(n_steps)
         self.step_torque = np.zeros(n_steps)
-        self.struct = BuffersStruct(
+        self.struct = _r("BuffersStruct")(
             n_decisions, self.features.ctypes.data_as(_DP), self.actions.ctypes.data_as(C.POINTER(C.c_int32)),
             self.rewards.ctypes.data_as(_DP), self.probs.ctypes.data_as(_DP), n_steps,
             self.step_rewards.ctypes.data_as(_DP) if n_steps else None,
             self.step_theta.ctypes.data_as(_DP) if n_steps else None,
             self.step_torque.ctypes.data_as(_DP) if n_steps else None)
 
-    def result(self, seed: int, e: EpisodeStruct) -> Rollout:
+    def result(self, seed: int, e: C.Structure) -> Rollout:
         d = e.n_decisions
         m = {"poured": e.poured, "spilled": e.spilled, "remaining": e.remaining, "finish_time": e.finish_time,
              "return": e.ret, "reward_sum": e.reward_sum, "max_theta": e.max_theta, "liquid_l": e.liquid_l,
@@ -509,7 +443,7 @@ class World:
         return self.observe()
 
     def step(self, action: float) -> Obs:
-        o = ObsStruct()
+        o = _r("ObsStruct")()
         if self._lib.poursim_step(self._check(), float(action), C.byref(o)) != 0:
             if self._lib.poursim_world_error(self._check()):
                 raise SimError(self._lib.poursim_world_error(self._check()).decode(errors="replace"))
@@ -522,7 +456,7 @@ class World:
             raise SimError("set_brake refused (no world)")
 
     def observe(self) -> Obs:
-        o = ObsStruct()
+        o = _r("ObsStruct")()
         self._lib.poursim_observe(self._check(), C.byref(o))
         return Obs.from_struct(o)
 
@@ -568,7 +502,7 @@ class World:
         ps, keep = policy._struct()
         n_steps = _n_steps(self.config)
         bufs = _Buffers(-(-n_steps // policy.decision_period), ps.n_actions, n_steps if record_steps else 0)
-        e = EpisodeStruct()
+        e = _r("EpisodeStruct")()
         rc = self._lib.poursim_rollout(self._check(), C.byref(ps), int(seed) & 0xFFFFFFFF, C.byref(bufs.struct),
                                        C.byref(e))
         if rc != 0:
@@ -594,7 +528,7 @@ def retention(config: Config | Mapping[str, float] | None = None, seed: int = 1,
     """Servo-tilts the bucket at rate [rad/s] to theta_end [rad] once per seed; docs/simulator.md."""
     lib = load_library()
     cfg = _as_config(config)
-    r, e = RetentionStruct(), _err()
+    r, e = _r("RetentionStruct")(), _err()
     if lib.poursim_measure_retention(cfg.handle, int(seed), int(n_seeds), float(rate), float(theta_end),
                                      C.byref(r), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
@@ -620,7 +554,7 @@ def slosh(config: Config | Mapping[str, float] | None = None, seed: int = 1, n_s
     lib = load_library()
     cfg = _as_config(config)
     cap = int(round(hold_s / cfg.dt)) + 1
-    trace, out, e = (C.c_double * cap)(), SloshStruct(), _err()
+    trace, out, e = (C.c_double * cap)(), _r("SloshStruct")(), _err()
     if lib.poursim_measure_slosh(cfg.handle, int(seed), int(n_seeds), float(tilt), float(ramp_s), float(hold_s),
                                  trace, cap, C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
@@ -636,7 +570,7 @@ def measure_drive(config: Config | Mapping[str, float] | None = None) -> dict:
     """The drive on the empty bucket against Newton and its datasheet line (poursim_measure_drive)."""
     lib = load_library()
     cfg = _as_config(config)
-    out, e = DriveCheckStruct(), _err()
+    out, e = _r("DriveCheckStruct")(), _err()
     if lib.poursim_measure_drive(cfg.handle, C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     return _struct_dict(out)
@@ -646,7 +580,7 @@ def measure_sensors(config: Config | Mapping[str, float] | None = None, seed: in
     """Encoder and load cells against mass, momentum and their config (poursim_measure_sensors)."""
     lib = load_library()
     cfg = _as_config(config)
-    out, e = SensorCheckStruct(), _err()
+    out, e = _r("SensorCheckStruct")(), _err()
     if lib.poursim_measure_sensors(cfg.handle, int(seed), C.byref(out), e, ERR_LEN) != 0:
         raise SimError(e.value.decode(errors="replace"))
     return _struct_dict(out)
@@ -655,7 +589,7 @@ def measure_sensors(config: Config | Mapping[str, float] | None = None, seed: in
 def features(theta_min: float, theta_max: float, omega_max: float, theta: float, omega: float, v_rotating: float,
              v_target: float, v_spill: float) -> np.ndarray:
     """poursim_features: the C rollout's normalisation of one state, [6] with the bias."""
-    p = PolicyStruct(theta_min=theta_min, theta_max=theta_max, omega_max=omega_max)
+    p = _r("PolicyStruct")(theta_min=theta_min, theta_max=theta_max, omega_max=omega_max)
     x = (C.c_double * N_FEATURES)()
     load_library().poursim_features(C.byref(p), theta, omega, v_rotating, v_target, v_spill, x)
     return np.array(x[:])

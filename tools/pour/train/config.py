@@ -304,6 +304,31 @@ def _validate_search(cfg: TrainConfig) -> None:
                                      f"options are in [{a.kind}]")
 
 
+def _with_rig(env: dict) -> dict:
+    """[env] with its rig (a name of pour.sim.rigs: configs/sim/<rig>.cfg) read into the options, ahead of
+    those written in [env.options]; a key in both is refused (the rig file is its one place)."""
+    if "rig" not in env:
+        return env
+    from pour.sim import rigs
+    env = dict(env)
+    rig = env.pop("rig")
+    if not isinstance(rig, str):
+        raise ConfigError(f"[env] rig = {rig!r}: expected a rig name ({', '.join(rigs.names())})")
+    try:
+        options = rigs.load(rig)
+    except rigs.RigError as e:
+        raise ConfigError(f"[env] rig: {e}") from None
+    own = env.get("options", {})
+    if not isinstance(own, dict):
+        raise ConfigError("[env.options]: expected a table")
+    twice = sorted(set(own) & set(options))
+    if twice:
+        raise ConfigError(f"[env.options] {', '.join(twice)}: already set by [env] rig = {rig!r} "
+                          f"(configs/sim/{rigs.RIGS[rig]})")
+    env["options"] = {**options, **own}
+    return env
+
+
 def from_dict(data: dict) -> TrainConfig:
     """Builds and validates a config from a parsed TOML document."""
     if not isinstance(data, dict):
@@ -320,7 +345,7 @@ def from_dict(data: dict) -> TrainConfig:
         if name in data:
             if not isinstance(data[name], dict):
                 raise ConfigError(f"[{name}]: expected a table")
-            kwargs[name] = _build(cls, name, data[name])
+            kwargs[name] = _build(cls, name, _with_rig(data[name]) if name == "env" else data[name])
     return validate(dataclasses.replace(base, **kwargs))
 
 

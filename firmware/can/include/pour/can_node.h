@@ -54,7 +54,7 @@ typedef struct {
   pour_commands_t commands;     /* Estop, ClearErrors, Stop and Reset since the last tick, in their order */
   bool param_pending;           /* param_request waits for the port */
   pour_can_param_request_t param_request;
-  bool armed;                   /* watchdog runs once the first valid sample or command arrived */
+  bool armed;                   /* watchdog runs once the first valid sample arrived */
   uint32_t ms_since_valid;
   uint16_t ms_to_heartbeat;
   uint8_t heartbeat_counter;

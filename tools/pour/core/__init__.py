@@ -5,7 +5,7 @@ Python keeps its own bit-exact copy of the fixed-point kernels only (pour.policy
 logits, softmax, argmax); the stateful parts — the safety envelope, the sensor estimator and the control
 pipeline — are the C code behind handles (host_sim/include/poursim/core.h), never a Python mirror of it:
 
-    from pour.policy import core
+    from pour import core
     env = core.Envelope()                          # the safety envelope, default config
     cmd = env.apply(32767, theta_urad=0, omega_urad_s=0); env.active   # POUR_LIMIT_* bits
     est = core.Estimator(encoder_bits=17)          # the sensor estimator
@@ -18,8 +18,8 @@ pipeline — are the C code behind handles (host_sim/include/poursim/core.h), ne
 
 A config (core.control_config()) is an opaque block whose fields are read and set by their C names
 (cfg.safety.tau_limit = 20000). Fault and mode names come from the core's own table (fault_name, mode_name).
-The only structs mirrored here are the plain records of a tick (a sample, a state, a tick's inputs and
-outputs); RECORDS lists them and tests/python/test_core_properties.py checks each size against C's.
+The plain records of a tick (a sample, a state, a tick's inputs and outputs) are built from the library's
+layout table (pour.records); RECORDS names them.
 """
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import libpoursim
+from pour import libpoursim, records
 
 q15 = C.c_int16
 POLICY_MAX_ACTIONS = 16
@@ -42,40 +42,15 @@ class CoreError(RuntimeError):
     """The core refused a config (its pour_status_t name in the message)."""
 
 
-class _Record(C.Structure):
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}(" + ", ".join(f"{k}={getattr(self, k)!r}" for k, _ in self._fields_) + ")"
+# The plain records of a tick that cross the C API on purpose: Python name -> C name. Their ctypes classes
+# are built from libpoursim's own layout table (pour.records); none is written here.
+RECORDS = {"SensorSample": "pour_sensors_t", "PlantState": "pour_state_t", "ControlInput": "pour_control_input_t",
+           "ControlOutput": "pour_control_output_t"}
 
 
-class SensorSample(_Record):
-    """pour_sensors_t: one raw sample, as it crosses the wire."""
-    _fields_ = [("seq", C.c_uint32), ("encoder", C.c_uint32), ("scale_rotating_g", C.c_int32),
-                ("scale_target_g", C.c_int32)]
+def _r(name: str) -> type:
+    return records.record(RECORDS[name])
 
-
-class PlantState(_Record):
-    """pour_state_t: the state the estimator makes of the samples."""
-    _fields_ = [("seq", C.c_uint32), ("theta_urad", C.c_int32), ("omega_urad_s", C.c_int32), ("v_rotating", q15),
-                ("v_target", q15), ("v_spill", q15)]
-
-
-class ControlInput(_Record):
-    """pour_control_input_t: one tick's inputs."""
-    _fields_ = [("sensors_fresh", C.c_bool), ("sensors", SensorSample), ("estop", C.c_bool),
-                ("clear_faults", C.c_bool), ("link_fault", C.c_bool), ("stop", C.c_bool), ("reset", C.c_bool),
-                ("drive_faults", C.c_uint16), ("drive_trusted", C.c_bool)]
-
-
-class ControlOutput(_Record):
-    """pour_control_output_t: one tick's outputs."""
-    _fields_ = [("torque", q15), ("action", C.c_uint8), ("probs", q15 * POLICY_MAX_ACTIONS), ("mode", C.c_uint8),
-                ("faults", C.c_uint16), ("limits", C.c_uint8), ("tick", C.c_uint32), ("refused", C.c_uint32), ("brake", C.c_bool),
-                ("power", C.c_bool)]
-
-
-# The records that cross the C API on purpose, by their C names (poursim_sizeof checks each).
-RECORDS = {"pour_sensors_t": SensorSample, "pour_state_t": PlantState, "pour_control_input_t": ControlInput,
-           "pour_control_output_t": ControlOutput}
 
 _lib: C.CDLL | None = None
 
@@ -106,16 +81,16 @@ def load() -> C.CDLL:
         "poursim_estimator_create": ([V] + err, V),
         "poursim_estimator_destroy": ([V], None),
         "poursim_estimator_reset": ([V], None),
-        "poursim_estimator_update": ([V, P(SensorSample), P(PlantState)], C.c_int),
+        "poursim_estimator_update": ([V, P(_r("SensorSample")), P(_r("PlantState"))], C.c_int),
         "poursim_core_create": ([V, C.c_int, C.c_int, C.c_int, P(C.c_int16), P(C.c_int16), C.c_int32, C.c_int32,
                                  C.c_int32, C.c_int32, C.c_uint32] + err, V),
         "poursim_core_destroy": ([V], None),
-        "poursim_core_update": ([V, P(ControlInput)], C.c_int),
-        "poursim_core_state": ([V, P(PlantState)], None),
+        "poursim_core_update": ([V, P(_r("ControlInput"))], C.c_int),
+        "poursim_core_state": ([V, P(_r("PlantState"))], None),
         "poursim_core_decide": ([V], None),
         "poursim_core_request": ([V, C.c_uint8, q15], None),
-        "poursim_core_shape": ([V, P(ControlOutput)], None),
-        "poursim_core_step": ([V, P(ControlInput), P(ControlOutput)], None),
+        "poursim_core_shape": ([V, P(_r("ControlOutput"))], None),
+        "poursim_core_step": ([V, P(_r("ControlInput")), P(_r("ControlOutput"))], None),
     }
     try:
         for name, (args, res) in sig.items():
@@ -139,8 +114,10 @@ def _names(fn: Any, count: int) -> dict[int, str]:
 fault_name, fault_names, mode_name = libpoursim.fault_name, libpoursim.fault_names, libpoursim.mode_name
 
 
-def __getattr__(name: str) -> int:
+def __getattr__(name: str) -> Any:
     """FAULT_<NAME> and MODE_<NAME>, read from the core's name table."""
+    if name in RECORDS:
+        return _r(name)
     if name.startswith("FAULT_"):
         table = {n: 1 << i for i in range(16) if (n := fault_name(1 << i)) is not None}
     elif name.startswith("MODE_"):
@@ -296,7 +273,7 @@ class Envelope(_Handle):
         return int(f.value), int(c.value)
 
 
-def _state_tuple(s: PlantState) -> tuple[int, int, int, int, int, int]:
+def _state_tuple(s: C.Structure) -> tuple[int, int, int, int, int, int]:
     return (int(s.seq), int(s.theta_urad), int(s.omega_urad_s), int(s.v_rotating), int(s.v_target), int(s.v_spill))
 
 
@@ -309,7 +286,7 @@ class Estimator(_Handle):
     def __init__(self, config: Config | _Group | None = None, **overrides: int):
         self._lib = load()
         self.config = config if config is not None else sensors_config(**overrides)
-        self._state = PlantState()
+        self._state = _r("PlantState")()
         err = C.create_string_buffer(ERR_LEN)
         self._h = _check_handle(self._lib.poursim_estimator_create(self.config.ptr, err, ERR_LEN), err, "estimator")
 
@@ -317,7 +294,7 @@ class Estimator(_Handle):
         self._lib.poursim_estimator_reset(self._h)
 
     def update(self, seq: int, encoder: int, scale_rotating_g: int, scale_target_g: int) -> tuple | None:
-        smp = SensorSample(int(seq) & 0xFFFFFFFF, int(encoder) & 0xFFFFFFFF, int(scale_rotating_g), int(scale_target_g))
+        smp = _r("SensorSample")(int(seq) & 0xFFFFFFFF, int(encoder) & 0xFFFFFFFF, int(scale_rotating_g), int(scale_target_g))
         if not self._lib.poursim_estimator_update(self._h, C.byref(smp), C.byref(self._state)):
             return None
         return _state_tuple(self._state)
@@ -368,14 +345,14 @@ class Controller(_Handle):
                                               int(weights.tau_max_mnm), int(weights.content_hash) & 0xFFFFFFFF,
                                               err, ERR_LEN)
         self._h = _check_handle(h, err, "pour_control_init")
-        self._in, self._out, self._state = ControlInput(), ControlOutput(), PlantState()
+        self._in, self._out, self._state = _r("ControlInput")(), _r("ControlOutput")(), _r("PlantState")()
 
     def _input(self, sample: Sequence[int] | None, estop: bool, clear_faults: bool, link_fault: bool, stop: bool,
-               reset: bool) -> ControlInput:
+               reset: bool) -> C.Structure:
         i = self._in
         i.sensors_fresh = sample is not None
         smp = sample if sample is not None else (0, 0, 0, 0)
-        i.sensors = SensorSample(int(smp[0]) & 0xFFFFFFFF, int(smp[1]) & 0xFFFFFFFF, int(smp[2]), int(smp[3]))
+        i.sensors = _r("SensorSample")(int(smp[0]) & 0xFFFFFFFF, int(smp[1]) & 0xFFFFFFFF, int(smp[2]), int(smp[3]))
         i.estop, i.clear_faults, i.link_fault, i.stop, i.reset = estop, clear_faults, link_fault, stop, reset
         return i
 
