@@ -366,6 +366,9 @@ std::string Board::load(const std::vector<uint8_t>& image_flash) {
 std::string Board::init() {
   if (uc_open(UC_ARCH_ARM, static_cast<uc_mode>(UC_MODE_THUMB | UC_MODE_MCLASS), &uc_) != UC_ERR_OK) return "cannot open the Unicorn engine";
   if (uc_ctl_set_cpu_model(uc_, UC_CPU_ARM_CORTEX_M4) != UC_ERR_OK) return "the Unicorn engine has no Cortex-M4";
+  // 32 MB of translated code (the image is under 128 KB), not the engine's default 1 GB: the board must run
+  // in the 512 MB user-mode Linux guest of the CAN tests.
+  if (uc_ctl_set_tcg_buffer_size(uc_, 32u * 1024u * 1024u) != UC_ERR_OK) return "cannot size the engine's code buffer";
   // Flash: code pages as host memory (read, execute), aliased at 0 (boot from main flash: RM0440 §2.6); the
   // two data pages at its end through the FLASH model.
   const uint32_t code = kDataPages - kFlashBase;
