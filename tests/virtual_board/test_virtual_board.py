@@ -148,3 +148,36 @@ def test_bad_options(args, message):
     r = run(*args)
     assert r.returncode == 2
     assert r.stderr.startswith("pour_virtual_board: ") and message in r.stderr and r.stderr.count("\n") == 1
+
+
+def launcher(*args: str, tools: Path | None = None) -> subprocess.CompletedProcess[str]:
+    import sys
+
+    e = dict(os.environ, PYTHONPATH=str(tools or Path(__file__).resolve().parents[2] / "tools"))
+    e.pop("POUR_BUILD_DIR", None)
+    return subprocess.run([sys.executable, "-m", "pour.virtual_board", *args], capture_output=True, text=True,
+                          timeout=120, env=e)
+
+
+def test_launcher_finds_the_program_and_the_image():
+    build = str(Path(VB).resolve().parents[1])
+    r = launcher("--build-dir", build, "--help")
+    assert r.returncode == 0 and r.stdout.startswith("usage: pour_virtual_board"), r.stderr
+    r = launcher("--build-dir", build, "--placeholder-analog", "--until-heartbeat", "--seconds", "2")
+    assert r.returncode == 0 and "heartbeat at" in r.stdout, r.stderr
+
+
+def test_launcher_without_a_build_says_so(tmp_path, monkeypatch, capsys):
+    # No build tree anywhere: paths.binary finds nothing (an editable install's finder would otherwise find this
+    # checkout's build/host whatever PYTHONPATH says).
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
+    from pour import paths, virtual_board
+
+    monkeypatch.setattr(paths, "binary", lambda name, build_dir=None: None)
+    assert virtual_board.main(["--build-dir", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "pour_virtual_board not found" in err, err
+    assert virtual_board.main(["--build-dir"]) == 2
+    assert "--build-dir needs a folder" in capsys.readouterr().err
