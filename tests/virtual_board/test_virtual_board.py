@@ -22,12 +22,15 @@ def run(*args: str, timeout: float = 120) -> subprocess.CompletedProcess[str]:
     return subprocess.run([VB, *args], capture_output=True, text=True, timeout=timeout)
 
 
-def image(tmp_path: Path, body: str, origin: int = 0x08000000) -> str:
-    """A Cortex-M4 image: the vector table (SP at the top of SRAM, reset to `start`), then body."""
+def image(tmp_path: Path, body: str, origin: int = 0x08000000, nmi: str = "") -> str:
+    """A Cortex-M4 image: the vector table (SP at the top of SRAM, reset to `start`, NMI to `nmi` if given),
+    then body."""
     assert CC, "arm-none-eabi-gcc is needed (scripts/setup.sh's toolchain)"
     src = tmp_path / "t.S"
     src.write_text(
-        ".syntax unified\n.thumb\n.section .text\n.word 0x20008000\n.word start + 1\n.thumb_func\nstart:\n" + body + "\n.ltorg\n"
+        ".syntax unified\n.thumb\n.section .text\n.word 0x20008000\n.word start + 1\n"
+        + (".word nmi + 1\n" if nmi else "") + ".thumb_func\nstart:\n" + body + "\n.ltorg\n"
+        + (".thumb_func\nnmi:\n" + nmi + "\n.ltorg\n" if nmi else "")
     )
     out = tmp_path / "t.elf"
     subprocess.run([CC, "-mcpu=cortex-m4", "-mthumb", "-nostdlib", f"-Wl,-Ttext=0x{origin:08x}", "-Wl,-e,start",
@@ -84,6 +87,26 @@ def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
     r = run("--elf", image(tmp_path, body), "--seconds", "1", "--stop-on-reset")
     assert "shorter than the flash page erase" in r.stderr, r.stderr
     assert "IWDG: no refresh" in r.stderr
+
+
+def test_ecc_error_on_a_data_page_raises_the_nmi(tmp_path):
+    # RM0440 §3.3.5: a double ECC error on a read sets FLASH_ECCR.ECCD and raises the NMI. The handler here reads
+    # ECCR, then an unmapped address whose stop names the handler's PC: only an NMI with ECCD set gets there.
+    nmi = """
+    ldr r0, =0x40022018
+    ldr r1, [r0]
+    lsrs r1, r1, #31
+    beq 2f
+    ldr r0, =0x60000004
+    ldr r1, [r0]
+2:  b 2b
+"""
+    body = "ldr r0, =0x0801F800\nldr r1, [r0]\n1: b 1b"
+    elf = image(tmp_path, body, nmi=nmi)
+    r = run("--elf", elf, "--seconds", "0.1", "--ecc-page", "63")
+    assert r.returncode == 1 and "unmapped address 0x60000004" in r.stderr, r.stderr
+    r = run("--elf", elf, "--seconds", "0.1")  # the same read of an intact page: no NMI
+    assert r.returncode == 0, r.stderr
 
 
 def test_read_of_peripheral_without_model_stops_with_pc_address_name(tmp_path):
