@@ -63,7 +63,7 @@ void Board::stop(const std::string& reason) {
     uint32_t pc = 0;
     uc_reg_read(uc_, UC_ARM_REG_PC, &pc);
     char b[64];
-    std::snprintf(b, sizeof b, " (pc 0x%08x, t %.3f ms)", pc, now_ps() / 1e9);
+    std::snprintf(b, sizeof b, " (pc 0x%08x, t %.3f ms)", pc, static_cast<double>(now_ps()) / 1e9);
     stopped_ = reason + b;
   }
   uc_emu_stop(uc_);
@@ -87,7 +87,7 @@ int Board::priority(int exc) const {
   if (exc >= 16) p = ipr_[exc - 16];
   else p = shpr_[exc - 4];
   const unsigned group_shift = prigroup_ + 1u;  // ARMv7-M B1.5.4: bits above PRIGROUP are the group priority
-  return (p & 0xF0u) >> group_shift << group_shift;
+  return static_cast<int>((p & 0xF0u) >> group_shift << group_shift);
 }
 
 bool Board::enabled(int exc) const {
@@ -297,7 +297,7 @@ bool Scs::write(uint32_t off, unsigned width, uint32_t value) {
   else if (w >= 0x100 && w < 0x110) b.iser_[(w - 0x100) / 4] |= value;
   else if (w >= 0x180 && w < 0x190) b.iser_[(w - 0x180) / 4] &= ~value;
   else if (w >= 0x200 && w < 0x210) {
-    for (uint32_t i = 0; i < 32; ++i) if ((value >> i & 1u) && (w - 0x200) * 8u + i < Board::kIrqs) b.pend(16 + (w - 0x200) * 8 + i);
+    for (uint32_t i = 0; i < 32; ++i) if ((value >> i & 1u) && (w - 0x200) * 8u + i < Board::kIrqs) b.pend(static_cast<int>(16u + (w - 0x200) * 8u + i));
   } else if (w >= 0x280 && w < 0x290) {
     for (uint32_t i = 0; i < 32; ++i) if ((value >> i & 1u) && (w - 0x280) * 8u + i < Board::kIrqs) b.pending_[16 + (w - 0x280) * 8 + i] = false;
   } else if (w >= 0x400 && w < 0x400 + Board::kIrqs) {
@@ -524,7 +524,7 @@ void Board::take_exception(int exc) {
   uint32_t xpsr = 0x01000000u | static_cast<uint32_t>(exc);
   uc_reg_write(uc_, UC_ARM_REG_XPSR, &xpsr);
   uint32_t vector = 0;
-  uc_mem_read(uc_, vtor_ + 4u * exc, &vector, 4);
+  uc_mem_read(uc_, vtor_ + 4u * static_cast<uint32_t>(exc), &vector, 4);
   if (!(vector & 1u)) {
     stop("vector " + std::to_string(exc) + " is not a Thumb address");
     return;
@@ -582,7 +582,7 @@ void Board::bridge() {
     ++frames_tx_;
     if ((f.id & 0x1Fu) == 1u && first_heartbeat_ps_ == UINT64_MAX) first_heartbeat_ps_ = now_ps();
     if (opt_.print_can) {
-      std::printf("%.3f ms tx %03x [%u]", now_ps() / 1e9, f.id, f.dlc);
+      std::printf("%.3f ms tx %03x [%u]", static_cast<double>(now_ps()) / 1e9, f.id, f.dlc);
       for (unsigned i = 0; i < f.dlc && i < 8; ++i) std::printf(" %02x", f.data[i]);
       std::printf("\n");
     }
@@ -612,7 +612,7 @@ int Board::run() {
   const uint64_t slice_max = 170000;  // at most 1 ms of the core at 170 MHz between bridge polls
   while (stopped_.empty()) {
     if (!reset_cause_.empty()) {
-      std::fprintf(stderr, "virtual board: reset at %.3f ms: %s\n", now_ps() / 1e9, reset_cause_.c_str());
+      std::fprintf(stderr, "virtual board: reset at %.3f ms: %s\n", static_cast<double>(now_ps()) / 1e9, reset_cause_.c_str());
       ++resets_;
       const bool iwdg = reset_cause_.rfind("IWDG", 0) == 0;
       rcc_.note_reset(iwdg ? (1u << 29) | (1u << 26) : (1u << 28) | (1u << 26));  // IWDGRSTF or SFTRSTF, and PINRSTF
@@ -642,7 +642,7 @@ int Board::run() {
     const uint64_t before = insns_;
     if (trace_ && (++iterations_ % 100000u) == 0u) {
       std::fprintf(stderr, "trace: pc 0x%08x insns %llu end %llu t %.3f ms active %zu\n", pc_, (unsigned long long)insns_,
-                   (unsigned long long)slice_end_, now_ps() / 1e9, active_.size());
+                   (unsigned long long)slice_end_, static_cast<double>(now_ps()) / 1e9, active_.size());
     }
     uc_err err = uc_emu_start(uc_, pc_ | 1u, 0xFFFFFFFFu, 0, 0);
     uint32_t pc = 0;
@@ -671,7 +671,7 @@ int Board::run() {
       insns_ = std::max(insns_, ((cycles() + cycles_until_ps(target)) * 1000u + opt_.cpi_milli - 1u) / opt_.cpi_milli);
       if (iwdg_.running() && iwdg_.expiry_ps() < flash_.stall_until_ps) {
         std::fprintf(stderr, "virtual board: IWDG timeout %.3f ms is shorter than the flash page erase %.3f ms\n",
-                     iwdg_.timeout_ps() / 1e9, flash_.erase_ps / 1e9);
+                     static_cast<double>(iwdg_.timeout_ps()) / 1e9, static_cast<double>(flash_.erase_ps) / 1e9);
       }
     } else if (idle_ || (wfi && best_pending() < 0)) {
       insns_ = std::max(insns_, slice_end_);  // nothing runs until the next event
@@ -681,13 +681,13 @@ int Board::run() {
       // Injection: the core stops fetching (a hung bus) for stall_core_ms; the IWDG is not refreshed.
       stalled_once_ = true;
       insns_ += (cycles_until_ps(now_ps() + static_cast<uint64_t>(opt_.stall_core_ms * 1e9)) * 1000u) / opt_.cpi_milli;
-      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, now_ps() / 1e9);
+      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, static_cast<double>(now_ps()) / 1e9);
     }
     systick_advance();
     for (Peripheral* m : models_) m->advance();
     bridge();
     if (opt_.realtime) {
-      const double emu = now_ps() / 1e12;
+      const double emu = static_cast<double>(now_ps()) / 1e12;
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
       if (emu > wall + 0.002) std::this_thread::sleep_for(std::chrono::duration<double>(emu - wall));
     }

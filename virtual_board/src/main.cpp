@@ -46,7 +46,7 @@ std::string sha256(const std::vector<uint8_t>& data) {
   auto rotr = [](uint32_t x, int n) { return (x >> n) | (x << (32 - n)); };
   for (size_t c = 0; c < m.size(); c += 64) {
     uint32_t w[64];
-    for (int i = 0; i < 16; ++i) w[i] = (uint32_t)m[c + 4 * i] << 24 | m[c + 4 * i + 1] << 16 | m[c + 4 * i + 2] << 8 | m[c + 4 * i + 3];
+    for (size_t i = 0; i < 16; ++i) w[i] = (uint32_t)m[c + 4 * i] << 24 | (uint32_t)m[c + 4 * i + 1] << 16 | (uint32_t)m[c + 4 * i + 2] << 8 | m[c + 4 * i + 3];
     for (int i = 16; i < 64; ++i) {
       const uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
       const uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
@@ -179,9 +179,9 @@ int main(int argc, char** argv) {
   const std::string e = board.init();
   if (!e.empty()) return bad(e);
   const int rc = board.run();
-  const double emu = board.now_ps() / 1e12;
+  const double emu = static_cast<double>(board.now_ps()) / 1e12;
   if (board.first_heartbeat_ps() != UINT64_MAX) {
-    std::printf("heartbeat at %.3f ms emulated\n", board.first_heartbeat_ps() / 1e9);
+    std::printf("heartbeat at %.3f ms emulated\n", static_cast<double>(board.first_heartbeat_ps()) / 1e9);
   }
   if (bench || o.until_heartbeat) {
     std::printf("emulated %.3f s in %.3f s wall: ratio %.2f; %llu instructions, %llu exceptions, %llu frames, %u resets\n", emu,

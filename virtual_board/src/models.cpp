@@ -146,10 +146,10 @@ void Rcc::on_write(uint32_t offset, uint32_t old, uint32_t* value) {
 
 uint32_t Rcc::hclk_hz() {
   uint64_t sys = 16000000u;
-  if (sws_ == 2u) sys = POUR_BOARD_HSE_HZ;
+  if (sws_ == 2u) sys = static_cast<uint64_t>(POUR_BOARD_HSE_HZ);
   if (sws_ == 3u) {
     const uint32_t p = reg(kPLLCFGR);
-    const uint64_t in = (p & 3u) == 3u ? POUR_BOARD_HSE_HZ : 16000000u;
+    const uint64_t in = (p & 3u) == 3u ? static_cast<uint64_t>(POUR_BOARD_HSE_HZ) : 16000000u;
     const uint32_t m = ((p >> 4) & 0xFu) + 1u, n = (p >> 8) & 0x7Fu, r = 2u * (((p >> 25) & 3u) + 1u);
     sys = in / m * n / r;
   }
