@@ -61,6 +61,15 @@ def test_healthy_run_has_no_reset():
     assert " 0 resets" in r.stdout
 
 
+def test_ecc_error_on_the_calibration_page_does_not_loop_the_board():
+    # Page 63 half-erased: the image's NMI clears ECCD, the calibration is corrupt (RUN refused), and the board
+    # comes up to its heartbeat without a reset (before the fix it reset every 213 ms and never sent one).
+    r = run("--elf", ELF, "--placeholder-analog", "--ecc-page", "63", "--seconds", "2", "--print-can", "--stop-on-reset")
+    assert r.returncode == 0, r.stderr
+    assert "reset at" not in r.stderr, r.stderr
+    assert any(line.split()[3] == "001" for line in r.stdout.splitlines() if " tx " in line), r.stdout
+
+
 def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
     # IWDG at LSI / 4 with RLR 99: 12.5 ms at 32 kHz, then a page erase (24.47 ms max): the chip resets inside it.
     body = """

@@ -119,7 +119,9 @@ int Board::execution_priority() {
 
 void Board::hook_block(uc_engine* uc, uint64_t address, uint32_t size, void* user) {
   Board* b = static_cast<Board*>(user);
-  if (b->insns_ >= b->slice_end_) {
+  // Stops asked for inside an access end the slice here, after the accessing instruction retired: a stop
+  // inside the MMIO callback would resume at the access and repeat it.
+  if (b->insns_ >= b->slice_end_ || b->stop_soon_) {
     uc_emu_stop(uc);
     return;
   }
@@ -221,7 +223,7 @@ bool Board::access(uint32_t addr, unsigned size, bool write, uint32_t* v) {
         if (h != hclk_) set_hclk(h);
         if (flash_.stall_until_ps > now_ps()) {
           stall_ = true;
-          uc_emu_stop(uc_);
+          stop_soon_ = true;
         }
       }
       if (flash_.nmi_pending) {
@@ -435,7 +437,7 @@ uint64_t Board::data_read(uc_engine*, uint64_t off, unsigned size, void* user) {
   if (b->flash_.nmi_pending) {
     b->flash_.nmi_pending = false;
     b->pend(kNmi);
-    uc_emu_stop(b->uc_);
+    b->stop_soon_ = true;
   }
   return v;
 }
@@ -531,6 +533,9 @@ void Board::take_exception(int exc) {
   }
   pending_[exc] = false;
   active_.push_back(exc);
+  if (trace_ && exc < 15) {
+    std::fprintf(stderr, "trace: exception %d from pc 0x%08x at %.3f ms\n", exc, r[6], static_cast<double>(now_ps()) / 1e9);
+  }
   pc_ = vector & ~1u;
   insns_ += 12;  // entry: 12 cycles (Cortex-M4 TRM §5.5.1), counted as instructions at CPI 1
   ++exceptions_taken_;
@@ -638,6 +643,7 @@ int Board::run() {
     slice_end_ = (next * 1000u + opt_.cpi_milli - 1u) / opt_.cpi_milli;
     idle_ = false;
     stall_ = false;
+    stop_soon_ = false;
     intno_ = -1;
     const uint64_t before = insns_;
     if (trace_ && (++iterations_ % 100000u) == 0u) {

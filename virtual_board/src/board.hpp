@@ -136,7 +136,7 @@ class Board : public BoardLink, public TimeSource {
   uint64_t time_ps_ = 0, time_cycles_ = 0;
   uint32_t hclk_ = 16000000u;
   uint32_t pc_ = 0;
-  bool idle_ = false, stall_ = false, check_irq_ = false, stalled_once_ = false;
+  bool idle_ = false, stall_ = false, stop_soon_ = false, check_irq_ = false, stalled_once_ = false;
   int intno_ = -1;
   std::string stopped_, reset_cause_;
   // NVIC, SCB, SysTick state
