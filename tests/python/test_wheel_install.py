@@ -32,7 +32,7 @@ def run(argv, **kw) -> subprocess.CompletedProcess:
 
 # What the wheel is built from: the package, the C and C++ sources of libpoursim and their CMake, the DBC and
 # the LCM types. Copied, so that a build leaves the source tree as it was.
-WHEEL_SOURCES = ["CMakeLists.txt", "cmake", "firmware", "host_sim", "can", "lcmtypes", "tools"]
+WHEEL_SOURCES = ["CMakeLists.txt", "cmake", "firmware", "host_sim", "can", "lcmtypes", "tools", "configs/sim"]
 
 
 def pip_wheel(src: Path, out: Path, *extra, env=None) -> subprocess.CompletedProcess:

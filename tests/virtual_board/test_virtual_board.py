@@ -39,7 +39,7 @@ def image(tmp_path: Path, body: str, origin: int = 0x08000000, nmi: str = "") ->
 
 
 def test_flashed_image_boots_to_heartbeat():
-    r = run("--elf", ELF, "--placeholder-analog", "--until-heartbeat", "--seconds", "5", "--print-can")
+    r = run("--elf", ELF, "--until-heartbeat", "--seconds", "5", "--print-can")
     assert r.returncode == 0, r.stderr
     assert "sha256 " in r.stderr
     ids = {line.split()[3] for line in r.stdout.splitlines() if " tx " in line}
@@ -48,14 +48,14 @@ def test_flashed_image_boots_to_heartbeat():
 
 
 def test_missed_watchdog_refresh_resets_the_chip():
-    r = run("--elf", ELF, "--placeholder-analog", "--seconds", "3", "--stall-core-at", "500", "--stall-core-ms", "300",
+    r = run("--elf", ELF, "--seconds", "3", "--stall-core-at", "500", "--stall-core-ms", "300",
             "--stop-on-reset")
     assert r.returncode == 0, r.stderr
     assert "reset at" in r.stderr and "IWDG: no refresh" in r.stderr, r.stderr
 
 
 def test_healthy_run_has_no_reset():
-    r = run("--elf", ELF, "--placeholder-analog", "--seconds", "3", "--stop-on-reset", "--bench")
+    r = run("--elf", ELF, "--seconds", "3", "--stop-on-reset", "--bench")
     assert r.returncode == 0, r.stderr
     assert "reset at" not in r.stderr
     assert " 0 resets" in r.stdout
@@ -64,7 +64,7 @@ def test_healthy_run_has_no_reset():
 def test_ecc_error_on_the_calibration_page_does_not_loop_the_board():
     # Page 63 half-erased: the image's NMI clears ECCD, the calibration is corrupt (RUN refused), and the board
     # comes up to its heartbeat without a reset (before the fix it reset every 213 ms and never sent one).
-    r = run("--elf", ELF, "--placeholder-analog", "--ecc-page", "63", "--seconds", "2", "--print-can", "--stop-on-reset")
+    r = run("--elf", ELF, "--ecc-page", "63", "--seconds", "2", "--print-can", "--stop-on-reset")
     assert r.returncode == 0, r.stderr
     assert "reset at" not in r.stderr, r.stderr
     assert any(line.split()[3] == "001" for line in r.stdout.splitlines() if " tx " in line), r.stdout
@@ -195,7 +195,7 @@ def test_launcher_finds_the_program_and_the_image():
     build = str(Path(VB).resolve().parents[1])
     r = launcher("--build-dir", build, "--help")
     assert r.returncode == 0 and r.stdout.startswith("usage: pour_virtual_board"), r.stderr
-    r = launcher("--build-dir", build, "--placeholder-analog", "--until-heartbeat", "--seconds", "2")
+    r = launcher("--build-dir", build, "--until-heartbeat", "--seconds", "2")
     assert r.returncode == 0 and "heartbeat at" in r.stdout, r.stderr
 
 

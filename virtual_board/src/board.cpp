@@ -390,15 +390,6 @@ std::string Board::init() {
   rcc_.flash = &flash_;
   rcc_.pwr = &pwr_;
   gates_ = {{&gpioa_, 0x4C, 0}, {&gpiob_, 0x4C, 1}, {&gpioc_, 0x4C, 2}, {&fdcan_, 0x58, 25}, {&sramcan_, 0x58, 25}, {&pwr_, 0x58, 28}};
-  if (opt_.placeholder_analog) {
-    for (const auto& n : std::vector<std::pair<std::string, uint32_t>>{{"TIM1", 0x400}, {"TIM4", 0x400}, {"LPTIMER1", 0x400},
-                                                                       {"ADC1", 0x100}, {"ADC2", 0x100}, {"ADC12_COMMON", 0x100},
-                                                                       {"OPAMP", 0x100}, {"COMP", 0x100}, {"DAC3", 0x400},
-                                                                       {"SYSCFG", 0x30}}) {
-      placeholders_.push_back(std::make_unique<Placeholder>(n.first, n.second));
-      models_.push_back(placeholders_.back().get());
-    }
-  }
   for (auto& m : extra_) models_.push_back(m.get());
   for (Peripheral* m : models_) {
     m->attach(this);

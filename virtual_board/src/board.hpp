@@ -22,7 +22,6 @@ struct Options {
   double seconds = 10.0;
   bool until_heartbeat = false;
   bool print_can = false;
-  bool placeholder_analog = false;
   bool realtime = false;
   bool stop_on_reset = false;
   bool estop_open = false;
@@ -123,7 +122,6 @@ class Board : public BoardLink, public TimeSource {
   Gpio gpioa_{"GPIOA", 0}, gpiob_{"GPIOB", 1}, gpioc_{"GPIOC", 2};
   Fdcan fdcan_;
   SramCan sramcan_;
-  std::vector<std::unique_ptr<Placeholder>> placeholders_;
   std::vector<std::unique_ptr<Peripheral>> extra_;
   std::unique_ptr<FlashData> flash_data_;
   std::vector<Peripheral*> models_;

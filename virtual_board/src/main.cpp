@@ -7,14 +7,30 @@
 #include <string>
 #include <vector>
 
+#include "analog.hpp"
 #include "board.hpp"
 
 namespace {
 
+// The analog chain's plant, stepped by the board as one more model: it covers no address, and its next event
+// is the next PWM period's start (virtual_board/analog/analog.hpp).
+class PlantStep : public vb::Peripheral {
+ public:
+  explicit PlantStep(vb::Plant* p) : Peripheral("plant", 0, 0), plant_(p) {}
+  bool read(uint32_t, unsigned, uint32_t*) override { return false; }
+  bool write(uint32_t, unsigned, uint32_t) override { return false; }
+  void reset() override { plant_->reset(); }
+  void advance() override { plant_->step_to_cycle(link_); }
+  uint64_t next_event() const override { return plant_->next_step_cycle(link_); }
+
+ private:
+  vb::Plant* plant_;
+};
+
 const char* kUsage =
     "usage: pour_virtual_board [--elf FILE] [--interface IFACE] [--seconds S] [--until-heartbeat] [--print-can]\n"
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
-    "                          [--stop-on-reset] [--cpi-milli N] [--placeholder-analog] [--bench]\n"
+    "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n";
@@ -138,7 +154,6 @@ int main(int argc, char** argv) {
       else if (a == "--print-can") o.print_can = true;
       else if (a == "--realtime") o.realtime = true;
       else if (a == "--stop-on-reset") o.stop_on_reset = true;
-      else if (a == "--placeholder-analog") o.placeholder_analog = true;
       else if (a == "--bench") bench = true;
       else if (a == "--estop") {
         if (!(v = value("--estop"))) return bad("--estop needs open or closed");
@@ -176,6 +191,10 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "virtual board: %s sha256 %s\n", o.elf.c_str(), sha256(bytes).c_str());
   vb::Board board(o);
   board.load(flash);
+  vb::AnalogSet analog;
+  analog = vb::make_analog_models(vb::AnalogOptions{});
+  for (auto& m : analog.peripherals) board.add_model(std::move(m));
+  board.add_model(std::make_unique<PlantStep>(analog.plant.get()));
   const std::string e = board.init();
   if (!e.empty()) return bad(e);
   const int rc = board.run();

@@ -203,13 +203,6 @@ class SramCan : public Peripheral {
   Fdcan* can_;
 };
 
-// --placeholder-analog only: a plain register store over an analog block's SVD registers, so that the
-// image can be booted to its CAN heartbeat before the analog models exist. Never the default.
-class Placeholder : public SvdRegisters {
- public:
-  Placeholder(const std::string& svd_name, uint32_t size) : SvdRegisters(svd_name, svd_name + " (placeholder)", size) {}
-};
-
 }  // namespace vb
 
 #endif

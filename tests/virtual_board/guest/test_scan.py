@@ -10,13 +10,13 @@ import time
 
 
 def test_pour_bench_scan_finds_the_virtual_board():
-    board = subprocess.Popen([os.environ["POUR_VB"], "--elf", os.environ["POUR_ELF"], "--placeholder-analog",
+    board = subprocess.Popen([os.environ["POUR_VB"], "--elf", os.environ["POUR_ELF"],
                               "--interface", "vcan0", "--seconds", "120"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        time.sleep(1.0)
+        time.sleep(2.0)  # boot and the first heartbeat (11.5 ms emulated), at the guest's pace
         assert board.poll() is None, board.communicate()
-        r = subprocess.run([sys.executable, "-m", "pour.bench.cli", "--channel", "vcan0", "--timeout", "3", "scan"],
+        r = subprocess.run([sys.executable, "-m", "pour.bench.cli", "--channel", "vcan0", "--timeout", "5", "scan"],
                            capture_output=True, text=True, timeout=120)
         assert r.returncode == 0, (r.stdout, r.stderr)
         # One node, 0 (the image's default id), with its Identity frame (policy, firmware): the heartbeat and
