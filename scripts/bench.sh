@@ -335,8 +335,8 @@ EOS
 FUZZ_TARGETS=(fuzz_weights_h fuzz_config fuzz_control_step fuzz_can_node fuzz_lcm_decode fuzz_lcm_port)
 fuzz_sources() {
   case $1 in
-    fuzz_weights_h) echo host_sim/src/weights_file.cpp ;;
-    fuzz_config) echo host_sim/src/config.cpp ;;
+    fuzz_weights_h) echo host_sim/physics/weights_file.cpp ;;
+    fuzz_config) echo host_sim/physics/config.cpp ;;
     fuzz_control_step) echo firmware/src/control.c firmware/src/safety.c firmware/src/sensors.c firmware/src/supervisor.c firmware/src/policy.c firmware/src/obs.c ;;
     fuzz_can_node) echo firmware/can/src/can_node.c firmware/can/src/can_codec.c firmware/src/control.c firmware/src/safety.c ;;
     fuzz_lcm_decode) echo build/host-fuzz-cov/lcmtypes/c/pour_sensor_sample_t.c build/host-fuzz-cov/lcmtypes/c/pour_command_t.c \

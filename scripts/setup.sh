@@ -39,6 +39,21 @@ APT_PACKAGES=(
   ca-certificates xz-utils curl
   openocd
 )
+# The crates' fetch (below): Debian 12's cargo-web, the newer cargo Debian keeps for its browsers' builds
+# (1.85 in bookworm, newer in its security updates). The older `cargo` package (0.66, Rust 1.65) cannot
+# serve: it reads the registry's index only through a git clone of all of it (its sparse index is behind
+# -Z), and it cannot parse stm32-metapac 21.0.0's manifest (edition 2024). cargo-web conflicts with Debian's
+# rustup package: where that is installed, its cargo (on PATH) is used instead. POUR_CARGO names another.
+if [ "$WITH_CRATE" = 1 ]; then
+  if [ -n "${POUR_CARGO:-}" ]; then
+    CARGO_BIN=$POUR_CARGO
+  elif dpkg-query -W -f='${Status}' rustup 2>/dev/null | grep -q 'install ok installed'; then
+    CARGO_BIN=cargo
+  else
+    APT_PACKAGES+=(cargo-web)
+    CARGO_BIN=/usr/bin/cargo
+  fi
+fi
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then
@@ -116,17 +131,21 @@ fi
 # files), which tests/board/check_registers.py compares the port's register tables with; the stm32g4xx-hal
 # crate, whose pin maps (generated from ST's STM32CubeMX database) it checks the board's alternate functions
 # against; and the stm32-metapac crate, ST's CubeMX pin data per package (src/chips/stm32g431cb/), for the
-# board's pin check. Each .crate file comes over HTTPS from the crate registry's download endpoint, pinned by
-# version and sha256 (scripts/lib/fetch_crate.py: no cargo, no git index), and is unpacked under
-# .deps/stm32g4/NAME-VERSION; never copied into the repo. The marker files crate-dir, hal-dir and
-# metapac-dir hold each unpacked crate's absolute path; NAME-VERSION.sha256 records the pin it was
-# checked against, so a changed pin fetches again.
+# board's pin check. cargo fetches them from the crate registry through its sparse index (no git index),
+# with every transitive dependency pinned by scripts/crates/Cargo.toml, into a private CARGO_HOME
+# (.deps/cargo); nothing is built. Each .crate file is then checked against its sha256 pinned here (ours, on
+# top of cargo's own check against the index) and unpacked under .deps/stm32g4/NAME-VERSION by
+# scripts/lib/unpack_crate.py; never copied into the repo. The marker files crate-dir, hal-dir and
+# metapac-dir hold each unpacked crate's absolute path; NAME-VERSION.sha256 records the pin it was checked
+# against, so a changed pin unpacks again.
 SVD_CRATES=("stm32g4 0.16.0 97bc6434066d2459f0e0834ade8b03e5c5e8d4aad84dc2ff50e56464e6104f4d crate-dir src/stm32g431/mod.rs"
             "stm32g4xx-hal 0.1.0 6402921e7994d834b5717593270b821dfb601d83ea7eeb4ebd6b2b3fe730f793 hal-dir src/pwm.rs"
             "stm32-metapac 21.0.0 e74b78632cea498cfb28386a29f8bfae7476d6570a78733eb5fecbee66c2f4ce metapac-dir src/chips/stm32g431cb/pac.rs")
 SVD_WORK=$ROOT/.deps/stm32g4
+CARGO_WORK=$ROOT/.deps/cargo
 if [ "$WITH_CRATE" = 1 ]; then
   mkdir -p "$SVD_WORK"
+  fetched=0
   for entry in "${SVD_CRATES[@]}"; do
     read -r name ver sha marker probe <<<"$entry"
     dir=$SVD_WORK/$name-$ver
@@ -134,8 +153,27 @@ if [ "$WITH_CRATE" = 1 ]; then
        && [ "$(cat "$SVD_WORK/$name-$ver.sha256" 2>/dev/null)" = "$sha" ]; then
       continue
     fi
-    log "crates: fetching $name $ver from the crate registry"
-    got=$("$PY" scripts/lib/fetch_crate.py "$name" "$ver" "$sha" "$SVD_WORK") || exit 1
+    if [ "$fetched" = 0 ]; then
+      command -v "$CARGO_BIN" >/dev/null || { log "crates: no cargo '$CARGO_BIN' (see the apt list's comment)"; exit 1; }
+      log "crates: fetching scripts/crates/Cargo.toml's dependencies from the crate registry ($($CARGO_BIN --version))"
+      # A copy of the manifest, so that the lock file cargo writes beside it stays out of the checkout.
+      mkdir -p "$CARGO_WORK/manifest/src"
+      cp scripts/crates/Cargo.toml "$CARGO_WORK/manifest/Cargo.toml"
+      cp scripts/crates/src/lib.rs "$CARGO_WORK/manifest/src/lib.rs"
+      rustc_env=()
+      [ "$CARGO_BIN" = /usr/bin/cargo ] && rustc_env=(RUSTC=/usr/bin/rustc)  # Debian's, beside its cargo
+      env "${rustc_env[@]}" CARGO_HOME="$CARGO_WORK/home" "$CARGO_BIN" fetch -q \
+        --manifest-path "$CARGO_WORK/manifest/Cargo.toml" || { log "crates: cargo fetch failed"; exit 1; }
+      fetched=1
+    fi
+    shopt -s nullglob
+    crates=("$CARGO_WORK"/home/registry/cache/*/"$name-$ver.crate")
+    shopt -u nullglob
+    [ ${#crates[@]} = 1 ] || { log "crates: cargo's cache holds ${#crates[@]} files $name-$ver.crate, not one"; exit 1; }
+    # cargo keeps a cached .crate file without checking it again: a refused one is removed with its cache.
+    got=$("$PY" scripts/lib/unpack_crate.py "$name" "$ver" "$sha" "${crates[0]}" "$SVD_WORK") \
+      || { log "crates: $name $ver refused; removing .deps/cargo, so that the next run fetches afresh"
+           rm -rf "$CARGO_WORK"; exit 1; }
     [ "$got" = "$dir" ] && [ -f "$dir/$probe" ] || { log "crates: no $probe under '$got'"; exit 1; }
     echo "$sha" > "$SVD_WORK/$name-$ver.sha256.part" && mv "$SVD_WORK/$name-$ver.sha256.part" "$SVD_WORK/$name-$ver.sha256"
     echo "$dir" > "$SVD_WORK/$marker.part" && mv "$SVD_WORK/$marker.part" "$SVD_WORK/$marker"

@@ -14,6 +14,14 @@ static const pour_param_info_t k_info[] = {
 #undef POUR_PARAM_INFO
 };
 
+/* The declaration checked by the compiler as well (scripts/param_table.py check names the rows in the build):
+ * two rows on one id are two equal case labels in pour_params_get, two of one name two equal enumerators, and
+ * an empty range a negative array size here. */
+#define POUR_PARAM_RANGE_CHECK(id, name, unit, lo, hi, type, field) \
+  typedef char pour_param_range_not_empty_##name[(lo) <= (hi) ? 1 : -1];
+POUR_PARAMS(POUR_PARAM_RANGE_CHECK)
+#undef POUR_PARAM_RANGE_CHECK
+
 /* The table is dense: row i has id i (a Unity test checks it), so the lookup is an index. */
 const pour_param_info_t *pour_param_info(uint8_t id) {
   return id < POUR_PARAM_COUNT ? &k_info[id] : NULL;

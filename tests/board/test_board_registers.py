@@ -92,7 +92,7 @@ def test_wrong_offset_in_our_table_fails(crate, table, tmp_path, capsys):
 def test_every_pin_the_port_uses_is_checked(table):
     """Each pin of pour/board_facts.h's table, and each pin the board's code names, is a PIN line."""
     pins = {line.split()[1] for line in table.read_text().splitlines() if line.startswith("PIN ")}
-    board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board_stm32g431.c").read_text()
+    board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board" / "board_stm32g431.c").read_text()
     used = set(re.findall(r"(?:BOARD_PIN|AF_PIN)\((\w+)\)", board_c)) - {"name"}
     assert used and used <= pins, used - pins
 
@@ -287,6 +287,6 @@ def test_every_pin_the_board_sets_up_is_decoded(table):
     pins = {line.split()[2]: line.split()[1] for line in text.splitlines() if line.startswith("PIN ")}
     moder = [w.split() for w in text.splitlines() if w.startswith("WRITE GPIO") and w.split()[2] == "MODER"]
     written = {"P" + w[1][4] + w[3][len("MODER"):] for w in moder}
-    board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board_stm32g431.c").read_text()
+    board_c = (SOURCE / "firmware" / "ports" / "cortex-m4" / "board" / "board_stm32g431.c").read_text()
     used = set(re.findall(r"(?:BOARD_PIN|AF_PIN)\((\w+)\)", board_c)) - {"name"}
     assert {pins[p] for p in written} == used

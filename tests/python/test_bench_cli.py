@@ -392,14 +392,14 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         saved = bp.load_dump(dump, bp.table())
         assert saved["omega_max"] == 1750000 and saved["theta_max"] == 2356194 and len(saved) == 28
         # Another set in force: theta_max below the dump's theta_min, so writing theta_min first is refused.
-        node.params.update({2: -600000, 3: -500000, 4: 1000})
+        node.params.update({2: -80000, 3: 50000, 4: 1000})
         doc = json.loads(dump.read_text())
-        doc["params"]["theta_min"]["raw"] = -400000
+        doc["params"]["theta_min"]["raw"] = 100000
         dump.write_text(json.dumps(doc))
         node.writes.clear()
         assert bench_cli.main(base + ["config", "restore", str(dump)]) == 0
         assert "28 parameters restored" in capsys.readouterr().out
-        assert node.params[2] == -400000 and node.params[3] == 2356194 and node.params[4] == 1750000
+        assert node.params[2] == 100000 and node.params[3] == 2356194 and node.params[4] == 1750000
         assert [pid for pid, _ in node.writes].index(2) > [pid for pid, _ in node.writes].index(3)
 
 

@@ -4,6 +4,7 @@ value lists are what scripts/param_table.py generates; a declaration with two ro
 one name or a bound that is no number fails naming the rows involved."""
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -93,3 +94,22 @@ def test_a_bridge_that_drifts_is_named(tmp_path, old, new, message):
     bad.write_text(text.replace(old, new))
     r = run("fields", "--bridge", str(bad))
     assert r.returncode == 1 and r.stderr.strip().splitlines() == [f"{bad}: {message}"], r.stderr
+
+
+@pytest.mark.parametrize("old,new,message", [
+    ("X(5, alpha_max,", "X(4, alpha_max,", "duplicate case value"),
+    ("X(27, slow_ki,", "X(27, slow_omega,", "POUR_PARAM_ID_slow_omega"),
+    ('X(17, encoder_zero, "counts", 0, 16777215,', 'X(17, encoder_zero, "counts", 16777215, 0,',
+     "pour_param_range_not_empty_encoder_zero"),
+], ids=["same id", "same name", "min > max"])
+def test_the_compiler_refuses_a_bad_declaration_too(tmp_path, old, new, message):
+    include = tmp_path / "include"
+    shutil.copytree(HEADER.parent.parent, include)
+    (include / "pour/params.h").write_text(HEADER.read_text().replace(old, new))
+    def compile_with(inc: Path) -> subprocess.CompletedProcess:
+        return subprocess.run([shutil.which("cc") or "cc", "-std=c99", "-fsyntax-only", "-I", str(inc),
+                               str(ROOT / "firmware/src/params.c")], capture_output=True, text=True, timeout=60)
+    good = compile_with(HEADER.parent.parent)
+    assert good.returncode == 0, good.stderr  # the same command takes the real declaration
+    r = compile_with(include)
+    assert r.returncode != 0 and message in r.stderr, r.stderr

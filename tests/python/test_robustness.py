@@ -81,7 +81,7 @@ def test_a_short_run_on_the_simulator_writes_the_table(tmp_path, source_dir, bui
 
 
 def test_episode_metrics_count_reversals_and_litres():
-    """libpoursim's episode figures (host_sim/src/metrics.cpp), through the trainer's C rollout."""
+    """libpoursim's episode figures (host_sim/physics/metrics.cpp), through the trainer's C rollout."""
     import math
 
     import numpy as np

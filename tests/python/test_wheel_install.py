@@ -30,9 +30,9 @@ def run(argv, **kw) -> subprocess.CompletedProcess:
     return subprocess.run([str(a) for a in argv], capture_output=True, text=True, timeout=300, **kw)
 
 
-# What the wheel is built from: the package, the C and C++ sources of libpoursim and their CMake, the DBC,
-# the LCM types and the rig distributions (configs/sim). Copied, so that a build leaves the source tree as it was.
-WHEEL_SOURCES = ["CMakeLists.txt", "cmake", "firmware", "host_sim", "can", "lcmtypes", "tools", "configs"]
+# What the wheel is built from: the package, the C and C++ sources of libpoursim and their CMake, the DBC and
+# the LCM types. Copied, so that a build leaves the source tree as it was.
+WHEEL_SOURCES = ["CMakeLists.txt", "cmake", "firmware", "host_sim", "can", "lcmtypes", "tools", "configs/sim"]
 
 
 def pip_wheel(src: Path, out: Path, *extra, env=None) -> subprocess.CompletedProcess:

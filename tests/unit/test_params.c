@@ -57,8 +57,8 @@ static void test_params_set_RefusesOutOfRangeAndUnknownIds(void) {
   TEST_ASSERT_EQUAL_MEMORY(&before, &params, sizeof params);
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_stop_timeout, 65535));
   TEST_ASSERT_EQUAL_UINT16(65535u, params.control.stop.timeout_ms);
-  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_theta_min, -3141593));
-  TEST_ASSERT_EQUAL_INT32(-3141593, params.control.safety.theta_min_urad);
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_theta_min, -87266));
+  TEST_ASSERT_EQUAL_INT32(-87266, params.control.safety.theta_min_urad);
 }
 
 /* The envelope's ranges are the safety case's (docs/safety.md, "The motion envelope"), not the types': 100 rad/s
@@ -79,6 +79,10 @@ static void test_params_set_RefusesAnEnvelopeBeyondTheSafetyCase(void) {
     TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, k_cases[i].id, k_cases[i].limit + 1));
   }
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, POUR_PARAM_ID_omega_max, 99999999));
+  /* the angles: from 5 deg past upright to the 135 deg hard stop */
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, POUR_PARAM_ID_theta_min, -87267));
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, POUR_PARAM_ID_theta_max, 2356195));
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OUT_OF_RANGE, pour_params_set(&params, POUR_PARAM_ID_theta_max, 3141593));
   TEST_ASSERT_EQUAL_MEMORY(&before, &params, sizeof params);
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_omega_max, 2000000));
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_governor_gain, 16384));

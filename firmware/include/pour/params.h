@@ -23,6 +23,8 @@
 #define POUR_PARAM_OMEGA_ENVELOPE_URAD_S 2000000   /* 2 rad/s: the hot-liquid limit, omega_max's default */
 #define POUR_PARAM_ALPHA_ENVELOPE_URAD_S2 3400000  /* 3.4 rad/s^2: omega_max in one 1.7 Hz slosh period */
 #define POUR_PARAM_GAIN_ENVELOPE 16384             /* 0.5 tau_max per rad/s: the stiffest stable governor */
+#define POUR_PARAM_THETA_LOW_URAD (-87266)         /* -5 deg: a little past upright, never backwards over */
+#define POUR_PARAM_THETA_HIGH_URAD 2356194         /* 135 deg: the hard stop of the bucket's tilt */
 
 /* X(id, name, unit, min, max, C type, field of pour_params_t). Ids are the bus's (ParamId in can/pour.dbc,
  * whose value table names them alike; tests/python/test_can_dbc.py keeps the two equal). */
@@ -30,8 +32,8 @@
   /* the motion envelope (pour_safety_config_t) */                                                            \
   X(0, tau_limit, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.tau_limit)                                    \
   X(1, slew_per_tick, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.slew_per_tick)                            \
-  X(2, theta_min, "urad", -3141593, 3141593, int32_t, control.safety.theta_min_urad)                         \
-  X(3, theta_max, "urad", -3141593, 3141593, int32_t, control.safety.theta_max_urad)                         \
+  X(2, theta_min, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD, int32_t, control.safety.theta_min_urad)                         \
+  X(3, theta_max, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD, int32_t, control.safety.theta_max_urad)                         \
   X(4, omega_max, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_max_urad_s)        \
   X(5, alpha_max, "urad/s2", 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, int32_t, control.safety.alpha_max_urad_s2)                     \
   X(6, omega_slack, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_slack_urad_s)    \

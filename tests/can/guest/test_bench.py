@@ -80,7 +80,7 @@ def test_bring_up_with_host_sim_as_the_plant(tmp_path):
         assert ok("config", "set", "--raw", "omega_max", "1500000") == "omega_max 1500000\n"
         assert ok("config", "set", "--raw", "stop_timeout", "4000") == "stop_timeout 4000\n"
         assert "OUT_OF_RANGE" in refused("config", "set", "--raw", "encoder_bits", "30")
-        assert "INCONSISTENT" in refused("config", "set", "--raw", "theta_min", "2400000")  # above theta_max
+        assert "INCONSISTENT" in refused("config", "set", "--raw", "theta_min", "2356194")  # at theta_max
         assert "no parameter 'nosuch'" in refused("config", "get", "nosuch")
         assert "parameters saved" in ok("config", "save")
         assert params.stat().st_size > 0

@@ -27,6 +27,7 @@
   R(RCC, CCIPR, 0x88)                                                                                          \
   R(PWR, CR5, 0x80)                                                                                            \
   R(FLASH, ACR, 0x00)                                                                                          \
+  R(FLASH, ECCR, 0x18)                                                                                         \
   R(FLASH, OPTR, 0x20)                                                                                         \
   R(IWDG, KR, 0x00)                                                                                            \
   R(IWDG, PR, 0x04)                                                                                            \
@@ -86,6 +87,7 @@
   F(FLASH, ACR, PRFTEN, 8, 1)                                                                                  \
   F(FLASH, ACR, ICEN, 9, 1)                                                                                    \
   F(FLASH, ACR, DCEN, 10, 1)                                                                                   \
+  F(FLASH, ECCR, ECCD, 31, 1)                                                                                  \
   F(FLASH, OPTR, N_BOOT1, 23, 1)                                                                               \
   F(FLASH, OPTR, N_SWBOOT0, 26, 1)                                                                             \
   F(FLASH, OPTR, N_BOOT0, 27, 1)                                                                               \

@@ -336,103 +336,112 @@ int run_experiment_cli(const Options &o, const poursim_config_t &cfg) {
   return done ? 0 : 1;
 }
 
-} // namespace
-
-int main(int argc, char **argv) {
-  using poursim::Episode;
-  using poursim::Recorder;
-  Options o;
-  int rc = parse_args(argc, argv, o);
-  if (rc >= 0) return rc;
-  char err[POURSIM_ERR_LEN];
+// What the steps of main() hand on: the configuration the run uses and the policy it runs (if any).
+struct Setup {
   poursim_config_t cfg = poursim_default_config();
   poursim_reward_t reward = poursim_default_reward();
+  poursim_weights_file_t weights{};
+};
 
-  // The policy first: the simulator runs at the tau_max the policy was trained with.
-  poursim_weights_file_t weights;
+// The policy first (the simulator runs at the tau_max the policy was trained with), then --config, each
+// --set and the validation. -1 when all is well, else the exit status.
+int load_setup(const Options &o, Setup &s) {
+  char err[POURSIM_ERR_LEN];
   if (!o.policy.empty()) {
-    if (poursim_weights_load(o.policy.c_str(), &weights, err, sizeof err) != POURSIM_OK) {
+    if (poursim_weights_load(o.policy.c_str(), &s.weights, err, sizeof err) != POURSIM_OK) {
       std::fprintf(stderr, "host_sim: bad policy: %s\n", err);
       return 2;
     }
-    cfg.tau_max = weights.tau_max_mnm * 1e-3;
+    s.cfg.tau_max = s.weights.tau_max_mnm * 1e-3;
   }
-  const double tau_policy = cfg.tau_max;
-  if (!o.config_path.empty() && poursim_config_load(o.config_path.c_str(), &cfg, err, sizeof err) != POURSIM_OK) {
+  const double tau_policy = s.cfg.tau_max;
+  if (!o.config_path.empty() && poursim_config_load(o.config_path.c_str(), &s.cfg, err, sizeof err) != POURSIM_OK) {
     std::fprintf(stderr, "host_sim: bad config: %s\n", err);
     return 2;
   }
-  for (const std::string &s : o.sets) {
-    size_t eq = s.find('=');
-    if (eq == std::string::npos) return usage_error("--set wants KEY=VALUE, got '%s'", s.c_str());
-    const std::string key = s.substr(0, eq), value = s.substr(eq + 1);
+  for (const std::string &set : o.sets) {
+    size_t eq = set.find('=');
+    if (eq == std::string::npos) return usage_error("--set wants KEY=VALUE, got '%s'", set.c_str());
+    const std::string key = set.substr(0, eq), value = set.substr(eq + 1);
     // A key of the world's config, else one of the reward that makes the figures' return.
     const bool world_key = poursim_config_key_info(key.c_str(), nullptr, nullptr, nullptr, nullptr, nullptr, nullptr) ==
                            POURSIM_OK;
-    if ((world_key ? poursim_config_set(&cfg, key.c_str(), value.c_str(), err, sizeof err)
-                   : poursim_reward_set(&reward, key.c_str(), value.c_str(), err, sizeof err)) != POURSIM_OK) {
+    if ((world_key ? poursim_config_set(&s.cfg, key.c_str(), value.c_str(), err, sizeof err)
+                   : poursim_reward_set(&s.reward, key.c_str(), value.c_str(), err, sizeof err)) != POURSIM_OK) {
       std::fprintf(stderr, "host_sim: bad --set: %s%s\n", err, key_hint(key).c_str());
       return 2;
     }
   }
-  if (poursim_config_validate(&cfg, err, sizeof err) != POURSIM_OK) {
+  if (poursim_config_validate(&s.cfg, err, sizeof err) != POURSIM_OK) {
     std::fprintf(stderr, "host_sim: bad config: %s\n", err);
     return 2;
   }
-  if (!o.policy.empty() && std::fabs(cfg.tau_max - tau_policy) > 1e-9) {
+  if (!o.policy.empty() && std::fabs(s.cfg.tau_max - tau_policy) > 1e-9) {
     std::fprintf(stderr,
                  "host_sim: mismatch: %s was trained with tau_max %.3f N·m (POUR_WEIGHTS_TAU_MAX_MNM) but the config "
                  "sets tau_max = %.3f\n",
-                 o.policy.c_str(), tau_policy, cfg.tau_max);
+                 o.policy.c_str(), tau_policy, s.cfg.tau_max);
     return 2;
   }
-  if (o.bench) return poursim::run_bench(cfg, o.policy, o.episodes);
-  if (!o.experiment.empty()) return run_experiment_cli(o, cfg);
+  return -1;
+}
 
-  // Every output checked before any work: none may name an input or another output, all must be writable.
-  std::string render_base, render_json, renderer;
+// Where --render writes: the animation, its .png snapshot and its .json trajectory, and the program that
+// draws them.
+struct RenderPlan {
+  std::string base, json, renderer;
+};
+
+// Every output checked before any work: none may name an input or another output, all must be writable.
+// -1 when all is well, else the exit status.
+int check_run_outputs(const Options &o, RenderPlan &render) {
   std::vector<poursim::NamedPath> outputs;
   if (!o.csv.empty()) outputs.push_back({"--csv", o.csv});
   if (!o.render.empty()) {
     std::string ext = o.render.size() > 4 ? o.render.substr(o.render.size() - 4) : "";
     if (ext != ".gif" && ext != ".mp4") return usage_error("--render wants a .gif or .mp4 file name, got '%s'", o.render.c_str());
-    render_base = o.render.substr(0, o.render.size() - 4);
-    if (render_base.empty() || render_base.back() == '/')
+    render.base = o.render.substr(0, o.render.size() - 4);
+    if (render.base.empty() || render.base.back() == '/')
       return usage_error("--render wants a file name before its .gif or .mp4, got '%s'", o.render.c_str());
     if (ext == ".mp4" && poursim::find_program("ffmpeg").empty()) {
       std::fprintf(stderr, "host_sim: --render %s: an MP4 needs ffmpeg on PATH (apt install ffmpeg); use a .gif\n",
                    o.render.c_str());
       return 2;
     }
-    renderer = poursim::find_program(poursim::renderer_name());
-    if (renderer.empty()) {
+    render.renderer = poursim::find_program(poursim::renderer_name());
+    if (render.renderer.empty()) {
       std::fprintf(stderr,
                    "host_sim: --render needs the renderer '%s', which is not an executable%s (put the venv's bin, "
                    "e.g. .venv/bin, on PATH, or set POUR_RENDER to the program)\n",
                    poursim::renderer_name(), std::strchr(poursim::renderer_name(), '/') != nullptr ? "" : " on PATH");
       return 2;
     }
-    render_json = render_base + ".json";
+    render.json = render.base + ".json";
     outputs.push_back({"--render", o.render});
-    outputs.push_back({"--render (its .png snapshot)", render_base + ".png"});
-    outputs.push_back({"--render (its .json trajectory)", render_json});
+    outputs.push_back({"--render (its .png snapshot)", render.base + ".png"});
+    outputs.push_back({"--render (its .json trajectory)", render.json});
   }
   std::string why;
   if (!poursim::check_outputs(outputs, {{"--policy", o.policy}, {"--config", o.config_path}}, &why))
     return usage_error("%s", why.c_str());
+  return -1;
+}
 
-  std::unique_ptr<poursim::Controller> ctl;
-  poursim::LcmController *lcm_ctl = nullptr;
-  std::vector<double> truth_w(POURSIM_N_FEATURES * POURSIM_MAX_ACTIONS), truth_levels(POURSIM_MAX_ACTIONS);
+// What drives the bucket: pour_controller over LCM, the firmware core in-process, or a baseline. *lcm is the
+// LCM controller when it is one. -1 when all is well, else the exit status.
+int make_run_controller(const Options &o, const Setup &s, std::unique_ptr<poursim::Controller> &ctl,
+                        poursim::LcmController **lcm) {
+  *lcm = nullptr;
   if (o.lcm) {
+    std::vector<double> truth_w(POURSIM_N_FEATURES * POURSIM_MAX_ACTIONS), truth_levels(POURSIM_MAX_ACTIONS);
     poursim::LcmLinkDef def;
     def.url = o.lcm_url;
     def.lockstep = !o.realtime;
     def.answer_timeout_ms = o.lcm_timeout_ms;
     if (!o.policy.empty()) {
-      def.expected_weights_hash = weights.content_hash;
+      def.expected_weights_hash = s.weights.content_hash;
       def.truth_obs = true;
-      poursim_weights_float_policy(&weights, truth_w.data(), truth_levels.data(), &def.truth_norm);
+      poursim_weights_float_policy(&s.weights, truth_w.data(), truth_levels.data(), &def.truth_norm);
     }
     std::string lerr;
     std::unique_ptr<poursim::LcmController> lc = poursim::LcmController::open(def, &lerr);
@@ -440,29 +449,130 @@ int main(int argc, char **argv) {
       std::fprintf(stderr, "host_sim: %s\n", lerr.c_str());
       return 1;
     }
-    lcm_ctl = lc.get();
+    *lcm = lc.get();
     ctl = std::move(lc);
-  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(weights, o.sampled, cfg, o.core_reset);
-  else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, cfg);
-  else if (o.baseline == "full") ctl = poursim::make_full_torque_controller(cfg);
-  else ctl = poursim::make_hand_controller(cfg);
+  } else if (!o.policy.empty()) ctl = poursim::make_firmware_controller(s.weights, o.sampled, s.cfg, o.core_reset);
+  else if (o.baseline == "rate") ctl = poursim::make_rate_controller(o.rate, s.cfg);
+  else if (o.baseline == "full") ctl = poursim::make_full_torque_controller(s.cfg);
+  else ctl = poursim::make_hand_controller(s.cfg);
+  return -1;
+}
 
-  poursim_world_t *world = poursim_create(&cfg, err, sizeof err);
+// What the episodes leave: each one's figures, the full drive's figures of each (drive = 1), and the first
+// episode's recording for --render.
+struct RunRecord {
+  std::vector<poursim::Episode> eps;
+  std::vector<poursim_drive_telemetry_t> drive;
+  poursim::Recorder first;
+};
+
+// The episodes, seeds seed0, seed0 + 1, ..., each printed unless --quiet and its steps written to csv (if
+// any). -1 when all ran, else the exit status.
+int run_episodes(const Options &o, const Setup &s, poursim_world_t *world, poursim::Controller &ctl,
+                 poursim::LcmController *lcm, uint32_t seed0, std::FILE *per, std::FILE *csv, RunRecord &run) {
+  for (int k = 0; k < o.episodes; ++k) {
+    uint32_t seed = seed0 + static_cast<uint32_t>(k);
+    poursim::Recorder rec;
+    rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
+    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEverySteps : 0;
+    poursim::Episode e = poursim::run_episode(world, ctl, seed, s.reward, &rec);
+    if (!e.error.empty()) {
+      int status = 1;
+      if (lcm != nullptr && lcm->failed()) {
+        std::fprintf(stderr, "host_sim: %s\n", e.error.c_str());
+        std::fprintf(stderr, "host_sim: %s\n", lcm->link().summary().c_str());
+        status = lcm->failure_status();
+      } else {
+        std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
+      }
+      return status;
+    }
+    run.eps.push_back(e);
+    poursim_drive_telemetry_t tel;
+    poursim_drive_telemetry(world, &tel);
+    run.drive.push_back(tel);
+    if (!o.quiet) poursim::print_episode(per, k + 1, e);
+    if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, s.cfg.tau_max);
+    if (k == 0 && !o.render.empty()) run.first = std::move(rec);
+  }
+  return -1;
+}
+
+// The summary (stdout), the drive's and the LCM link's figures, then the CSV renamed into place and the
+// render drawn. The exit status: 0, or 1 when an output could not be written.
+int report_run(const Options &o, const Setup &s, poursim_world_t *world, const poursim::Controller &ctl,
+               poursim::LcmController *lcm, uint32_t seed0, std::FILE *per, poursim::AtomicFile *csv_file,
+               const RenderPlan &render, const RunRecord &run) {
+  poursim::print_summary(stdout, o.json, ctl.name(), seed0, s.cfg.tau_max, run.eps,
+                         s.cfg.drive == 1 ? &run.drive : nullptr);
+  if (s.cfg.drive == 1) {
+    const poursim_drive_telemetry_t w = poursim::drive_worst(run.drive);
+    std::fprintf(per, "drive (field-oriented, docs/motor.md): peak phase current %.1f A, peak bus %.2f V (lowest %.2f V), "
+                 "faults %s\n",
+                 w.peak_current, w.peak_vbus, w.min_vbus, poursim::drive_fault_names(w.faults).c_str());
+  }
+  if (lcm != nullptr) {
+    lcm->link().drain(50);
+    std::fprintf(per, "%s\n", lcm->link().summary().c_str());
+  }
+  int status = 0;
+  std::string why;
+  if (csv_file != nullptr) {
+    if (!csv_file->commit(&why)) {
+      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
+      status = 1;
+    } else if (!o.quiet) {
+      std::fprintf(per, "trajectory: %s\n", o.csv.c_str());
+    }
+  }
+  if (!o.render.empty()) {
+    if (!poursim::save_render_json(render.json, *poursim_world_config(world), run.first, ctl.name(), run.eps[0].m,
+                                   &why)) {
+      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
+      status = 1;
+    } else if (poursim::run_render(render.renderer, render.json, o.render) != 0) {
+      status = 1;
+    } else if (!o.quiet) {
+      std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render.base.c_str(),
+                   render.json.c_str());
+    }
+  }
+  return status;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  Options o;
+  int rc = parse_args(argc, argv, o);
+  if (rc >= 0) return rc;
+  Setup s;
+  if ((rc = load_setup(o, s)) >= 0) return rc;
+  if (o.bench) return poursim::run_bench(s.cfg, o.policy, o.episodes);
+  if (!o.experiment.empty()) return run_experiment_cli(o, s.cfg);
+  RenderPlan render;
+  if ((rc = check_run_outputs(o, render)) >= 0) return rc;
+  std::unique_ptr<poursim::Controller> ctl;
+  poursim::LcmController *lcm = nullptr;
+  if ((rc = make_run_controller(o, s, ctl, &lcm)) >= 0) return rc;
+
+  char err[POURSIM_ERR_LEN];
+  poursim_world_t *world = poursim_create(&s.cfg, err, sizeof err);
   if (world == nullptr) {
     std::fprintf(stderr, "host_sim: %s\n", err);
     return 1;
   }
-  if (lcm_ctl != nullptr) lcm_ctl->set_world(world);
-  uint32_t seed0 = o.seed >= 0 ? static_cast<uint32_t>(o.seed) : cfg.seed;
+  if (lcm != nullptr) lcm->set_world(world);
+  const uint32_t seed0 = o.seed >= 0 ? static_cast<uint32_t>(o.seed) : s.cfg.seed;
   std::FILE *per = o.json ? stderr : stdout;
   if (!o.quiet)
     std::fprintf(per, "host_sim: %s, %d episode%s of %.1f s, tau_max %.1f N·m, seed %u\n", ctl->name().c_str(),
-                 o.episodes, o.episodes > 1 ? "s" : "", cfg.episode_s, cfg.tau_max, seed0);
-  std::vector<Episode> eps;
+                 o.episodes, o.episodes > 1 ? "s" : "", s.cfg.episode_s, s.cfg.tau_max, seed0);
   // Written beside the target and renamed at the end: an existing CSV stays whole until the new one is.
   poursim::AtomicFile csv_file;
   std::FILE *csv = nullptr;
   if (!o.csv.empty()) {
+    std::string why;
     if (!csv_file.open(o.csv, &why)) {
       std::fprintf(stderr, "host_sim: %s\n", why.c_str());
       poursim_destroy(world);
@@ -471,65 +581,9 @@ int main(int argc, char **argv) {
     csv = csv_file.stream();
     poursim::write_csv_header(csv);
   }
-  Recorder first;
-  std::vector<poursim_drive_telemetry_t> drive; // the full drive's figures of each episode (drive = 1)
-  for (int k = 0; k < o.episodes; ++k) {
-    uint32_t seed = seed0 + static_cast<uint32_t>(k);
-    Recorder rec;
-    rec.steps = !o.csv.empty() || (k == 0 && !o.render.empty());
-    rec.frame_every = (k == 0 && !o.render.empty()) ? kFrameEverySteps : 0;
-    Episode e = poursim::run_episode(world, *ctl, seed, reward, &rec);
-    if (!e.error.empty()) {
-      int status = 1;
-      if (lcm_ctl != nullptr && lcm_ctl->failed()) {
-        std::fprintf(stderr, "host_sim: %s\n", e.error.c_str());
-        std::fprintf(stderr, "host_sim: %s\n", lcm_ctl->link().summary().c_str());
-        status = lcm_ctl->failure_status();
-      } else {
-        std::fprintf(stderr, "host_sim: seed %u: %s\n", seed, e.error.c_str());
-      }
-      poursim_destroy(world);
-      return status;
-    }
-    eps.push_back(e);
-    poursim_drive_telemetry_t tel;
-    poursim_drive_telemetry(world, &tel);
-    drive.push_back(tel);
-    if (!o.quiet) poursim::print_episode(per, k + 1, e);
-    if (csv != nullptr) poursim::write_csv_episode(csv, k + 1, seed, rec.samples, cfg.tau_max);
-    if (k == 0 && !o.render.empty()) first = std::move(rec);
-  }
-  poursim::print_summary(stdout, o.json, ctl->name(), seed0, cfg.tau_max, eps, cfg.drive == 1 ? &drive : nullptr);
-  if (cfg.drive == 1) {
-    const poursim_drive_telemetry_t w = poursim::drive_worst(drive);
-    std::fprintf(per, "drive (field-oriented, docs/motor.md): peak phase current %.1f A, peak bus %.2f V (lowest %.2f V), "
-                 "faults %s\n",
-                 w.peak_current, w.peak_vbus, w.min_vbus, poursim::drive_fault_names(w.faults).c_str());
-  }
-  if (lcm_ctl != nullptr) {
-    lcm_ctl->link().drain(50);
-    std::fprintf(per, "%s\n", lcm_ctl->link().summary().c_str());
-  }
-  int status = 0;
-  if (csv != nullptr) {
-    if (!csv_file.commit(&why)) {
-      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
-      status = 1;
-    } else if (!o.quiet) {
-      std::fprintf(per, "trajectory: %s\n", o.csv.c_str());
-    }
-  }
-  if (!o.render.empty()) {
-    if (!poursim::save_render_json(render_json, *poursim_world_config(world), first, ctl->name(), eps[0].m, &why)) {
-      std::fprintf(stderr, "host_sim: %s\n", why.c_str());
-      status = 1;
-    } else if (poursim::run_render(renderer, render_json, o.render) != 0) {
-      status = 1;
-    } else if (!o.quiet) {
-      std::fprintf(per, "render: %s and %s.png (trajectory %s)\n", o.render.c_str(), render_base.c_str(),
-                   render_json.c_str());
-    }
-  }
+  RunRecord run;
+  rc = run_episodes(o, s, world, *ctl, lcm, seed0, per, csv, run);
+  if (rc < 0) rc = report_run(o, s, world, *ctl, lcm, seed0, per, csv != nullptr ? &csv_file : nullptr, render, run);
   poursim_destroy(world);
-  return status;
+  return rc;
 }

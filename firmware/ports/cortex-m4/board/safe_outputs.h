@@ -5,5 +5,9 @@
 #define POUR_SAFE_OUTPUTS_H
 
 void pour_safe_outputs(void);
+/* startup.c: every fault (safe outputs, then a stop the watchdog ends), and the NMI, a fault unless the board
+ * replaces it (board_stm32g431.c: a flash ECC error). */
+void Fault_Handler(void);
+void NMI_Handler(void);
 
 #endif /* POUR_SAFE_OUTPUTS_H */

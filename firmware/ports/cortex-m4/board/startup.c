@@ -15,7 +15,6 @@ extern uint32_t __data_load__, __data_start__, __data_end__, __bss_start__, __bs
 extern int main(void);
 void Reset_Handler(void);
 void Default_Handler(void);
-void Fault_Handler(void);
 __attribute__((weak)) void pour_safe_outputs(void) {}
 #ifdef POUR_SEMIHOSTED
 extern void _start(void);
@@ -30,6 +29,9 @@ void Fault_Handler(void) {
 }
 
 void Default_Handler(void) { Fault_Handler(); }
+
+/* The NMI: a fault unless the board says otherwise (board_stm32g431.c: a flash ECC error on a data page). */
+__attribute__((weak)) void NMI_Handler(void) { Fault_Handler(); }
 
 void Reset_Handler(void) {
   uint32_t *src = &__data_load__;
@@ -70,7 +72,7 @@ typedef void (*pour_vector_t)(void);
 __attribute__((section(".isr_vector"), used)) static const pour_vector_t vectors[16 + POUR_N_DEVICE_VECTORS] = {
     (pour_vector_t)(uintptr_t)&__StackTop,
     Reset_Handler,
-    Fault_Handler, /* NMI */
+    NMI_Handler,   /* NMI */
     Fault_Handler, /* HardFault */
     Fault_Handler, /* MemManage */
     Fault_Handler, /* BusFault */

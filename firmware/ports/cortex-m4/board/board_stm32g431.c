@@ -238,8 +238,27 @@ static pour_cal_status_t calibration_status = POUR_CAL_EMPTY;
 static const pour_flash_t calibration_flash = {
     POUR_PERIPH(FLASH), (volatile uint32_t *)(uintptr_t)POUR_FLASH_CAL_ADDR, POUR_FLASH_CAL_PAGE, WAIT_POLLS, flash_stall};
 
+/* A double ECC error on a flash read (a page left half-erased by a lost supply: RM0440 §3.3.5) raises the NMI
+ * with FLASH_ECCR.ECCD set. Taken as a fault, it would reset the board for ever, reading the same page at
+ * every start: instead it is cleared and remembered, and the page read under it is corrupt. Any other NMI (the
+ * clock security system) is a fault. */
+static volatile bool flash_ecc_error;
+
+void NMI_Handler(void) {
+  volatile uint32_t *const f = POUR_PERIPH(FLASH);
+  if ((f[POUR_FLASH_ECCR] & POUR_MSK(FLASH, ECCR, ECCD)) == 0u) {
+    Fault_Handler();
+  }
+  f[POUR_FLASH_ECCR] |= POUR_MSK(FLASH, ECCR, ECCD); /* write 1 to clear */
+  flash_ecc_error = true;
+}
+
 pour_status_t pour_hal_calibration_load(void) {
+  flash_ecc_error = false;
   calibration_status = pour_calibration_load(&calibration_flash, &calibration);
+  if (flash_ecc_error) {
+    calibration_status = POUR_CAL_CORRUPT; /* a word of the page did not read back: never trusted */
+  }
   return calibration_status == POUR_CAL_OK ? POUR_OK : POUR_ECALIBRATION;
 }
 

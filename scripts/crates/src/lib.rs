@@ -1,0 +1,2 @@
+// SPDX-License-Identifier: MIT
+// Empty: the package exists only so that cargo fetches its dependencies (Cargo.toml).

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// The Plant's rotor through the gear to host_sim's bucket world (world_coupling.hpp).
+#include "world_coupling.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vb {
+
+WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
+  if (!(std::isfinite(o.stiffness_nm_per_rad) && o.stiffness_nm_per_rad > 0.0)) {
+    error_ = "world coupling: stiffness_nm_per_rad must be a finite number > 0";
+    plant_ = nullptr;
+    return;
+  }
+  if (!(std::isfinite(o.damping_nms) && o.damping_nms >= 0.0)) {
+    error_ = "world coupling: damping_nms must be a finite number >= 0";
+    plant_ = nullptr;
+    return;
+  }
+  poursim_config_t c = poursim_default_config();
+  c.seed = o.seed;
+  c.drive = 0;                    // the ideal drive as a torque source: the motor is the plant's
+  c.command_latency_ticks = 1;    // its minimum: the gear's torque of step k acts in step k + 1
+  c.torque_scale = 1.0;
+  c.tau_max = 1000.0;             // the action's scale, beyond any torque the gear carries
+  c.motor_peak_torque = 1000.0;   // no clamp: the plant's motor limits itself
+  c.motor_no_load_speed = 1000.0; // its maximum: the envelope takes < 0.3 % at the bucket's 2.5 rad/s
+  c.motor_rotor_inertia = 0.0;    // the plant's rotor carries J; the world must not count it twice
+  char err[POURSIM_ERR_LEN] = "";
+  world_ = poursim_create(&c, err, sizeof err);
+  if (world_ == nullptr) {
+    error_ = std::string("world coupling: ") + err;
+    plant_ = nullptr;
+    return;
+  }
+  const poursim_config_t* ep = poursim_episode_config(world_);
+  n_ = ep->gear_ratio;
+  dt_ = ep->dt;
+  tau_max_ = ep->tau_max;
+  poursim_observe(world_, &obs_);
+  if (o.brake) set_brake(true);
+  if (plant_ != nullptr) plant_->set_load([this](double t, double th, double w) { return load(t, th, w); });
+}
+
+WorldCoupling::~WorldCoupling() {
+  if (plant_ != nullptr) plant_->set_load(nullptr);
+  poursim_destroy(world_);
+}
+
+void WorldCoupling::set_brake(bool engaged) {
+  if (world_ != nullptr) poursim_set_brake(world_, engaged ? 1 : 0);
+}
+
+WorldSensors WorldCoupling::sensors() const {
+  WorldSensors s;
+  s.step = obs_.step;
+  s.encoder = obs_.encoder;
+  s.scale_rotating_g = obs_.scale_rotating_g;
+  s.scale_target_g = obs_.scale_target_g;
+  return s;
+}
+
+bool WorldCoupling::sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const {
+  auto grams = [](int32_t g) {
+    return static_cast<int16_t>(std::max<int32_t>(-POUR_CAN_SCALE_MAX_G, std::min<int32_t>(POUR_CAN_SCALE_MAX_G, g)));
+  };
+  const pour_can_sensors_t m = {static_cast<uint8_t>(obs_.step & 0xFFu), obs_.encoder, grams(obs_.scale_rotating_g),
+                                grams(obs_.scale_target_g)};
+  return pour_can_pack_sensors(node_id, &m, frame) == POUR_OK;
+}
+
+uint64_t WorldCoupling::trajectory_hash() const { return world_ != nullptr ? poursim_trajectory_hash(world_) : 0u; }
+
+double WorldCoupling::load(double t, double theta_m, double omega_m) {
+  if (!ok()) return 0.0;
+  // The physics step that ended at t: the gear's torque averaged over its PWM periods, into the world.
+  const double next = static_cast<double>(obs_.step + 1u) * dt_;
+  if (t + 1e-12 >= next && samples_ > 0) {
+    last_torque_ = sum_ / samples_;
+    sum_ = 0.0;
+    samples_ = 0;
+    const int rc = poursim_step(world_, last_torque_ / tau_max_, &obs_);
+    if (rc != POURSIM_OK) {
+      error_ = poursim_world_error(world_);
+      if (error_.empty()) error_ = "poursim_step failed";
+      return 0.0;
+    }
+  }
+  // The gear: the shaft's angle over N against the bucket's, a spring and a damper at the output.
+  const double tau_out = o_.stiffness_nm_per_rad * (theta_m / n_ - obs_.theta) + o_.damping_nms * (omega_m / n_ - obs_.omega);
+  sum_ += tau_out;
+  ++samples_;
+  return tau_out / n_;  // at the motor (an ideal gear: the torque scales by N, the losses are the world's)
+}
+
+}  // namespace vb
