@@ -27,6 +27,7 @@ pour_control_config_t firmware_config(const poursim_config_t &sim) {
 
 void CoreController::reset(uint32_t seed) {
   seq_ = 0;
+  sensed_ = due_ = false;
   if (restart_by_reset_ && status_ == POUR_OK) {
     restart_pending_ = true; // the core and its output carry on, as a linked controller's do
     return;
@@ -35,8 +36,8 @@ void CoreController::reset(uint32_t seed) {
   out_ = pour_control_output_t{};
 }
 
-double CoreController::command(const poursim_obs_t &obs) {
-  if (status_ != POUR_OK) return 0.0;
+void CoreController::sense(const poursim_obs_t &obs) {
+  if (status_ != POUR_OK) return;
   pour_control_input_t in{};
   in.sensors_fresh = true;
   in.sensors = to_sensor_sample(obs, seq_++);
@@ -46,7 +47,15 @@ double CoreController::command(const poursim_obs_t &obs) {
     in.clear_faults = in.stop = in.reset = true;
     restart_pending_ = false;
   }
-  if (pour_control_update(&ctl_, &in)) decide(&ctl_, *pour_control_state(&ctl_));
+  due_ = pour_control_update(&ctl_, &in);
+  sensed_ = true;
+}
+
+double CoreController::command(const poursim_obs_t &obs) {
+  if (status_ != POUR_OK) return 0.0;
+  if (!sensed_) sense(obs);
+  sensed_ = false;
+  if (due_) decide(&ctl_, *pour_control_state(&ctl_));
   pour_control_shape(&ctl_, &out_);
   return out_.torque / 32768.0;
 }

@@ -59,12 +59,16 @@ class CoreController : public Controller {
   void reset(uint32_t seed) override;
   void set_rig(const poursim_config_t &rig) override { rig_ = rig; }
   double command(const poursim_obs_t &obs) override;
+  // The pipeline's first stage alone on obs (estimate, supervise), ahead of the command(obs) that follows,
+  // which then only decides and shapes: the Gymnasium stepper reads the state the latest step made.
+  void sense(const poursim_obs_t &obs);
   int action() const override { return out_.action; }
   bool failed() const override { return status_ != POUR_OK; }
   std::string failure() const override;
   bool brake() const override { return status_ == POUR_OK && out_.brake; }
   uint16_t faults() const override { return out_.faults; }
   const pour_control_output_t &output() const { return out_; }
+  const pour_control_t &core() const { return ctl_; } // the running core (its estimated state)
   // On (after the first episode): reset() restarts the same core by ClearErrors, Stop and Reset in the next
   // tick instead of initialising a fresh one, as a linked pour_controller is restarted between episodes.
   void restart_by_reset(bool on) { restart_by_reset_ = on; }
@@ -84,6 +88,7 @@ class CoreController : public Controller {
   pour_status_t status_ = POUR_EINVAL;
   uint32_t seq_ = 0;
   bool restart_by_reset_ = false, restart_pending_ = false;
+  bool sensed_ = false, due_ = false; // sense() ran for the next command(), and its verdict
 };
 
 // The firmware core (pour_control_step) with a weights.h loaded at run time, fed the rig's sensor sample

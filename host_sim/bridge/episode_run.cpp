@@ -18,63 +18,76 @@ std::string world_failure(const poursim_world_t *world, const char *call, int st
 
 } // namespace
 
+void EpisodeRun::keep_frame() {
+  std::vector<float> xy(static_cast<size_t>(2 * n_particles_));
+  poursim_particles(world_, xy.data(), nullptr, n_particles_);
+  rec_->frames.push_back(std::move(xy));
+  rec_->frame_theta.push_back(obs_.theta);
+  rec_->frame_t.push_back(obs_.t);
+}
+
+bool EpisodeRun::begin(uint32_t seed) {
+  e_ = Episode{};
+  e_.seed = seed;
+  fault_step_ = -1;
+  int rc = poursim_reset(world_, seed);
+  if (rc != POURSIM_OK) {
+    e_.error = world_failure(world_, "poursim_reset", rc);
+    e_.status = rc;
+    return false;
+  }
+  ctl_.set_rig(*poursim_episode_config(world_));
+  ctl_.reset(seed);
+  tau_max_ = poursim_world_config(world_)->tau_max;
+  n_particles_ = poursim_particle_count(world_);
+  poursim_observe(world_, &obs_);
+  meter_.reset(*poursim_episode_config(world_), reward_, obs_);
+  if (rec_ != nullptr && rec_->frame_every > 0) {
+    rec_->radius.assign(static_cast<size_t>(n_particles_), 0.0f);
+    poursim_particles(world_, nullptr, rec_->radius.data(), n_particles_);
+    keep_frame();
+  }
+  return true;
+}
+
+bool EpisodeRun::tick() {
+  const double a = ctl_.command(obs_);
+  if (ctl_.failed()) {
+    e_.error = ctl_.failure();
+    e_.status = POURSIM_ESTATE;
+    return false;
+  }
+  if (fault_step_ < 0 && ctl_.faults() != 0) fault_step_ = static_cast<int>(obs_.step);
+  int rc = poursim_set_brake(world_, ctl_.brake() ? 1 : 0);
+  if (rc == POURSIM_OK) rc = poursim_step(world_, a, &obs_);
+  if (rc != POURSIM_OK) {
+    e_.error = world_failure(world_, "poursim_step", rc);
+    e_.status = rc;
+    return false;
+  }
+  meter_.add(obs_, a * tau_max_);
+  if (hook_ != nullptr) hook_->after_step(obs_, a, meter_);
+  if (rec_ != nullptr) {
+    if (rec_->steps) rec_->samples.push_back({obs_, ctl_.action(), meter_.last_reward()});
+    if (rec_->frame_every > 0 && obs_.step % static_cast<uint32_t>(rec_->frame_every) == 0) keep_frame();
+  }
+  return true;
+}
+
+const Episode &EpisodeRun::finish() {
+  e_.m = meter_.result();
+  e_.m.faults = ctl_.faults();
+  e_.m.fault_step = fault_step_;
+  return e_;
+}
+
 Episode run_episode(poursim_world_t *world, Controller &ctl, uint32_t seed, const poursim_reward_t &reward,
                     Recorder *rec, StepHook *hook) {
-  Episode e;
-  e.seed = seed;
-  int rc = poursim_reset(world, seed);
-  if (rc != POURSIM_OK) {
-    e.error = world_failure(world, "poursim_reset", rc);
-    e.status = rc;
-    return e;
-  }
-  ctl.set_rig(*poursim_episode_config(world));
-  ctl.reset(seed);
-  const poursim_config_t *cfg = poursim_world_config(world);
-  const int n = poursim_particle_count(world);
-  poursim_obs_t o;
-  poursim_observe(world, &o);
-  EpisodeMeter meter;
-  meter.reset(*poursim_episode_config(world), reward, o);
-  auto keep_frame = [&](const poursim_obs_t &ob) {
-    std::vector<float> xy(static_cast<size_t>(2 * n));
-    poursim_particles(world, xy.data(), nullptr, n);
-    rec->frames.push_back(std::move(xy));
-    rec->frame_theta.push_back(ob.theta);
-    rec->frame_t.push_back(ob.t);
-  };
-  if (rec != nullptr && rec->frame_every > 0) {
-    rec->radius.assign(static_cast<size_t>(n), 0.0f);
-    poursim_particles(world, nullptr, rec->radius.data(), n);
-    keep_frame(o);
-  }
-  int fault_step = -1;
-  while (!o.done) {
-    const double a = ctl.command(o);
-    if (ctl.failed()) {
-      e.error = ctl.failure();
-      e.status = POURSIM_ESTATE;
-      return e;
-    }
-    if (fault_step < 0 && ctl.faults() != 0) fault_step = static_cast<int>(o.step);
-    rc = poursim_set_brake(world, ctl.brake() ? 1 : 0);
-    if (rc == POURSIM_OK) rc = poursim_step(world, a, &o);
-    if (rc != POURSIM_OK) {
-      e.error = world_failure(world, "poursim_step", rc);
-      e.status = rc;
-      return e;
-    }
-    meter.add(o, a * cfg->tau_max);
-    if (hook != nullptr) hook->after_step(o, a, meter);
-    if (rec != nullptr) {
-      if (rec->steps) rec->samples.push_back({o, ctl.action(), meter.last_reward()});
-      if (rec->frame_every > 0 && o.step % static_cast<uint32_t>(rec->frame_every) == 0) keep_frame(o);
-    }
-  }
-  e.m = meter.result();
-  e.m.faults = ctl.faults();
-  e.m.fault_step = fault_step;
-  return e;
+  EpisodeRun run(world, ctl, reward, rec, hook);
+  if (!run.begin(seed)) return run.episode();
+  while (!run.done())
+    if (!run.tick()) return run.episode();
+  return run.finish();
 }
 
 } // namespace poursim

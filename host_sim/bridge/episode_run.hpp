@@ -49,6 +49,39 @@ struct Episode {
   int status = POURSIM_OK; // with an error: the refused world call's status, POURSIM_ESTATE for the controller
 };
 
+// One episode, tick by tick: the one tick driver of host_sim's episodes, the trainer's rollouts and the
+// Gymnasium stepper (poursim_stepper_*). begin() resets world and controller to seed; each tick() asks the
+// controller for its command on the latest observation, applies its brake, steps the world and meters the
+// step; finish() gives the figures. A false return means the controller failed or the world refused a call:
+// episode() then holds the error and the status.
+class EpisodeRun {
+ public:
+  EpisodeRun(poursim_world_t *world, Controller &ctl, const poursim_reward_t &reward, Recorder *rec = nullptr,
+             StepHook *hook = nullptr)
+      : world_(world), ctl_(ctl), reward_(reward), rec_(rec), hook_(hook) {}
+  bool begin(uint32_t seed);
+  bool tick();
+  bool done() const { return obs_.done != 0; }
+  const poursim_obs_t &obs() const { return obs_; }
+  const EpisodeMeter &meter() const { return meter_; }
+  // The figures so far (final once done), with the controller's faults and the step that first saw one.
+  const Episode &finish();
+  const Episode &episode() const { return e_; }
+
+ private:
+  void keep_frame();
+  poursim_world_t *world_;
+  Controller &ctl_;
+  poursim_reward_t reward_;
+  Recorder *rec_;
+  StepHook *hook_;
+  Episode e_;
+  EpisodeMeter meter_;
+  poursim_obs_t obs_{};
+  double tau_max_ = 0.0;
+  int n_particles_ = 0, fault_step_ = -1;
+};
+
 // Resets world and controller to seed and steps until the observation says the episode is done, or until
 // the controller fails or the world refuses a call (the error then says why); reward makes the figures'
 // return. rec and hook (either may be null) receive what they ask for.

@@ -11,9 +11,8 @@ from gymnasium.utils.env_checker import check_env
 
 import pour.sim.gym_env
 from pour.eval import evaluate
-from pour import core
 from pour.policy import weights_h
-from pour.sim import adapter, envs
+from pour.sim import adapter, envs, poursim
 from pour.train import config as cfgmod
 from pour.train import trainer
 
@@ -65,7 +64,7 @@ def test_gym_steps_reproduce_the_c_rollout():
     env = pour.sim.gym_env.PourEnv("sim", episode_s=0.6)
     env._plant.reset(31)
     env._k, env._started = 0, True
-    assert isinstance(env._plant.core, core.Controller)
+    assert isinstance(env._plant.stepper, poursim.Stepper)  # libpoursim's tick driver, none in Python
     xs, rewards = [env._plant.features()], []
     for a in ep.actions:
         obs, r, term, trunc, info = env.step(int(a))

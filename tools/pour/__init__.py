@@ -8,7 +8,8 @@
                   fixed-point reference (fixedpoint), weights.h (weights_h), policy.json -> weights.h
                   (export), golden vectors (golden)
     pour.sim      the simulator: libpoursim's binding (poursim), the episode record (episode), the trainer's
-                  episode sources (envs, adapter) and the Gymnasium environment (gym_env)
+                  episode sources (envs, adapter), the Gymnasium environment (gym_env) and the named rig
+                  distributions of configs/sim (rigs)
     pour.train    REINFORCE: run config (config), gradients (reinforce), rollout executors (executors),
                   the training loop (trainer), the Ray benchmark (ray_bench)
     pour.eval     held-out evaluation and figures: evaluate, robustness, robust_scale, results, sweep,

@@ -3,7 +3,7 @@
 
 SimEnv.rollout runs one whole episode in C (poursim_rollout: float softmax-linear policy inside the
 firmware's pipeline) and returns it as an Episode. SimStepper advances the world tick by tick for the
-Gymnasium environment through the same pipeline (pour.core, from the same library), so a stepped
+Gymnasium environment through libpoursim's stepper (the same tick driver, pipeline and meter), so a stepped
 episode equals the C rollout's. Failures come out as
 EnvError, which the trainer reports; pour.libpoursim finds the library.
 """
@@ -15,14 +15,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from pour import core
 from pour.policy import linear
-from pour.policy import fixedpoint as fp
 from pour.sim import episode, poursim
-
-
-# A torque command beyond +-1 N.m has a sign; a flip of it is a reversal (host_sim's kReversalTorque).
-REVERSAL_NM = 1.0
 
 
 @contextmanager
@@ -87,41 +81,28 @@ class SimEnv:
 
 
 class SimStepper:
-    """Tick-by-tick access for the Gymnasium environment through the firmware's own pipeline (pour.core:
-    pour_control_update, the agent's level as a request, pour_control_shape), on the firmware config for the
-    simulated rig that poursim_rollout uses: the same estimator, supervisor, envelope and controlled stop, so a
-    stepped episode equals the C rollout's tick for tick. The core's fault bits are in .faults."""
+    """Tick-by-tick access for the Gymnasium environment: libpoursim's stepper (poursim.Stepper), the tick
+    driver and episode meter of poursim_rollout and host_sim, inside the firmware's own pipeline on the
+    firmware config for the episode's drawn rig, the agent's level as the request of each due decision. So a
+    stepped episode equals the C rollout's tick for tick; nothing of the tick or the meter is in Python. The
+    core's fault bits are in .faults; .torques holds the core's command of every tick so far (Q15)."""
 
     def __init__(self, options: dict[str, Any] | None = None, decision_period_ms: int = 1):
         self.world, self.reward = _open_world(dict(options or {}))
         self.tau_max_nm = float(self.world.config.tau_max)
         self.period = int(decision_period_ms)
+        with _env_errors("poursim_stepper_create"):
+            self.stepper = poursim.Stepper(self.world, self.reward, self.period)
 
     def reset(self, seed: int) -> None:
-        with _env_errors("poursim_reset"):
-            self.obs = self.world.reset(seed)
-        with _env_errors("the firmware core in libpoursim"):   # for the drawn rig, as the rollouts' is
-            self.fw_config = core.control_config(self.world.episode_rig())
-        try:
-            self.core = core.Controller(None, self.fw_config, decision_period_ms=self.period)
-        except core.CoreError as exc:
-            raise episode.EnvError(f"the firmware core refused its config: {exc}") from exc
-        self.seq = 0
-        self.out: core.Output | None = None
-        self.torques: list[int] = []  # the core's command of every tick so far, Q15
-        self.settled: list[float] = []  # V_target + V_spill after every tick so far
-        self.ret, self._discount, self.reversals, self._last_sign = 0.0, 1.0, 0, 0
-        self._sense()
-
-    def _sense(self) -> None:
-        """The latest sample into the pipeline's first stage; whether a decision is due comes back."""
-        o = self.obs
-        self.due = self.core.update((self.seq, o.encoder, o.scale_rotating_g, o.scale_target_g))
-        self.seq += 1
+        with _env_errors("poursim_stepper_reset"):
+            self.stepper.reset(seed)
+        self.torques: list[int] = []
+        self.obs = self.stepper.obs()
 
     @property
     def faults(self) -> int:
-        return self.out.faults if self.out is not None else 0
+        return self.stepper.faults
 
     @property
     def v_tgt(self) -> float:
@@ -132,44 +113,21 @@ class SimStepper:
         return float(self.obs.v_spill)
 
     def features(self) -> np.ndarray:
-        _, theta, omega, v_rot, v_tgt, v_spill = self.core.state()
+        _, theta, omega, v_rot, v_tgt, v_spill = self.stepper.state()
         return episode.normalise(theta * 1e-6, omega * 1e-6, v_rot / 32768.0, v_tgt / 32768.0, v_spill / 32768.0)
 
     def advance(self, level: float, ticks: int, action: int = 0) -> float:
         """ticks steps with level (a fraction of tau_max) as the request of each decision due meanwhile."""
-        req = fp.float_to_q15(level)
-        r = 0.0
-        with _env_errors("poursim_step"):
-            for _ in range(ticks):
-                if self.due:
-                    self.core.request(action, req)
-                self.out = self.core.shape()
-                self.torques.append(self.out.torque)
-                self.world.set_brake(self.out.brake)
-                self.obs = self.world.step(self.out.torque / 32768.0)
-                self._sense()
-                self._meter(self.out.torque / 32768.0 * self.tau_max_nm)
-                r += self.reward.step(self.obs.v_target, self.obs.v_spill)
+        with _env_errors("poursim_stepper_advance"):
+            r, commands = self.stepper.advance(action, level, ticks)
+        self.torques.extend(int(c) for c in commands)
+        self.obs = self.stepper.obs()
         return r
 
-    def _meter(self, command_nm: float) -> None:
-        """The C rollout's episode meter (host_sim's EpisodeMeter) for one tick: the settled share, a torque
-        reversal (the command's sign beyond REVERSAL_NM flipping) and the discounted return."""
-        o = self.obs
-        self.settled.append(float(o.v_target + o.v_spill))
-        sign = 1 if command_nm > REVERSAL_NM else (-1 if command_nm < -REVERSAL_NM else 0)
-        if sign:
-            self.reversals += int(self._last_sign != 0 and sign != self._last_sign)
-            self._last_sign = sign
-        self.ret += self._discount * self.reward.step(o.v_target, o.v_spill)
-        self._discount *= self.reward.gamma
-
     def metrics(self) -> dict[str, float]:
-        """The episode so far as the C rollout reports it: volumes, finish time (the first tick by which 99 %
-        of what left the bucket had settled, -1 when less than 1 % left), torque reversals and the return."""
-        o, dt = self.obs, float(self.world.config.dt)
-        fin = self.settled[-1] if self.settled else 0.0
-        done = np.flatnonzero(np.asarray(self.settled) >= 0.99 * fin) if fin >= 0.01 else np.array([], dtype=int)
-        return {"v_target": float(o.v_target), "v_spill": float(o.v_spill), "v_rotating": float(o.v_rotating),
-                "finish_s": float((done[0] + 1) * dt) if done.size else -1.0, "reversals": self.reversals,
-                "return": self.ret}
+        """The episode so far as the C rollout reports it (libpoursim's meter): volumes, finish time (the
+        first tick by which 99 % of what left the bucket had settled, -1 when less than 1 % left), torque
+        reversals and the return."""
+        m = self.stepper.episode()
+        return {"v_target": float(m["poured"]), "v_spill": float(m["spilled"]), "v_rotating": float(m["remaining"]),
+                "finish_s": float(m["finish_time"]), "reversals": int(m["reversals"]), "return": float(m["ret"])}

@@ -124,6 +124,15 @@ def _declare(lib: C.CDLL) -> None:
         "poursim_features": ([P(_r("PolicyStruct")), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
                               P(C.c_double)], None),
         "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
+        "poursim_stepper_create": ([C.c_void_p, P(_r("RewardStruct")), C.c_int] + err, C.c_void_p),
+        "poursim_stepper_destroy": ([C.c_void_p], None),
+        "poursim_stepper_reset": ([C.c_void_p, C.c_uint32] + err, C.c_int),
+        "poursim_stepper_advance": ([C.c_void_p, C.c_int, C.c_double, C.c_int, P(C.c_double), P(C.c_int16)] + err,
+                                    C.c_int),
+        "poursim_stepper_obs": ([C.c_void_p, P(_r("ObsStruct"))], None),
+        "poursim_stepper_state": ([C.c_void_p, P(records.record("pour_state_t"))], None),
+        "poursim_stepper_faults": ([C.c_void_p], C.c_int),
+        "poursim_stepper_episode": ([C.c_void_p, P(_r("EpisodeStruct"))], None),
     }
     for name, (args, res) in sig.items():
         fn = getattr(lib, name)
@@ -512,6 +521,59 @@ class World:
         return bufs.result(seed, e)
 
 
+class Stepper:
+    """An episode of world tick by tick with decisions from outside (poursim_stepper_*): libpoursim's own
+    tick driver and episode meter, those of rollout() and host_sim, inside the firmware's pipeline (a fresh
+    core per reset, for the episode's drawn rig). Keeps the world open while it lives."""
+
+    def __init__(self, world: "World", reward: Reward, decision_period: int):
+        self._lib, self.world = load_library(), world
+        e = _err()
+        rs = _r("RewardStruct")(reward.k_target, reward.k_spill, reward.gamma)
+        self._s = self._lib.poursim_stepper_create(world._check(), C.byref(rs), int(decision_period), e, ERR_LEN)
+        if not self._s:
+            raise SimError(e.value.decode(errors="replace"))
+        self._obs, self._state, self._ep = _r("ObsStruct")(), records.record("pour_state_t")(), _r("EpisodeStruct")()
+
+    def __del__(self) -> None:
+        if getattr(self, "_s", None):
+            self._lib.poursim_stepper_destroy(self._s)
+            self._s = None
+
+    def reset(self, seed: int) -> None:
+        e = _err()
+        if self._lib.poursim_stepper_reset(self._s, int(seed) & 0xFFFFFFFF, e, ERR_LEN) != 0:
+            raise SimError(e.value.decode(errors="replace"))
+
+    def advance(self, action: int, level: float, ticks: int) -> tuple[float, np.ndarray]:
+        """ticks steps; the rewards summed and the core's command of each step (Q15, int16)."""
+        r, cmds, e = C.c_double(), np.zeros(max(int(ticks), 0), dtype=np.int16), _err()
+        if self._lib.poursim_stepper_advance(self._s, int(action), float(level), int(ticks), C.byref(r),
+                                             cmds.ctypes.data_as(C.POINTER(C.c_int16)), e, ERR_LEN) != 0:
+            raise SimError(e.value.decode(errors="replace"))
+        return r.value, cmds
+
+    def obs(self) -> Obs:
+        self._lib.poursim_stepper_obs(self._s, C.byref(self._obs))
+        return Obs.from_struct(self._obs)
+
+    def state(self) -> tuple[int, int, int, int, int, int]:
+        """The core's estimated state (seq, θ [µrad], θ̇ [µrad/s], V_rot, V_tgt, V_spill Q15)."""
+        s = self._state
+        self._lib.poursim_stepper_state(self._s, C.byref(s))
+        return (int(s.seq), int(s.theta_urad), int(s.omega_urad_s), int(s.v_rotating), int(s.v_target),
+                int(s.v_spill))
+
+    @property
+    def faults(self) -> int:
+        return int(self._lib.poursim_stepper_faults(self._s))
+
+    def episode(self) -> dict:
+        """The meter's figures so far, as rollout() reports them in Rollout.metrics."""
+        self._lib.poursim_stepper_episode(self._s, C.byref(self._ep))
+        return _struct_dict(self._ep)
+
+
 @dataclass
 class Retention:
     """What the bucket keeps as it tilts (poursim_measure_retention), against an ideal liquid."""
@@ -606,4 +668,4 @@ def uniform_levels(n_actions: int) -> np.ndarray:
 
 __all__: Sequence[str] = ("SimError", "World", "Policy", "Reward", "default_reward", "reward_from", "features", "Rollout", "Obs", "Retention", "Slosh", "default_config",
                           "make_config", "retention", "slosh", "measure_drive", "measure_sensors",
-                          "load_library", "uniform_levels", "Config", "KeyInfo", "describe", "config_keys", "REGIONS", "version")
+                          "load_library", "uniform_levels", "Stepper", "Config", "KeyInfo", "describe", "config_keys", "REGIONS", "version")
