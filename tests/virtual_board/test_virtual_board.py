@@ -194,7 +194,9 @@ def launcher(*args: str, tools: Path | None = None) -> subprocess.CompletedProce
 def test_launcher_finds_the_program_and_the_image():
     build = str(Path(VB).resolve().parents[1])
     r = launcher("--build-dir", build, "--help")
-    assert r.returncode == 0 and r.stdout.startswith("usage: pour_virtual_board"), r.stderr
+    # the launcher's own usage, then the program's options
+    assert r.returncode == 0 and r.stdout.startswith("usage: pour-virtual-board"), r.stderr
+    assert "\nusage: pour_virtual_board" in r.stdout, r.stdout
     r = launcher("--build-dir", build, "--until-heartbeat", "--seconds", "2")
     assert r.returncode == 0 and "heartbeat at" in r.stdout, r.stderr
 
@@ -213,3 +215,8 @@ def test_launcher_without_a_build_says_so(tmp_path, monkeypatch, capsys):
     assert err.count("\n") == 1 and "pour_virtual_board not found" in err, err
     assert virtual_board.main(["--build-dir"]) == 2
     assert "--build-dir needs a folder" in capsys.readouterr().err
+    # --help and --version need no build (a plain install of the tools answers them)
+    assert virtual_board.main(["--build-dir", str(tmp_path), "--help"]) == 0
+    assert capsys.readouterr().out.startswith("usage: pour-virtual-board")
+    assert virtual_board.main(["--version"]) == 0
+    assert capsys.readouterr().out.startswith("pour-virtual-board ")

@@ -28,7 +28,8 @@ class PlantStep : public vb::Peripheral {
 };
 
 const char* kUsage =
-    "usage: pour_virtual_board [--elf FILE] [--interface IFACE] [--seconds S] [--until-heartbeat] [--print-can]\n"
+    "usage: pour_virtual_board [--elf FILE] [--channel CHANNEL [--interface socketcan]] [--seconds S] [--until-heartbeat]\n"
+    "                          [--print-can]\n"
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
@@ -40,7 +41,9 @@ int bad(const std::string& msg) {
   return 2;
 }
 
-uint32_t u32(const std::vector<uint8_t>& b, size_t o) { return b[o] | b[o + 1] << 8 | b[o + 2] << 16 | (uint32_t)b[o + 3] << 24; }
+uint32_t u32(const std::vector<uint8_t>& b, size_t o) {
+  return uint32_t{b[o]} | uint32_t{b[o + 1]} << 8 | uint32_t{b[o + 2]} << 16 | uint32_t{b[o + 3]} << 24;
+}
 uint16_t u16(const std::vector<uint8_t>& b, size_t o) { return static_cast<uint16_t>(b[o] | b[o + 1] << 8); }
 
 // SHA-256 (FIPS 180-4), to print the image's hash as scripts/flash.sh's sha256sum would.
@@ -142,10 +145,15 @@ int main(int argc, char** argv) {
       } else if (a == "--elf") {
         if (!(v = value("--elf"))) return bad("--elf needs a file");
         o.elf = v;
-      } else if (a == "--interface" || a == "--iface") {
-        if (!(v = value(a.c_str()))) return bad(a + " needs an interface name");
+      } else if (a == "--channel") {  // python-can's and pour-bench's names: the channel is vcan0, can0
+        if (!(v = value("--channel"))) return bad("--channel needs a SocketCAN interface name (vcan0)");
         o.interface = v;
         o.realtime = true;
+      } else if (a == "--interface") {
+        if (!(v = value("--interface"))) return bad("--interface needs a backend (socketcan)");
+        if (std::string(v) != "socketcan") return bad("--interface '" + std::string(v) + "': only socketcan is supported");
+      } else if (a == "--iface") {
+        return bad("--iface is now --channel (python-can's name): --channel vcan0");
       } else if (a == "--seconds") {
         if (!(v = value("--seconds"))) return bad("--seconds needs a number");
         o.seconds = std::stod(v);

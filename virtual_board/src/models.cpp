@@ -374,7 +374,7 @@ uint32_t Gpio::on_read(uint32_t offset, uint32_t stored) {
     const uint32_t pull = (reg(0x0C) >> (2u * pin)) & 3u;
     int level = 0;
     if (mode == 1u || mode == 2u) {
-      level = mode == 1u ? (reg(0x14) >> pin & 1u) : 0;
+      level = mode == 1u ? static_cast<int>(reg(0x14) >> pin & 1u) : 0;
       if (mode == 2u && external[pin] >= 0) level = external[pin];
     } else if (mode == 0u) {
       level = external[pin] >= 0 ? external[pin] : pull == 1u ? 1 : 0;

@@ -11,7 +11,7 @@ import time
 
 def test_pour_bench_scan_finds_the_virtual_board():
     board = subprocess.Popen([os.environ["POUR_VB"], "--elf", os.environ["POUR_ELF"],
-                              "--interface", "vcan0", "--seconds", "120"],
+                              "--channel", "vcan0", "--seconds", "120"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         time.sleep(2.0)  # boot and the first heartbeat (11.5 ms emulated), at the guest's pace
