@@ -2,6 +2,10 @@
 #include "pour/policy.h"
 
 #include <stddef.h>
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#include <arm_acle.h>
+#include <string.h>
+#endif
 
 /* Rounding right shifts below rely on >> of a negative int64 being arithmetic (floor), as GCC and
  * Clang define it and as Python's >> behaves. */
@@ -81,6 +85,31 @@ pour_status_t pour_policy_weights_validate(const pour_policy_weights_t *weights)
   return POUR_OK;
 }
 
+/* Whether every partial sum of round((x·W)[a] / 2^f), the rounding's half included and in any order of the
+ * terms, lies in int32 for every x in [0, 32767]^5: each sum is between the bias term plus half plus the
+ * negative terms' extreme and the same plus the positive terms' (x >= 0), so those two bounds decide. */
+static bool sums_fit_i32(const pour_policy_weights_t *weights) {
+  const unsigned n = weights->n_actions;
+  const int64_t half = weights->w_frac_bits > 0u ? (int64_t)1 << (weights->w_frac_bits - 1u) : 0;
+  for (unsigned a = 0; a < n; ++a) {
+    const int64_t base = (int64_t)weights->w[POUR_OBS_N * n + a] * POUR_Q15_ONE_INT + half;
+    int64_t lo = base;
+    int64_t hi = base;
+    for (unsigned k = 0; k < (unsigned)POUR_OBS_N; ++k) {
+      const int64_t term = (int64_t)weights->w[k * n + a] * POUR_Q15_MAX;
+      if (term < 0) {
+        lo += term;
+      } else {
+        hi += term;
+      }
+    }
+    if (lo < INT32_MIN || hi > INT32_MAX) {
+      return false;
+    }
+  }
+  return true;
+}
+
 pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_t *weights,
                                pour_policy_mode_t mode, uint32_t seed) {
   if (policy == NULL || (mode != POUR_POLICY_GREEDY && mode != POUR_POLICY_SAMPLED)) {
@@ -93,6 +122,7 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
   policy->weights = weights;
   policy->mode = mode;
   policy->rng = seed != 0u ? seed : DEFAULT_SEED;
+  policy->sums_fit_i32 = sums_fit_i32(weights);
   return POUR_OK;
 }
 
@@ -185,8 +215,11 @@ void pour_policy_softmax_q15(const int32_t *logits, unsigned n, q15_t *probs) {
 
 unsigned pour_policy_argmax(const int32_t *logits, unsigned n) {
   unsigned best = 0;
+  int32_t top = logits[0];
   for (unsigned a = 1; a < n; ++a) {
-    if (logits[a] > logits[best]) { /* strict: a tie keeps the lower index */
+    const int32_t v = logits[a];
+    if (v > top) { /* strict: a tie keeps the lower index */
+      top = v;
       best = a;
     }
   }
@@ -227,12 +260,75 @@ void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out
   }
 }
 
+/* The logits of pour_policy_logits when sums_fit_i32 holds (pour_policy_init decides): each action's exact
+ * sum in one int32, (bias + half + Σ x w) >> f, with no saturation needed, two actions at a time. On the
+ * Cortex-M4 one word load brings both actions' weights of a row (an unaligned LDR where n is odd: ARMv7-M
+ * allows it to normal memory) and SMLABB/SMLABT/SMLATB/SMLATT (ACLE __smlaxy) multiply the observations,
+ * packed two to a word, by either half. The portable path computes the same integers from int16 loads:
+ * no partial sum overflows, so the DSP's wrapping accumulate and C's int32 arithmetic agree exactly. */
+static void logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
+  const unsigned n = weights->n_actions;
+  const unsigned f = weights->w_frac_bits;
+  const int32_t half = f > 0u ? (int32_t)(1u << (f - 1u)) : 0;
+  const int16_t *p = weights->w;      /* rows 0, 1, 2 at p, p + n, p + 2n */
+  const int16_t *q = p + 3u * n;      /* rows 3, 4 and the bias row at q, q + n, q + 2n */
+  unsigned a = 0;
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+  const uint32_t x01 = (uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16;
+  const uint32_t x23 = (uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16;
+  const int32_t x4 = obs->x[4];
+  for (; a + 1u < n; a += 2u, p += 2, q += 2) {
+    uint32_t v;
+    memcpy(&v, q + 2u * n, sizeof v); /* the bias row: 32768 w, the half added */
+    int32_t s0 = ((int32_t)(v << 16) >> 1) + half;
+    int32_t s1 = ((int32_t)v >> 16) * POUR_Q15_ONE_INT + half;
+    memcpy(&v, p, sizeof v);
+    s0 = __smlabb((int32_t)x01, (int32_t)v, s0);
+    s1 = __smlabt((int32_t)x01, (int32_t)v, s1);
+    memcpy(&v, p + n, sizeof v);
+    s0 = __smlatb((int32_t)x01, (int32_t)v, s0);
+    s1 = __smlatt((int32_t)x01, (int32_t)v, s1);
+    memcpy(&v, p + 2u * n, sizeof v);
+    s0 = __smlabb((int32_t)x23, (int32_t)v, s0);
+    s1 = __smlabt((int32_t)x23, (int32_t)v, s1);
+    memcpy(&v, q, sizeof v);
+    s0 = __smlatb((int32_t)x23, (int32_t)v, s0);
+    s1 = __smlatt((int32_t)x23, (int32_t)v, s1);
+    memcpy(&v, q + n, sizeof v);
+    s0 = __smlabb(x4, (int32_t)v, s0);
+    s1 = __smlabt(x4, (int32_t)v, s1);
+    logits[a] = s0 >> f;
+    logits[a + 1u] = s1 >> f;
+  }
+#else
+  for (; a + 1u < n; a += 2u, p += 2, q += 2) {
+    int32_t s0 = q[2u * n] * POUR_Q15_ONE_INT + half;
+    int32_t s1 = q[2u * n + 1u] * POUR_Q15_ONE_INT + half;
+    for (unsigned k = 0; k < 3u; ++k) {
+      s0 += obs->x[k] * p[k * n];
+      s1 += obs->x[k] * p[k * n + 1u];
+    }
+    for (unsigned k = 0; k < 2u; ++k) {
+      s0 += obs->x[3u + k] * q[k * n];
+      s1 += obs->x[3u + k] * q[k * n + 1u];
+    }
+    logits[a] = s0 >> f;
+    logits[a + 1u] = s1 >> f;
+  }
+#endif
+  if (a < n) { /* an odd count's last action: a pair would read past the bias row */
+    logits[a] = (q[2u * n] * POUR_Q15_ONE_INT + half + obs->x[0] * p[0] + obs->x[1] * p[n] + obs->x[2] * p[2u * n] +
+                 obs->x[3] * q[0] + obs->x[4] * q[n]) >> f;
+  }
+}
+
 bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
   const pour_policy_weights_t *w = policy->weights;
   const unsigned n = w->n_actions;
-  pour_policy_logits(w, obs, out->logits);
-  for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
-    out->logits[a] = 0;
+  if (policy->sums_fit_i32) {
+    logits_i32(w, obs, out->logits);
+  } else {
+    pour_policy_logits(w, obs, out->logits);
   }
   if (policy->mode == POUR_POLICY_SAMPLED) {
     pour_policy_fill_probs(policy, out);
@@ -244,6 +340,9 @@ bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_polic
 }
 
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
+  for (unsigned a = policy->weights->n_actions; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    out->logits[a] = 0;
+  }
   if (!pour_policy_decide(policy, obs, out)) {
     pour_policy_fill_probs(policy, out);
   }

@@ -137,11 +137,31 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
     (void)pour_safety_apply(&safety, (q15_t)(i * 997u), states[i & 63u].theta_urad, states[i & 63u].omega_urad_s);
   }
   const uint32_t envelope = elapsed(t0, now());
+  static pour_supervisor_t sup;
+  const pour_supervisor_config_t svc = bench_config().supervisor;
+  (void)pour_supervisor_init(&sup, &svc, w->norm.theta_min_urad, w->norm.theta_max_urad);
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    (void)pour_supervisor_step(&sup, &states[i & 63u], true);
+    pour_supervisor_record(&sup, &states[i & 63u], (q15_t)(i * 997u));
+  }
+  const uint32_t supervise = elapsed(t0, now());
   t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
     pour_policy_eval(&policy, &obs[i & 63u], &ev);
   }
   const uint32_t eval = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    (void)pour_policy_decide(&policy, &obs[i & 63u], &ev);
+  }
+  const uint32_t decide = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    ev.logits[i & 15u] = (int32_t)i;
+    ev.action = (uint8_t)pour_policy_argmax(ev.logits, w->n_actions);
+  }
+  const uint32_t argmax = elapsed(t0, now());
   t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
     pour_policy_logits(w, &obs[i & 63u], ev.logits);
@@ -154,13 +174,18 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
   }
   const uint32_t softmax = elapsed(t0, now());
   const uint64_t scale = 1000ull * N_STEPS;
-  printf("  per call (loop included): pour_estimator_update %u, pour_safety_apply %u, pour_obs_quantize %u, "
-         "pour_policy_eval %u = logits %u + softmax %u + argmax\n",
+  printf("  per call (loop included): pour_estimator_update %u, pour_safety_apply %u, pour_supervisor_step + _record %u, "
+         "pour_obs_quantize %u, "
+         "pour_policy_eval %u = logits %u (the general kernel) + softmax %u + argmax %u;\n"
+         "  the greedy decision (pour_policy_decide: the int32 kernel and the argmax, no softmax) %u\n",
          (unsigned)((estimate * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((envelope * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((supervise * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((quant * (uint64_t)insn_per_kilotick) / scale), (unsigned)((eval * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((logits * (uint64_t)insn_per_kilotick) / scale),
-         (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale));
+         (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((argmax * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((decide * (uint64_t)insn_per_kilotick) / scale));
 }
 
 int main(void) {
