@@ -265,14 +265,17 @@ void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out
  * Cortex-M4 one word load brings both actions' weights of a row (an unaligned LDR where n is odd: ARMv7-M
  * allows it to normal memory) and SMLABB/SMLABT/SMLATB/SMLATT (ACLE __smlaxy) multiply the observations,
  * packed two to a word, by either half. The portable path computes the same integers from int16 loads:
- * no partial sum overflows, so the DSP's wrapping accumulate and C's int32 arithmetic agree exactly. */
-static void logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
+ * no partial sum overflows, so the DSP's wrapping accumulate and C's int32 arithmetic agree exactly.
+ * Returns the argmax as pour_policy_argmax finds it (strictly greater: a tie keeps the lower index). */
+static unsigned logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
   const unsigned n = weights->n_actions;
   const unsigned f = weights->w_frac_bits;
   const int32_t half = f > 0u ? (int32_t)(1u << (f - 1u)) : 0;
   const int16_t *p = weights->w;      /* rows 0, 1, 2 at p, p + n, p + 2n */
   const int16_t *q = p + 3u * n;      /* rows 3, 4 and the bias row at q, q + n, q + 2n */
   unsigned a = 0;
+  unsigned best = 0;
+  int32_t top = INT32_MIN; /* logits[0] >= it: index 0 unless a later logit is strictly greater */
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
   const uint32_t x01 = (uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16;
   const uint32_t x23 = (uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16;
@@ -297,8 +300,18 @@ static void logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *o
     memcpy(&v, q + n, sizeof v);
     s0 = __smlabb(x4, (int32_t)v, s0);
     s1 = __smlabt(x4, (int32_t)v, s1);
-    logits[a] = s0 >> f;
-    logits[a + 1u] = s1 >> f;
+    s0 >>= f;
+    s1 >>= f;
+    logits[a] = s0;
+    logits[a + 1u] = s1;
+    if (s0 > top) {
+      top = s0;
+      best = a;
+    }
+    if (s1 > top) {
+      top = s1;
+      best = a + 1u;
+    }
   }
 #else
   for (; a + 1u < n; a += 2u, p += 2, q += 2) {
@@ -312,30 +325,45 @@ static void logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *o
       s0 += obs->x[3u + k] * q[k * n];
       s1 += obs->x[3u + k] * q[k * n + 1u];
     }
-    logits[a] = s0 >> f;
-    logits[a + 1u] = s1 >> f;
+    s0 >>= f;
+    s1 >>= f;
+    logits[a] = s0;
+    logits[a + 1u] = s1;
+    if (s0 > top) {
+      top = s0;
+      best = a;
+    }
+    if (s1 > top) {
+      top = s1;
+      best = a + 1u;
+    }
   }
 #endif
   if (a < n) { /* an odd count's last action: a pair would read past the bias row */
-    logits[a] = (q[2u * n] * POUR_Q15_ONE_INT + half + obs->x[0] * p[0] + obs->x[1] * p[n] + obs->x[2] * p[2u * n] +
-                 obs->x[3] * q[0] + obs->x[4] * q[n]) >> f;
+    const int32_t s = (q[2u * n] * POUR_Q15_ONE_INT + half + obs->x[0] * p[0] + obs->x[1] * p[n] +
+                       obs->x[2] * p[2u * n] + obs->x[3] * q[0] + obs->x[4] * q[n]) >> f;
+    logits[a] = s;
+    best = s > top ? a : best;
   }
+  return best;
 }
 
 bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
   const pour_policy_weights_t *w = policy->weights;
   const unsigned n = w->n_actions;
+  unsigned best;
   if (policy->sums_fit_i32) {
-    logits_i32(w, obs, out->logits);
+    best = logits_i32(w, obs, out->logits);
   } else {
     pour_policy_logits(w, obs, out->logits);
+    best = pour_policy_argmax(out->logits, n);
   }
   if (policy->mode == POUR_POLICY_SAMPLED) {
     pour_policy_fill_probs(policy, out);
     out->action = (uint8_t)pour_policy_sample(out->probs, n, &policy->rng);
     return true;
   }
-  out->action = (uint8_t)pour_policy_argmax(out->logits, n);
+  out->action = (uint8_t)best;
   return false;
 }
 
