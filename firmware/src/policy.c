@@ -123,6 +123,14 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
   policy->mode = mode;
   policy->rng = seed != 0u ? seed : DEFAULT_SEED;
   policy->sums_fit_i32 = sums_fit_i32(weights);
+  const unsigned n = weights->n_actions;
+  for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    for (unsigned k = 0; k < 3u; ++k) { /* feature pairs (0, 1), (2, 3), (4, bias) of action a */
+      policy->packed[a][k] = a < n ? (uint16_t)weights->w[2u * k * n + a] |
+                                         (uint32_t)(uint16_t)weights->w[(2u * k + 1u) * n + a] << 16
+                                   : 0u;
+    }
+  }
   return POUR_OK;
 }
 
@@ -260,92 +268,48 @@ void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out
   }
 }
 
-/* The logits of pour_policy_logits when sums_fit_i32 holds (pour_policy_init decides): each action's exact
- * sum in one int32, (bias + half + Σ x w) >> f, with no saturation needed, two actions at a time. On the
- * Cortex-M4 one word load brings both actions' weights of a row (an unaligned LDR where n is odd: ARMv7-M
- * allows it to normal memory) and SMLABB/SMLABT/SMLATB/SMLATT (ACLE __smlaxy) multiply the observations,
- * packed two to a word, by either half. The portable path computes the same integers from int16 loads:
- * no partial sum overflows, so the DSP's wrapping accumulate and C's int32 arithmetic agree exactly.
- * Returns the argmax as pour_policy_argmax finds it (strictly greater: a tie keeps the lower index). */
-static unsigned logits_i32(const pour_policy_weights_t *weights, const pour_obs_t *obs, int32_t *logits) {
+/* The logits of pour_policy_logits when sums_fit_i32 holds (pour_policy_init decides), from the weights
+ * pour_policy_init packed per action: {w0 | w1 << 16, w2 | w3 << 16, w4 | bias << 16}. Each action's exact sum
+ * in one int32, (half + Σ x w + 32768 bias) >> f, no saturation needed. On the Cortex-M4 three words per action
+ * (one LDM) and three dual multiply-accumulates (ACLE __smlad twice, then __smlsd with (x4, -32768): x4 w4 -
+ * (-32768) bias); their additions wrap, but the exact sum fits int32, so the result is exact. The portable path
+ * computes the same integers from the halves. Returns the argmax as pour_policy_argmax finds it (strictly
+ * greater: a tie keeps the lower index). */
+static unsigned logits_i32(const pour_policy_t *policy, const pour_obs_t *obs, int32_t *logits) {
+  const pour_policy_weights_t *weights = policy->weights;
   const unsigned n = weights->n_actions;
   const unsigned f = weights->w_frac_bits;
   const int32_t half = f > 0u ? (int32_t)(1u << (f - 1u)) : 0;
-  const int16_t *p = weights->w;      /* rows 0, 1, 2 at p, p + n, p + 2n */
-  const int16_t *q = p + 3u * n;      /* rows 3, 4 and the bias row at q, q + n, q + 2n */
-  unsigned a = 0;
-  unsigned best = 0;
+  const uint32_t *pw = policy->packed[0];
+  const uint32_t *const end = pw + 3u * n;
+  int32_t *o = logits;
+  const int32_t *top_at = logits;
   int32_t top = INT32_MIN; /* logits[0] >= it: index 0 unless a later logit is strictly greater */
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
-  const uint32_t x01 = (uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16;
-  const uint32_t x23 = (uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16;
-  const int32_t x4 = obs->x[4];
-  for (; a + 1u < n; a += 2u, p += 2, q += 2) {
-    uint32_t v;
-    memcpy(&v, q + 2u * n, sizeof v); /* the bias row: 32768 w, the half added */
-    int32_t s0 = ((int32_t)(v << 16) >> 1) + half;
-    int32_t s1 = ((int32_t)v >> 16) * POUR_Q15_ONE_INT + half;
-    memcpy(&v, p, sizeof v);
-    s0 = __smlabb((int32_t)x01, (int32_t)v, s0);
-    s1 = __smlabt((int32_t)x01, (int32_t)v, s1);
-    memcpy(&v, p + n, sizeof v);
-    s0 = __smlatb((int32_t)x01, (int32_t)v, s0);
-    s1 = __smlatt((int32_t)x01, (int32_t)v, s1);
-    memcpy(&v, p + 2u * n, sizeof v);
-    s0 = __smlabb((int32_t)x23, (int32_t)v, s0);
-    s1 = __smlabt((int32_t)x23, (int32_t)v, s1);
-    memcpy(&v, q, sizeof v);
-    s0 = __smlatb((int32_t)x23, (int32_t)v, s0);
-    s1 = __smlatt((int32_t)x23, (int32_t)v, s1);
-    memcpy(&v, q + n, sizeof v);
-    s0 = __smlabb(x4, (int32_t)v, s0);
-    s1 = __smlabt(x4, (int32_t)v, s1);
-    s0 >>= f;
-    s1 >>= f;
-    logits[a] = s0;
-    logits[a + 1u] = s1;
-    if (s0 > top) {
-      top = s0;
-      best = a;
-    }
-    if (s1 > top) {
-      top = s1;
-      best = a + 1u;
-    }
-  }
+  const int32_t x01 = (int32_t)((uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16);
+  const int32_t x23 = (int32_t)((uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16);
+  const int32_t x45 = (int32_t)((uint16_t)obs->x[4] | 0x80000000u); /* (x4, -32768) */
+  for (; pw != end; pw += 3, ++o) {
+    int32_t s = __smlad(x01, (int32_t)pw[0], half);
+    s = __smlad(x23, (int32_t)pw[1], s);
+    s = __smlsd(x45, (int32_t)pw[2], s) >> f;
 #else
-  for (; a + 1u < n; a += 2u, p += 2, q += 2) {
-    int32_t s0 = q[2u * n] * POUR_Q15_ONE_INT + half;
-    int32_t s1 = q[2u * n + 1u] * POUR_Q15_ONE_INT + half;
+  for (; pw != end; pw += 3, ++o) {
+    int32_t s = half;
     for (unsigned k = 0; k < 3u; ++k) {
-      s0 += obs->x[k] * p[k * n];
-      s1 += obs->x[k] * p[k * n + 1u];
+      const int32_t lo = (int16_t)(uint16_t)(pw[k] & 0xFFFFu);
+      const int32_t hi = (int16_t)(uint16_t)(pw[k] >> 16);
+      s += obs->x[2u * k] * lo + (k < 2u ? obs->x[2u * k + 1u] : POUR_Q15_ONE_INT) * hi;
     }
-    for (unsigned k = 0; k < 2u; ++k) {
-      s0 += obs->x[3u + k] * q[k * n];
-      s1 += obs->x[3u + k] * q[k * n + 1u];
-    }
-    s0 >>= f;
-    s1 >>= f;
-    logits[a] = s0;
-    logits[a + 1u] = s1;
-    if (s0 > top) {
-      top = s0;
-      best = a;
-    }
-    if (s1 > top) {
-      top = s1;
-      best = a + 1u;
-    }
-  }
+    s >>= f;
 #endif
-  if (a < n) { /* an odd count's last action: a pair would read past the bias row */
-    const int32_t s = (q[2u * n] * POUR_Q15_ONE_INT + half + obs->x[0] * p[0] + obs->x[1] * p[n] +
-                       obs->x[2] * p[2u * n] + obs->x[3] * q[0] + obs->x[4] * q[n]) >> f;
-    logits[a] = s;
-    best = s > top ? a : best;
+    *o = s;
+    if (s > top) {
+      top = s;
+      top_at = o;
+    }
   }
-  return best;
+  return (unsigned)(top_at - logits);
 }
 
 bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
@@ -353,7 +317,7 @@ bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_polic
   const unsigned n = w->n_actions;
   unsigned best;
   if (policy->sums_fit_i32) {
-    best = logits_i32(w, obs, out->logits);
+    best = logits_i32(policy, obs, out->logits);
   } else {
     pour_policy_logits(w, obs, out->logits);
     best = pour_policy_argmax(out->logits, n);
