@@ -289,10 +289,16 @@ static unsigned logits_i32(const pour_policy_t *policy, const pour_obs_t *obs, i
   const int32_t x01 = (int32_t)((uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16);
   const int32_t x23 = (int32_t)((uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16);
   const int32_t x45 = (int32_t)((uint16_t)obs->x[4] | 0x80000000u); /* (x4, -32768) */
-  for (; pw != end; pw += 3, ++o) {
-    int32_t s = __smlad(x01, (int32_t)pw[0], half);
-    s = __smlad(x23, (int32_t)pw[1], s);
-    s = __smlsd(x45, (int32_t)pw[2], s) >> f;
+  for (; pw != end; ++o) {
+    /* The action's three words in one LDM that steps pw on (the compiler issues three LDRs and an ADD);
+     * LDM wants its registers in ascending order. */
+    register uint32_t w0 __asm__("r4");
+    register uint32_t w1 __asm__("r5");
+    register uint32_t w2 __asm__("r6");
+    __asm__("ldmia %3!, {%0, %1, %2}" : "=r"(w0), "=r"(w1), "=r"(w2), "+r"(pw) : "m"(*(const uint32_t(*)[3])pw));
+    int32_t s = __smlad(x01, (int32_t)w0, half);
+    s = __smlad(x23, (int32_t)w1, s);
+    s = __smlsd(x45, (int32_t)w2, s) >> f;
 #else
   for (; pw != end; pw += 3, ++o) {
     int32_t s = half;
