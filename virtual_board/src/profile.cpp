@@ -78,10 +78,7 @@ void Profiler::block(uc_engine* uc, uint32_t address, uint32_t n, size_t depth) 
         fn.incl_sum += incl;
         fn.excl_sum += excl;
         fn.incl_max = std::max(fn.incl_max, incl);
-        if (excl > fn.excl_max) {
-          fn.excl_max = excl;
-          fn.isr_in_worst = isr;
-        }
+        fn.excl_max = std::max(fn.excl_max, excl);
         fn.preempted += isr > 0 ? 1u : 0u;
       }
     }
@@ -101,7 +98,6 @@ void Profiler::block(uc_engine* uc, uint32_t address, uint32_t n, size_t depth) 
 void Profiler::exception_entry(int exc, uint32_t handler, uint32_t overhead) {
   Exc& e = excs_[exc];
   if (e.handler.empty()) e.handler = symbol_at(handler);
-  e.overhead = overhead;
   if (!frames_.empty()) ++e.preempted;
   frames_.push_back(Frame{exc, executed_, 0, overhead});
 }
@@ -154,11 +150,10 @@ void Profiler::report(std::FILE* out, unsigned cpi_milli, uint32_t hclk_hz, doub
     const double n = static_cast<double>(fn.calls);
     std::fprintf(out,
                  "profile: function %s: %llu calls, instructions excluding interrupts mean %.1f worst %llu, including them "
-                 "mean %.1f worst %llu; %llu calls preempted; the worst call's own %llu had %llu instructions of interrupts "
-                 "inside it\n",
+                 "mean %.1f worst %llu; %llu calls preempted\n",
                  fn.name.c_str(), (unsigned long long)fn.calls, static_cast<double>(fn.excl_sum) / n,
                  (unsigned long long)fn.excl_max, static_cast<double>(fn.incl_sum) / n, (unsigned long long)fn.incl_max,
-                 (unsigned long long)fn.preempted, (unsigned long long)fn.excl_max, (unsigned long long)fn.isr_in_worst);
+                 (unsigned long long)fn.preempted);
   }
 }
 

@@ -48,7 +48,6 @@ class Profiler {
   struct Func {
     std::string name;
     uint64_t calls = 0, incl_sum = 0, incl_max = 0, excl_sum = 0, excl_max = 0, preempted = 0;
-    uint64_t isr_in_worst = 0;  // what preempted the call with the most instructions of its own
   };
   struct Call {  // a timed function in progress, thread mode
     size_t func;
