@@ -123,6 +123,7 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
   policy->mode = mode;
   policy->rng = seed != 0u ? seed : DEFAULT_SEED;
   policy->sums_fit_i32 = sums_fit_i32(weights);
+  policy->half = weights->w_frac_bits > 0u ? (int32_t)(1u << (weights->w_frac_bits - 1u)) : 0;
   const unsigned n = weights->n_actions;
   for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
     for (unsigned k = 0; k < 3u; ++k) { /* feature pairs (0, 1), (2, 3), (4, bias) of action a */
@@ -279,7 +280,7 @@ static unsigned logits_i32(const pour_policy_t *policy, const pour_obs_t *obs, i
   const pour_policy_weights_t *weights = policy->weights;
   const unsigned n = weights->n_actions;
   const unsigned f = weights->w_frac_bits;
-  const int32_t half = f > 0u ? (int32_t)(1u << (f - 1u)) : 0;
+  const int32_t half = policy->half;
   const uint32_t *pw = policy->packed[0];
   const uint32_t *const end = pw + 3u * n;
   int32_t *o = logits;

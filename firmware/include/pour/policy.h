@@ -36,6 +36,7 @@ typedef struct {
   pour_policy_mode_t mode;
   uint32_t rng; /* xorshift32 state, never 0 */
   bool sums_fit_i32; /* every partial sum of the logits fits int32 for any observation: the cheap kernel */
+  int32_t half;      /* the logits' rounding: 2^(w_frac_bits - 1), 0 for w_frac_bits 0 */
   /* The weights again, per action, two int16 to a word: {w0 | w1 << 16, w2 | w3 << 16, w4 | bias << 16}, so that
    * the cheap kernel loads an action's six in three words (a copy made by pour_policy_init, 192 B). */
   uint32_t packed[POUR_POLICY_MAX_ACTIONS][3];

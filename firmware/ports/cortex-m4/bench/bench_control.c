@@ -66,8 +66,9 @@ static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
 /* The schedule as shipped, tick by tick: each step timed on its own, the times summed per phase of the
  * decision period (phase 0: the decision tick, 1: the tick after it, ...), the timer's own cost taken off.
  * Returns the largest per-phase mean [instructions] and prints every phase. */
-static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_kilotick) {
-  const pour_control_config_t config = bench_config();
+static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_kilotick, int32_t knee_urad) {
+  pour_control_config_t config = bench_config();
+  config.safety.knee_theta_urad = knee_urad; /* 0: no fill schedule (the default) */
   if (pour_control_init(&ctl, &config, w) != POUR_OK || w->decision_period_ms > 16u) {
     return 0u;
   }
@@ -200,9 +201,14 @@ int main(void) {
   every_tick.content_hash = pour_policy_weights_hash(&every_tick);
   report("control step, average:", &pour_weights_compiled, insn_per_kilotick);
   report("control step, decision every tick:", &every_tick, insn_per_kilotick);
-  const uint32_t worst = worst_phase(&pour_weights_compiled, insn_per_kilotick);
+  const uint32_t worst = worst_phase(&pour_weights_compiled, insn_per_kilotick, 0);
   printf("%-34s %5u instructions/step (the shipped schedule's costliest tick)\n", "control step, worst tick:",
          (unsigned)worst);
+  /* A rig file's fill schedule puts a knee in the envelope: below it, within the braking curve's last stretch,
+   * the speed limit is a square root (safety.c's isqrt64). The swing here (0.92 .. 1.00 rad) runs through it. */
+  const uint32_t knee = worst_phase(&pour_weights_compiled, insn_per_kilotick, 1060000);
+  printf("%-34s %5u instructions/step (a fill schedule's knee at 1.06 rad, the swing just below it)\n",
+         "control step, worst tick, knee:", (unsigned)knee);
   report_kernels(&pour_weights_compiled, insn_per_kilotick);
   printf("controller state: sizeof(pour_control_t) = %u B (the core has no static data)\n",
          (unsigned)sizeof(pour_control_t));
