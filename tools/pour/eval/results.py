@@ -23,7 +23,7 @@ from pour.eval import evaluate
 from pour.policy import export, weights_h
 from pour.sim import envs
 from pour.sim.episode import FINISH_MAX_S, POURED_MIN_PCT, SPILLED_MAX_PCT
-from pour.train import trainer
+from pour.train import rundir
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
 
@@ -76,7 +76,7 @@ def _run_policies(run: Path) -> tuple[tuple[str, int, int], dict[str, Any], list
     """A run's (env kind, n_actions, decision period), its output policies ('best', 'last') and its validated
     history: W arrays for the trainer's and the linear actors' runs (policy.json, history_w), tuples of layers for
     an MLP actor's (actor.json, pour.examples.sb3_ppo --actor mlp: history_mlp_<k>)."""
-    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    ck = rundir.load_checkpoint(run / "checkpoint.npz")
     if (run / "actor.json").exists():
         try:
             doc = json.loads((run / "actor.json").read_text(encoding="utf-8"))
@@ -142,7 +142,7 @@ def reach(run: Path, n: int) -> dict[str, Any]:
     of 10 s: its training episodes and wall time then (None when it never did), from the actor history in its
     checkpoint (W, or an MLP's layers, _run_policies) and the validation columns of its log."""
     spec, _, history = _run_policies(run)
-    log = trainer.read_log(run / "log.csv")
+    log = rundir.read_log(run / "log.csv")
     checks = 0
     for i, row in enumerate(log):
         vt, vs = float(row["eval_v_target"]), float(row["eval_v_spill"])
@@ -187,7 +187,7 @@ def reach_row(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
 
 
 def _last_log_row(run: Path) -> dict[str, str]:
-    rows = trainer.read_log(run / "log.csv")
+    rows = rundir.read_log(run / "log.csv")
     if not rows:
         raise ValueError(f"{run}/log.csv has no rows")
     return rows[-1]
@@ -220,7 +220,7 @@ def init_row(config_path: str, n: int) -> dict[str, Any]:
     """The policy a training config starts from, greedy, on the held-out seeds."""
     from pour.train import config
     cfg = config.load(config_path)
-    w = trainer.weights(cfg, trainer.initial_params(cfg))
+    w = rundir.weights(cfg, rundir.initial_params(cfg))
     sim = envs.make_env("sim", cfg.policy.n_actions, cfg.policy.decision_period_ms, 10.0)
     ms = [sim.rollout(w, seed, True).metrics for seed in range(FIRST_SEED, FIRST_SEED + n)]
     return _row(f"initial policy of {Path(config_path).name}", "greedy float, C rollout",

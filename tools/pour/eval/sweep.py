@@ -142,7 +142,7 @@ def run_trial(doc: dict[str, Any], run_dir: str, held_out: int) -> dict[str, Any
     from pour.train import trainer
     cfg = cfgmod.from_dict(doc)
     res = trainer.train(cfg, run_dir, quiet=True)
-    log = trainer.read_log(Path(run_dir) / "log.csv")
+    log = rundir.read_log(Path(run_dir) / "log.csv")
     env = envs.make_env(cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms, HELD_OUT_EPISODE_S,
                         cfg.env.options)
     eps = [env.rollout(res.best_w, s, True) for s in range(results.FIRST_SEED, results.FIRST_SEED + held_out)]
