@@ -118,7 +118,7 @@ def train(cfg: TrainConfig, run_dir: Path, resume: bool, quiet: bool, stop_after
           make_runner: Any) -> rundir.RunResult:
     """trainer.train for algo.kind 'ars' and 'cem' (pour.train.methods)."""
     run = rundir.Run(cfg, run_dir)
-    r, n_act = cfg.ars, cfg.policy.n_actions
+    r = cfg.ars
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
     params = rundir.initial_params(cfg)
     std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)

@@ -263,8 +263,7 @@ class Runner:
             self.pool = None
 
 
-# --- the trainer's Ray tasks -----------------------------------------------------------------------
-
+# --- Ray tasks: plain ones (RayTasks) and the trainer's episodes (RayRunner) -----------------------
 
 def rollout_batch(env_args: tuple, w: np.ndarray, seeds: Sequence[int], greedy: bool,
                   kill_marker: str | None = None) -> tuple[str, list[envs.Episode]]:
@@ -301,7 +300,37 @@ def batches(seeds: Sequence[int], n_tasks: int) -> list[list[int]]:
     return out
 
 
-class RayRunner:
+class RayTasks:
+    """Plain Ray tasks of one CPU each (pour-sweep's trials, pour-robust-scale's batches), on a connection
+    made as connect() makes it and shut down at the end if this made it; a context manager."""
+
+    def __init__(self, address: str | None = None, num_cpus: int | None = None):
+        self.ray = import_ray()
+        self.owns_ray = connect(address, num_cpus)
+
+    def cpus(self) -> int:
+        """The cluster's CPUs (at least 1)."""
+        return max(1, int(self.ray.cluster_resources().get("CPU", 1)))
+
+    def starmap(self, fn: Callable[..., Any], jobs: Sequence[tuple], desc: str, quiet: bool = False) -> list[Any]:
+        """starmap() on Ray: one task a job, each re-run up to MAX_RETRIES times if its worker dies; the results
+        in job order, with gather()'s progress bar; an error or Ctrl-C cancels the unfinished tasks."""
+        task = self.ray.remote(num_cpus=1, max_retries=MAX_RETRIES, retry_exceptions=False)(fn)
+        return gather(self.ray, [task.remote(*j) for j in jobs], desc, quiet)
+
+    def close(self) -> None:
+        if self.owns_ray and self.ray.is_initialized():
+            self.ray.shutdown()
+        self.owns_ray = False
+
+    def __enter__(self) -> Any:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+class RayRunner(RayTasks):
     """Runner's interface on Ray tasks. address: see connect(); episodes_per_task: batch size
     (default: the episodes of a call spread evenly, one batch per CPU of the cluster)."""
 
@@ -314,8 +343,7 @@ class RayRunner:
                          cfg.env.episode_s, cfg.env.options)
         # Fail early and clearly in the driver (missing library, bad option), as the local runner does.
         self.tau_max_nm = float(envs.make_env(*self.env_args).tau_max_nm)
-        self.ray = import_ray()
-        self.owns_ray = connect(address, num_cpus)
+        super().__init__(address, num_cpus)
         self.episodes_per_task = episodes_per_task
         self.kill_marker = kill_marker
         self.max_retries = max_retries
@@ -391,15 +419,7 @@ class RayRunner:
 
     def close(self) -> None:
         self.cancel()
-        if self.owns_ray and self.ray.is_initialized():
-            self.ray.shutdown()
-        self.owns_ray = False
-
-    def __enter__(self) -> "RayRunner":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
+        super().close()
 
 
 def gather(ray: Any, refs: Sequence[Any], desc: str, quiet: bool = False) -> list[Any]:
@@ -433,36 +453,6 @@ def cancel_all(ray: Any, refs: Sequence[Any]) -> None:
                 ray.cancel(ref, force=True)
             except Exception:  # already finished or gone meanwhile: nothing to stop
                 pass
-
-
-class RayTasks:
-    """Plain Ray tasks of one CPU each (pour-sweep's trials, pour-robust-scale's batches), on a connection
-    made as connect() makes it and shut down at the end if this made it; a context manager."""
-
-    def __init__(self, address: str | None = None, num_cpus: int | None = None):
-        self.ray = import_ray()
-        self.owns_ray = connect(address, num_cpus)
-
-    def cpus(self) -> int:
-        """The cluster's CPUs (at least 1)."""
-        return max(1, int(self.ray.cluster_resources().get("CPU", 1)))
-
-    def starmap(self, fn: Callable[..., Any], jobs: Sequence[tuple], desc: str, quiet: bool = False) -> list[Any]:
-        """starmap() on Ray: one task a job, each re-run up to MAX_RETRIES times if its worker dies; the results
-        in job order, with gather()'s progress bar; an error or Ctrl-C cancels the unfinished tasks."""
-        task = self.ray.remote(num_cpus=1, max_retries=MAX_RETRIES, retry_exceptions=False)(fn)
-        return gather(self.ray, [task.remote(*j) for j in jobs], desc, quiet)
-
-    def close(self) -> None:
-        if self.owns_ray and self.ray.is_initialized():
-            self.ray.shutdown()
-        self.owns_ray = False
-
-    def __enter__(self) -> "RayTasks":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
 
 
 def runner_factory(executor: str, address: str | None = None) -> Any:
