@@ -397,8 +397,6 @@ def test_fill_schedule_knee_is_the_hydrostatic_onset_less_3_degrees(fill_depth):
     fills cover both shapes of the liquid at the onset (a triangle below half the depth, a trapezoid above).
     A fill at or below fill_schedule_l gets no schedule."""
     lib = poursim.load_library()
-    lib.poursim_ideal_retained.argtypes = [ctypes.c_double] * 4
-    lib.poursim_ideal_retained.restype = ctypes.c_double
     rig = poursim.make_config({"fill_depth": fill_depth, "fill_schedule_l": 1.0})
     depth = rig["bucket_height"] - rig["bucket_wall"]
     onset = core.control_config(rig).safety.knee_theta_urad * 1e-6 + np.radians(3.0)

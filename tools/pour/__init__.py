@@ -1,7 +1,8 @@
 """pour: offline tools for the soymilk-pouring controller.
 
-    pour.paths, pour.atomic, pour.libpoursim, pour.records   shared: the build tree and the package data,
-                  atomic writes, libpoursim.so opened once, the ctypes records built from its layout table
+    pour.paths, pour.atomic, pour.libpoursim, pour.records, pour.functions   shared: the build tree and the
+                  package data, atomic writes, libpoursim.so opened once, the ctypes records built from its
+                  layout table, its functions declared from its function table
     pour.core     the firmware core through ctypes: its config, envelope, estimator and control pipeline
     pour.cli      shared: every program's --version and its progress bars (tqdm, off with --quiet)
     pour.policy   the policy as the firmware runs it: float softmax-linear (linear), its bit-exact

@@ -6,14 +6,13 @@ A dump is a JSON file of every parameter's raw value with its SI reading; a rest
 against the table before it writes anything."""
 from __future__ import annotations
 
-import ctypes as C
 import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pour import atomic, libpoursim, records
+from pour import atomic, functions
 
 # Firmware unit -> (SI unit, SI per firmware unit). Q15 torques are fractions of the node's full-scale torque
 # (Identity.TauMax), named as such.
@@ -85,8 +84,7 @@ class Param:
 
 def table() -> dict[str, Param]:
     """Every parameter of the firmware's table, by name, in id order (SimError without libpoursim)."""
-    fn = libpoursim.load().pour_param_info
-    fn.argtypes, fn.restype = [C.c_uint8], C.POINTER(records.record("pour_param_info_t"))
+    fn = functions.library().pour_param_info
     out: dict[str, Param] = {}
     for pid in range(256):
         row = fn(pid)
