@@ -293,3 +293,33 @@ def test_pour_results_reach_refuses_a_run_without_history(tmp_path):
     rundir.save_checkpoint(tmp_path / "r" / "checkpoint.npz", ck)
     with pytest.raises(ValueError, match="no W history"):
         results.reach(tmp_path / "r", 2)
+
+
+@pytest.mark.parametrize("kind", ["ars", "cem"])
+def test_python_m_trainer_runs_the_search_methods_as_the_entry_point_does(tmp_path, kind):
+    """`python -m pour.train.trainer` runs the trainer as __main__, a second copy of the module: the methods
+    come from the registry (pour.train.methods), not from a table the search module fills when imported, so
+    that copy finds them too, and its run is the in-process one."""
+    import subprocess
+    import sys
+    import tomllib
+
+    doc = {**TOY, "iterations": 2, "algo": {**TOY["algo"], "kind": kind}}
+    if kind == "cem":
+        doc["ars"] = {}
+        doc["cem"] = {"population": 4, "elites": 2}
+    lines = []
+    for k, v in doc.items():
+        if not isinstance(v, dict):
+            lines.append(f"{k} = {json.dumps(v)}")
+    for k, v in doc.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
+    toml = tmp_path / "c.toml"
+    toml.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(toml), "--out", str(tmp_path / "m"), "--quiet"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    trainer.train(cfgmod.from_dict(tomllib.loads(toml.read_text())), tmp_path / "in", quiet=True)
+    assert (tmp_path / "m" / "policy.json").read_bytes() == (tmp_path / "in" / "policy.json").read_bytes()
