@@ -58,6 +58,7 @@ def test_every_function_tools_calls_is_in_the_table():
 def test_a_function_not_in_the_table_cannot_be_called():
     with pytest.raises(SimError, match="function table has no 'poursim_not_there'"):
         functions.library().poursim_not_there()
+    assert hasattr(functions.library(), "poursim_step") and not hasattr(functions.library(), "poursim_not_there")
 
 
 def test_a_kind_the_binding_does_not_know_is_refused():

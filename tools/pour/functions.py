@@ -55,6 +55,10 @@ def ctype(kind: str, record_types: dict[str, type]) -> Any:
     raise SimError(f"libpoursim's function table names a kind {kind!r} that pour.functions does not know")
 
 
+class MissingFunction(SimError, AttributeError):
+    """A function libpoursim's table does not name (an AttributeError too, so hasattr() answers False)."""
+
+
 class Functions:
     """The declared functions of one library, as attributes; path is the library's file."""
 
@@ -71,7 +75,8 @@ class Functions:
     def __getattr__(self, name: str) -> Any:   # only for names that are not declared
         if name.startswith("__"):
             raise AttributeError(name)
-        raise SimError(f"libpoursim's function table has no {name!r}: list it in host_sim/bridge/function_table.cpp")
+        raise MissingFunction(f"libpoursim's function table has no {name!r}: list it in "
+                              "host_sim/bridge/function_table.cpp")
 
 
 _functions: Functions | None = None
