@@ -3,8 +3,9 @@
 
 #include <stddef.h>
 
-/* docs/safety.md gives the reasons for each default. */
-#define DEFAULT_ENCODER_BITS 17u
+#include "pour/params.h"
+
+/* docs/safety.md gives the reasons for each default; encoder_bits's is the declaration's (POUR_PARAMS). */
 #define DEFAULT_BANDWIDTH_RAD_S 300u /* θ̇ noise 10 mrad/s rms from 17-bit counts; stable governor loop */
 #define DEFAULT_SCALE_MIN_G (-2000)  /* a tared cell reads a little below zero, never 2 kg below */
 #define DEFAULT_SCALE_MAX_G 30000    /* the load cells' range: 12.4 kg of liquid (fill +20 %) fits twice */
@@ -16,9 +17,16 @@
 
 _Static_assert((-3 >> 1) == -2, "arithmetic right shift required"); /* rounding shifts, as Python's >> */
 
+/* The declaration's rows of group sensors (POUR_PARAMS, pour/params.h); the other groups' live elsewhere. */
+#define SENSORS_ROW_safety(member, type, value)
+#define SENSORS_ROW_stop(member, type, value)
+#define SENSORS_ROW_sensors(member, type, value) c.member = (type)(value);
+#define SENSORS_ROW_port(member, type, value)
+#define SENSORS_DEFAULT(id, name, unit, def, lo, hi, type, group, member) SENSORS_ROW_##group(member, type, def)
+
 pour_sensors_config_t pour_sensors_default_config(void) {
   pour_sensors_config_t c;
-  c.encoder_bits = DEFAULT_ENCODER_BITS;
+  POUR_PARAMS(SENSORS_DEFAULT)
   c.bandwidth_rad_s = DEFAULT_BANDWIDTH_RAD_S;
   c.scale_min_g = DEFAULT_SCALE_MIN_G;
   c.scale_max_g = DEFAULT_SCALE_MAX_G;

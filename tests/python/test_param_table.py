@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """The parameter declaration (POUR_PARAMS) against what repeats it: docs/can.md's table and the DBC's ParamId
-value lists are what scripts/param_table.py generates; a declaration with two rows on one CAN id, two rows of
-one name or a bound that is no number fails naming the rows involved."""
+value lists are what scripts/param_table.py generates, and the compiled defaults are the declared ones; a
+declaration with two rows on one CAN id, two rows of one name, a default outside its range or a bound that is
+no number fails naming the rows involved, in scripts/param_table.py and in the compiler."""
 from __future__ import annotations
 
 import shutil
@@ -49,14 +50,19 @@ def _bad(tmp_path: Path, old: str, new: str) -> Path:
 BAD = [
     ("X(5, alpha_max,", "X(4, alpha_max,", "omega_max and alpha_max have the same CAN parameter id 4"),
     ("X(27, slow_ki,", "X(27, slow_omega,", "ids 24 and 27 have the same name slow_omega"),
-    ('X(17, encoder_zero, "counts", 0, 16777215,', 'X(17, encoder_zero, "counts", 16777215, 0,',
+    ('X(17, encoder_zero, "counts", 0, 0, 16777215,', 'X(17, encoder_zero, "counts", 0, 16777215, 0,',
      "encoder_zero: min 16777215 is above max 0"),
-    ('X(15, node_id, "", 0, 63,', 'X(15, node_id, "", 0, NODE_MAX,',
+    ('X(6, omega_slack, "urad/s", 800000,', 'X(6, omega_slack, "urad/s", 3000000,',
+     "omega_slack: default 3000000 is outside its range 1 .. 2000000"),
+    ('X(0, tau_limit, "Q15", POUR_Q15_MAX, 1,', 'X(0, tau_limit, "Q15", 0, 1,',
+     "tau_limit: default 0 is outside its range 1 .. 32767"),
+    ('X(15, node_id, "", 0, 0, 63,', 'X(15, node_id, "", 0, 0, NODE_MAX,',
      "node_id: bound NODE_MAX is not a number or a #define of the headers"),
 ]
 
 
-@pytest.mark.parametrize("old,new,message", BAD, ids=["same id", "same name", "min > max", "unknown bound"])
+@pytest.mark.parametrize("old,new,message", BAD, ids=["same id", "same name", "min > max", "default above max",
+                                                     "default below min", "unknown bound"])
 def test_a_bad_declaration_is_refused_naming_its_rows(tmp_path, old, new, message):
     r = run("check", "--header", str(_bad(tmp_path, old, new)))
     assert r.returncode == 1 and r.stdout == "", (r.stdout, r.stderr)
@@ -99,9 +105,10 @@ def test_a_bridge_that_drifts_is_named(tmp_path, old, new, message):
 @pytest.mark.parametrize("old,new,message", [
     ("X(5, alpha_max,", "X(4, alpha_max,", "duplicate case value"),
     ("X(27, slow_ki,", "X(27, slow_omega,", "POUR_PARAM_ID_slow_omega"),
-    ('X(17, encoder_zero, "counts", 0, 16777215,', 'X(17, encoder_zero, "counts", 16777215, 0,',
-     "pour_param_range_not_empty_encoder_zero"),
-], ids=["same id", "same name", "min > max"])
+    BAD[2][:2] + ("pour_param_range_not_empty_encoder_zero",),
+    BAD[3][:2] + ("pour_param_default_in_range_omega_slack",),
+    BAD[4][:2] + ("pour_param_default_in_range_tau_limit",),
+], ids=["same id", "same name", "min > max", "default above max", "default below min"])
 def test_the_compiler_refuses_a_bad_declaration_too(tmp_path, old, new, message):
     include = tmp_path / "include"
     shutil.copytree(HEADER.parent.parent, include)
@@ -113,3 +120,33 @@ def test_the_compiler_refuses_a_bad_declaration_too(tmp_path, old, new, message)
     assert good.returncode == 0, good.stderr  # the same command takes the real declaration
     r = compile_with(include)
     assert r.returncode != 0 and message in r.stderr, r.stderr
+
+
+def _declaration() -> list[dict]:
+    sys.path.insert(0, str(SCRIPT.parent))
+    try:
+        import param_table
+    finally:
+        sys.path.pop(0)
+    return param_table.declaration()
+
+
+def test_the_modules_default_configs_are_the_declared_defaults(build_dir, monkeypatch):
+    """pour_control_default_config (through libpoursim's field table, by C path) holds each declared row's
+    default: a module that kept its own value, or set a row to another member, differs here."""
+    monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
+    from pour import core
+    cfg = core.control_config()
+    rows = [r for r in _declaration() if r["field"].startswith("control.")]
+    assert len(rows) == 21
+    got = {r["name"]: cfg.get(r["field"][len("control."):]) for r in rows}
+    assert got == {r["name"]: r["default"] for r in rows}
+
+
+def test_the_bench_table_is_the_declaration(build_dir, monkeypatch):
+    """pour-bench's table (libpoursim's pour_param_info) has every row of the declaration, with its id, unit,
+    range and default, and no other."""
+    monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
+    from pour.bench import params
+    got = [(p.id, p.name, p.unit, p.min, p.max, p.default) for p in params.table().values()]
+    assert got == [(r["id"], r["name"], r["unit"], r["min"], r["max"], r["default"]) for r in _declaration()]
