@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 """The controller's parameter declaration (POUR_PARAMS in firmware/include/pour/params.h) checked and put where
 it is repeated: each row's CAN id and name unique, the ids dense from 0, min <= max and the default within them
-once the symbolic values are resolved; the parameter table in docs/can.md and the DBC's ParamId value lists
+once the symbolic values are resolved, the member named by the rule params.h states (the name less its group's
+prefix, plus its unit's suffix); the parameter table in docs/can.md and the DBC's ParamId value lists
 (can/pour.dbc) generated from it.
 
   param_table.py check [--header H]        the declaration alone
@@ -32,6 +33,21 @@ ROW = re.compile(r'X\(\s*(\d+)\s*,\s*(\w+)\s*,\s*"([^"]*)"\s*,\s*([^,]+?)\s*,\s*
 GROUP = re.compile(r"^#define\s+POUR_PARAM_IN_(\w+)\(member\)\s+([\w.]*?)\.?member\s*$", re.M)
 DEFINE = re.compile(r"^#define\s+(\w+)\s+\(?(-?\d+)u?\)?(?:\s|$)", re.M)
 ALIAS = re.compile(r"^#define\s+(\w+)\s+([A-Z_][A-Z0-9_]*)\s*$", re.M)
+
+
+# The naming rule params.h states: a row's member is its name less the group's prefix, plus the unit's suffix.
+UNIT_SUFFIX = {"urad": "_urad", "urad/s": "_urad_s", "urad/s2": "_urad_s2", "ms": "_ms", "1/s": "_per_s",
+               "ppm": "_ppm", "g": "_g", "1/1000": "_milli", "Q15": "", "Q15/(rad/s)": "", "bits": "", "counts": "",
+               "": ""}
+GROUP_PREFIX = {"stop": "stop_"}
+
+
+def member_of(name: str, group: str, unit: str) -> str | None:
+    """The member the naming rule gives a row, None when its unit has no suffix in the rule."""
+    if unit not in UNIT_SUFFIX:
+        return None
+    prefix = GROUP_PREFIX.get(group, "")
+    return (name[len(prefix):] if name.startswith(prefix) else name) + UNIT_SUFFIX[unit]
 
 
 class DeclError(Exception):
@@ -100,6 +116,16 @@ def declaration(header: Path = HEADER) -> list[dict]:
             problems.append(f"{r['name']}: min {r['min']} is above max {r['max']}")
         elif None not in (r["default"], r["min"], r["max"]) and not r["min"] <= r["default"] <= r["max"]:
             problems.append(f"{r['name']}: default {r['default']} is outside its range {r['min']} .. {r['max']}")
+    for r in rows:
+        want = member_of(r["name"], r["group"], r["unit"])
+        prefix = GROUP_PREFIX.get(r["group"], "")
+        if want is None:
+            problems.append(f"{r['name']}: unit {r['unit']!r} has no member suffix in the naming rule")
+        elif not r["name"].startswith(prefix):
+            problems.append(f"{r['name']}: a row of group {r['group']} is named {prefix}...")
+        elif r["member"] != want:
+            problems.append(f"{r['name']}: its member is {r['member']}, the naming rule gives {want} "
+                            f"(name less '{prefix}', plus the unit's suffix '{UNIT_SUFFIX[r['unit']]}')")
     missing = sorted(set(range(len(rows))) - set(by_id))
     if missing and not any("same CAN" in p for p in problems):
         problems.append(f"the ids are not dense from 0: {', '.join(map(str, missing))} missing")

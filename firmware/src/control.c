@@ -79,7 +79,7 @@ static void start_afresh(pour_control_t *ctl) {
 }
 
 static bool stop_config_ok(const pour_stop_config_t *s) {
-  return s->torque_max > 0 && s->return_speed_urad_s > 0 && s->return_gain_per_s >= 1u && s->torque_per_rad_s > 0 &&
+  return s->torque_max > 0 && s->return_speed_urad_s > 0 && s->return_gain_per_s >= 1u && s->gain > 0 &&
          s->rest_theta_urad > 0 && s->rest_omega_urad_s > 0 && s->timeout_ms >= 1u;
 }
 
@@ -203,7 +203,7 @@ static q15_t stop_request(const pour_stop_config_t *c, const pour_state_t *s) {
   ref = ref > c->return_speed_urad_s ? c->return_speed_urad_s
                                       : (ref < -c->return_speed_urad_s ? -c->return_speed_urad_s : ref);
   /* err [µrad/s] * Q15 per rad/s / 1e6; |err| < 2^32, |gain| < 2^15: int64 holds it. */
-  const int64_t t = ((ref - s->omega_urad_s) * c->torque_per_rad_s) / 1000000;
+  const int64_t t = ((ref - s->omega_urad_s) * c->gain) / 1000000;
   return (q15_t)(t > c->torque_max ? c->torque_max : (t < -c->torque_max ? -c->torque_max : t));
 }
 

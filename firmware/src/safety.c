@@ -29,7 +29,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   const pour_safety_config_t *c = config;
   if (c->tau_limit <= 0 || c->slew_per_tick <= 0 || c->theta_max_urad <= c->theta_min_urad ||
       c->omega_max_urad_s <= 0 || c->omega_max_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->alpha_max_urad_s2 < 1000 ||
-      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->torque_per_rad_s <= 0 ||
+      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->governor_gain <= 0 ||
       c->knee_theta_urad < 0 || c->knee_theta_urad > POUR_SAFETY_KNEE_MAX_URAD || c->slow_omega_urad_s <= 0 ||
       c->slow_omega_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->knee_decel_urad_s2 < 1000 ||
       c->knee_decel_urad_s2 > POUR_SAFETY_DECEL_MAX_URAD_S2 || c->slow_torque_ff < 0) {
@@ -39,7 +39,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   safety->torque = 0;
   safety->active = 0u;
   safety->alpha_step_urad_s = (int32_t)(((int64_t)c->alpha_max_urad_s2 + 500) / 1000);
-  safety->gain_q32 = (int32_t)(((int64_t)c->torque_per_rad_s * ((int64_t)1 << 32) + 500000) / 1000000);
+  safety->gain_q32 = (int32_t)(((int64_t)c->governor_gain * ((int64_t)1 << 32) + 500000) / 1000000);
   safety->ceiling_urad_s = c->omega_slack_urad_s;
   safety->floor_urad_s = -c->omega_slack_urad_s;
   safety->integral_mq15 = 0;

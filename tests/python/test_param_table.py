@@ -49,7 +49,9 @@ def _bad(tmp_path: Path, old: str, new: str) -> Path:
 
 BAD = [
     ("X(5, alpha_max,", "X(4, alpha_max,", "omega_max and alpha_max have the same CAN parameter id 4"),
-    ("X(27, slow_ki,", "X(27, slow_omega,", "ids 24 and 27 have the same name slow_omega"),
+    ('X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s)',
+     'X(27, slow_omega, "urad/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_omega_urad_s)',
+     "ids 24 and 27 have the same name slow_omega"),
     ('X(17, encoder_zero, "counts", 0, 0, 16777215,', 'X(17, encoder_zero, "counts", 0, 16777215, 0,',
      "encoder_zero: min 16777215 is above max 0"),
     ('X(6, omega_slack, "urad/s", 800000,', 'X(6, omega_slack, "urad/s", 3000000,',
@@ -58,11 +60,18 @@ BAD = [
      "tau_limit: default 0 is outside its range 1 .. 32767"),
     ('X(15, node_id, "", 0, 0, 63,', 'X(15, node_id, "", 0, 0, NODE_MAX,',
      "node_id: bound NODE_MAX is not a number or a #define of the headers"),
+    ("q15_t, safety, slow_torque_ff)", "q15_t, safety, slow_ff)",
+     "slow_torque_ff: its member is slow_ff, the naming rule gives slow_torque_ff (name less '', plus the unit's "
+     "suffix '')"),
+    ('X(13, stop_rest_omega, "urad/s",', 'X(13, stop_rest_omega, "mrad/s",',
+     "stop_rest_omega: unit 'mrad/s' has no member suffix in the naming rule"),
+    ("X(14, stop_timeout,", "X(14, timeout,", "timeout: a row of group stop is named stop_..."),
 ]
 
 
 @pytest.mark.parametrize("old,new,message", BAD, ids=["same id", "same name", "min > max", "default above max",
-                                                     "default below min", "unknown bound"])
+                                                     "default below min", "unknown bound", "member off the rule",
+                                                     "unit off the rule", "group prefix missing"])
 def test_a_bad_declaration_is_refused_naming_its_rows(tmp_path, old, new, message):
     r = run("check", "--header", str(_bad(tmp_path, old, new)))
     assert r.returncode == 1 and r.stdout == "", (r.stdout, r.stderr)

@@ -30,7 +30,7 @@ typedef struct {
   q15_t torque_max;             /* |stop torque| <= this, Q15, > 0 (then the envelope's clamp and slew) */
   int32_t return_speed_urad_s;  /* toward upright at no more than this [µrad/s], > 0 */
   uint16_t return_gain_per_s;   /* speed reference = -gain * θ [1/s], >= 1 */
-  q15_t torque_per_rad_s;       /* torque per rad/s of speed error, Q15, > 0 */
+  q15_t gain;                   /* torque per rad/s of speed error, Q15 per rad/s, > 0 */
   int32_t rest_theta_urad;      /* done when |θ| <= this ... [µrad], > 0 */
   int32_t rest_omega_urad_s;    /* ... and |θ̇| <= this [µrad/s], > 0 */
   uint16_t timeout_ms;          /* brake anyway after this long [ms], >= 1 */

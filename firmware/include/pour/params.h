@@ -58,7 +58,7 @@
   X(6, omega_slack, "urad/s", 800000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, omega_slack_urad_s) \
   /* 0.5 tau_max per rad/s: the stiffest governor stable on the lightest load with 2 ticks of latency */      \
   X(7, governor_gain, "Q15/(rad/s)", POUR_PARAM_GAIN_ENVELOPE, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, safety,     \
-    torque_per_rad_s)                                                                                          \
+    governor_gain)                                                                                             \
   /* the controlled stop (pour_stop_config_t; docs/safety.md, "Defaults", controlled stop) */                 \
   /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s, gently enough not to throw the liquid */                   \
   X(8, stop_torque_max, "Q15", 16384, 1, POUR_Q15_MAX, q15_t, stop, torque_max)                               \
@@ -68,7 +68,7 @@
   /* the speed reference falls to 0 over the last half radian */                                              \
   X(10, stop_return_gain, "1/s", 2, 1, UINT16_MAX, uint16_t, stop, return_gain_per_s)                         \
   /* 0.5 tau_max per rad/s of speed error */                                                                  \
-  X(11, stop_gain, "Q15/(rad/s)", 16384, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, stop, torque_per_rad_s)           \
+  X(11, stop_gain, "Q15/(rad/s)", 16384, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, stop, gain)                       \
   /* 5 deg of upright and 0.05 rad/s: "at rest", as the fault tests measure it */                             \
   X(12, stop_rest_theta, "urad", 87266, 1, 3141593, int32_t, stop, rest_theta_urad)                           \
   X(13, stop_rest_omega, "urad/s", 50000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, rest_omega_urad_s) \
@@ -100,6 +100,14 @@
   X(26, slow_torque_ff, "Q15", 1638, 0, POUR_Q15_MAX, q15_t, safety, slow_torque_ff)                          \
   /* K * 5/s * 0.16 rad/s: the integral takes up a full bucket's 3-5 N m within a second */                   \
   X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s)
+
+/* One name per parameter. A row's name is the one the bus (ParamId), pour-bench, the docs and the node's table
+ * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, none for the
+ * others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms, _per_s (1/s), _ppm, _g, _milli (1/1000),
+ * none for Q15, Q15/(rad/s), bits, counts and plain numbers. So theta_max is safety.theta_max_urad, stop_timeout
+ * stop.timeout_ms, governor_gain safety.governor_gain; Python and the simulator's bridge reach a field by its C
+ * path (control.safety.theta_max_urad). scripts/param_table.py check holds every row to this rule. A rig file's
+ * fill_schedule_l is no parameter: it is the fill [L] from which the simulator sets a rig's knee_theta. */
 
 /* Where each group's members live in pour_params_t. */
 #define POUR_PARAM_IN_safety(member) control.safety.member
