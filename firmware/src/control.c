@@ -19,7 +19,7 @@
 #define STOP_ROW_stop(member, type, value) config.stop.member = (type)(value);
 #define STOP_ROW_sensors(member, type, value)
 #define STOP_ROW_port(member, type, value)
-#define STOP_DEFAULT(id, name, unit, def, lo, hi, type, group, member) STOP_ROW_##group(member, type, def)
+#define STOP_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) STOP_ROW_##group(member, type, def)
 
 pour_control_config_t pour_control_default_config(void) {
   pour_control_config_t config;

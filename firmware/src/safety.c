@@ -14,7 +14,7 @@
 #define SAFETY_ROW_stop(member, type, value)
 #define SAFETY_ROW_sensors(member, type, value)
 #define SAFETY_ROW_port(member, type, value)
-#define SAFETY_DEFAULT(id, name, unit, def, lo, hi, type, group, member) SAFETY_ROW_##group(member, type, def)
+#define SAFETY_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) SAFETY_ROW_##group(member, type, def)
 
 pour_safety_config_t pour_safety_default_config(void) {
   pour_safety_config_t config;

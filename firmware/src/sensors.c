@@ -22,7 +22,7 @@ _Static_assert((-3 >> 1) == -2, "arithmetic right shift required"); /* rounding 
 #define SENSORS_ROW_stop(member, type, value)
 #define SENSORS_ROW_sensors(member, type, value) c.member = (type)(value);
 #define SENSORS_ROW_port(member, type, value)
-#define SENSORS_DEFAULT(id, name, unit, def, lo, hi, type, group, member) SENSORS_ROW_##group(member, type, def)
+#define SENSORS_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) SENSORS_ROW_##group(member, type, def)
 
 pour_sensors_config_t pour_sensors_default_config(void) {
   pour_sensors_config_t c;

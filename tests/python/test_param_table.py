@@ -49,8 +49,8 @@ def _bad(tmp_path: Path, old: str, new: str) -> Path:
 
 BAD = [
     ("X(5, alpha_max,", "X(4, alpha_max,", "omega_max and alpha_max have the same CAN parameter id 4"),
-    ('X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s)',
-     'X(27, slow_omega, "urad/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_omega_urad_s)',
+    ('X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s,',
+     'X(27, slow_omega, "urad/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_omega_urad_s,',
      "ids 24 and 27 have the same name slow_omega"),
     ('X(17, encoder_zero, "counts", 0, 0, 16777215,', 'X(17, encoder_zero, "counts", 0, 16777215, 0,',
      "encoder_zero: min 16777215 is above max 0"),
@@ -60,7 +60,7 @@ BAD = [
      "tau_limit: default 0 is outside its range 1 .. 32767"),
     ('X(15, node_id, "", 0, 0, 63,', 'X(15, node_id, "", 0, 0, NODE_MAX,',
      "node_id: bound NODE_MAX is not a number or a #define of the headers"),
-    ("q15_t, safety, slow_torque_ff)", "q15_t, safety, slow_ff)",
+    ("q15_t, safety, slow_torque_ff,", "q15_t, safety, slow_ff,",
      "slow_torque_ff: its member is slow_ff, the naming rule gives slow_torque_ff (name less '', plus the unit's "
      "suffix '')"),
     ('X(13, stop_rest_omega, "urad/s",', 'X(13, stop_rest_omega, "mrad/s",',
@@ -159,3 +159,41 @@ def test_the_bench_table_is_the_declaration(build_dir, monkeypatch):
     from pour.bench import params
     got = [(p.id, p.name, p.unit, p.min, p.max, p.default) for p in params.table().values()]
     assert got == [(r["id"], r["name"], r["unit"], r["min"], r["max"], r["default"]) for r in _declaration()]
+
+
+SAFETY_MD = ROOT / "docs/safety.md"
+
+
+@pytest.mark.parametrize("old,new,message", [
+    ("| `omega_slack` (6) | `safety.omega_slack_urad_s` | 800000 urad/s |",
+     "| `omega_slack` (6) | `safety.omega_slack_urad_s` | 900000 urad/s |",
+     "a parameter table differs from POUR_PARAMS; run scripts/param_table.py docs --write"),
+    ("| `governor_gain` | the stiffest governor", "| `torque_per_rad_s` | the stiffest governor",
+     "`torque_per_rad_s` in a parameter table is no row of POUR_PARAMS"),
+    ("<!-- params:begin ids=23-27 ", "<!-- params:begin ids=23-29 ", "ids=23-29: no row has id 28, 29"),
+], ids=["a generated value edited by hand", "a hand table naming no parameter", "a block of ids that are none"])
+def test_safety_md_drifting_from_the_declaration_is_named(tmp_path, old, new, message):
+    text = SAFETY_MD.read_text()
+    assert text.count(old) == 1, old
+    bad = tmp_path / "safety.md"
+    bad.write_text(text.replace(old, new))
+    r = run("docs", "--check", "--doc", str(bad))
+    assert r.returncode == 1 and r.stderr.strip().splitlines() == [f"{bad}: {message}"], r.stderr
+    assert run("docs", "--check", "--doc", str(SAFETY_MD)).returncode == 0
+
+
+def test_docs_write_puts_the_declaration_back(tmp_path):
+    bad = tmp_path / "safety.md"
+    bad.write_text(SAFETY_MD.read_text().replace("| 800000 urad/s |", "| 900000 urad/s |"))
+    assert run("docs", "--write", "--doc", str(bad)).returncode == 0
+    assert bad.read_text() == SAFETY_MD.read_text() and not list(tmp_path.glob("*.tmp"))
+
+
+def test_a_row_that_does_not_parse_is_named_not_dropped(tmp_path):
+    """A row the parser cannot read (here one column too many) is reported, not silently left out."""
+    old = 'X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, port, scale_target_tare_g,'
+    r = run("check", "--header", str(_bad(tmp_path, old, old.replace("port,", "port, 7,"))))
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode == 1 and lines[0] == (
+        "params.h: a row does not read as X(id, name, unit, default, min, max, type, group, member, doc): "
+        'X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, por ...'), r.stderr

@@ -28,78 +28,81 @@
 #define POUR_PARAM_THETA_LOW_URAD (-87266)         /* -5 deg: a little past upright, never backwards over */
 #define POUR_PARAM_THETA_HIGH_URAD 2356194         /* 135 deg: the hard stop of the bucket's tilt */
 
-/* X(id, name, unit, default, min, max, C type, group, member). The row's field is POUR_PARAM_IN_<group>(member)
- * of pour_params_t: the group names the config struct it lives in, and that struct's default config
- * (pour_safety_default_config, pour_sensors_default_config, pour_control_default_config's stop, and
- * pour_params_default for the port's own) sets each member to the row's default, so a default is written once,
- * here. Reasons for the defaults: docs/safety.md ("Defaults and why", "Fill schedule", "Defaults"). Ids are the
- * bus's (ParamId in can/pour.dbc, whose value lists name them alike). A default outside [min, max], two rows on
- * one id or two of one name fail the build: scripts/param_table.py check names the rows, and the compiler
- * (params.c) refuses them too. */
-#define POUR_PARAMS(X)                                                                                         \
-  /* the motion envelope (pour_safety_config_t; docs/safety.md, "Defaults and why", "Defaults") */            \
-  /* the policy was trained against tau_max; lower it on a bench to be gentle */                              \
-  X(0, tau_limit, "Q15", POUR_Q15_MAX, 1, POUR_Q15_MAX, q15_t, safety, tau_limit)                             \
-  /* a full -1 -> +1 swing (65535 LSB) in 20 ticks, two decision periods */                                   \
-  X(1, slew_per_tick, "Q15", 3277, 1, POUR_Q15_MAX, q15_t, safety, slew_per_tick)                             \
-  /* -5 deg: a little past upright so the bucket can settle, never backwards over */                          \
-  X(2, theta_min, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,     \
-    int32_t, safety, theta_min_urad)                                                                           \
-  /* 135 deg: the hard stop of the bucket's tilt (the simulator's joint limit): never push into it */         \
-  X(3, theta_max, "urad", POUR_PARAM_THETA_HIGH_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,    \
-    int32_t, safety, theta_max_urad)                                                                           \
-  /* 2 rad/s: 93 degC liquid stays in the bucket, the hot-liquid limit */                                     \
-  X(4, omega_max, "urad/s", POUR_PARAM_OMEGA_ENVELOPE_URAD_S, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t,      \
-    safety, omega_max_urad_s)                                                                                  \
-  /* 3.4 rad/s^2: omega_max reached in one 1.7 Hz slosh period */                                             \
-  X(5, alpha_max, "urad/s2", POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2,         \
-    int32_t, safety, alpha_max_urad_s2)                                                                        \
-  /* 0.8 rad/s: K * slack = 0.4 tau_max holds and starts the full bucket */                                   \
-  X(6, omega_slack, "urad/s", 800000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, omega_slack_urad_s) \
-  /* 0.5 tau_max per rad/s: the stiffest governor stable on the lightest load with 2 ticks of latency */      \
-  X(7, governor_gain, "Q15/(rad/s)", POUR_PARAM_GAIN_ENVELOPE, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, safety,     \
-    governor_gain)                                                                                             \
-  /* the controlled stop (pour_stop_config_t; docs/safety.md, "Defaults", controlled stop) */                 \
-  /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s, gently enough not to throw the liquid */                   \
-  X(8, stop_torque_max, "Q15", 16384, 1, POUR_Q15_MAX, q15_t, stop, torque_max)                               \
-  /* 1 rad/s back toward upright: no slosh over the lip */                                                    \
-  X(9, stop_return_speed, "urad/s", 1000000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop,               \
-    return_speed_urad_s)                                                                                       \
-  /* the speed reference falls to 0 over the last half radian */                                              \
-  X(10, stop_return_gain, "1/s", 2, 1, UINT16_MAX, uint16_t, stop, return_gain_per_s)                         \
-  /* 0.5 tau_max per rad/s of speed error */                                                                  \
-  X(11, stop_gain, "Q15/(rad/s)", 16384, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, stop, gain)                       \
-  /* 5 deg of upright and 0.05 rad/s: "at rest", as the fault tests measure it */                             \
-  X(12, stop_rest_theta, "urad", 87266, 1, 3141593, int32_t, stop, rest_theta_urad)                           \
-  X(13, stop_rest_omega, "urad/s", 50000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, rest_omega_urad_s) \
-  /* from 135 deg at 1 rad/s takes 2.4 s: twice that, then brake anyway */                                    \
-  X(14, stop_timeout, "ms", 5000, 1, UINT16_MAX, uint16_t, stop, timeout_ms)                                  \
-  /* the node and the encoder; the port binds the node id at start-up (pour_params_default's node_id) */      \
-  X(15, node_id, "", 0, 0, 63, uint8_t, port, node_id)                                                        \
-  /* the bench rig's absolute encoder (47.9 urad a count) */                                                  \
-  X(16, encoder_bits, "bits", 17, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, uint8_t, sensors, encoder_bits) \
-  X(17, encoder_zero, "counts", 0, 0, 16777215, int32_t, port, encoder_zero)                                  \
-  /* the gearbox between the motor and the output shaft (the drive's: motor torque = output torque / ratio) */ \
-  X(18, gear_ratio, "1/1000", 1000, 1000, 1000000, int32_t, port, gear_ratio_milli)                           \
-  /* the load cells: grams = (reading - tare) * factor; uncalibrated: factor 1.0, no tare */                  \
-  X(19, scale_rotating_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port,                  \
-    scale_rotating_factor_ppm)                                                                                 \
-  X(20, scale_rotating_tare, "g", 0, -32767, 32767, int32_t, port, scale_rotating_tare_g)                     \
-  X(21, scale_target_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port,                    \
-    scale_target_factor_ppm)                                                                                   \
-  X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, port, scale_target_tare_g)                         \
-  /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */          \
-  /* 0: off; the rig file gives the knee, its fill's onset angle less 3 deg */                                \
-  X(23, knee_theta, "urad", 0, 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, safety, knee_theta_urad)                \
-  /* 0.16 rad/s past the knee: 11-12 L leave no faster than the target takes them */                          \
-  X(24, slow_omega, "urad/s", 160000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, slow_omega_urad_s)  \
-  /* 10 rad/s^2: 2 rad/s down to the slow speed within 11 deg before the knee */                              \
-  X(25, knee_decel, "urad/s2", 10000000, 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, safety,                 \
-    knee_decel_urad_s2)                                                                                        \
-  /* 0.05 tau_max = 1 N m: the part of the load the integral need not build up */                             \
-  X(26, slow_torque_ff, "Q15", 1638, 0, POUR_Q15_MAX, q15_t, safety, slow_torque_ff)                          \
-  /* K * 5/s * 0.16 rad/s: the integral takes up a full bucket's 3-5 N m within a second */                   \
-  X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s)
+/* X(id, name, unit, default, min, max, C type, group, member, doc). The row's field is
+ * POUR_PARAM_IN_<group>(member) of pour_params_t: the group names the config struct it lives in, and that
+ * struct's default config (pour_safety_default_config, pour_sensors_default_config, pour_control_default_config's
+ * stop, and pour_params_default for the port's own) sets each member to the row's default, so a default is
+ * written once, here; doc says in one line why it is the default (docs/safety.md shows it, with the longer
+ * arguments of "Defaults and why" and "Fill schedule"). Ids are the bus's (ParamId in can/pour.dbc, whose value
+ * lists name them alike). A default outside [min, max], two rows on one id or two of one name fail the build:
+ * scripts/param_table.py check names the rows, and the compiler (params.c) refuses them too. */
+#define POUR_PARAMS(X)                                                                                               \
+  /* the motion envelope (pour_safety_config_t; docs/safety.md, "Defaults and why") */                               \
+  X(0, tau_limit, "Q15", POUR_Q15_MAX, 1, POUR_Q15_MAX, q15_t, safety, tau_limit,                                    \
+    "1.0 tau_max: the policy was trained against tau_max; lower it on a bench to be gentle")                         \
+  X(1, slew_per_tick, "Q15", 3277, 1, POUR_Q15_MAX, q15_t, safety, slew_per_tick,                                    \
+    "a full -1 to +1 swing in 20 ms (two decision periods): no torque steps into the gearbox or the liquid")         \
+  X(2, theta_min, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,          \
+    int32_t, safety, theta_min_urad,                                                                                 \
+    "-5 deg: a little past upright so the bucket can settle, never backwards over")                                  \
+  X(3, theta_max, "urad", POUR_PARAM_THETA_HIGH_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,         \
+    int32_t, safety, theta_max_urad,                                                                                 \
+    "135 deg: the bucket's hard stop (the simulator's joint limit): never push into it")                             \
+  X(4, omega_max, "urad/s", POUR_PARAM_OMEGA_ENVELOPE_URAD_S, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety,  \
+    omega_max_urad_s,                                                                                                \
+    "2 rad/s: 93 degC liquid stays in the bucket (the hot-liquid limit)")                                            \
+  X(5, alpha_max, "urad/s2", POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, int32_t,    \
+    safety, alpha_max_urad_s2,                                                                                       \
+    "3.4 rad/s^2: omega_max reached in one period of the 1.7 Hz slosh mode, which the ramp then leaves at rest")     \
+  X(6, omega_slack, "urad/s", 800000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, omega_slack_urad_s,      \
+    "0.8 rad/s: K * slack = 0.4 tau_max holds and starts the full bucket, above the supervisor's torque_min")        \
+  X(7, governor_gain, "Q15/(rad/s)", POUR_PARAM_GAIN_ENVELOPE, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, safety,           \
+    governor_gain,                                                                                                   \
+    "0.5 tau_max per rad/s: the stiffest governor stable on the lightest load with 2 ticks of latency")              \
+  /* the controlled stop (pour_stop_config_t; docs/safety.md, "Defaults", controlled stop) */                        \
+  X(8, stop_torque_max, "Q15", 16384, 1, POUR_Q15_MAX, q15_t, stop, torque_max,                                      \
+    "0.5 tau_max: decelerates 16 rad/s in well under 0.2 s, gently enough not to throw the liquid")                  \
+  X(9, stop_return_speed, "urad/s", 1000000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, return_speed_urad_s,\
+    "1 rad/s: back toward upright slowly, no slosh over the lip")                                                    \
+  X(10, stop_return_gain, "1/s", 2, 1, UINT16_MAX, uint16_t, stop, return_gain_per_s,                                \
+    "the speed reference falls to 0 over the last half radian")                                                      \
+  X(11, stop_gain, "Q15/(rad/s)", 16384, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, stop, gain,                             \
+    "0.5 tau_max per rad/s of speed error")                                                                          \
+  X(12, stop_rest_theta, "urad", 87266, 1, 3141593, int32_t, stop, rest_theta_urad,                                  \
+    "5 deg of upright: at rest, as the fault tests measure it")                                                      \
+  X(13, stop_rest_omega, "urad/s", 50000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, rest_omega_urad_s,     \
+    "0.05 rad/s: at rest, as the fault tests measure it")                                                            \
+  X(14, stop_timeout, "ms", 5000, 1, UINT16_MAX, uint16_t, stop, timeout_ms,                                         \
+    "from 135 deg at 1 rad/s takes 2.4 s: twice that, then brake anyway")                                            \
+  /* the node, the encoder, the gearbox and the load cells (the port's own, and pour_sensors_config_t) */            \
+  X(15, node_id, "", 0, 0, 63, uint8_t, port, node_id,                                                               \
+    "the port binds it at start-up (its command line, the board's stored set)")                                      \
+  X(16, encoder_bits, "bits", 17, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, uint8_t, sensors, encoder_bits,      \
+    "the bench rig's absolute encoder (47.9 urad a count)")                                                          \
+  X(17, encoder_zero, "counts", 0, 0, 16777215, int32_t, port, encoder_zero,                                         \
+    "uncalibrated: the raw count read upright, set by the calibration")                                              \
+  X(18, gear_ratio, "1/1000", 1000, 1000, 1000000, int32_t, port, gear_ratio_milli,                                  \
+    "motor turns per output turn (the drive's: motor torque = output torque / ratio); 1 until the rig's is set")     \
+  X(19, scale_rotating_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port,                         \
+    scale_rotating_factor_ppm,                                                                                       \
+    "uncalibrated: grams = (reading - tare) * factor, factor 1.0")                                                   \
+  X(20, scale_rotating_tare, "g", 0, -32767, 32767, int32_t, port, scale_rotating_tare_g,                            \
+    "uncalibrated: no tare (the reading with the rotating bucket empty)")                                            \
+  X(21, scale_target_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port, scale_target_factor_ppm,  \
+    "uncalibrated: factor 1.0")                                                                                      \
+  X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, port, scale_target_tare_g,                                \
+    "uncalibrated: no tare")                                                                                         \
+  /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */                  \
+  X(23, knee_theta, "urad", 0, 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, safety, knee_theta_urad,                       \
+    "0: off; the rig file gives the knee, its fill's onset angle less 3 deg")                                        \
+  X(24, slow_omega, "urad/s", 160000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, slow_omega_urad_s,       \
+    "0.16 rad/s past the knee: 11-12 L leave no faster than the target takes them")                                  \
+  X(25, knee_decel, "urad/s2", 10000000, 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, safety, knee_decel_urad_s2,   \
+    "10 rad/s^2: 2 rad/s down to 0.16 rad/s within 0.2 rad (11 deg) before the knee")                                \
+  X(26, slow_torque_ff, "Q15", 1638, 0, POUR_Q15_MAX, q15_t, safety, slow_torque_ff,                                 \
+    "0.05 tau_max = 1 N m: the part of the load the integral need not build up")                                     \
+  X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s,                                           \
+    "K * 5/s * 0.16 rad/s = 8 N m/s: the integral takes up a full bucket's 3-5 N m within a second")
 
 /* One name per parameter. A row's name is the one the bus (ParamId), pour-bench, the docs and the node's table
  * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, none for the
@@ -119,7 +122,7 @@
 
 /* POUR_PARAM_ID_<name>: each parameter's id, from the table. */
 typedef enum {
-#define POUR_PARAM_ENUM(id, name, unit, def, lo, hi, type, group, member) POUR_PARAM_ID_##name = id,
+#define POUR_PARAM_ENUM(id, name, unit, def, lo, hi, type, group, member, doc) POUR_PARAM_ID_##name = id,
   POUR_PARAMS(POUR_PARAM_ENUM)
 #undef POUR_PARAM_ENUM
 } pour_param_id_t;
