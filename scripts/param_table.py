@@ -9,7 +9,7 @@ the DBC's ParamId value lists (can/pour.dbc) checked against it.
   param_table.py check [--header H]        the declaration alone
   param_table.py docs (--check | --write)  the tables of docs/can.md and docs/safety.md between their
                                            marker comments (ids=0-7: those rows, their reasons)
-  param_table.py dbc --check               every VAL_ ... ParamId list in can/pour.dbc
+  param_table.py dbc (--check | --write)   every VAL_ ... ParamId list in can/pour.dbc
   param_table.py fields [--bridge F]       the simulator bridge's field paths (POURSIM_FW_FIELD) against
                                            every leaf of pour_control_config_t, and POUR_PARAMS's fields
 
@@ -234,18 +234,33 @@ def docs(rows: list[dict], write: bool, files: tuple[Path, ...] = DOCS) -> int:
     return bad
 
 
-def dbc(rows: list[dict]) -> int:
-    want = {r["id"]: r["name"] for r in rows}
-    lists = re.findall(r"^VAL_ (\d+) ParamId (.*);$", DBC.read_text(), re.M)
+def dbc_list(rows: list[dict]) -> str:
+    return " ".join(f'{r["id"]} "{r["name"]}"' for r in rows) + " "
+
+
+def dbc(rows: list[dict], write: bool = False, path: Path = DBC) -> int:
+    """Every VAL_ <message> ParamId list of the DBC against the declaration; with write, each rewritten from it."""
+    name = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+    text = path.read_text()
+    lists = re.findall(r"^VAL_ (\d+) ParamId (.*);$", text, re.M)
     if not lists:
-        print(f"{DBC.relative_to(ROOT)}: no VAL_ ... ParamId list", file=sys.stderr)
+        print(f"{name}: no VAL_ ... ParamId list", file=sys.stderr)
         return 1
+    want = {r["id"]: r["name"] for r in rows}
+    if write:
+        new = re.sub(r"^(VAL_ \d+ ParamId ).*;$", lambda m: m.group(1) + dbc_list(rows) + ";", text, flags=re.M)
+        if new != text:
+            tmp = path.with_suffix(".dbc.tmp")
+            tmp.write_text(new)
+            tmp.replace(path)
+        return 0
     bad = 0
     for msg, body in lists:
         got = {int(k): v for k, v in re.findall(r'(\d+) "([^"]*)"', body)}
         if got != want:
             diff = sorted(set(got.items()) ^ set(want.items()))
-            print(f"{DBC.relative_to(ROOT)}: VAL_ {msg} ParamId differs from POUR_PARAMS at {diff[:4]}", file=sys.stderr)
+            print(f"{name}: VAL_ {msg} ParamId differs from POUR_PARAMS at {diff[:4]}; "
+                  "run scripts/param_table.py dbc --write", file=sys.stderr)
             bad = 1
     return bad
 
@@ -318,7 +333,11 @@ def main(argv: list[str] | None = None) -> int:
     g.add_argument("--check", action="store_true")
     g.add_argument("--write", action="store_true")
     d.add_argument("--doc", type=Path, action="append", help="a Markdown file in place of docs/can.md, docs/safety.md")
-    sub.add_parser("dbc").add_argument("--check", action="store_true", required=True)
+    b = sub.add_parser("dbc")
+    g = b.add_mutually_exclusive_group(required=True)
+    g.add_argument("--check", action="store_true")
+    g.add_argument("--write", action="store_true")
+    b.add_argument("--dbc", type=Path, default=DBC, help="a DBC in place of can/pour.dbc")
     sub.add_parser("fields").add_argument("--bridge", type=Path, default=None)
     args = ap.parse_args(argv)
     header = getattr(args, "header", HEADER)
@@ -330,7 +349,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.cmd == "docs":
         return docs(rows, args.write, tuple(args.doc) if args.doc else DOCS)
     if args.cmd == "dbc":
-        return dbc(rows)
+        return dbc(rows, args.write, args.dbc)
     if args.cmd == "fields":
         return fields(rows, args.bridge or bridge_file())
     return 0

@@ -197,3 +197,24 @@ def test_a_row_that_does_not_parse_is_named_not_dropped(tmp_path):
     assert r.returncode == 1 and lines[0] == (
         "params.h: a row does not read as X(id, name, unit, default, min, max, type, group, member, doc): "
         'X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, por ...'), r.stderr
+
+
+DBC = ROOT / "can/pour.dbc"
+
+
+def test_a_dbc_list_that_drifts_is_named_and_written_back(tmp_path):
+    bad = tmp_path / "pour.dbc"
+    text = DBC.read_text()
+    bad.write_text(text.replace('VAL_ 9 ParamId 0 "tau_limit" 1 "slew_per_tick"', 'VAL_ 9 ParamId 0 "tau_limit" 1 "slew"'))
+    r = run("dbc", "--check", "--dbc", str(bad))
+    assert r.returncode == 1 and r.stderr.strip().splitlines() == [
+        f"{bad}: VAL_ 9 ParamId differs from POUR_PARAMS at [(1, 'slew'), (1, 'slew_per_tick')]; "
+        "run scripts/param_table.py dbc --write"], r.stderr
+    assert run("dbc", "--write", "--dbc", str(bad)).returncode == 0
+    assert bad.read_text() == text  # the shipped DBC is what the declaration writes, byte for byte
+
+
+def test_every_declared_unit_has_an_si_reading():
+    """pour-bench shows each parameter in SI units; a row whose unit it does not know would show raw."""
+    from pour.bench import params
+    assert {r["unit"] for r in _declaration()} <= set(params.SI)

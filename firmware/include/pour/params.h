@@ -34,7 +34,7 @@
  * stop, and pour_params_default for the port's own) sets each member to the row's default, so a default is
  * written once, here; doc says in one line why it is the default (docs/safety.md shows it, with the longer
  * arguments of "Defaults and why" and "Fill schedule"). Ids are the bus's (ParamId in can/pour.dbc, whose value
- * lists name them alike). A default outside [min, max], two rows on one id or two of one name fail the build:
+ * lists scripts/param_table.py dbc --write writes from this table). A default outside [min, max], two rows on one id or two of one name fail the build:
  * scripts/param_table.py check names the rows, and the compiler (params.c) refuses them too. */
 #define POUR_PARAMS(X)                                                                                               \
   /* the motion envelope (pour_safety_config_t; docs/safety.md, "Defaults and why") */                               \
