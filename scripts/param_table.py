@@ -40,7 +40,7 @@ ALIAS = re.compile(r"^#define\s+(\w+)\s+([A-Z_][A-Z0-9_]*)\s*$", re.M)
 UNIT_SUFFIX = {"urad": "_urad", "urad/s": "_urad_s", "urad/s2": "_urad_s2", "ms": "_ms", "1/s": "_per_s",
                "ppm": "_ppm", "g": "_g", "1/1000": "_milli", "Q15": "", "Q15/(rad/s)": "", "bits": "", "counts": "",
                "": ""}
-GROUP_PREFIX = {"stop": "stop_"}
+GROUP_PREFIX = {"stop": "stop_", "supervisor": "supervisor_"}
 
 
 def member_of(name: str, group: str, unit: str) -> str | None:

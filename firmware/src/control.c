@@ -18,6 +18,7 @@
 #define STOP_ROW_safety(member, type, value)
 #define STOP_ROW_stop(member, type, value) config.stop.member = (type)(value);
 #define STOP_ROW_sensors(member, type, value)
+#define STOP_ROW_supervisor(member, type, value)
 #define STOP_ROW_port(member, type, value)
 #define STOP_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) STOP_ROW_##group(member, type, def)
 

@@ -46,6 +46,7 @@ const char *pour_param_result_name(pour_param_result_t result) {
 #define PARAMS_ROW_safety(member, type, value)
 #define PARAMS_ROW_stop(member, type, value)
 #define PARAMS_ROW_sensors(member, type, value)
+#define PARAMS_ROW_supervisor(member, type, value)
 #define PARAMS_ROW_port(member, type, value) params->member = (type)(value);
 #define PARAMS_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) PARAMS_ROW_##group(member, type, def)
 

@@ -13,6 +13,7 @@
 #define SAFETY_ROW_safety(member, type, value) config.member = (type)(value);
 #define SAFETY_ROW_stop(member, type, value)
 #define SAFETY_ROW_sensors(member, type, value)
+#define SAFETY_ROW_supervisor(member, type, value)
 #define SAFETY_ROW_port(member, type, value)
 #define SAFETY_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) SAFETY_ROW_##group(member, type, def)
 

@@ -37,6 +37,10 @@ def test_the_envelope_ranges_are_the_safety_cases():
     for name in ("omega_max", "omega_slack", "slow_omega", "stop_return_speed", "stop_rest_omega"):
         assert rows[name]["max"] == 2_000_000, name  # docs/safety.md: 2 rad/s, the hot-liquid limit
     assert rows["alpha_max"]["max"] == 3_400_000 and rows["governor_gain"]["max"] == 16384
+    # the supervisor's and the estimator's limits: the safety case's values are the loosest the bus takes
+    assert rows["supervisor_theta_margin"]["max"] == rows["supervisor_theta_margin"]["default"] == 87266  # 5 deg
+    assert rows["supervisor_omega_max"]["max"] == rows["supervisor_omega_max"]["default"] == 4_000_000  # 4 rad/s
+    assert rows["jump_max"]["max"] == rows["jump_max"]["default"] == 10_000  # 10 mrad
 
 
 def _bad(tmp_path: Path, old: str, new: str) -> Path:
@@ -147,7 +151,7 @@ def test_the_modules_default_configs_are_the_declared_defaults(build_dir, monkey
     from pour import core
     cfg = core.control_config()
     rows = [r for r in _declaration() if r["field"].startswith("control.")]
-    assert len(rows) == 21
+    assert len(rows) == 24
     got = {r["name"]: cfg.get(r["field"][len("control."):]) for r in rows}
     assert got == {r["name"]: r["default"] for r in rows}
 
@@ -170,7 +174,7 @@ SAFETY_MD = ROOT / "docs/safety.md"
      "a parameter table differs from POUR_PARAMS; run scripts/param_table.py docs --write"),
     ("| `governor_gain` | the stiffest governor", "| `torque_per_rad_s` | the stiffest governor",
      "`torque_per_rad_s` in a parameter table is no row of POUR_PARAMS"),
-    ("<!-- params:begin ids=23-27 ", "<!-- params:begin ids=23-29 ", "ids=23-29: no row has id 28, 29"),
+    ("<!-- params:begin ids=28-30 ", "<!-- params:begin ids=28-32 ", "ids=28-32: no row has id 31, 32"),
 ], ids=["a generated value edited by hand", "a hand table naming no parameter", "a block of ids that are none"])
 def test_safety_md_drifting_from_the_declaration_is_named(tmp_path, old, new, message):
     text = SAFETY_MD.read_text()

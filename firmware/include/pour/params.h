@@ -27,11 +27,17 @@
 #define POUR_PARAM_GAIN_ENVELOPE 16384             /* 0.5 tau_max per rad/s: the stiffest stable governor */
 #define POUR_PARAM_THETA_LOW_URAD (-87266)         /* -5 deg: a little past upright, never backwards over */
 #define POUR_PARAM_THETA_HIGH_URAD 2356194         /* 135 deg: the hard stop of the bucket's tilt */
+/* The supervisor's and the estimator's limits a commissioning engineer may tighten but not loosen: beyond them
+ * a fault is detected later or not at all (docs/safety.md, "Ranges the node accepts"; docs/hazards.md). */
+#define POUR_PARAM_THETA_MARGIN_URAD 87266         /* 5 deg: POSITION at most this far past the envelope's limits */
+#define POUR_PARAM_OVERSPEED_URAD_S 4000000        /* 4 rad/s: OVERSPEED at most twice the hot-liquid limit */
+#define POUR_PARAM_JUMP_URAD 10000                 /* 10 mrad: a count at most this far off its prediction */
 
 /* X(id, name, unit, default, min, max, C type, group, member, doc). The row's field is
  * POUR_PARAM_IN_<group>(member) of pour_params_t: the group names the config struct it lives in, and that
- * struct's default config (pour_safety_default_config, pour_sensors_default_config, pour_control_default_config's
- * stop, and pour_params_default for the port's own) sets each member to the row's default, so a default is
+ * struct's default config (pour_safety_default_config, pour_sensors_default_config,
+ * pour_supervisor_default_config, pour_control_default_config's stop, and pour_params_default for the port's
+ * own) sets each member to the row's default, so a default is
  * written once, here; doc says in one line why it is the default (docs/safety.md shows it, with the longer
  * arguments of "Defaults and why" and "Fill schedule"). Ids are the bus's (ParamId in can/pour.dbc, whose value
  * lists scripts/param_table.py dbc --write writes from this table). A default outside [min, max], two rows on one id or two of one name fail the build:
@@ -102,11 +108,20 @@
   X(26, slow_torque_ff, "Q15", 1638, 0, POUR_Q15_MAX, q15_t, safety, slow_torque_ff,                                 \
     "0.05 tau_max = 1 N m: the part of the load the integral need not build up")                                     \
   X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s,                                           \
-    "K * 5/s * 0.16 rad/s = 8 N m/s: the integral takes up a full bucket's 3-5 N m within a second")
+    "K * 5/s * 0.16 rad/s = 8 N m/s: the integral takes up a full bucket's 3-5 N m within a second")                 \
+  /* the supervisor's limits and the estimator's jump limit (docs/safety.md, "Ranges the node accepts") */           \
+  X(28, supervisor_theta_margin, "urad", POUR_PARAM_THETA_MARGIN_URAD, 1, POUR_PARAM_THETA_MARGIN_URAD, int32_t,     \
+    supervisor, theta_margin_urad,                                                                                   \
+    "5 deg past the envelope's limits: an overshoot no nominal pour shows (nominal -0.0 .. 128.4 deg)")              \
+  X(29, supervisor_omega_max, "urad/s", POUR_PARAM_OVERSPEED_URAD_S, 1, POUR_PARAM_OVERSPEED_URAD_S, int32_t,        \
+    supervisor, omega_max_urad_s,                                                                                    \
+    "4 rad/s, twice the envelope's limit: a speed the governor could not hold (its droop is <= 0.54 rad/s)")         \
+  X(30, jump_max, "urad", POUR_PARAM_JUMP_URAD, 1, POUR_PARAM_JUMP_URAD, int32_t, sensors, jump_max_urad,            \
+    "10 mrad: the loop lags that far only beyond 900 rad/s^2; a count further off its prediction jumped")
 
 /* One name per parameter. A row's name is the one the bus (ParamId), pour-bench, the docs and the node's table
- * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, none for the
- * others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms, _per_s (1/s), _ppm, _g, _milli (1/1000),
+ * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, supervisor_ for
+ * the supervisor's, none for the others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms, _per_s (1/s), _ppm, _g, _milli (1/1000),
  * none for Q15, Q15/(rad/s), bits, counts and plain numbers. So theta_max is safety.theta_max_urad, stop_timeout
  * stop.timeout_ms, governor_gain safety.governor_gain; Python and the simulator's bridge reach a field by its C
  * path (control.safety.theta_max_urad). scripts/param_table.py check holds every row to this rule. A rig file's
@@ -116,9 +131,12 @@
 #define POUR_PARAM_IN_safety(member) control.safety.member
 #define POUR_PARAM_IN_stop(member) control.stop.member
 #define POUR_PARAM_IN_sensors(member) control.sensors.member
+#define POUR_PARAM_IN_supervisor(member) control.supervisor.member
 #define POUR_PARAM_IN_port(member) member
 
-#define POUR_PARAM_COUNT 28u
+/* The number of rows (ids 0 .. count - 1). */
+#define POUR_PARAM_PLUS_ONE(...) +1u
+#define POUR_PARAM_COUNT (0u POUR_PARAMS(POUR_PARAM_PLUS_ONE))
 
 /* POUR_PARAM_ID_<name>: each parameter's id, from the table. */
 typedef enum {
