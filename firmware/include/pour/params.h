@@ -19,7 +19,7 @@
 
 #define POUR_PARAM_FACTOR_ONE 1000000 /* a scale factor of 1.0 [ppm] */
 
-/* The safety case's ranges (docs/safety.md, "The motion envelope", "Defaults and why"), not the types': a
+/* The safety case's ranges (docs/safety.md, "Ranges the node accepts"), not the types': a
  * write beyond them is refused (POUR_PARAM_OUT_OF_RANGE) on the node, over CAN and from flash. They are compiled
  * in; widening one is a reviewed change of this file and a new firmware build, never a bus write. */
 #define POUR_PARAM_OMEGA_ENVELOPE_URAD_S 2000000   /* 2 rad/s: the hot-liquid limit, omega_max's default */
@@ -37,11 +37,11 @@
  * POUR_PARAM_IN_<group>(member) of pour_params_t: the group names the config struct it lives in, and that
  * struct's default config (pour_safety_default_config, pour_sensors_default_config,
  * pour_supervisor_default_config, pour_control_default_config's stop, and pour_params_default for the port's
- * own) sets each member to the row's default, so a default is
- * written once, here; doc says in one line why it is the default (docs/safety.md shows it, with the longer
- * arguments of "Defaults and why" and "Fill schedule"). Ids are the bus's (ParamId in can/pour.dbc, whose value
- * lists scripts/param_table.py dbc --write writes from this table). A default outside [min, max], two rows on one id or two of one name fail the build:
- * scripts/param_table.py check names the rows, and the compiler (params.c) refuses them too. */
+ * own) sets each member to the row's default, so a default is written once, here. doc says in one line why it
+ * is the default (docs/safety.md shows it, beside the longer arguments of "Defaults and why"). Ids are the
+ * bus's: ParamId's value lists in can/pour.dbc are what scripts/param_table.py dbc --write writes from this
+ * table. A default outside [min, max], two rows on one id or two of one name fail the build: scripts/
+ * param_table.py check names the rows, and the compiler (params.c) refuses them too. */
 #define POUR_PARAMS(X)                                                                                               \
   /* the motion envelope (pour_safety_config_t; docs/safety.md, "Defaults and why") */                               \
   X(0, tau_limit, "Q15", POUR_Q15_MAX, 1, POUR_Q15_MAX, q15_t, safety, tau_limit,                                    \
@@ -120,12 +120,13 @@
     "10 mrad: the loop lags that far only beyond 900 rad/s^2; a count further off its prediction jumped")
 
 /* One name per parameter. A row's name is the one the bus (ParamId), pour-bench, the docs and the node's table
- * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, supervisor_ for
- * the supervisor's, none for the others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms, _per_s (1/s), _ppm, _g, _milli (1/1000),
- * none for Q15, Q15/(rad/s), bits, counts and plain numbers. So theta_max is safety.theta_max_urad, stop_timeout
- * stop.timeout_ms, governor_gain safety.governor_gain; Python and the simulator's bridge reach a field by its C
- * path (control.safety.theta_max_urad). scripts/param_table.py check holds every row to this rule. A rig file's
- * fill_schedule_l is no parameter: it is the fill [L] from which the simulator sets a rig's knee_theta. */
+ * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, supervisor_
+ * for the supervisor's, none for the others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms,
+ * _per_s (1/s), _ppm, _g, _milli (1/1000); none for Q15, Q15/(rad/s), bits, counts and plain numbers. So
+ * theta_max is safety.theta_max_urad, stop_timeout stop.timeout_ms, governor_gain safety.governor_gain; Python
+ * and the simulator's bridge reach a field by its C path (control.safety.theta_max_urad). scripts/param_table.py
+ * check holds every row to this rule. A rig file's fill_schedule_l is no parameter: it is the fill [L] from
+ * which the simulator sets a rig's knee_theta. */
 
 /* Where each group's members live in pour_params_t. */
 #define POUR_PARAM_IN_safety(member) control.safety.member
