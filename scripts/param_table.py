@@ -123,6 +123,8 @@ def declaration(header: Path = HEADER) -> list[dict]:
             problems.append(f"{r['name']}: min {r['min']} is above max {r['max']}")
         elif None not in (r["default"], r["min"], r["max"]) and not r["min"] <= r["default"] <= r["max"]:
             problems.append(f"{r['name']}: default {r['default']} is outside its range {r['min']} .. {r['max']}")
+        if not r["doc"].strip() or "|" in r["doc"]:
+            problems.append(f"{r['name']}: its doc must say in one line, without '|', why its default is what it is")
     for r in rows:
         want = member_of(r["name"], r["group"], r["unit"])
         prefix = GROUP_PREFIX.get(r["group"], "")

@@ -70,12 +70,14 @@ BAD = [
     ('X(13, stop_rest_omega, "urad/s",', 'X(13, stop_rest_omega, "mrad/s",',
      "stop_rest_omega: unit 'mrad/s' has no member suffix in the naming rule"),
     ("X(14, stop_timeout,", "X(14, timeout,", "timeout: a row of group stop is named stop_..."),
+    ('"uncalibrated: no tare")', '"")',
+     "scale_target_tare: its doc must say in one line, without '|', why its default is what it is"),
 ]
 
 
 @pytest.mark.parametrize("old,new,message", BAD, ids=["same id", "same name", "min > max", "default above max",
                                                      "default below min", "unknown bound", "member off the rule",
-                                                     "unit off the rule", "group prefix missing"])
+                                                     "unit off the rule", "group prefix missing", "no doc"])
 def test_a_bad_declaration_is_refused_naming_its_rows(tmp_path, old, new, message):
     r = run("check", "--header", str(_bad(tmp_path, old, new)))
     assert r.returncode == 1 and r.stdout == "", (r.stdout, r.stderr)
