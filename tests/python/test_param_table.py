@@ -5,6 +5,7 @@ declaration with two rows on one CAN id, two rows of one name, a default outside
 no number fails naming the rows involved, in scripts/param_table.py and in the compiler."""
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -224,3 +225,20 @@ def test_every_declared_unit_has_an_si_reading():
     """pour-bench shows each parameter in SI units; a row whose unit it does not know would show raw."""
     from pour.bench import params
     assert {r["unit"] for r in _declaration()} <= set(params.SI)
+
+
+def test_the_naming_rule_params_h_states_is_the_one_checked():
+    """Each unit suffix and group prefix param_table.py holds a row to is named in params.h's rule, and the rule
+    names no suffix the checker does not know."""
+    sys.path.insert(0, str(SCRIPT.parent))
+    try:
+        import param_table
+    finally:
+        sys.path.pop(0)
+    text = HEADER.read_text()
+    rule = text[text.index("/* One name per parameter."):]
+    rule = " ".join(rule[:rule.index("*/")].replace("\n *", " ").split())
+    stated = set(re.findall(r"(?<![\w.])_[a-z0-9_]+\b", rule)) - {"_"}
+    assert stated == {s for s in param_table.UNIT_SUFFIX.values() if s}, stated
+    for group, prefix in param_table.GROUP_PREFIX.items():
+        assert f"({prefix} for the" in rule or f", {prefix} for the" in rule, (group, prefix)
