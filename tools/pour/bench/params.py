@@ -80,9 +80,11 @@ class Param:
         return f"{self.to_si(self.min):.6g} .. {self.to_si(self.max):.6g} {self.si_unit}".rstrip()
 
     def describe(self, raw: int) -> str:
-        """`omega_max 1.5 rad/s (range 1e-06 .. 6.28319 rad/s; raw 1500000 urad/s)`."""
+        """`omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; default 2 rad/s; raw 1500000 urad/s)`."""
         si = f"{self.to_si(raw):.6g} {self.si_unit}".rstrip()
-        return f"{self.name} {si} (range {self.range_text()}; raw {raw} {self.unit})".replace(" )", ")")
+        default = f"{self.to_si(self.default):.6g} {self.si_unit}".rstrip()
+        return (f"{self.name} {si} (range {self.range_text()}; default {default}; "
+                f"raw {raw} {self.unit})").replace(" )", ")")
 
 
 def table() -> dict[str, Param]:
