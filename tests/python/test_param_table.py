@@ -242,3 +242,39 @@ def test_the_naming_rule_params_h_states_is_the_one_checked():
     assert stated == {s for s in param_table.UNIT_SUFFIX.values() if s}, stated
     for group, prefix in param_table.GROUP_PREFIX.items():
         assert f"({prefix} for the" in rule or f", {prefix} for the" in rule, (group, prefix)
+
+
+def _hand_defaults(text: str) -> list[tuple[str, str]]:
+    """(field, default cell) of docs/safety.md's hand-written '| field | default | reason |' tables (the core's
+    fields that are no bus parameter): the rows naming one field whose default is a raw integer, maybe with a
+    reading in parentheses ('11469 (0.35 τ_max = 7 N·m)', '1,000'); readings in other units are not compared."""
+    out, inside = [], False
+    for line in text.splitlines():
+        if line.startswith("| field | default | reason |"):
+            inside = True
+            continue
+        if not line.startswith("|"):
+            inside = False
+        if not inside or line.startswith("|---"):
+            continue
+        cells = [c.strip() for c in line.strip("|").split(" | ")]
+        m = re.fullmatch(r"`([\w.]+)`", cells[0])
+        v = re.fullmatch(r"([−-]?\d[\d,]*)(?: \(.*\))?", cells[1])
+        if m and v:
+            out.append((m.group(1), v.group(1).replace(",", "").replace("−", "-")))
+    return out
+
+
+def test_the_hand_written_defaults_in_safety_md_are_the_compiled_ones(build_dir, monkeypatch):
+    """The core's fields that are no parameter keep their defaults in their modules; where docs/safety.md's
+    tables give one as a raw integer, it is what pour_control_default_config holds (by its C path, or the one
+    field whose path ends so)."""
+    monkeypatch.setenv("POUR_BUILD_DIR", str(build_dir))
+    from pour import core
+    cfg = core.control_config()
+    rows = _hand_defaults(SAFETY_MD.read_text())
+    assert len(rows) >= 8, rows
+    for name, want in rows:
+        paths = [f for f in cfg.fields() if f == name or f.endswith("." + name)]
+        assert len(paths) == 1, (name, paths)
+        assert cfg.get(paths[0]) == int(want), (name, want)
