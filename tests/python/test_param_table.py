@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: MIT
-"""The parameter declaration (POUR_PARAMS) against what repeats it: docs/can.md's table and the DBC's ParamId
-value lists are what scripts/param_table.py generates, and the compiled defaults are the declared ones; a
-declaration with two rows on one CAN id, two rows of one name, a default outside its range or a bound that is
-no number fails naming the rows involved, in scripts/param_table.py and in the compiler."""
+"""The parameter declaration (POUR_PARAMS) against what repeats it: the tables of docs/can.md and docs/safety.md
+and the DBC's ParamId value lists are what scripts/param_table.py writes, the compiled defaults (the modules'
+default configs, pour-bench's table) are the declared ones, and each row's C member follows the naming rule
+params.h states; a declaration with two rows on one CAN id, two rows of one name, a default outside its range,
+a bound that is no number, a member off the rule or a row that does not parse fails naming the rows involved,
+in scripts/param_table.py and (where C can say it) in the compiler."""
 from __future__ import annotations
 
 import re
@@ -28,13 +30,22 @@ def test_the_tree_agrees_with_the_declaration(args):
     assert r.returncode == 0 and r.stderr == "", r.stderr
 
 
-def test_the_envelope_ranges_are_the_safety_cases():
+def _module():
+    """scripts/param_table.py as a module."""
     sys.path.insert(0, str(SCRIPT.parent))
     try:
         import param_table
     finally:
         sys.path.pop(0)
-    rows = {r["name"]: r for r in param_table.declaration()}
+    return param_table
+
+
+def _declaration() -> list[dict]:
+    return _module().declaration()
+
+
+def test_the_envelope_ranges_are_the_safety_cases():
+    rows = {r["name"]: r for r in _declaration()}
     for name in ("omega_max", "omega_slack", "slow_omega", "stop_return_speed", "stop_rest_omega"):
         assert rows[name]["max"] == 2_000_000, name  # docs/safety.md: 2 rad/s, the hot-liquid limit
     assert rows["alpha_max"]["max"] == 3_400_000 and rows["governor_gain"]["max"] == 16384
@@ -138,15 +149,6 @@ def test_the_compiler_refuses_a_bad_declaration_too(tmp_path, old, new, message)
     assert r.returncode != 0 and message in r.stderr, r.stderr
 
 
-def _declaration() -> list[dict]:
-    sys.path.insert(0, str(SCRIPT.parent))
-    try:
-        import param_table
-    finally:
-        sys.path.pop(0)
-    return param_table.declaration()
-
-
 def test_the_modules_default_configs_are_the_declared_defaults(build_dir, monkeypatch):
     """pour_control_default_config (through libpoursim's field table, by C path) holds each declared row's
     default: a module that kept its own value, or set a row to another member, differs here."""
@@ -230,11 +232,7 @@ def test_every_declared_unit_has_an_si_reading():
 def test_the_naming_rule_params_h_states_is_the_one_checked():
     """Each unit suffix and group prefix param_table.py holds a row to is named in params.h's rule, and the rule
     names no suffix the checker does not know."""
-    sys.path.insert(0, str(SCRIPT.parent))
-    try:
-        import param_table
-    finally:
-        sys.path.pop(0)
+    param_table = _module()
     text = HEADER.read_text()
     rule = text[text.index("/* One name per parameter."):]
     rule = " ".join(rule[:rule.index("*/")].replace("\n *", " ").split())
