@@ -214,7 +214,8 @@ DBC = ROOT / "can/pour.dbc"
 def test_a_dbc_list_that_drifts_is_named_and_written_back(tmp_path):
     bad = tmp_path / "pour.dbc"
     text = DBC.read_text()
-    bad.write_text(text.replace('VAL_ 9 ParamId 0 "tau_limit" 1 "slew_per_tick"', 'VAL_ 9 ParamId 0 "tau_limit" 1 "slew"'))
+    head = 'VAL_ 9 ParamId 0 "tau_limit" 1 '
+    bad.write_text(text.replace(head + '"slew_per_tick"', head + '"slew"'))
     r = run("dbc", "--check", "--dbc", str(bad))
     assert r.returncode == 1 and r.stderr.strip().splitlines() == [
         f"{bad}: VAL_ 9 ParamId differs from POUR_PARAMS at [(1, 'slew'), (1, 'slew_per_tick')]; "
