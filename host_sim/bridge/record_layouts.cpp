@@ -74,7 +74,7 @@ const poursim_record_field_t kTable[] = {
     F(poursim_weights_file_t, has_float_reference), F(poursim_weights_file_t, w_float),
     // pour.bench.params
     F(pour_param_info_t, id), F(pour_param_info_t, name), F(pour_param_info_t, unit), F(pour_param_info_t, min),
-    F(pour_param_info_t, max),
+    F(pour_param_info_t, max), F(pour_param_info_t, default_value),
     // the firmware core (pour.core)
     F(pour_sensors_t, seq), F(pour_sensors_t, encoder), F(pour_sensors_t, scale_rotating_g),
     F(pour_sensors_t, scale_target_g),

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
-"""The controller's parameters in SI units, for pour-bench config: each parameter's unit and range come from the
-firmware's own table (POUR_PARAMS in firmware/include/pour/params.h, read through libpoursim's
-pour_param_info), the value on the bus is that unit's integer, and SI maps each firmware unit to its SI one.
+"""The controller's parameters in SI units, for pour-bench config: each parameter's unit, default and range come
+from the firmware's own table (POUR_PARAMS in firmware/include/pour/params.h, read through libpoursim's
+pour_param_info; no list is kept here), the value on the bus is that unit's integer, and SI maps each firmware
+unit to its SI one.
 A dump is a JSON file of every parameter's raw value with its SI reading; a restore checks the whole file
 against the table before it writes anything."""
 from __future__ import annotations
@@ -47,6 +48,7 @@ class Param:
     unit: str   # the firmware's (the bus value's)
     min: int    # raw, inclusive
     max: int
+    default: int  # raw, as compiled (the node id the port's own)
 
     @property
     def si_unit(self) -> str:
@@ -77,9 +79,11 @@ class Param:
         return f"{self.to_si(self.min):.6g} .. {self.to_si(self.max):.6g} {self.si_unit}".rstrip()
 
     def describe(self, raw: int) -> str:
-        """`omega_max 1.5 rad/s (range 1e-06 .. 6.28319 rad/s; raw 1500000 urad/s)`."""
+        """`omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; default 2 rad/s; raw 1500000 urad/s)`."""
         si = f"{self.to_si(raw):.6g} {self.si_unit}".rstrip()
-        return f"{self.name} {si} (range {self.range_text()}; raw {raw} {self.unit})".replace(" )", ")")
+        default = f"{self.to_si(self.default):.6g} {self.si_unit}".rstrip()
+        return (f"{self.name} {si} (range {self.range_text()}; default {default}; "
+                f"raw {raw} {self.unit})").replace(" )", ")")
 
 
 def table() -> dict[str, Param]:
@@ -90,7 +94,8 @@ def table() -> dict[str, Param]:
         row = fn(pid)
         if row:
             r = row.contents
-            out[r.name.decode()] = Param(int(r.id), r.name.decode(), r.unit.decode(), int(r.min), int(r.max))
+            out[r.name.decode()] = Param(int(r.id), r.name.decode(), r.unit.decode(), int(r.min), int(r.max),
+                                          int(r.default_value))
     return out
 
 
