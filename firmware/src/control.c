@@ -232,8 +232,7 @@ static bool stop_active(pour_control_t *ctl) {
 
 static void fill_output(const pour_control_t *ctl, q15_t torque, pour_control_output_t *out) {
   out->torque = torque;
-  out->action = ctl->eval.action;
-  memcpy(out->probs, ctl->eval.probs, sizeof out->probs);
+  out->action = ctl->eval.action; /* out->probs: pour_control_probs, on demand */
   out->mode = (uint8_t)ctl->mode;
   out->faults = ctl->faults;
   out->limits = ctl->safety.active;
@@ -456,14 +455,9 @@ STAGE void decide_stage(pour_control_t *ctl) {
     return; /* an external controller: its request stays */
   }
   pour_obs_quantize(&w->norm, &ctl->state, &ctl->obs);
-  /* A greedy decision needs only the argmax; its probabilities (telemetry) follow on the next tick,
-   * which has the time: the decision tick stays the cheapest it can be. With a decision every tick
-   * there is no next tick to spare. */
+  /* A greedy decision needs only the argmax of the logits: no tick computes its probabilities (telemetry);
+   * pour_control_probs does, for a caller that reports them. */
   ctl->probs_pending = !pour_policy_decide(&ctl->policy, &ctl->obs, &ctl->eval);
-  if (ctl->probs_pending && w->decision_period_ms == 1u) {
-    pour_policy_fill_probs(&ctl->policy, &ctl->eval);
-    ctl->probs_pending = false;
-  }
   ctl->request = w->action_levels[ctl->eval.action];
 }
 
@@ -495,10 +489,6 @@ STAGE void shape_stage(pour_control_t *ctl, pour_control_output_t *out) {
     fill_output(ctl, hold_safe(ctl), out); /* IDLE, and FAULT once the stop is over */
     return;
   }
-  if (run && !ctl->decision_due && ctl->probs_pending) {
-    pour_policy_fill_probs(&ctl->policy, &ctl->eval);
-    ctl->probs_pending = false;
-  }
   /* The one place a request becomes a command: the decision's in RUN, the stop's in FAULT; neither ever
    * steps the torque by more than the slew limit. */
   const q15_t request = run ? ctl->request : stop_request(&ctl->config.stop, &ctl->state);
@@ -512,12 +502,25 @@ STAGE void shape_stage(pour_control_t *ctl, pour_control_output_t *out) {
   }
 }
 
+void pour_control_probs(pour_control_t *ctl, pour_control_output_t *out) {
+  if (ctl->probs_pending) {
+    pour_policy_fill_probs(&ctl->policy, &ctl->eval); /* the latest greedy decision's, once */
+    ctl->probs_pending = false;
+  }
+  memcpy(out->probs, ctl->eval.probs, sizeof out->probs);
+}
+
 bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in) { return update_stage(ctl, in); }
 
 void pour_control_decide(pour_control_t *ctl) { decide_stage(ctl); }
 
 void pour_control_shape(pour_control_t *ctl, pour_control_output_t *out) { shape_stage(ctl, out); }
 
+/* Not inlined into a port's tick: the step stays one function in the image, so that a profiler finds it by its
+ * symbol (virtual_board --profile; docs/virtual-board.md, "Cycle counts"). One call costs a few instructions. */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out) {
   if (update_stage(ctl, in)) {
     decide_stage(ctl);

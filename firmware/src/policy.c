@@ -2,6 +2,10 @@
 #include "pour/policy.h"
 
 #include <stddef.h>
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#include <arm_acle.h>
+#include <string.h>
+#endif
 
 /* Rounding right shifts below rely on >> of a negative int64 being arithmetic (floor), as GCC and
  * Clang define it and as Python's >> behaves. */
@@ -81,6 +85,31 @@ pour_status_t pour_policy_weights_validate(const pour_policy_weights_t *weights)
   return POUR_OK;
 }
 
+/* Whether every partial sum of round((x·W)[a] / 2^f), the rounding's half included and in any order of the
+ * terms, lies in int32 for every x in [0, 32767]^5: each sum is between the bias term plus half plus the
+ * negative terms' extreme and the same plus the positive terms' (x >= 0), so those two bounds decide. */
+static bool sums_fit_i32(const pour_policy_weights_t *weights) {
+  const unsigned n = weights->n_actions;
+  const int64_t half = weights->w_frac_bits > 0u ? (int64_t)1 << (weights->w_frac_bits - 1u) : 0;
+  for (unsigned a = 0; a < n; ++a) {
+    const int64_t base = (int64_t)weights->w[POUR_OBS_N * n + a] * POUR_Q15_ONE_INT + half;
+    int64_t lo = base;
+    int64_t hi = base;
+    for (unsigned k = 0; k < (unsigned)POUR_OBS_N; ++k) {
+      const int64_t term = (int64_t)weights->w[k * n + a] * POUR_Q15_MAX;
+      if (term < 0) {
+        lo += term;
+      } else {
+        hi += term;
+      }
+    }
+    if (lo < INT32_MIN || hi > INT32_MAX) {
+      return false;
+    }
+  }
+  return true;
+}
+
 pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_t *weights,
                                pour_policy_mode_t mode, uint32_t seed) {
   if (policy == NULL || (mode != POUR_POLICY_GREEDY && mode != POUR_POLICY_SAMPLED)) {
@@ -93,6 +122,16 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
   policy->weights = weights;
   policy->mode = mode;
   policy->rng = seed != 0u ? seed : DEFAULT_SEED;
+  policy->sums_fit_i32 = sums_fit_i32(weights);
+  policy->half = weights->w_frac_bits > 0u ? (int32_t)(1u << (weights->w_frac_bits - 1u)) : 0;
+  const unsigned n = weights->n_actions;
+  for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    for (unsigned k = 0; k < 3u; ++k) { /* feature pairs (0, 1), (2, 3), (4, bias) of action a */
+      policy->packed[a][k] = a < n ? (uint16_t)weights->w[2u * k * n + a] |
+                                         (uint32_t)(uint16_t)weights->w[(2u * k + 1u) * n + a] << 16
+                                   : 0u;
+    }
+  }
   return POUR_OK;
 }
 
@@ -185,8 +224,11 @@ void pour_policy_softmax_q15(const int32_t *logits, unsigned n, q15_t *probs) {
 
 unsigned pour_policy_argmax(const int32_t *logits, unsigned n) {
   unsigned best = 0;
+  int32_t top = logits[0];
   for (unsigned a = 1; a < n; ++a) {
-    if (logits[a] > logits[best]) { /* strict: a tie keeps the lower index */
+    const int32_t v = logits[a];
+    if (v > top) { /* strict: a tie keeps the lower index */
+      top = v;
       best = a;
     }
   }
@@ -227,23 +269,79 @@ void pour_policy_fill_probs(const pour_policy_t *policy, pour_policy_eval_t *out
   }
 }
 
+/* The logits of pour_policy_logits when sums_fit_i32 holds (pour_policy_init decides), from the weights
+ * pour_policy_init packed per action: {w0 | w1 << 16, w2 | w3 << 16, w4 | bias << 16}. Each action's exact sum
+ * in one int32, (half + Σ x w + 32768 bias) >> f, no saturation needed. On the Cortex-M4 three words per action
+ * (one LDM) and three dual multiply-accumulates (ACLE __smlad twice, then __smlsd with (x4, -32768): x4 w4 -
+ * (-32768) bias); their additions wrap, but the exact sum fits int32, so the result is exact. The portable path
+ * computes the same integers from the halves. Returns the argmax as pour_policy_argmax finds it (strictly
+ * greater: a tie keeps the lower index). */
+static unsigned logits_i32(const pour_policy_t *policy, const pour_obs_t *obs, int32_t *logits) {
+  const pour_policy_weights_t *weights = policy->weights;
+  const unsigned n = weights->n_actions;
+  const unsigned f = weights->w_frac_bits;
+  const int32_t half = policy->half;
+  const uint32_t *pw = policy->packed[0];
+  const uint32_t *const end = pw + 3u * n;
+  int32_t *o = logits;
+  const int32_t *top_at = logits;
+  int32_t top = INT32_MIN; /* logits[0] >= it: index 0 unless a later logit is strictly greater */
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+  const int32_t x01 = (int32_t)((uint16_t)obs->x[0] | (uint32_t)(uint16_t)obs->x[1] << 16);
+  const int32_t x23 = (int32_t)((uint16_t)obs->x[2] | (uint32_t)(uint16_t)obs->x[3] << 16);
+  const int32_t x45 = (int32_t)((uint16_t)obs->x[4] | 0x80000000u); /* (x4, -32768) */
+  for (; pw != end; ++o) {
+    /* The action's three words in one LDM that steps pw on (the compiler issues three LDRs and an ADD);
+     * LDM wants its registers in ascending order. */
+    register uint32_t w0 __asm__("r4");
+    register uint32_t w1 __asm__("r5");
+    register uint32_t w2 __asm__("r6");
+    __asm__("ldmia %3!, {%0, %1, %2}" : "=r"(w0), "=r"(w1), "=r"(w2), "+r"(pw) : "m"(*(const uint32_t(*)[3])pw));
+    int32_t s = __smlad(x01, (int32_t)w0, half);
+    s = __smlad(x23, (int32_t)w1, s);
+    s = __smlsd(x45, (int32_t)w2, s) >> f;
+#else
+  for (; pw != end; pw += 3, ++o) {
+    int32_t s = half;
+    for (unsigned k = 0; k < 3u; ++k) {
+      const int32_t lo = (int16_t)(uint16_t)(pw[k] & 0xFFFFu);
+      const int32_t hi = (int16_t)(uint16_t)(pw[k] >> 16);
+      s += obs->x[2u * k] * lo + (k < 2u ? obs->x[2u * k + 1u] : POUR_Q15_ONE_INT) * hi;
+    }
+    s >>= f;
+#endif
+    *o = s;
+    if (s > top) {
+      top = s;
+      top_at = o;
+    }
+  }
+  return (unsigned)(top_at - logits);
+}
+
 bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
   const pour_policy_weights_t *w = policy->weights;
   const unsigned n = w->n_actions;
-  pour_policy_logits(w, obs, out->logits);
-  for (unsigned a = n; a < POUR_POLICY_MAX_ACTIONS; ++a) {
-    out->logits[a] = 0;
+  unsigned best;
+  if (policy->sums_fit_i32) {
+    best = logits_i32(policy, obs, out->logits);
+  } else {
+    pour_policy_logits(w, obs, out->logits);
+    best = pour_policy_argmax(out->logits, n);
   }
   if (policy->mode == POUR_POLICY_SAMPLED) {
     pour_policy_fill_probs(policy, out);
     out->action = (uint8_t)pour_policy_sample(out->probs, n, &policy->rng);
     return true;
   }
-  out->action = (uint8_t)pour_policy_argmax(out->logits, n);
+  out->action = (uint8_t)best;
   return false;
 }
 
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out) {
+  for (unsigned a = policy->weights->n_actions; a < POUR_POLICY_MAX_ACTIONS; ++a) {
+    out->logits[a] = 0;
+  }
   if (!pour_policy_decide(policy, obs, out)) {
     pour_policy_fill_probs(policy, out);
   }

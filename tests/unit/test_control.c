@@ -96,7 +96,7 @@ static void test_control_step_FirstFreshSampleStartsRunAndDecides(void) {
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_TRUE(pour_weights_compiled.action_levels[out.action] > 0);
   TEST_ASSERT_EQUAL_INT16(config.safety.slew_per_tick, out.torque); /* slewing up from zero */
-  step(true); /* a greedy decision's probabilities come with the tick after it */
+  pour_control_probs(&ctl, &out); /* a greedy decision's probabilities, when asked for */
   int32_t sum = 0;
   for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
     sum += out.probs[a];
@@ -104,21 +104,31 @@ static void test_control_step_FirstFreshSampleStartsRunAndDecides(void) {
   TEST_ASSERT_INT_WITHIN(6, 32768, sum);
 }
 
-static void test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick(void) {
+static void test_control_step_GreedyProbabilitiesOnlyWhenAskedFor(void) {
+  memset(out.probs, 0x5A, sizeof out.probs);
   step(true);
   const uint8_t action = out.action;
-  int32_t sum = 0;
   for (unsigned a = 0; a < POUR_POLICY_MAX_ACTIONS; ++a) {
-    sum += out.probs[a];
+    TEST_ASSERT_EQUAL_HEX16(0x5A5A, (uint16_t)out.probs[a]); /* the step computes no softmax and leaves them */
   }
-  TEST_ASSERT_EQUAL_INT32(0, sum); /* the decision tick carries only the action: it is the costly one */
-  step(true);
+  TEST_ASSERT_TRUE(ctl.probs_pending);
+  for (unsigned i = 0; i < 3u; ++i) {
+    step(true); /* nor does any tick after it */
+  }
+  TEST_ASSERT_TRUE(ctl.probs_pending);
+  pour_control_probs(&ctl, &out);
+  TEST_ASSERT_FALSE(ctl.probs_pending);
   pour_policy_eval_t ev;
   pour_policy_t policy;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
   pour_policy_eval(&policy, &ctl.obs, &ev);
   TEST_ASSERT_EQUAL_UINT8(action, ev.action);
   TEST_ASSERT_EQUAL_INT16_ARRAY(ev.probs, out.probs, POUR_POLICY_MAX_ACTIONS);
+  q15_t again[POUR_POLICY_MAX_ACTIONS];
+  memcpy(again, out.probs, sizeof again);
+  memset(out.probs, 0, sizeof out.probs);
+  pour_control_probs(&ctl, &out); /* asked again: the same, without a second softmax */
+  TEST_ASSERT_EQUAL_INT16_ARRAY(again, out.probs, POUR_POLICY_MAX_ACTIONS);
 }
 
 static void test_control_step_DecidesEveryPeriodAndHoldsBetween(void) {
@@ -543,7 +553,7 @@ int main(void) {
   RUN_TEST(test_control_init_PassesOnAWeightsError);
   RUN_TEST(test_control_step_IdleWaitsForFirstStateWithoutTimingOut);
   RUN_TEST(test_control_step_FirstFreshSampleStartsRunAndDecides);
-  RUN_TEST(test_control_step_GreedyProbabilitiesFollowTheDecisionByOneTick);
+  RUN_TEST(test_control_step_GreedyProbabilitiesOnlyWhenAskedFor);
   RUN_TEST(test_control_step_DecidesEveryPeriodAndHoldsBetween);
   RUN_TEST(test_control_step_StaleInputAfterTimeoutGivesSafeTorqueAndLatches);
   RUN_TEST(test_control_step_ClearReturnsToIdleThenRun);

@@ -118,6 +118,48 @@ static void test_obs_norm_validate_RefusesEmptyOrInvertedRanges(void) {
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_obs_norm_validate(&norm));
 }
 
+/* The Q15 of num / den as tools/pour/policy/fixedpoint.py's ratio_q15 writes it: (2 num 32768 + den) // (2 den),
+ * clipped to [0, 32767], in int64 (an independent form of what obs.c computes in 32 bits where it can). */
+static q15_t reference_q15(int64_t num, int64_t den) {
+  if (num <= 0) {
+    return 0;
+  }
+  const int64_t q = (2 * num * 32768 + den) / (2 * den);
+  return (q15_t)(q > 32767 ? 32767 : q);
+}
+
+static uint32_t next(uint32_t *x) {
+  *x ^= *x << 13;
+  *x ^= *x >> 17;
+  *x ^= *x << 5;
+  return *x;
+}
+
+/* Random norms, narrow (the 32-bit path) and wide (spans past 2^24 and up to 2^32 - 1), random states. */
+static void test_obs_quantize_MatchesTheReferenceOverRandomNormsAndStates(void) {
+  uint32_t x = 2463534242u;
+  for (unsigned i = 0; i < 4000u; ++i) {
+    const unsigned shift = next(&x) % 32u; /* spans from a few µrad to the whole int32 range */
+    const int32_t lo = (int32_t)next(&x) >> (shift / 2u);
+    int64_t hi = (int64_t)lo + 1 + (int64_t)(next(&x) >> shift);
+    hi = hi > INT32_MAX ? INT32_MAX : hi;
+    if (hi <= lo) {
+      continue;
+    }
+    norm.theta_min_urad = lo;
+    norm.theta_max_urad = (int32_t)hi;
+    norm.omega_max_urad_s = (int32_t)(1u + (next(&x) >> (1u + shift % 31u)));
+    const int32_t theta = (int32_t)next(&x) >> (next(&x) % 32u);
+    const int32_t omega = (int32_t)next(&x) >> (next(&x) % 32u);
+    state.theta_urad = theta;
+    state.omega_urad_s = omega;
+    pour_obs_quantize(&norm, &state, &obs);
+    TEST_ASSERT_EQUAL_INT16(reference_q15((int64_t)theta - lo, hi - lo), obs.x[0]);
+    TEST_ASSERT_EQUAL_INT16(reference_q15((int64_t)omega + norm.omega_max_urad_s, 2 * (int64_t)norm.omega_max_urad_s),
+                            obs.x[1]);
+  }
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_obs_quantize_ThetaEndsMapToZeroAndMax);
@@ -128,5 +170,6 @@ int main(void) {
   RUN_TEST(test_obs_quantize_OmegaIsCentredAndSaturates);
   RUN_TEST(test_obs_quantize_NegativeVolumesBecomeZero);
   RUN_TEST(test_obs_norm_validate_RefusesEmptyOrInvertedRanges);
+  RUN_TEST(test_obs_quantize_MatchesTheReferenceOverRandomNormsAndStates);
   return UNITY_END();
 }

@@ -268,6 +268,88 @@ static void test_policy_eval_SampledIsReproducibleFromTheSeed(void) {
   TEST_ASSERT_TRUE_MESSAGE(differs > 0u, "sampled mode always picked the same action");
 }
 
+/* pour_policy_decide's kernel (int32 sums, two actions at a time, the DSP path on the Cortex-M4) against
+ * pour_policy_logits (the int64-exact general one): random weights scaled so that some policies fit int32 and
+ * some do not, every n (odd and even), every f, random and extreme observations. */
+static void test_policy_decide_LogitsEqualTheGeneralKernel(void) {
+  uint32_t rng = 12345u;
+  unsigned fits = 0, falls_back = 0;
+  for (unsigned trial = 0; trial < 600u; ++trial) {
+    const unsigned n = POUR_POLICY_MIN_ACTIONS + trial % (POUR_POLICY_MAX_ACTIONS - POUR_POLICY_MIN_ACTIONS + 1u);
+    const uint8_t f = (uint8_t)(trial % 16u);
+    const unsigned shift = trial % 2u == 0u ? 1u : 2u + pour_policy_xorshift32(&rng) % 14u; /* |w| < 2^15 >> (shift - 1) */
+    make_weights(n, f, 0);
+    for (unsigned i = 0; i < POUR_POLICY_N_FEATURES * n; ++i) {
+      w[i] = (int16_t)(((int32_t)(pour_policy_xorshift32(&rng) >> 16) - 32768) >> (shift - 1u));
+    }
+    weights.content_hash = pour_policy_weights_hash(&weights);
+    TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_GREEDY, 1u));
+    fits += policy.sums_fit_i32 ? 1u : 0u;
+    falls_back += policy.sums_fit_i32 ? 0u : 1u;
+    for (unsigned j = 0; j < 8u; ++j) {
+      for (unsigned k = 0; k < POUR_OBS_N; ++k) {
+        const uint32_t r = pour_policy_xorshift32(&rng);
+        obs.x[k] = (q15_t)(j == 0u ? 0 : (j == 1u ? POUR_Q15_MAX : (j == 2u ? ((r & 1u) ? POUR_Q15_MAX : 0) : (r >> 17))));
+      }
+      int32_t expect[POUR_POLICY_MAX_ACTIONS];
+      pour_policy_logits(&weights, &obs, expect);
+      memset(&ev, 0xA5, sizeof ev);
+      (void)pour_policy_decide(&policy, &obs, &ev);
+      TEST_ASSERT_EQUAL_INT32_ARRAY(expect, ev.logits, n);
+      TEST_ASSERT_EQUAL_UINT8(pour_policy_argmax(expect, n), ev.action);
+    }
+  }
+  TEST_ASSERT_TRUE_MESSAGE(fits > 100u && falls_back > 100u, "the trials did not cover both kernels");
+}
+
+/* The int32 kernel's bound is tight: action 0's largest sum, 1 (half, f = 1) + 32767 (32767 + 32767 + 4), is
+ * exactly INT32_MAX and fits; one more unit of weight does not, and the general kernel takes over. */
+static void test_policy_init_Int32BoundIsExact(void) {
+  make_weights(2, 1, 0);
+  w[0] = 32767; /* observation 0, action 0 (row-major: w[k * n + a]) */
+  w[2] = 32767; /* observation 1 */
+  w[8] = 4;     /* observation 4 */
+  TEST_ASSERT_TRUE(1 + (int64_t)32767 * (32767 + 32767 + 4) == INT32_MAX); /* no 64-bit asserts on the MCU */
+  weights.content_hash = pour_policy_weights_hash(&weights);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_TRUE(policy.sums_fit_i32);
+  set_obs(POUR_Q15_MAX);
+  int32_t expect[2];
+  pour_policy_logits(&weights, &obs, expect);
+  (void)pour_policy_decide(&policy, &obs, &ev);
+  TEST_ASSERT_EQUAL_INT32(INT32_MAX >> 1, ev.logits[0]);
+  TEST_ASSERT_EQUAL_INT32_ARRAY(expect, ev.logits, 2);
+  w[8] = 5;
+  weights.content_hash = pour_policy_weights_hash(&weights);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_FALSE(policy.sums_fit_i32);
+  pour_policy_logits(&weights, &obs, expect);
+  (void)pour_policy_decide(&policy, &obs, &ev);
+  TEST_ASSERT_EQUAL_INT32_ARRAY(expect, ev.logits, 2);
+  /* The low side: 1 - 32768 * 32768 (bias) - 32768 * 32767 - 1 * 32767 = INT32_MIN + 2 fits, -2 does not. */
+  w[8] = 0;
+  w[2] = 0;
+  w[0] = -32768;
+  w[10] = -32768;
+  w[4] = -1;
+  TEST_ASSERT_TRUE(1 - (int64_t)32768 * 32768 - (int64_t)32767 * (32768 + 1) == (int64_t)INT32_MIN + 2);
+  weights.content_hash = pour_policy_weights_hash(&weights);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_TRUE(policy.sums_fit_i32);
+  pour_policy_logits(&weights, &obs, expect);
+  (void)pour_policy_decide(&policy, &obs, &ev);
+  TEST_ASSERT_EQUAL_INT32_ARRAY(expect, ev.logits, 2);
+  w[4] = -2;
+  weights.content_hash = pour_policy_weights_hash(&weights);
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &weights, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_FALSE(policy.sums_fit_i32);
+}
+
+static void test_policy_init_ShippedPolicyTakesTheInt32Kernel(void) {
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_policy_init(&policy, &pour_weights_compiled, POUR_POLICY_GREEDY, 1u));
+  TEST_ASSERT_TRUE(policy.sums_fit_i32);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_policy_logits_AllMaxInputsWithMinWeightsSaturateLow);
@@ -289,5 +371,8 @@ int main(void) {
   RUN_TEST(test_policy_eval_GreedyFollowsArgmaxAndClearsUnusedSlots);
   RUN_TEST(test_policy_eval_ExampleTurnsBackOncePoured);
   RUN_TEST(test_policy_eval_SampledIsReproducibleFromTheSeed);
+  RUN_TEST(test_policy_decide_LogitsEqualTheGeneralKernel);
+  RUN_TEST(test_policy_init_Int32BoundIsExact);
+  RUN_TEST(test_policy_init_ShippedPolicyTakesTheInt32Kernel);
   return UNITY_END();
 }

@@ -158,6 +158,7 @@ void Board::hook_block(uc_engine* uc, uint64_t address, uint32_t size, void* use
     }
   }
   b->insns_ += n;
+  if (b->profiler_) b->profiler_->block(uc, static_cast<uint32_t>(address), n, b->active_.size());
 }
 
 void Board::hook_intr(uc_engine* uc, uint32_t intno, void* user) {
@@ -402,6 +403,13 @@ std::string Board::init() {
       mapped_pages_.insert(a);
     }
   }
+  if (opt_.profile) {
+    // The 1 kHz step (the board's tick and the core's step in it) and the policy's kernels, timed by symbol.
+    profiler_ = std::make_unique<Profiler>();
+    const std::string e = profiler_->load(opt_.elf, {"pour_board_loop_tick", "pour_control_step", "pour_policy_decide",
+                                                     "pour_policy_fill_probs", "pour_policy_softmax_q15"});
+    if (!e.empty()) return e;
+  }
   uc_hook h;
   uc_hook_add(uc_, &h, UC_HOOK_BLOCK, reinterpret_cast<void*>(&Board::hook_block), this, 1, 0);
   uc_hook_add(uc_, &h, UC_HOOK_INTR, reinterpret_cast<void*>(&Board::hook_intr), this, 1, 0);
@@ -487,6 +495,7 @@ void Board::core_reset(bool power_on) {
   uc_reg_write(uc_, UC_ARM_REG_LR, &lr);
   pc_ = pc & ~1u;
   (void)power_on;
+  if (profiler_) profiler_->reset();
 }
 
 void Board::take_exception(int exc) {
@@ -529,6 +538,7 @@ void Board::take_exception(int exc) {
   }
   pc_ = vector & ~1u;
   insns_ += 12;  // entry: 12 cycles (Cortex-M4 TRM §5.5.1), counted as instructions at CPI 1
+  if (profiler_) profiler_->exception_entry(exc, pc_, 12);
   ++exceptions_taken_;
 }
 
@@ -555,6 +565,7 @@ void Board::exception_return(uint32_t exc_return) {
   if (done >= 16 && irq_level_[done - 16]) pend(done);  // a level still high pends again
   pc_ = r[6] & ~1u;
   insns_ += 10;  // return: 10 cycles (Cortex-M4 TRM §5.5.1)
+  if (profiler_) profiler_->exception_return(10);
 }
 
 std::string Board::open_can() {
@@ -690,6 +701,7 @@ int Board::run() {
     }
   }
   wall_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (profiler_) profiler_->report(stdout, opt_.cpi_milli, hclk_, static_cast<double>(now_ps()) / 1e12);
   if (!stopped_.empty()) {
     std::fprintf(stderr, "virtual board: stopped: %s\n", stopped_.c_str());
     return 1;

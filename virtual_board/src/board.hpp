@@ -13,6 +13,7 @@
 
 #include "models.hpp"
 #include "peripheral.hpp"
+#include "profile.hpp"
 
 namespace vb {
 
@@ -28,6 +29,7 @@ struct Options {
   int ecc_page = -1;
   unsigned cpi_milli = 1000;  // cycles per instruction x 1000 (docs/virtual-board.md: the CPI model)
   double stall_core_at_ms = -1.0, stall_core_ms = 0.0;
+  bool profile = false;  // instructions per exception handler and per 1 kHz step (profile.hpp), printed at the end
 };
 
 class Board;
@@ -154,6 +156,7 @@ class Board : public BoardLink, public TimeSource {
   double wall_s_ = 0;
   bool trace_ = false;
   uint64_t iterations_ = 0;
+  std::unique_ptr<Profiler> profiler_;  // --profile
 };
 
 }  // namespace vb

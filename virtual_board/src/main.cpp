@@ -31,7 +31,7 @@ const char* kUsage =
     "usage: pour_virtual_board [--elf FILE] [--channel CHANNEL [--interface socketcan]] [--seconds S] [--until-heartbeat]\n"
     "                          [--print-can]\n"
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
-    "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
+    "                          [--stop-on-reset] [--cpi-milli N] [--bench] [--profile]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n";
@@ -163,6 +163,7 @@ int main(int argc, char** argv) {
       else if (a == "--realtime") o.realtime = true;
       else if (a == "--stop-on-reset") o.stop_on_reset = true;
       else if (a == "--bench") bench = true;
+      else if (a == "--profile") o.profile = true;  // virtual_board/src/profile.hpp
       else if (a == "--estop") {
         if (!(v = value("--estop"))) return bad("--estop needs open or closed");
         if (std::string(v) != "open" && std::string(v) != "closed") return bad("--estop must be open or closed");

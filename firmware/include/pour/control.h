@@ -86,8 +86,8 @@ typedef struct {
 typedef struct {
   q15_t torque;   /* command, fraction of tau_max Q15 */
   uint8_t action; /* index of the current policy action */
-  q15_t probs[POUR_POLICY_MAX_ACTIONS]; /* probabilities of the latest decision, Q15 (greedy: from the
-                                         * tick after it, unless decisions come every tick) */
+  q15_t probs[POUR_POLICY_MAX_ACTIONS]; /* probabilities of the latest decision, Q15: written only by
+                                         * pour_control_probs (the step leaves them as they were) */
   uint8_t mode;   /* pour_mode_t */
   uint16_t faults; /* POUR_FAULT_* */
   uint8_t limits;  /* POUR_LIMIT_* active this tick */
@@ -110,7 +110,7 @@ typedef struct {
   pour_state_t state; /* state estimated from the latest fresh, plausible sample */
   pour_obs_t obs;
   pour_policy_eval_t eval;
-  bool probs_pending;     /* the latest greedy decision's probabilities are computed on the next tick */
+  bool probs_pending;     /* the latest greedy decision's probabilities are not computed yet (pour_control_probs) */
   bool decision_due;      /* this tick's update found a decision due */
   uint16_t decision_period_ms; /* ticks between decisions in RUN */
   q15_t request;          /* the latest decision's torque request, Q15 (into the envelope every RUN tick) */
@@ -193,7 +193,14 @@ uint8_t pour_control_experiment_answer(pour_control_t *ctl);
 void pour_control_shape(pour_control_t *ctl, pour_control_output_t *out);
 
 /* One 1 ms tick with the fixed-point policy: update, decide when due, shape. Never fails: problems show as
- * mode and fault bits in the output. */
+ * mode and fault bits in the output. It computes no softmax for a greedy policy (the argmax of the logits is
+ * the decision) and leaves out->probs as they were: see pour_control_probs. */
 void pour_control_step(pour_control_t *ctl, const pour_control_input_t *in, pour_control_output_t *out);
+
+/* The latest decision's probabilities into out->probs (Q15, zero past n_actions; zero before the first decision
+ * and for an external controller): a sampled decision's as drawn from, a greedy decision's computed here on the
+ * first call after it (one softmax, ~500 instructions on the Cortex-M4), so that only a port that reports them
+ * pays, and outside the tick's budget. */
+void pour_control_probs(pour_control_t *ctl, pour_control_output_t *out);
 
 #endif /* POUR_CONTROL_H */

@@ -35,6 +35,11 @@ typedef struct {
   const pour_policy_weights_t *weights;
   pour_policy_mode_t mode;
   uint32_t rng; /* xorshift32 state, never 0 */
+  bool sums_fit_i32; /* every partial sum of the logits fits int32 for any observation: the cheap kernel */
+  int32_t half;      /* the logits' rounding: 2^(w_frac_bits - 1), 0 for w_frac_bits 0 */
+  /* The weights again, per action, two int16 to a word: {w0 | w1 << 16, w2 | w3 << 16, w4 | bias << 16}, so that
+   * the cheap kernel loads an action's six in three words (a copy made by pour_policy_init, 192 B). */
+  uint32_t packed[POUR_POLICY_MAX_ACTIONS][3];
 } pour_policy_t;
 
 /* One evaluation: logits Q16.15 in int32, probabilities Q15 (sum within docs' LSB bound of 1). */
@@ -58,8 +63,9 @@ pour_status_t pour_policy_init(pour_policy_t *policy, const pour_policy_weights_
  * Never fails on an initialised policy. Equals pour_policy_decide, then pour_policy_fill_probs if needed. */
 void pour_policy_eval(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
 
-/* The decision alone: logits and the action. Greedy mode needs no probabilities for it and leaves out->probs
- * as they were (returns false); sampled mode draws from them, so fills them (returns true). */
+/* The decision alone: the n_actions logits and the action (out->logits past n_actions are left as they were:
+ * pour_policy_eval zeroes them). Greedy mode needs no probabilities for it and leaves out->probs as they were
+ * (returns false); sampled mode draws from them, so fills them (returns true). */
 bool pour_policy_decide(pour_policy_t *policy, const pour_obs_t *obs, pour_policy_eval_t *out);
 
 /* The probabilities of out->logits (softmax, zero past n_actions): what a greedy decision left out. */

@@ -60,6 +60,7 @@ typedef struct {
 } loop_t;
 
 static void send_answer(loop_t *l) {
+  pour_control_probs(&l->ctl, &l->out); /* POUR_TORQUE carries them: the step leaves them to this call */
   const pour_io_answer_t a = {
       .utime = wall_us(),
       .sample_seq = l->last_seq,

@@ -66,8 +66,9 @@ static uint32_t time_steps(const pour_policy_weights_t *w, int do_step) {
 /* The schedule as shipped, tick by tick: each step timed on its own, the times summed per phase of the
  * decision period (phase 0: the decision tick, 1: the tick after it, ...), the timer's own cost taken off.
  * Returns the largest per-phase mean [instructions] and prints every phase. */
-static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_kilotick) {
-  const pour_control_config_t config = bench_config();
+static uint32_t worst_phase(const pour_policy_weights_t *w, uint32_t insn_per_kilotick, int32_t knee_urad) {
+  pour_control_config_t config = bench_config();
+  config.safety.knee_theta_urad = knee_urad; /* 0: no fill schedule (the default) */
   if (pour_control_init(&ctl, &config, w) != POUR_OK || w->decision_period_ms > 16u) {
     return 0u;
   }
@@ -137,11 +138,31 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
     (void)pour_safety_apply(&safety, (q15_t)(i * 997u), states[i & 63u].theta_urad, states[i & 63u].omega_urad_s);
   }
   const uint32_t envelope = elapsed(t0, now());
+  static pour_supervisor_t sup;
+  const pour_supervisor_config_t svc = bench_config().supervisor;
+  (void)pour_supervisor_init(&sup, &svc, w->norm.theta_min_urad, w->norm.theta_max_urad);
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    (void)pour_supervisor_step(&sup, &states[i & 63u], true);
+    pour_supervisor_record(&sup, &states[i & 63u], (q15_t)(i * 997u));
+  }
+  const uint32_t supervise = elapsed(t0, now());
   t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
     pour_policy_eval(&policy, &obs[i & 63u], &ev);
   }
   const uint32_t eval = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    (void)pour_policy_decide(&policy, &obs[i & 63u], &ev);
+  }
+  const uint32_t decide = elapsed(t0, now());
+  t0 = now();
+  for (uint32_t i = 0; i < N_STEPS; ++i) {
+    ev.logits[i & 15u] = (int32_t)i;
+    ev.action = (uint8_t)pour_policy_argmax(ev.logits, w->n_actions);
+  }
+  const uint32_t argmax = elapsed(t0, now());
   t0 = now();
   for (uint32_t i = 0; i < N_STEPS; ++i) {
     pour_policy_logits(w, &obs[i & 63u], ev.logits);
@@ -154,13 +175,18 @@ static void report_kernels(const pour_policy_weights_t *w, uint32_t insn_per_kil
   }
   const uint32_t softmax = elapsed(t0, now());
   const uint64_t scale = 1000ull * N_STEPS;
-  printf("  per call (loop included): pour_estimator_update %u, pour_safety_apply %u, pour_obs_quantize %u, "
-         "pour_policy_eval %u = logits %u + softmax %u + argmax\n",
+  printf("  per call (loop included): pour_estimator_update %u, pour_safety_apply %u, pour_supervisor_step + _record %u, "
+         "pour_obs_quantize %u, "
+         "pour_policy_eval %u = logits %u (the general kernel) + softmax %u + argmax %u;\n"
+         "  the greedy decision (pour_policy_decide: the int32 kernel and the argmax, no softmax) %u\n",
          (unsigned)((estimate * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((envelope * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((supervise * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((quant * (uint64_t)insn_per_kilotick) / scale), (unsigned)((eval * (uint64_t)insn_per_kilotick) / scale),
          (unsigned)((logits * (uint64_t)insn_per_kilotick) / scale),
-         (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale));
+         (unsigned)((softmax * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((argmax * (uint64_t)insn_per_kilotick) / scale),
+         (unsigned)((decide * (uint64_t)insn_per_kilotick) / scale));
 }
 
 int main(void) {
@@ -175,9 +201,14 @@ int main(void) {
   every_tick.content_hash = pour_policy_weights_hash(&every_tick);
   report("control step, average:", &pour_weights_compiled, insn_per_kilotick);
   report("control step, decision every tick:", &every_tick, insn_per_kilotick);
-  const uint32_t worst = worst_phase(&pour_weights_compiled, insn_per_kilotick);
+  const uint32_t worst = worst_phase(&pour_weights_compiled, insn_per_kilotick, 0);
   printf("%-34s %5u instructions/step (the shipped schedule's costliest tick)\n", "control step, worst tick:",
          (unsigned)worst);
+  /* A rig file's fill schedule puts a knee in the envelope: below it, within the braking curve's last stretch,
+   * the speed limit is a square root (safety.c's isqrt64). The swing here (0.92 .. 1.00 rad) runs through it. */
+  const uint32_t knee = worst_phase(&pour_weights_compiled, insn_per_kilotick, 1060000);
+  printf("%-34s %5u instructions/step (a fill schedule's knee at 1.06 rad, the swing just below it)\n",
+         "control step, worst tick, knee:", (unsigned)knee);
   report_kernels(&pour_weights_compiled, insn_per_kilotick);
   printf("controller state: sizeof(pour_control_t) = %u B (the core has no static data)\n",
          (unsigned)sizeof(pour_control_t));
