@@ -85,7 +85,38 @@ class WorldCoupling {
   poursim_obs_t obs_{};
   double n_ = 20.0, dt_ = 0.001, tau_max_ = 1000.0;
   double sum_ = 0.0, last_torque_ = 0.0;
+  double theta_m0_ = 0.0, t0_ = 0.0;  // the shaft's angle and the plant's time when the bucket was coupled
   int samples_ = 0;
+};
+
+// The rig before the fill (the bench calibrates the drive with the rotating bucket empty: the interlock of
+// firmware/ports/common/calibration_flow.h refuses more than 200 g on its scale): the empty bucket on its
+// bearing through the same gear spring, a rigid inertia about its centre (its centre of mass on the axis: no
+// gravity torque), host_sim's joint friction and holding brake, and the rig's sensors as the world's read
+// (the output encoder of encoder_bits, both scales tared empty, with the load cells' noise).
+class EmptyBucket {
+ public:
+  // Installs the plant's load; the gear's zero is the shaft's angle now.
+  EmptyBucket(const WorldCouplingOptions& o, Plant* plant);
+  ~EmptyBucket();
+  EmptyBucket(const EmptyBucket&) = delete;
+  EmptyBucket& operator=(const EmptyBucket&) = delete;
+  void set_brake(bool engaged) { brake_ = engaged; }
+  bool sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const;
+  double bucket_theta() const { return theta_; }
+  uint32_t steps() const { return step_; }
+
+ private:
+  double load(double t, double theta_m, double omega_m);
+  Plant* plant_;
+  WorldCouplingOptions o_;
+  poursim_config_t c_{};
+  double inertia_ = 0.0, theta_ = 0.0, omega_ = 0.0, theta_m0_ = 0.0, t0_ = 0.0, t_last_ = -1.0;
+  uint32_t step_ = 0, encoder_ = 0;
+  int32_t scale_rot_ = 0, scale_tgt_ = 0;
+  bool brake_ = true;
+  uint64_t rng_ = 0;
+  double gauss();
 };
 
 }  // namespace vb

@@ -576,6 +576,7 @@ void Board::bridge() {
     const CanFrame f = fdcan_.transmitted.front();
     fdcan_.transmitted.pop_front();
     ++frames_tx_;
+    if (on_tx) on_tx(f);
     if ((f.id & 0x1Fu) == 1u && first_heartbeat_ps_ == UINT64_MAX) first_heartbeat_ps_ = now_ps();
     if (opt_.print_can) {
       std::printf("%.3f ms tx %03x [%u]", static_cast<double>(now_ps()) / 1e9, f.id, f.dlc);
@@ -616,7 +617,7 @@ int Board::run() {
       core_reset(false);
       if (opt_.stop_on_reset) break;
     }
-    if (now_ps() >= end_ps) break;
+    if (now_ps() >= end_ps || finish_) break;
     if (opt_.until_heartbeat && first_heartbeat_ps_ != UINT64_MAX) break;
     // Pending exceptions, highest priority first, while they preempt.
     for (int guard = 0; guard < 4; ++guard) {
