@@ -677,9 +677,13 @@ int Board::run() {
     }
     if (opt_.stall_core_at_ms >= 0 && now_ps() >= static_cast<uint64_t>(opt_.stall_core_at_ms * 1e9) && !stalled_once_) {
       // Injection: the core stops fetching (a hung bus) for stall_core_ms; the IWDG is not refreshed.
+      // The watchdog's reset, if it comes first, ends the stall (the models run on to it).
       stalled_once_ = true;
-      insns_ += (cycles_until_ps(now_ps() + static_cast<uint64_t>(opt_.stall_core_ms * 1e9)) * 1000u) / opt_.cpi_milli;
-      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, static_cast<double>(now_ps()) / 1e9);
+      const uint64_t at = now_ps();
+      uint64_t until = at + static_cast<uint64_t>(opt_.stall_core_ms * 1e9);
+      if (iwdg_.running()) until = std::min(until, std::max(at, iwdg_.expiry_ps()));
+      insns_ += (cycles_until_ps(until) * 1000u + opt_.cpi_milli - 1u) / opt_.cpi_milli;
+      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, static_cast<double>(at) / 1e9);
     }
     systick_advance();
     for (Peripheral* m : models_) m->advance();

@@ -191,10 +191,12 @@ void Iwdg::settle() {
   domain_rl_ = regs_.at(0x08) & 0xFFFu;
 }
 
-void Iwdg::reload() {
+void Iwdg::reload(bool start) {
   settle();
   reload_ps_ = t_->now_ps();
-  loaded_ps_ = (uint64_t)(domain_rl_ + 1u) * (4u << (domain_pr_ > 6u ? 6u : domain_pr_)) * 1000000000000ull / lsi_hz;
+  // Started by 0xCCCC, the counter counts down from its reset value 0xFFF (RM0440 §41.3.2); 0xAAAA loads RLR.
+  const uint32_t count = start ? 0xFFFu : domain_rl_;
+  loaded_ps_ = (uint64_t)(count + 1u) * (4u << (domain_pr_ > 6u ? 6u : domain_pr_)) * 1000000000000ull / lsi_hz;
 }
 
 uint32_t Iwdg::on_read(uint32_t offset, uint32_t stored) {
@@ -208,12 +210,12 @@ void Iwdg::on_write(uint32_t offset, uint32_t old, uint32_t* value) {
   if (offset == 0x00) {
     const uint32_t key = *value & 0xFFFFu;
     if (key == 0xCCCCu) {
-      if (!running_) reload();
+      if (!running_) reload(true);
       running_ = true;
     } else if (key == 0x5555u) {
       unlocked_ = true;
     } else if (key == 0xAAAAu) {
-      reload();
+      reload(false);
       unlocked_ = false;
     } else {
       unlocked_ = false;

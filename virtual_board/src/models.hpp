@@ -111,7 +111,7 @@ class Iwdg : public SvdRegisters {
  private:
   TimeSource* t_;
   void settle();   // RLR / PR into the counter's domain once RVU / PVU have cleared
-  void reload();   // the counter loaded with the domain's values
+  void reload(bool start);  // the counter loaded: 0xFFF at the start, else the domain's RLR
   bool running_ = false, unlocked_ = false;
   uint64_t reload_ps_ = 0, busy_until_ps_ = 0, loaded_ps_ = 0;
   uint32_t domain_pr_ = 0, domain_rl_ = 0xFFFu;  // the reset values (RM0440 §41.4.2, §41.4.3)

@@ -199,8 +199,10 @@ void Rig::advance() {
     board_->gpio(kEstopPort).external[kEstopPin] = 1;  // the normally-closed contact opens: the pull-up wins
     estop_opened_ = true;
   }
+  // The angle where the fault began: the last one seen before its time (a stalled core's slice ends after it).
+  if (o_.fault_at_ms >= 0.0 && !fault_theta_taken_ && now < o_.fault_at_ms) theta_before_fault_ = theta();
   if (o_.fault_at_ms >= 0.0 && !fault_theta_taken_ && now >= o_.fault_at_ms) {
-    theta_fault_ = theta();
+    theta_fault_ = theta_before_fault_;
     mode_at_fault_ = mode_;
     fault_theta_taken_ = true;
   }

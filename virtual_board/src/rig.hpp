@@ -87,7 +87,7 @@ class Rig : public Peripheral {
   uint32_t run_step_ = 0;
   bool have_episode_ = false;
   double poured_ = 0, spilled_ = 0, theta_episode_ = 0;
-  double theta_fault_ = 0.0, theta_end_ = 0.0, theta_max_after_fault_ = 0.0;
+  double theta_before_fault_ = 0.0, theta_fault_ = 0.0, theta_end_ = 0.0, theta_max_after_fault_ = 0.0;
   bool fault_theta_taken_ = false;
   int mode_at_fault_ = -1;
   bool estop_opened_ = false;
