@@ -7,11 +7,27 @@
 
 #include "rig_sensors.hpp"
 
+extern "C" {
+#include "pour/drive.h"
+}
+
 namespace vb {
+
+double default_gear_efficiency() { return pour_drive_default_config().gear_efficiency_q15 / 32768.0; }
+
+double gear_load_at_motor(double tau_out, double omega_m, double ratio, double eta) {
+  return tau_out * omega_m >= 0.0 ? tau_out / (ratio * eta) : tau_out * eta / ratio;
+}
 
 WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
   if (!(std::isfinite(o.stiffness_nm_per_rad) && o.stiffness_nm_per_rad > 0.0)) {
     error_ = "world coupling: stiffness_nm_per_rad must be a finite number > 0";
+    plant_ = nullptr;
+    return;
+  }
+  eta_ = o.gear_efficiency == 0.0 ? default_gear_efficiency() : o.gear_efficiency;
+  if (!(std::isfinite(eta_) && eta_ >= 0.5 && eta_ <= 1.0)) {
+    error_ = "world coupling: gear_efficiency must be in 0.5 .. 1 (or 0: host_sim's full drive's)";
     plant_ = nullptr;
     return;
   }
@@ -99,7 +115,7 @@ double WorldCoupling::load(double t, double theta_m, double omega_m) {
   const double tau_out = o_.stiffness_nm_per_rad * ((theta_m - theta_m0_) / n_ - obs_.theta) + o_.damping_nms * (omega_m / n_ - obs_.omega);
   sum_ += tau_out;
   ++samples_;
-  return tau_out / n_;  // at the motor (an ideal gear: the torque scales by N, the losses are the world's)
+  return gear_load_at_motor(tau_out, omega_m, n_, eta_);
 }
 
 // ------------------------------------------------------------------------------------------ EmptyBucket
@@ -112,6 +128,7 @@ constexpr double kEmptyBucketOutputInertia = 0.038;  // [kg m^2], the bucket and
 
 EmptyBucket::EmptyBucket(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
   c_ = poursim_default_config();
+  eta_ = o.gear_efficiency == 0.0 ? default_gear_efficiency() : o.gear_efficiency;
   inertia_ = kEmptyBucketOutputInertia - c_.motor_rotor_inertia * c_.gear_ratio * c_.gear_ratio;
   brake_ = true;
   rng_ = 0x9E3779B97F4A7C15ull ^ o.seed;
@@ -167,7 +184,7 @@ double EmptyBucket::load(double t, double theta_m, double omega_m) {
     scale_rot_ = reading();
     scale_tgt_ = reading();
   }
-  return tau / c_.gear_ratio;
+  return gear_load_at_motor(tau, omega_m, c_.gear_ratio, eta_);
 }
 
 }  // namespace vb

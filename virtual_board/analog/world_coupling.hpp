@@ -28,6 +28,14 @@ extern "C" {  // the C header carries no linkage of its own
 }
 
 namespace vb {
+// The torque the gear's output torque tau_out puts on the motor [N m]: / N, and through the gearbox's
+// efficiency eta, whose loss the motor pays when it drives (tau_out and the shaft's speed omega_m one way)
+// and the bucket pays when it drives the motor.
+double gear_load_at_motor(double tau_out, double omega_m, double ratio, double eta);
+double default_gear_efficiency();  // host_sim's full drive's (see WorldCouplingOptions::gear_efficiency)
+}  // namespace vb
+
+namespace vb {
 
 struct WorldCouplingOptions {
   uint32_t seed = 1;              // the world's reset seed (liquid arrangement, load cells' noise)
@@ -36,6 +44,10 @@ struct WorldCouplingOptions {
   // the spring about 0.5 of critical.
   double stiffness_nm_per_rad = 2000.0;
   double damping_nms = 4.4;
+  // The gearbox's efficiency: it loses (1 - eta) of the power that crosses it, whichever way it flows, as
+  // host_sim's full drive has it (host_sim/physics/foc_drive.cpp, which takes the value of the drive's
+  // configuration, gear_efficiency_q15: 0.90; no vendor figure for the rig's gearhead). 0 takes that value.
+  double gear_efficiency = 0.0;
   bool brake = false;             // the holding brake engaged from the start
 };
 
@@ -78,6 +90,7 @@ class WorldCoupling {
 
  private:
   double load(double t, double theta_m, double omega_m);  // the plant's load at the motor [N m]
+  double eta_ = 1.0;
   poursim_world_t* world_ = nullptr;
   Plant* plant_ = nullptr;
   WorldCouplingOptions o_;
@@ -110,6 +123,7 @@ class EmptyBucket {
   double load(double t, double theta_m, double omega_m);
   Plant* plant_;
   WorldCouplingOptions o_;
+  double eta_ = 1.0;
   poursim_config_t c_{};
   double inertia_ = 0.0, theta_ = 0.0, omega_ = 0.0, theta_m0_ = 0.0, t0_ = 0.0, t_last_ = -1.0;
   uint32_t step_ = 0, encoder_ = 0;

@@ -37,7 +37,7 @@ const char* kUsage =
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "                          [--world | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
-    "                          [--episode-s S] [--hold-s S]\n"
+    "                          [--episode-s S] [--hold-s S] [--csv FILE]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n"
@@ -48,6 +48,7 @@ const char* kUsage =
     "                  --episode-s (10) of RUN, --hold-s (1.5) more, a reset and CalibrationRead; prints R, L, poured,\n"
     "                  spilled, theta. --reset-before-pour: the reset and the read-back before the pour instead.\n"
     "                  Exit 1 if a step fails (the reason on stderr)\n"
+    "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
     "  --estop-at MS   the e-stop contact opens at MS emulated; --overcurrent-at MS: --overcurrent-a A (-50: out of\n"
     "                  the phase, through its shunt) added to phase U's current from MS on\n";
 
@@ -207,6 +208,11 @@ int main(int argc, char** argv) {
       } else if (a == "--world") rig.world = true;
       else if (a == "--pour") rig.pour = true;
       else if (a == "--reset-before-pour") rig.reset_before_pour = true;
+      else if (a == "--csv") {
+        if (!(v = value(a.c_str()))) return bad("--csv needs a file");
+        rig.csv = v;
+        if (rig.csv.empty()) return bad("--csv needs a file");
+      }
       else if (a == "--seed") {
         if (!(v = value(a.c_str()))) return bad("--seed needs a number");
         const long long s = std::stoll(v);
@@ -238,6 +244,8 @@ int main(int argc, char** argv) {
     }
   }
   if (rig.reset_before_pour && !rig.pour) return bad("--reset-before-pour needs --pour");
+  if (!rig.csv.empty() && !rig.pour) return bad("--csv needs --pour");
+  if (!rig.csv.empty() && rig.csv == o.elf) return bad("--csv must not name the image");
   if (rig.world && rig.pour) return bad("--world and --pour exclude each other (--pour fills the bucket itself)");
   const bool with_rig = rig.world || rig.pour;
   if (!with_rig && (rig.estop_at_ms >= 0 || overcurrent_at_ms >= 0)) return bad("--estop-at and --overcurrent-at need --world or --pour");

@@ -207,6 +207,16 @@ void Rig::advance() {
     fault_theta_taken_ = true;
   }
   if (fault_theta_taken_) theta_max_after_fault_ = std::max(theta_max_after_fault_, std::fabs(theta() - theta_fault_));
+  // The episode's trajectory, as host_sim --csv writes it (the columns the two have in common).
+  if (!o_.csv.empty() && world_ && run_ms_ >= 0.0 && !have_episode_ && world_->steps() != csv_step_) {
+    csv_step_ = world_->steps();
+    const poursim_obs_t& ob = world_->obs();
+    char line[200];
+    const uint32_t k = csv_step_ - run_step_;
+    std::snprintf(line, sizeof line, "%u,%u,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.4f,%d\n", o_.seed, k, k * 1e-3, ob.theta, ob.omega,
+                  ob.v_rotating, ob.v_target, ob.v_spill, ob.v_flight, world_->gear_torque(), mode_);
+    csv_ += line;
+  }
   if (!o_.pour) return;
   if (now > o_.timeout_s * 1e3 && stage_ != Stage::Done) {
     fail("the script did not end within " + std::to_string(o_.timeout_s) + " s emulated");
@@ -305,6 +315,21 @@ void Rig::advance() {
 
 int Rig::report() {
   std::fputs(log_.c_str(), stdout);
+  if (!o_.csv.empty()) {
+    // Written beside its target and renamed over it when complete.
+    const std::string tmp = o_.csv + ".tmp";
+    FILE* f = std::fopen(tmp.c_str(), "w");
+    bool ok = f != nullptr;
+    if (ok) {
+      ok = std::fputs("seed,step,t_s,theta_rad,omega_rad_s,v_rotating,v_target,v_spill,v_flight,gear_torque_nm,mode\n", f) >= 0 &&
+           std::fputs(csv_.c_str(), f) >= 0;
+      ok = std::fclose(f) == 0 && ok;
+    }
+    if (!ok || std::rename(tmp.c_str(), o_.csv.c_str()) != 0) {
+      std::remove(tmp.c_str());
+      if (error_.empty()) error_ = "cannot write " + o_.csv;
+    }
+  }
   if (have_cal_) {
     const double r = cal_.resistance_mohm * 1e-3, l = cal_.inductance_uh * 1e-6;
     std::printf("calibration: R %.4f ohm (model %.4f, %+.2f %%), L %.1f uH (model %.1f, %+.2f %%), pole pairs %u (model %d)\n", r,

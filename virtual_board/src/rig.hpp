@@ -35,6 +35,7 @@ struct RigOptions {
   double estop_at_ms = -1.0; // the e-stop contact opens at this emulated time [ms]
   double fault_at_ms = -1.0; // the earliest injected fault (e-stop, overcurrent, a stalled core) [ms]
   double timeout_s = 60.0;   // a script that has not ended by then fails
+  std::string csv;           // --csv FILE: the world's every step from RUN on (host_sim --csv's columns)
 };
 
 class Rig : public Peripheral {
@@ -91,7 +92,8 @@ class Rig : public Peripheral {
   bool fault_theta_taken_ = false;
   int mode_at_fault_ = -1;
   bool estop_opened_ = false;
-  std::string log_;
+  std::string log_, csv_;
+  uint32_t csv_step_ = UINT32_MAX;
 };
 
 }  // namespace vb
