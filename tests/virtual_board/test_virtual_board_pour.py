@@ -157,7 +157,8 @@ def test_the_world_in_the_loop_is_deterministic():
 
 @pytest.mark.parametrize("args, says", [
     (["--world", "--pour"], "exclude each other"),
-    (["--estop-at", "100"], "need --world or --pour"),
+    (["--estop-at", "100"], "need --world, --empty-rig or --pour"),
+    (["--empty-rig", "--world"], "exclude each other"),
     (["--world", "--overcurrent-at", "-1"], "--overcurrent-at must be"),
     (["--pour", "--overcurrent-at", "10", "--overcurrent-a", "0"], "--overcurrent-a must be"),
     (["--world", "--seed", "-1"], "--seed must be"),

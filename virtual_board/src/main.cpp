@@ -36,13 +36,14 @@ const char* kUsage =
     "                          [--print-can]\n"
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
-    "                          [--world | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
+    "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
     "                          [--episode-s S] [--hold-s S] [--csv FILE]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n"
     "  --world         host_sim's bucket world (seed --seed) behind the gear from power-on: the rig's Sensors frame\n"
     "                  into FDCAN1 every 1 ms physics step, the holding brake on PB3\n"
+    "  --empty-rig     the same with the rotating bucket empty (the bench's calibration: pour-bench calibrate)\n"
     "  --pour          the bench's script, in emulated time (docs/virtual-board.md): the empty rig, CalibrationStart,\n"
     "                  the outcome, the bucket filled (held by the brake), ClearErrors, the pour, Stop after\n"
     "                  --episode-s (10) of RUN, --hold-s (1.5) more, a reset and CalibrationRead; prints R, L, poured,\n"
@@ -206,6 +207,7 @@ int main(int argc, char** argv) {
         o.stall_core_ms = std::stod(v);
         if (!(o.stall_core_ms > 0)) return bad("--stall-core-ms must be positive");
       } else if (a == "--world") rig.world = true;
+      else if (a == "--empty-rig") rig.empty = true;
       else if (a == "--pour") rig.pour = true;
       else if (a == "--reset-before-pour") rig.reset_before_pour = true;
       else if (a == "--csv") {
@@ -246,9 +248,11 @@ int main(int argc, char** argv) {
   if (rig.reset_before_pour && !rig.pour) return bad("--reset-before-pour needs --pour");
   if (!rig.csv.empty() && !rig.pour) return bad("--csv needs --pour");
   if (!rig.csv.empty() && rig.csv == o.elf) return bad("--csv must not name the image");
-  if (rig.world && rig.pour) return bad("--world and --pour exclude each other (--pour fills the bucket itself)");
-  const bool with_rig = rig.world || rig.pour;
-  if (!with_rig && (rig.estop_at_ms >= 0 || overcurrent_at_ms >= 0)) return bad("--estop-at and --overcurrent-at need --world or --pour");
+  if ((rig.world ? 1 : 0) + (rig.empty ? 1 : 0) + (rig.pour ? 1 : 0) > 1) {
+    return bad("--world, --empty-rig and --pour exclude each other (--pour fills the bucket itself)");
+  }
+  const bool with_rig = rig.world || rig.pour || rig.empty;
+  if (!with_rig && (rig.estop_at_ms >= 0 || overcurrent_at_ms >= 0)) return bad("--estop-at and --overcurrent-at need --world, --empty-rig or --pour");
   if (rig.pour && !seconds_given) o.seconds = 60.0;
   rig.timeout_s = o.seconds;
   if (overcurrent_at_ms >= 0) {

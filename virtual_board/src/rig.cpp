@@ -34,7 +34,7 @@ Rig::Rig(const RigOptions& o, Board* board, Plant* plant)
     : Peripheral("rig (sensor node, bucket, host)", 0, 0), o_(o), board_(board), plant_(plant) {
   wo_.seed = o.seed;
   node_ = pour_can_node_default_config().node_id;  // until the board's first frame names its node
-  if (o_.pour) {
+  if (o_.pour || o_.empty) {
     empty_ = std::make_unique<EmptyBucket>(wo_, plant_);
   } else {
     world_ = std::make_unique<WorldCoupling>(wo_, plant_);

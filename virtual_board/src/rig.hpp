@@ -26,6 +26,7 @@ namespace vb {
 
 struct RigOptions {
   bool world = false;        // --world: the filled bucket's world behind the gear from power-on
+  bool empty = false;        // --empty-rig: the empty bucket from power-on (pour-bench calibrate over a bus)
   bool pour = false;         // --pour: the empty rig, calibrate, fill (held), pour, stop, reset, read back
   bool reset_before_pour = false;  // --reset-before-pour: the fill while the board is held in reset, the
                                    // read-back after it, then the pour (docs/virtual-board.md: the finding)

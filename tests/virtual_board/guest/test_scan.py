@@ -26,3 +26,26 @@ def test_pour_bench_scan_finds_the_virtual_board():
     finally:
         board.terminate()
         board.wait(timeout=10)
+
+
+def test_pour_bench_calibrates_the_virtual_board_on_the_empty_rig():
+    # The rig's node (--empty-rig: the empty bucket behind the gear, its Sensors frames every 1 ms) and
+    # pour-bench over vcan0 as against a real board: CalibrationStart, MEASURING, the outcome 3.1 s later,
+    # then the stored block read back (CalibrationRead).
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    board = subprocess.Popen([os.environ["POUR_VB"], "--elf", os.environ["POUR_ELF"], "--empty-rig",
+                              "--channel", "vcan0", "--seconds", "120"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    bench = [sys.executable, "-m", "pour.bench.cli", "--channel", "vcan0", "--timeout", "5"]
+    try:
+        time.sleep(2.0)
+        assert board.poll() is None, board.communicate()
+        r = subprocess.run(bench + ["--weights", os.path.join(root, "policy", "weights.h"), "--yes", "calibrate"],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0 and "node 0: calibrated:" in r.stdout, (r.stdout, r.stderr)
+        r = subprocess.run(bench + ["calibration"], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0 and "node 0:" in r.stdout, (r.stdout, r.stderr)
+        print(r.stdout)
+    finally:
+        board.terminate()
+        board.wait(timeout=10)
