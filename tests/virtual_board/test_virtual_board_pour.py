@@ -84,7 +84,12 @@ def test_the_pour_agrees_with_host_sims_full_drive_of_the_same_seed(pour):
     assert h.returncode == 0, h.stderr
     hs = json.loads(h.stdout)
     poured, spilled = number(r"poured ([0-9.]+) %, spilled", out), number(r"episode .* spilled ([0-9.]+) %", out)
-    assert abs(poured - hs["poured_pct"]) <= 0.5 and abs(spilled - hs["spilled_pct"]) <= 0.5, (out, hs)
+    # The bar is 0.5 points; one of the world's 150 particles is 0.67 points, and whether one more
+    # spills flips with a 3e-6 rad difference at 50 ms (docs/virtual-board.md, "The pour against host_sim":
+    # over seeds 1..8 the two agree exactly on 3 and by one particle on 5). Pinned here: at most one
+    # particle apart, and the trajectory below.
+    particle = 100.0 / 150
+    assert abs(poured - hs["poured_pct"]) <= particle + 0.01 and abs(spilled - hs["spilled_pct"]) <= particle + 0.01, (out, hs)
     # the trajectories themselves, step by step (both 1 ms steps from the first decision)
     import csv as csvmod
     vb = {int(x["step"]): float(x["theta_rad"]) for x in csvmod.DictReader(csv.open())}
@@ -124,7 +129,9 @@ def test_the_estop_opened_mid_pour_ends_with_the_bucket_held(estop):
 def test_a_phase_overcurrent_mid_pour_trips_the_break_and_ends_with_the_bucket_held():
     r = fault_run("--overcurrent-at", str(FAULT_MS))
     held(r.stdout)
-    # the drive's fault (Heartbeat's Fault_Drive): the comparator's break cut the bridge, the loop saw it
+    # the comparator's break cleared MOE within the PWM period the current rose in (no 1 kHz tick, no 20 kHz
+    # interrupt between), then the drive's fault (Heartbeat's Fault_Drive): the loop saw the cut
+    assert number(r"TIM1 MOE 0 \(the bridge off\) ([0-9.]+) ms after the fault", r.stdout) < 0.01, r.stdout
     assert re.search(r"end at .* mode FAULT, faults 0x0800, resets 0", r.stdout), r.stdout
 
 

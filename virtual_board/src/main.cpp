@@ -37,7 +37,7 @@ const char* kUsage =
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
-    "                          [--episode-s S] [--hold-s S] [--csv FILE]\n"
+    "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n"
@@ -49,6 +49,7 @@ const char* kUsage =
     "                  --episode-s (10) of RUN, --hold-s (1.5) more, a reset and CalibrationRead; prints R, L, poured,\n"
     "                  spilled, theta. --reset-before-pour: the reset and the read-back before the pour instead.\n"
     "                  Exit 1 if a step fails (the reason on stderr)\n"
+    "  --brake-ms MS   the brake holds MS after PB3 falls (default 20, assumed); released at once\n"
     "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
     "  --estop-at MS   the e-stop contact opens at MS emulated; --overcurrent-at MS: --overcurrent-a A (-50: out of\n"
     "                  the phase, through its shunt) added to phase U's current from MS on\n";
@@ -233,6 +234,10 @@ int main(int argc, char** argv) {
         if (!(v = value(a.c_str()))) return bad("--overcurrent-a needs amperes");
         overcurrent_a = std::stod(v);
         if (!(std::fabs(overcurrent_a) <= 1000.0) || overcurrent_a == 0.0) return bad("--overcurrent-a must be in -1000 .. 1000 A, not 0");
+      } else if (a == "--brake-ms") {
+        if (!(v = value(a.c_str()))) return bad("--brake-ms needs milliseconds");
+        rig.brake_ms = std::stod(v);
+        if (!(rig.brake_ms >= 0 && rig.brake_ms <= 1000)) return bad("--brake-ms must be in 0 .. 1000");
       } else if (a == "--episode-s" || a == "--hold-s") {
         if (!(v = value(a.c_str()))) return bad(a + " needs seconds");
         const double s = std::stod(v);
@@ -280,6 +285,7 @@ int main(int argc, char** argv) {
     auto r = std::make_unique<vb::Rig>(rig, &board, analog.plant.get());
     if (!r->error().empty()) return bad(r->error());
     the_rig = r.get();
+    r->watch(analog.tim1);
     board.add_model(std::move(r));  // after the plant: each step's frame leaves once the world has stepped
   }
   const std::string e = board.init();

@@ -3,6 +3,8 @@
 // (rig.hpp).
 #include "rig.hpp"
 
+#include "../analog/models.hpp"  // the analog models (virtual_board/analog): Tim1
+
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
@@ -171,8 +173,14 @@ void Rig::frame(const CanFrame& cf) {
 void Rig::advance() {
   if (stage_ == Stage::Failed) return;
   const double now = now_ms();
-  // The holding brake follows PB3: engaged unless the pin is driven high (the external pull-down).
-  const bool engaged = !board_->gpio(kBrakePort).driven_high(kBrakePin);
+  // The holding brake follows PB3: engaged unless the pin is driven high (the external pull-down); a
+  // spring-applied brake holds brake_ms after its coil is cut, and lets go at once when it is energised.
+  const bool asked = !board_->gpio(kBrakePort).driven_high(kBrakePin);
+  if (asked != line_engaged_) {
+    line_engaged_ = asked;
+    line_ms_ = now;
+  }
+  const bool engaged = line_engaged_ && now >= line_ms_ + o_.brake_ms;
   if (engaged != brake_ || sent_step_ == UINT32_MAX) {
     brake_ = engaged;
     if (world_) world_->set_brake(engaged);
@@ -206,6 +214,7 @@ void Rig::advance() {
     mode_at_fault_ = mode_;
     fault_theta_taken_ = true;
   }
+  if (fault_theta_taken_ && moe_off_ms_ < 0.0 && tim1_ != nullptr && !tim1_->moe()) moe_off_ms_ = now;
   if (fault_theta_taken_) theta_max_after_fault_ = std::max(theta_max_after_fault_, std::fabs(theta() - theta_fault_));
   // The episode's trajectory, as host_sim --csv writes it (the columns the two have in common).
   if (!o_.csv.empty() && world_ && run_ms_ >= 0.0 && !have_episode_ && world_->steps() != csv_step_) {
@@ -353,6 +362,7 @@ int Rig::report() {
   if (fault_theta_taken_) {
     std::printf("fault at %.1f ms: theta %.2f deg (mode %s); moved at most %.2f deg after it\n", o_.fault_at_ms, theta_fault_ * kDeg,
                 mode_name(mode_at_fault_), theta_max_after_fault_ * kDeg);
+    if (moe_off_ms_ >= 0.0) std::printf("TIM1 MOE 0 (the bridge off) %.3f ms after the fault\n", moe_off_ms_ - o_.fault_at_ms);
   }
   if (end_ms_ >= 0.0) {
     std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u\n", end_ms_, theta_end_ * kDeg,

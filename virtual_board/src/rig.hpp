@@ -36,6 +36,9 @@ struct RigOptions {
   double estop_at_ms = -1.0; // the e-stop contact opens at this emulated time [ms]
   double fault_at_ms = -1.0; // the earliest injected fault (e-stop, overcurrent, a stalled core) [ms]
   double timeout_s = 60.0;   // a script that has not ended by then fails
+  // The spring-applied brake holds this long after PB3 falls (assumed, as tests/board/
+  // test_board_calibration_run.cpp's brake: no vendor figure for the rig's brake) [ms].
+  double brake_ms = 20.0;
   std::string csv;           // --csv FILE: the world's every step from RUN on (host_sim --csv's columns)
 };
 
@@ -52,6 +55,8 @@ class Rig : public Peripheral {
   // stderr), 3 if the bars of the run were not met (see docs/virtual-board.md).
   int report();
   const std::string& error() const { return error_; }
+  // The bridge's timer, to time when its outputs went off after an injected fault (MOE: the break's cut).
+  void watch(const Tim1* tim1) { tim1_ = tim1; }
 
  private:
   enum class Stage { Boot, Calibrating, Filling, Resetting, ReadBack, Pour, Stopped, Done, Failed };
@@ -63,6 +68,8 @@ class Rig : public Peripheral {
   void say(const char* fmt, ...);
 
   RigOptions o_;
+  const Tim1* tim1_ = nullptr;
+  double moe_off_ms_ = -1.0;  // the first time at or after the fault that TIM1's MOE read 0
   Board* board_;
   Plant* plant_;
   WorldCouplingOptions wo_;
@@ -71,6 +78,8 @@ class Rig : public Peripheral {
   uint8_t node_ = 0;
   uint32_t sent_step_ = UINT32_MAX;
   bool brake_ = true, fill_on_reset_ = false, streaming_ = true;
+  bool line_engaged_ = true;  // PB3's level asks for the brake
+  double line_ms_ = -1e9;
   Stage stage_ = Stage::Boot;
   std::string error_;
   // what the board said
