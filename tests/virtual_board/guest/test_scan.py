@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Inside the user-mode Linux guest with vcan0 (tests/can/uml_run.py): the virtual board runs the flashed
-image on vcan0, and pour-bench scan finds its node by its heartbeat, as it would a real board."""
+image on vcan0, pour-bench scan finds its node by its heartbeat, and pour-bench calibrate calibrates it on the
+empty rig (--empty-rig), as they would a real board."""
 from __future__ import annotations
 
 import os
