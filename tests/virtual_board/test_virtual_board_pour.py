@@ -155,6 +155,23 @@ def test_a_pour_after_a_reset_runs_on_a_stale_encoder_offset_and_ends_held():
     assert re.search(r"end at .* theta (-?[0-5]\.[0-9]+) deg, brake engaged, mode FAULT, faults 0x0020", r.stdout), r.stdout
 
 
+@pytest.mark.parametrize("fault", [["--corrupt-page", "63"], ["--ecc-page", "63"]], ids=["corrupt", "ecc"])
+def test_a_bad_calibration_page_keeps_run_refused_by_name_and_the_bucket_held(fault):
+    # The full bucket's rig sending, a ClearErrors at 300 ms (pour-bench clear): RUN is never entered, the
+    # reason is named (CalibrationResult.Stored CORRUPT, Identity.InitStatus -5 = POUR_ECALIBRATION), the board
+    # does not loop (no reset) and the brake holds the bucket upright. An empty page (EMPTY) for contrast.
+    r = run("--world", "--read-calibration", "--clear-at", "300", "--seconds", "1", "--stop-on-reset", *fault)
+    assert r.returncode == 0 and "reset at" not in r.stderr, r.stderr
+    assert "calibration read: init status -5, stored 2 " in r.stdout, r.stdout
+    assert "after ClearErrors at 300.0 ms: RUN never entered" in r.stdout, r.stdout
+    assert re.search(r"end at 1000\.0 ms: theta -?0\.[0-9]+ deg, brake engaged, mode FAULT, faults 0x0800, resets 0", r.stdout), r.stdout
+
+
+def test_an_empty_calibration_page_is_named_empty():
+    r = run("--world", "--read-calibration", "--seconds", "0.3")
+    assert r.returncode == 0 and "calibration read: init status -5, stored 1 " in r.stdout, r.stdout
+
+
 def test_the_world_in_the_loop_is_deterministic():
     a = run("--world", "--seed", "3", "--seconds", "0.3", "--print-can")
     b = run("--world", "--seed", "3", "--seconds", "0.3", "--print-can")
@@ -171,6 +188,10 @@ def test_the_world_in_the_loop_is_deterministic():
     (["--world", "--seed", "-1"], "--seed must be"),
     (["--world", "--seed", "x"], "bad number for --seed"),
     (["--reset-before-pour"], "needs --pour"),
+    (["--read-calibration"], "need --world or --empty-rig"),
+    (["--world", "--clear-at", "x"], "bad number for --clear-at"),
+    (["--world", "--corrupt-page", "61"], "--corrupt-page must be 62 or 63"),
+    (["--pour", "--brake-ms", "-1"], "--brake-ms must be"),
     (["--world", "--csv", "x.csv"], "--csv needs --pour"),
     (["--pour", "--episode-s", "0"], "--episode-s must be"),
 ])

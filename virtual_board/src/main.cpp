@@ -2,6 +2,7 @@
 // pour_virtual_board: the flashed pour_firmware.elf on an emulated STM32G431 (docs/virtual-board.md).
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -38,6 +39,7 @@ const char* kUsage =
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
     "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS]\n"
+    "                          [--read-calibration] [--clear-at MS] [--corrupt-page N]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n"
@@ -51,6 +53,9 @@ const char* kUsage =
     "                  Exit 1 if a step fails (the reason on stderr)\n"
     "  --brake-ms MS   the brake holds MS after PB3 falls (default 20, assumed); released at once\n"
     "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
+    "  --read-calibration  with --world or --empty-rig: CalibrationRead 50 ms after the first heartbeat\n"
+    "  --clear-at MS       with --world or --empty-rig: ClearErrors at MS emulated\n"
+    "  --corrupt-page N    page 62 or 63 starts with a double-word of zeros (a write cut short)\n"
     "  --estop-at MS   the e-stop contact opens at MS emulated; --overcurrent-at MS: --overcurrent-a A (-50: out of\n"
     "                  the phase, through its shunt) added to phase U's current from MS on\n";
 
@@ -151,6 +156,7 @@ int main(int argc, char** argv) {
   vb::RigOptions rig;
   vb::AnalogOptions ao;
   double overcurrent_at_ms = -1.0;
+  int corrupt_page = -1;
   ao.fault_phase_overcurrent_a = 0.0;
   double overcurrent_a = -50.0;
   for (int i = 1; i < argc; ++i) {
@@ -209,6 +215,17 @@ int main(int argc, char** argv) {
         if (!(o.stall_core_ms > 0)) return bad("--stall-core-ms must be positive");
       } else if (a == "--world") rig.world = true;
       else if (a == "--empty-rig") rig.empty = true;
+      else if (a == "--read-calibration") rig.read_calibration = true;
+      else if (a == "--clear-at") {
+        if (!(v = value(a.c_str()))) return bad("--clear-at needs milliseconds");
+        rig.clear_at_ms = std::stod(v);
+        if (!(rig.clear_at_ms >= 0 && rig.clear_at_ms < 1e9)) return bad("--clear-at must be in 0 .. 1e9 ms");
+      }
+      else if (a == "--corrupt-page") {
+        if (!(v = value(a.c_str()))) return bad("--corrupt-page needs a page number");
+        corrupt_page = std::stoi(v);
+        if (corrupt_page < 62 || corrupt_page > 63) return bad("--corrupt-page must be 62 or 63 (the data pages)");
+      }
       else if (a == "--pour") rig.pour = true;
       else if (a == "--reset-before-pour") rig.reset_before_pour = true;
       else if (a == "--csv") {
@@ -252,6 +269,9 @@ int main(int argc, char** argv) {
   }
   if (rig.reset_before_pour && !rig.pour) return bad("--reset-before-pour needs --pour");
   if (!rig.csv.empty() && !rig.pour) return bad("--csv needs --pour");
+  if ((rig.read_calibration || rig.clear_at_ms >= 0) && !(rig.world || rig.empty)) {
+    return bad("--read-calibration and --clear-at need --world or --empty-rig");
+  }
   if (!rig.csv.empty() && rig.csv == o.elf) return bad("--csv must not name the image");
   if ((rig.world ? 1 : 0) + (rig.empty ? 1 : 0) + (rig.pour ? 1 : 0) > 1) {
     return bad("--world, --empty-rig and --pour exclude each other (--pour fills the bucket itself)");
@@ -273,6 +293,11 @@ int main(int argc, char** argv) {
   std::vector<uint8_t> flash;
   const std::string err = load_elf(o.elf, bytes, &flash);
   if (!err.empty()) return bad(err);
+  if (corrupt_page >= 0) {
+    // A block whose write stopped after its first double-word, programmed 0 (not the block's magic): the rest
+    // of the page erased.
+    std::fill_n(flash.begin() + static_cast<long>(corrupt_page) * 2048, 8, uint8_t{0});
+  }
   std::fprintf(stderr, "virtual board: %s sha256 %s\n", o.elf.c_str(), sha256(bytes).c_str());
   vb::AnalogSet analog;  // before the board: the plant outlives the models (and the rig's load on it)
   vb::Board board(o);

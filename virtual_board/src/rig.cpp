@@ -152,6 +152,10 @@ void Rig::frame(const CanFrame& cf) {
             stage_ms_ = now;
           }
         }
+      } else if (!o_.pour && r.status == POUR_CAN_CAL_STORED && read_sent_ && !have_readback_) {
+        readback_ = r;
+        have_readback_ = true;
+        init_after_reset_ = init_status_;
       } else if (stage_ == Stage::ReadBack && r.status == POUR_CAN_CAL_STORED) {
         readback_ = r;
         have_readback_ = true;
@@ -226,7 +230,21 @@ void Rig::advance() {
                   ob.v_rotating, ob.v_target, ob.v_spill, ob.v_flight, world_->gear_torque(), mode_);
     csv_ += line;
   }
-  if (!o_.pour) return;
+  if (!o_.pour) {
+    // pour-bench calibration: what the boot found in the calibration page.
+    if (o_.read_calibration && heartbeat_ && !read_sent_ && now >= stage_ms_ + 50.0) {
+      send(POUR_CAN_CMD_CALIBRATION_READ);
+      read_sent_ = true;
+    }
+    if (o_.clear_at_ms >= 0.0 && !clear_sent_ && now >= o_.clear_at_ms) {
+      send(POUR_CAN_CMD_CLEAR_ERRORS);
+      clear_sent_ = true;
+    }
+    if (clear_sent_ && mode_ == POUR_MODE_RUN) mode_after_clear_ = POUR_MODE_RUN;
+    theta_end_ = theta();
+    end_ms_ = now;
+    return;
+  }
   if (now > o_.timeout_s * 1e3 && stage_ != Stage::Done) {
     fail("the script did not end within " + std::to_string(o_.timeout_s) + " s emulated");
     return;
@@ -345,7 +363,10 @@ int Rig::report() {
                 plant_->r_phase(), 100.0 * (r / plant_->r_phase() - 1.0), l * 1e6, plant_->l_phase() * 1e6,
                 100.0 * (l / plant_->l_phase() - 1.0), cal_.pole_pairs, plant_->pole_pairs());
   }
-  if (have_readback_) {
+  if (have_readback_ && !o_.pour) {
+    std::printf("calibration read: init status %d, stored %u (can/pour.dbc CalibrationResult.Stored: 0 OK, 1 EMPTY, 2 CORRUPT)\n",
+                init_after_reset_, readback_.stored);
+  } else if (have_readback_) {
     std::printf("read back after the reset: init status %d, stored %u, R %.4f ohm, L %.1f uH, pole pairs %u%s\n",
                 init_after_reset_, readback_.stored, readback_.resistance_mohm * 1e-3, static_cast<double>(readback_.inductance_uh),
                 readback_.pole_pairs,
@@ -363,6 +384,10 @@ int Rig::report() {
     std::printf("fault at %.1f ms: theta %.2f deg (mode %s); moved at most %.2f deg after it\n", o_.fault_at_ms, theta_fault_ * kDeg,
                 mode_name(mode_at_fault_), theta_max_after_fault_ * kDeg);
     if (moe_off_ms_ >= 0.0) std::printf("TIM1 MOE 0 (the bridge off) %.3f ms after the fault\n", moe_off_ms_ - o_.fault_at_ms);
+  }
+  if (clear_sent_) {
+    std::printf("after ClearErrors at %.1f ms: %s\n", o_.clear_at_ms,
+                mode_after_clear_ == POUR_MODE_RUN ? "RUN was entered" : "RUN never entered");
   }
   if (end_ms_ >= 0.0) {
     std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u\n", end_ms_, theta_end_ * kDeg,

@@ -27,6 +27,8 @@ namespace vb {
 struct RigOptions {
   bool world = false;        // --world: the filled bucket's world behind the gear from power-on
   bool empty = false;        // --empty-rig: the empty bucket from power-on (pour-bench calibrate over a bus)
+  bool read_calibration = false;  // --read-calibration: CalibrationRead 50 ms after the first heartbeat
+  double clear_at_ms = -1.0;      // --clear-at MS: ClearErrors at this emulated time (pour-bench clear)
   bool pour = false;         // --pour: the empty rig, calibrate, fill (held), pour, stop, reset, read back
   bool reset_before_pour = false;  // --reset-before-pour: the fill while the board is held in reset, the
                                    // read-back after it, then the pour (docs/virtual-board.md: the finding)
@@ -89,7 +91,8 @@ class Rig : public Peripheral {
   double stage_ms_ = 0.0, last_clear_ms_ = -1e9;
   int cal_results_ = 0;
   pour_can_calibration_result_t cal_{}, readback_{};
-  bool have_cal_ = false, have_readback_ = false;
+  bool have_cal_ = false, have_readback_ = false, read_sent_ = false, clear_sent_ = false;
+  int mode_after_clear_ = -1;
   int init_after_reset_ = 99;
   unsigned resets_ = 0, fill_resets_ = 0;  // chip resets after power-on; the script's
   bool powered_ = false;
