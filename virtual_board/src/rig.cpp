@@ -274,7 +274,7 @@ void Rig::advance() {
     case Stage::Resetting:
       if (now >= stage_ms_ + 200.0) {
         fill_on_reset_ = !world_;
-        ++fill_resets_;
+        ++script_resets_;
         board_->request_reset(fill_on_reset_ ? "the bench's reset (NRST), the bucket filled meanwhile" : "the bench's reset (NRST)");
         stage_ = Stage::ReadBack;
         stage_ms_ = now;
@@ -297,7 +297,7 @@ void Rig::advance() {
           send(POUR_CAN_CMD_CLEAR_ERRORS);  // pour-bench clear: a board that latched the wait in FAULT
           last_clear_ms_ = now;
         } else if (now > stage_ms_ + 3000.0) {
-          fail(std::string("the board did not enter RUN within 3 s of the read-back (mode ") + mode_name(mode_) + ")");
+          fail(std::string("the board did not enter RUN within 3 s of the fill (mode ") + mode_name(mode_) + ")");
         }
         break;
       }
@@ -312,9 +312,9 @@ void Rig::advance() {
         send(POUR_CAN_CMD_STOP);
         stop_ms_ = now;
         stage_ = Stage::Stopped;
-      } else if (fault_seen_ms_ < 0.0 && (mode_ == POUR_MODE_FAULT || mode_ == POUR_MODE_ESTOP || resets_ > fill_resets_)) {
+      } else if (fault_seen_ms_ < 0.0 && (mode_ == POUR_MODE_FAULT || mode_ == POUR_MODE_ESTOP || resets_ > script_resets_)) {
         fault_seen_ms_ = now;
-        say("fault: seen at %.1f ms (mode %s, faults 0x%04x, resets %u)", now, mode_name(mode_), faults_, resets_ - fill_resets_);
+        say("fault: seen at %.1f ms (mode %s, faults 0x%04x, resets %u)", now, mode_name(mode_), faults_, resets_ - script_resets_);
         stop_ms_ = now;
         stage_ = Stage::Stopped;
       }
@@ -391,7 +391,7 @@ int Rig::report() {
   }
   if (end_ms_ >= 0.0) {
     std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u\n", end_ms_, theta_end_ * kDeg,
-                brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - fill_resets_);
+                brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - script_resets_);
     if (world_) std::printf("world: poured %.2f %%, spilled %.2f %%, left %.2f %%\n", 100.0 * world_->poured(), 100.0 * world_->spilled(),
                             100.0 * world_->remaining());
   }

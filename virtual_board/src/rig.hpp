@@ -94,7 +94,7 @@ class Rig : public Peripheral {
   bool have_cal_ = false, have_readback_ = false, read_sent_ = false, clear_sent_ = false;
   int mode_after_clear_ = -1;
   int init_after_reset_ = 99;
-  unsigned resets_ = 0, fill_resets_ = 0;  // chip resets after power-on; the script's
+  unsigned resets_ = 0, script_resets_ = 0;  // chip resets after power-on; the script's
   bool powered_ = false;
   // the pour
   double run_ms_ = -1.0, stop_ms_ = -1.0, fault_seen_ms_ = -1.0, end_ms_ = -1.0;
