@@ -571,6 +571,15 @@ std::string Board::open_can() {
   return {};
 }
 
+void Board::to_bus(const CanFrame& f) {
+  if (can_fd_ < 0) return;
+  can_frame cf{};
+  cf.can_id = f.id;
+  cf.can_dlc = f.dlc;
+  std::memcpy(cf.data, f.data, 8);
+  (void)!write(can_fd_, &cf, sizeof cf);
+}
+
 void Board::bridge() {
   while (!fdcan_.transmitted.empty()) {
     const CanFrame f = fdcan_.transmitted.front();

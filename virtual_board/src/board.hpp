@@ -73,6 +73,7 @@ class Board : public BoardLink, public TimeSource {
   // The bus seen from the host's side without SocketCAN (virtual_board/src/rig.hpp): a frame into FDCAN1's
   // RX path as one from the bus arrives, and every frame the board puts on the bus.
   void receive_frame(const CanFrame& f) { fdcan_.receive(f); }
+  void to_bus(const CanFrame& f);  // onto the SocketCAN bus when bridged (another node's frame: candump sees it)
   std::function<void(const CanFrame&)> on_tx;
   void finish() { finish_ = true; }  // the run ends normally after this slice (a host script's end)
 

@@ -203,6 +203,7 @@ void Rig::advance() {
       CanFrame c{f.id, f.dlc, {}};
       std::memcpy(c.data, f.data, 8);
       board_->receive_frame(c);
+      board_->to_bus(c);  // bridged: the rig's node is on the bus too
     }
     sent_step_ = steps;
   }

@@ -45,8 +45,14 @@ def test_pour_bench_calibrates_the_virtual_board_on_the_empty_rig():
                            capture_output=True, text=True, timeout=120)
         assert r.returncode == 0 and "node 0: calibrated:" in r.stdout, (r.stdout, r.stderr)
         r = subprocess.run(bench + ["calibration"], capture_output=True, text=True, timeout=120)
-        assert r.returncode == 0 and "node 0:" in r.stdout, (r.stdout, r.stderr)
-        print(r.stdout)
+        assert r.returncode == 0 and "node 0:" in r.stdout and "(stored OK)" in r.stdout, (r.stdout, r.stderr)
+        # the rig's Sensors frames (node 0, cmd 0x10: id 0x010) are on the bus beside the board's own
+        log = os.path.join(os.environ.get("TMPDIR", "/tmp"), "vboard_rig.log")
+        r = subprocess.run(bench + ["log", log, "--seconds", "0.5"], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0, (r.stdout, r.stderr)
+        with open(log) as f:
+            ids = [line.split()[2].split("#")[0] for line in f if "#" in line]
+        assert ids.count("010") > 100 and "012" in ids, ids[:20]
     finally:
         board.terminate()
         board.wait(timeout=10)
