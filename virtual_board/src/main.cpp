@@ -39,7 +39,7 @@ const char* kUsage =
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N] [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
     "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS]\n"
-    "                          [--read-calibration] [--clear-at MS] [--corrupt-page N]\n"
+    "                          [--read-calibration] [--clear-at MS] [--fill-at MS] [--corrupt-page N]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
     "covers, a configuration the manual forbids), 2 on bad input.\n"
@@ -55,6 +55,7 @@ const char* kUsage =
     "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
     "  --read-calibration  with --world or --empty-rig: CalibrationRead 50 ms after the first heartbeat\n"
     "  --clear-at MS       with --world or --empty-rig: ClearErrors at MS emulated\n"
+    "  --fill-at MS        with --empty-rig: the bucket filled at MS (once the brake holds): host_sim's world\n"
     "  --corrupt-page N    page 62 or 63 starts with a double-word of zeros (a write cut short)\n"
     "  --estop-at MS   the e-stop contact opens at MS emulated; --overcurrent-at MS: --overcurrent-a A (-50: out of\n"
     "                  the phase, through its shunt) added to phase U's current from MS on\n";
@@ -216,7 +217,11 @@ int main(int argc, char** argv) {
       } else if (a == "--world") rig.world = true;
       else if (a == "--empty-rig") rig.empty = true;
       else if (a == "--read-calibration") rig.read_calibration = true;
-      else if (a == "--clear-at") {
+      else if (a == "--fill-at") {
+        if (!(v = value(a.c_str()))) return bad("--fill-at needs milliseconds");
+        rig.fill_at_ms = std::stod(v);
+        if (!(rig.fill_at_ms >= 0 && rig.fill_at_ms < 1e9)) return bad("--fill-at must be in 0 .. 1e9 ms");
+      } else if (a == "--clear-at") {
         if (!(v = value(a.c_str()))) return bad("--clear-at needs milliseconds");
         rig.clear_at_ms = std::stod(v);
         if (!(rig.clear_at_ms >= 0 && rig.clear_at_ms < 1e9)) return bad("--clear-at must be in 0 .. 1e9 ms");
@@ -269,6 +274,7 @@ int main(int argc, char** argv) {
   }
   if (rig.reset_before_pour && !rig.pour) return bad("--reset-before-pour needs --pour");
   if (!rig.csv.empty() && !rig.pour) return bad("--csv needs --pour");
+  if (rig.fill_at_ms >= 0 && !rig.empty) return bad("--fill-at needs --empty-rig");
   if ((rig.read_calibration || rig.clear_at_ms >= 0) && !(rig.world || rig.empty)) {
     return bad("--read-calibration and --clear-at need --world or --empty-rig");
   }

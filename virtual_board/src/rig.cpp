@@ -242,6 +242,11 @@ void Rig::advance() {
       clear_sent_ = true;
     }
     if (clear_sent_ && mode_ == POUR_MODE_RUN) mode_after_clear_ = POUR_MODE_RUN;
+    if (o_.fill_at_ms >= 0.0 && empty_ && now >= o_.fill_at_ms && brake_) {
+      fill();
+      std::fprintf(stderr, "virtual board: the bucket filled at %.1f ms\n", now);  // at once: a bench waits for it
+      std::fflush(stderr);
+    }
     theta_end_ = theta();
     end_ms_ = now;
     return;

@@ -29,6 +29,7 @@ struct RigOptions {
   bool empty = false;        // --empty-rig: the empty bucket from power-on (pour-bench calibrate over a bus)
   bool read_calibration = false;  // --read-calibration: CalibrationRead 50 ms after the first heartbeat
   double clear_at_ms = -1.0;      // --clear-at MS: ClearErrors at this emulated time (pour-bench clear)
+  double fill_at_ms = -1.0;       // --fill-at MS: with --empty-rig, the bucket filled then (once the brake holds)
   bool pour = false;         // --pour: the empty rig, calibrate, fill (held), pour, stop, reset, read back
   bool reset_before_pour = false;  // --reset-before-pour: the fill while the board is held in reset, the
                                    // read-back after it, then the pour (docs/virtual-board.md: the finding)
