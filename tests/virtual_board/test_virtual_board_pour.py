@@ -172,6 +172,16 @@ def test_an_empty_calibration_page_is_named_empty():
     assert r.returncode == 0 and "calibration read: init status -5, stored 1 " in r.stdout, r.stdout
 
 
+def test_the_pour_is_deterministic(pour, tmp_path):
+    # The same seed again, its first second: every step of the world identical to the fixture's run.
+    csv = tmp_path / "again.csv"
+    r = run("--pour", "--seed", str(SEED), "--episode-s", "1", "--hold-s", "0.1", "--csv", str(csv))
+    assert r.returncode == 0, r.stderr
+    again = csv.read_text().splitlines()
+    first = pour[1].read_text().splitlines()[:len(again)]
+    assert len(again) > 1000 and again == first
+
+
 def test_the_world_in_the_loop_is_deterministic():
     a = run("--world", "--seed", "3", "--seconds", "0.3", "--print-can")
     b = run("--world", "--seed", "3", "--seconds", "0.3", "--print-can")
