@@ -16,6 +16,10 @@
 #                                take is in firmware/ports/common)
 #   common -> a port             nothing under firmware/ports/common includes a file of ports/cortex-m4 or
 #                                ports/linux
+#   host_sim's rooms, bottom up  host_sim/physics includes nothing of host_sim/{bridge,checks,cli};
+#                                host_sim/bridge nothing of host_sim/{checks,cli}; nothing libpoursim
+#                                compiles (poursim_objects) includes host_sim/cli (the benches, programs
+#                                beside the CLIs, may use its output helpers)
 # Usage: cmake -DGRAPH=<build>/architecture/targets.cmake -P cmake/CheckArchitecture.cmake
 cmake_minimum_required(VERSION 3.25)
 if(NOT GRAPH OR NOT EXISTS "${GRAPH}")
@@ -180,6 +184,8 @@ foreach(t IN LISTS POUR_TARGETS)
     math(EXPR scanned "${scanned} + 1")
     in(from_fw "${file}" "firmware")
     in(from_common "${file}" "firmware/ports/common")
+    in(from_physics "${file}" "host_sim/physics")
+    in(from_sim_bridge "${file}" "host_sim/bridge")
     rel(file_rel "${file}")
     cmake_path(GET file PARENT_PATH here)
     includes_of(names "${file}")
@@ -215,6 +221,16 @@ foreach(t IN LISTS POUR_TARGETS)
       in(to_linux "${found}" "firmware/ports/linux")
       if(from_common AND (to_cm4 OR to_linux))
         list(APPEND violations "common -> a port: ${file_rel} includes '${name}' = ${found_rel} (target ${t})")
+      endif()
+      in(to_sim_bridge "${found}" "host_sim/bridge")
+      in(to_checks "${found}" "host_sim/checks")
+      in(to_cli "${found}" "host_sim/cli")
+      if(from_physics AND (to_sim_bridge OR to_checks OR to_cli))
+        list(APPEND violations "physics -> a room above: ${file_rel} includes '${name}' = ${found_rel} (target ${t})")
+      elseif(from_sim_bridge AND (to_checks OR to_cli))
+        list(APPEND violations "bridge -> a room above: ${file_rel} includes '${name}' = ${found_rel} (target ${t})")
+      elseif(t STREQUAL "poursim_objects" AND to_cli)
+        list(APPEND violations "libpoursim -> cli: ${file_rel} includes '${name}' = ${found_rel} (target ${t})")
       endif()
       string(FIND "${found}" "${root}/" inside)
       if(inside EQUAL 0 AND NOT found IN_LIST seen)

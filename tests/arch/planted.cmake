@@ -92,4 +92,22 @@ check(common_to_port "${graph_text}" "${includes_text}"
       "common -> a port: ${flow} includes 'board_drive.h' = firmware/ports/cortex-m4/board/board_drive.h")
 unplant("${flow}")
 
+# host_sim's rooms: the physics reaching up into the bridge, the bridge into the checks, the library into
+# the CLI (each through the include folders libpoursim's objects already take).
+set(fluid "host_sim/physics/fluid.cpp")
+plant("${fluid}" "#include \"controllers.hpp\"")
+check(physics_to_bridge "${graph_text}" "${includes_text}"
+      "physics -> a room above: ${fluid} includes 'controllers.hpp' = host_sim/bridge/controllers.hpp \\(target poursim_objects\\)")
+unplant("${fluid}")
+set(rollout "host_sim/bridge/rollout.cpp")
+plant("${rollout}" "#include \"motor_checks.hpp\"")
+check(bridge_to_checks "${graph_text}" "${includes_text}"
+      "bridge -> a room above: ${rollout} includes 'motor_checks.hpp' = host_sim/checks/motor_checks.hpp")
+unplant("${rollout}")
+set(checks "host_sim/checks/checks.cpp")
+plant("${checks}" "#include \"summary.hpp\"")
+check(library_to_cli "${graph_text}" "${includes_text}"
+      "libpoursim -> cli: ${checks} includes 'summary.hpp' = host_sim/cli/summary.hpp \\(target poursim_objects\\)")
+unplant("${checks}")
+
 file(REMOVE_RECURSE "${WORK}")
