@@ -21,6 +21,7 @@ namespace {
 constexpr double kDeg = 180.0 / 3.141592653589793;
 constexpr unsigned kBrakePort = 1, kBrakePin = 3;   // PB3 (pour/board_facts.h POUR_BOARD_PIN_BRAKE)
 constexpr unsigned kEstopPort = 1, kEstopPin = 8;   // PB8 (POUR_BOARD_PIN_ESTOP)
+constexpr unsigned kPowerPort = 0, kPowerPin = 15;  // PA15, high = the power stage on (POUR_BOARD_PIN_POWER)
 const char* mode_name(int m) {
   switch (m) {
     case 0: return "IDLE";
@@ -220,6 +221,8 @@ void Rig::advance() {
     fault_theta_taken_ = true;
   }
   if (fault_theta_taken_ && moe_off_ms_ < 0.0 && tim1_ != nullptr && !tim1_->moe()) moe_off_ms_ = now;
+  if (fault_theta_taken_ && power_off_ms_ < 0.0 && !board_->gpio(kPowerPort).driven_high(kPowerPin)) power_off_ms_ = now;
+  if (fault_theta_taken_ && brake_on_ms_ < 0.0 && brake_) brake_on_ms_ = now;
   if (fault_theta_taken_) theta_max_after_fault_ = std::max(theta_max_after_fault_, std::fabs(theta() - theta_fault_));
   // The episode's trajectory, as host_sim --csv writes it (the columns the two have in common).
   if (!o_.csv.empty() && world_ && run_ms_ >= 0.0 && !have_episode_ && world_->steps() != csv_step_) {
@@ -390,6 +393,8 @@ int Rig::report() {
     std::printf("fault at %.1f ms: theta %.2f deg (mode %s); moved at most %.2f deg after it\n", o_.fault_at_ms, theta_fault_ * kDeg,
                 mode_name(mode_at_fault_), theta_max_after_fault_ * kDeg);
     if (moe_off_ms_ >= 0.0) std::printf("TIM1 MOE 0 (the bridge off) %.3f ms after the fault\n", moe_off_ms_ - o_.fault_at_ms);
+    if (power_off_ms_ >= 0.0) std::printf("PA15 low (the power stage off) %.3f ms after the fault\n", power_off_ms_ - o_.fault_at_ms);
+    if (brake_on_ms_ >= 0.0) std::printf("the brake holding %.3f ms after the fault\n", brake_on_ms_ - o_.fault_at_ms);
   }
   if (clear_sent_) {
     std::printf("after ClearErrors at %.1f ms: %s\n", o_.clear_at_ms,

@@ -73,6 +73,7 @@ class Rig : public Peripheral {
   RigOptions o_;
   const Tim1* tim1_ = nullptr;
   double moe_off_ms_ = -1.0;  // the first time at or after the fault that TIM1's MOE read 0
+  double power_off_ms_ = -1.0, brake_on_ms_ = -1.0;  // ... that PA15 (power) was low, the brake held
   Board* board_;
   Plant* plant_;
   WorldCouplingOptions wo_;
