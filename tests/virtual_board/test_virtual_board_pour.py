@@ -124,6 +124,8 @@ def estop():
 def test_the_estop_opened_mid_pour_ends_with_the_bucket_held(estop):
     held(estop.stdout)
     assert re.search(r"mode ESTOP, faults 0x0002", estop.stdout), estop.stdout
+    # docs/safety.md: the e-stop's tick engages the brake and cuts the power (the next 1 kHz tick)
+    assert number(r"PA15 low \(the power stage off\) ([0-9.]+) ms after", estop.stdout) < 1.5, estop.stdout
 
 
 def test_a_phase_overcurrent_mid_pour_trips_the_break_and_ends_with_the_bucket_held():
@@ -132,6 +134,9 @@ def test_a_phase_overcurrent_mid_pour_trips_the_break_and_ends_with_the_bucket_h
     # the comparator's break cleared MOE within the PWM period the current rose in (no 1 kHz tick, no 20 kHz
     # interrupt between), then the drive's fault (Heartbeat's Fault_Drive): the loop saw the cut
     assert number(r"TIM1 MOE 0 \(the bridge off\) ([0-9.]+) ms after the fault", r.stdout) < 0.01, r.stdout
+    # docs/bringup.md: the power is cut only once the brake holds (its 20 ms here, --brake-ms)
+    power = number(r"PA15 low \(the power stage off\) ([0-9.]+) ms after", r.stdout)
+    assert power > number(r"the brake holding ([0-9.]+) ms after", r.stdout), r.stdout
     assert re.search(r"end at .* mode FAULT, faults 0x0800, resets 0", r.stdout), r.stdout
 
 
