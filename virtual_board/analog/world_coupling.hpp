@@ -8,7 +8,9 @@
 //   ... run the board: each 1 kHz physics step is taken from inside the plant's PWM periods ...
 //   world.sensors();   // the scales, for the board's CAN bridge (Sensors frames)
 //
-// The gear is a torsional spring and damper between the shaft (theta_m / N) and the bucket (theta_b): the
+// The gear is a torsional spring and damper between the shaft ((theta_m - its angle when the bucket was
+// coupled) / N) and the bucket (theta_b), behind a gearbox that loses (1 - eta) of the power crossing it
+// (gear_load_at_motor): the
 // plant's rotor integrates at the PWM rate, the bucket at the world's dt, each seeing the other's state of
 // the last step (lockstep, no wall clock, deterministic for a seed). The world runs its ideal drive
 // (drive 0) as a pure torque source: it applies the gear's average torque of the last physics step (after
