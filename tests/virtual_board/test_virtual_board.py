@@ -47,6 +47,15 @@ def test_flashed_image_boots_to_heartbeat():
     assert "heartbeat at" in r.stdout
 
 
+def test_drive_telemetry_goes_out_with_every_heartbeat():
+    # A heartbeat tick queues four frames (Torque, Heartbeat, Identity, DriveTelemetry) into FDCAN1's TX FIFO
+    # of three: before board_loop.c kept what does not fit for the next tick, DriveTelemetry never left (0 of 10).
+    r = run("--elf", ELF, "--seconds", "1", "--print-can")
+    assert r.returncode == 0, r.stderr
+    ids = [line.split()[3] for line in r.stdout.splitlines() if " tx " in line]
+    assert ids.count("001") == 10 and ids.count("004") == 10 and ids.count("007") == 10, sorted(set(ids))
+
+
 def test_missed_watchdog_refresh_resets_the_chip():
     r = run("--elf", ELF, "--seconds", "3", "--stall-core-at", "500", "--stall-core-ms", "300",
             "--stop-on-reset")

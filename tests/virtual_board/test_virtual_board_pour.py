@@ -137,7 +137,8 @@ def test_a_phase_overcurrent_mid_pour_trips_the_break_and_ends_with_the_bucket_h
     # docs/bringup.md: the power is cut only once the brake holds (its 20 ms here, --brake-ms)
     power = number(r"PA15 low \(the power stage off\) ([0-9.]+) ms after", r.stdout)
     assert power > number(r"the brake holding ([0-9.]+) ms after", r.stdout), r.stdout
-    assert re.search(r"end at .* mode FAULT, faults 0x0800, resets 0", r.stdout), r.stdout
+    # ... and DriveTelemetry names it: POUR_DRIVE_FAULT_HW_OVERCURRENT (0x0002, pour/drive_faults.h)
+    assert re.search(r"end at .* mode FAULT, faults 0x0800, resets 0, drive faults 0x0002", r.stdout), r.stdout
 
 
 def test_a_missed_watchdog_refresh_mid_pour_resets_the_chip_and_ends_with_the_bucket_held():

@@ -39,7 +39,7 @@ const char* kUsage =
     "                          [--stop-on-reset] [--cpi-milli N] [--bench]\n"
     "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N]\n"
     "                          [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
-    "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS]\n"
+    "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS] [--gear-stiffness K]\n"
     "                          [--read-calibration] [--clear-at MS] [--fill-at MS] [--corrupt-page N]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
@@ -53,6 +53,7 @@ const char* kUsage =
     "                  --episode-s (10) of RUN, --hold-s (1.5) more, a reset and CalibrationRead; prints R, L, poured,\n"
     "                  spilled, theta. --reset-before-pour: the reset and the read-back before the pour instead.\n"
     "                  Exit 1 if a step fails (the reason on stderr)\n"
+    "  --gear-stiffness K  the gear's spring at the output [N m/rad] (default 2000, assumed), its damping scaled\n"
     "  --brake-ms MS   the brake holds MS after PB3 falls (default 20, assumed); released at once\n"
     "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
     "  --read-calibration  with --world or --empty-rig: CalibrationRead 50 ms after the first heartbeat\n"
@@ -258,6 +259,10 @@ int main(int argc, char** argv) {
         if (!(v = value(a.c_str()))) return bad("--overcurrent-a needs amperes");
         overcurrent_a = std::stod(v);
         if (!(std::fabs(overcurrent_a) <= 1000.0) || overcurrent_a == 0.0) return bad("--overcurrent-a must be in -1000 .. 1000 A, not 0");
+      } else if (a == "--gear-stiffness") {
+        if (!(v = value(a.c_str()))) return bad("--gear-stiffness needs N m/rad");
+        rig.gear_stiffness = std::stod(v);
+        if (!(rig.gear_stiffness >= 100 && rig.gear_stiffness <= 1e5)) return bad("--gear-stiffness must be in 100 .. 1e5 N m/rad");
       } else if (a == "--brake-ms") {
         if (!(v = value(a.c_str()))) return bad("--brake-ms needs milliseconds");
         rig.brake_ms = std::stod(v);

@@ -36,6 +36,11 @@ const char* mode_name(int m) {
 Rig::Rig(const RigOptions& o, Board* board, Plant* plant)
     : Peripheral("rig (sensor node, bucket, host)", 0, 0), o_(o), board_(board), plant_(plant) {
   wo_.seed = o.seed;
+  if (o.gear_stiffness > 0.0) {
+    // the damping scaled to keep its share of critical (WorldCouplingOptions: about 0.5)
+    wo_.damping_nms *= std::sqrt(o.gear_stiffness / wo_.stiffness_nm_per_rad);
+    wo_.stiffness_nm_per_rad = o.gear_stiffness;
+  }
   node_ = pour_can_node_default_config().node_id;  // until the board's first frame names its node
   if (o_.pour || o_.empty) {
     empty_ = std::make_unique<EmptyBucket>(wo_, plant_);
@@ -128,6 +133,11 @@ void Rig::frame(const CanFrame& cf) {
     case POUR_CAN_CMD_IDENTITY: {
       pour_can_identity_t id;
       if (pour_can_unpack_identity(&f, &id) == POUR_CAN_RX_OK) init_status_ = id.init_status;
+      break;
+    }
+    case POUR_CAN_CMD_DRIVE_TELEMETRY: {
+      pour_can_drive_telemetry_t d;
+      if (pour_can_unpack_drive_telemetry(&f, &d) == POUR_CAN_RX_OK) drive_faults_ = d.drive_faults;
       break;
     }
     case POUR_CAN_CMD_TORQUE: {
@@ -401,8 +411,8 @@ int Rig::report() {
                 mode_after_clear_ == POUR_MODE_RUN ? "RUN was entered" : "RUN never entered");
   }
   if (end_ms_ >= 0.0) {
-    std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u\n", end_ms_, theta_end_ * kDeg,
-                brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - script_resets_);
+    std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u, drive faults 0x%04x\n", end_ms_,
+                theta_end_ * kDeg, brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - script_resets_, drive_faults_);
     if (world_) std::printf("world: poured %.2f %%, spilled %.2f %%, left %.2f %%\n", 100.0 * world_->poured(), 100.0 * world_->spilled(),
                             100.0 * world_->remaining());
   }

@@ -42,6 +42,7 @@ struct RigOptions {
   // The spring-applied brake holds this long after PB3 falls (assumed, as tests/board/
   // test_board_calibration_run.cpp's brake: no vendor figure for the rig's brake) [ms].
   double brake_ms = 20.0;
+  double gear_stiffness = 0.0;  // --gear-stiffness: the gear's spring [N m/rad]; 0 WorldCouplingOptions' (2000)
   std::string csv;           // --csv FILE: the world's every step from RUN on (host_sim --csv's columns)
 };
 
@@ -89,7 +90,7 @@ class Rig : public Peripheral {
   // what the board said
   bool heartbeat_ = false;
   int mode_ = -1, init_status_ = 99;
-  uint16_t faults_ = 0;
+  uint16_t faults_ = 0, drive_faults_ = 0;  // Heartbeat's, DriveTelemetry's (pour/drive_faults.h)
   double stage_ms_ = 0.0, last_clear_ms_ = -1e9;
   int cal_results_ = 0;
   pour_can_calibration_result_t cal_{}, readback_{};
