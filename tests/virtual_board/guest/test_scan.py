@@ -24,6 +24,11 @@ def test_pour_bench_scan_finds_the_virtual_board():
         # identity the image sends, decoded by pour-bench as a real board's.
         lines = [line for line in r.stdout.splitlines() if line.startswith("node ")]
         assert len(lines) == 1 and lines[0].startswith("node 0: mode ") and "policy 0x" in lines[0], r.stdout
+        # pour-bench info shows the drive's telemetry (it was dropped from the full TX FIFO: board_loop.c)
+        r = subprocess.run([sys.executable, "-m", "pour.bench.cli", "--channel", "vcan0", "--timeout", "5", "info"],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 0 and "no DriveTelemetry" not in r.stdout, (r.stdout, r.stderr)
+        print(r.stdout)
     finally:
         board.terminate()
         board.wait(timeout=10)
