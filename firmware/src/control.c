@@ -4,6 +4,8 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "pour/params.h"
+
 /* docs/safety.md gives the reasons for each default. */
 #define DEFAULT_INPUT_TIMEOUT_MS 20u
 #define DEFAULT_SEED 1u
@@ -11,13 +13,14 @@
 #define DEFAULT_PLAUSIBLE_OMEGA_URAD_S 50000000 /* 50 rad/s, ~8 turns/s */
 #define DEFAULT_PLAUSIBLE_VOLUME_SUM 65536      /* off: load-cell volumes pass 1 under impact and slosh */
 #define DEFAULT_RESTART_JUMP_MAX_URAD 52360     /* 3 deg: the gearbox's backlash and the brake's give */
-#define DEFAULT_STOP_TORQUE_MAX 16384            /* 0.5 tau_max: decelerates 16 rad/s in < 0.2 s */
-#define DEFAULT_STOP_RETURN_SPEED_URAD_S 1000000 /* 1 rad/s back toward upright: no slosh over the lip */
-#define DEFAULT_STOP_RETURN_GAIN_PER_S 2u
-#define DEFAULT_STOP_TORQUE_PER_RAD_S 16384      /* 0.5 tau_max per rad/s of speed error */
-#define DEFAULT_STOP_REST_THETA_URAD 87266       /* 5 deg of upright */
-#define DEFAULT_STOP_REST_OMEGA_URAD_S 50000     /* 0.05 rad/s: at rest */
-#define DEFAULT_STOP_TIMEOUT_MS 5000u            /* from 135 deg at 1 rad/s takes 2.4 s: twice that */
+
+/* The controlled stop's defaults are the declaration's rows of group stop (POUR_PARAMS, pour/params.h). */
+#define STOP_ROW_safety(member, type, value)
+#define STOP_ROW_stop(member, type, value) config.stop.member = (type)(value);
+#define STOP_ROW_sensors(member, type, value)
+#define STOP_ROW_supervisor(member, type, value)
+#define STOP_ROW_port(member, type, value)
+#define STOP_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) STOP_ROW_##group(member, type, def)
 
 pour_control_config_t pour_control_default_config(void) {
   pour_control_config_t config;
@@ -32,13 +35,7 @@ pour_control_config_t pour_control_default_config(void) {
   config.plausible_volume_sum = DEFAULT_PLAUSIBLE_VOLUME_SUM;
   config.restart_jump_max_urad = DEFAULT_RESTART_JUMP_MAX_URAD;
   config.supervisor = pour_supervisor_default_config();
-  config.stop.torque_max = DEFAULT_STOP_TORQUE_MAX;
-  config.stop.return_speed_urad_s = DEFAULT_STOP_RETURN_SPEED_URAD_S;
-  config.stop.return_gain_per_s = DEFAULT_STOP_RETURN_GAIN_PER_S;
-  config.stop.torque_per_rad_s = DEFAULT_STOP_TORQUE_PER_RAD_S;
-  config.stop.rest_theta_urad = DEFAULT_STOP_REST_THETA_URAD;
-  config.stop.rest_omega_urad_s = DEFAULT_STOP_REST_OMEGA_URAD_S;
-  config.stop.timeout_ms = DEFAULT_STOP_TIMEOUT_MS;
+  POUR_PARAMS(STOP_DEFAULT)
   config.experiment = pour_experiment_default_config();
   return config;
 }
@@ -83,7 +80,7 @@ static void start_afresh(pour_control_t *ctl) {
 }
 
 static bool stop_config_ok(const pour_stop_config_t *s) {
-  return s->torque_max > 0 && s->return_speed_urad_s > 0 && s->return_gain_per_s >= 1u && s->torque_per_rad_s > 0 &&
+  return s->torque_max > 0 && s->return_speed_urad_s > 0 && s->return_gain_per_s >= 1u && s->gain > 0 &&
          s->rest_theta_urad > 0 && s->rest_omega_urad_s > 0 && s->timeout_ms >= 1u;
 }
 
@@ -207,7 +204,7 @@ static q15_t stop_request(const pour_stop_config_t *c, const pour_state_t *s) {
   ref = ref > c->return_speed_urad_s ? c->return_speed_urad_s
                                       : (ref < -c->return_speed_urad_s ? -c->return_speed_urad_s : ref);
   /* err [µrad/s] * Q15 per rad/s / 1e6; |err| < 2^32, |gain| < 2^15: int64 holds it. */
-  const int64_t t = ((ref - s->omega_urad_s) * c->torque_per_rad_s) / 1000000;
+  const int64_t t = ((ref - s->omega_urad_s) * c->gain) / 1000000;
   return (q15_t)(t > c->torque_max ? c->torque_max : (t < -c->torque_max ? -c->torque_max : t));
 }
 

@@ -9,16 +9,18 @@
 #define BLOB_CRC 4u
 
 static const pour_param_info_t k_info[] = {
-#define POUR_PARAM_INFO(id, name, unit, lo, hi, type, field) {id, #name, unit, lo, hi},
+#define POUR_PARAM_INFO(id, name, unit, def, lo, hi, type, group, member, doc) {id, #name, unit, lo, hi, def},
     POUR_PARAMS(POUR_PARAM_INFO)
 #undef POUR_PARAM_INFO
 };
 
 /* The declaration checked by the compiler as well (scripts/param_table.py check names the rows in the build):
- * two rows on one id are two equal case labels in pour_params_get, two of one name two equal enumerators, and
- * an empty range a negative array size here. */
-#define POUR_PARAM_RANGE_CHECK(id, name, unit, lo, hi, type, field) \
-  typedef char pour_param_range_not_empty_##name[(lo) <= (hi) ? 1 : -1];
+ * two rows on one id are two equal case labels in pour_params_get, two of one name two equal enumerators, an
+ * empty range or a default outside its row's range a negative array size here, named for the row. (Arrays, not
+ * _Static_assert: under -std=c99 glibc's stand-in for _Static_assert drops the message and with it the row.) */
+#define POUR_PARAM_RANGE_CHECK(id, name, unit, def, lo, hi, type, group, member, doc)   \
+  typedef char pour_param_range_not_empty_##name[(lo) <= (hi) ? 1 : -1];           \
+  typedef char pour_param_default_in_range_##name[(lo) <= (def) && (def) <= (hi) ? 1 : -1];
 POUR_PARAMS(POUR_PARAM_RANGE_CHECK)
 #undef POUR_PARAM_RANGE_CHECK
 
@@ -40,21 +42,24 @@ const char *pour_param_result_name(pour_param_result_t result) {
   }
 }
 
+/* The port's own rows at their declared defaults; the other groups' come with control. */
+#define PARAMS_ROW_safety(member, type, value)
+#define PARAMS_ROW_stop(member, type, value)
+#define PARAMS_ROW_sensors(member, type, value)
+#define PARAMS_ROW_supervisor(member, type, value)
+#define PARAMS_ROW_port(member, type, value) params->member = (type)(value);
+#define PARAMS_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) PARAMS_ROW_##group(member, type, def)
+
 void pour_params_default(pour_params_t *params, const pour_control_config_t *control, uint8_t node_id) {
   params->control = *control;
+  POUR_PARAMS(PARAMS_DEFAULT)
   params->node_id = node_id;
-  params->encoder_zero = 0;
-  params->gear_ratio_milli = 1000;
-  params->scale_rotating_factor_ppm = POUR_PARAM_FACTOR_ONE;
-  params->scale_rotating_tare_g = 0;
-  params->scale_target_factor_ppm = POUR_PARAM_FACTOR_ONE;
-  params->scale_target_tare_g = 0;
 }
 
 pour_param_result_t pour_params_get(const pour_params_t *params, uint8_t id, int32_t *value) {
   switch (id) {
-#define POUR_PARAM_GET(pid, name, unit, lo, hi, type, field) \
-  case pid: *value = (int32_t)params->field; return POUR_PARAM_OK;
+#define POUR_PARAM_GET(pid, name, unit, def, lo, hi, type, group, member, doc) \
+  case pid: *value = (int32_t)params->POUR_PARAM_IN_##group(member); return POUR_PARAM_OK;
     POUR_PARAMS(POUR_PARAM_GET)
 #undef POUR_PARAM_GET
     default: return POUR_PARAM_UNKNOWN_ID;
@@ -70,8 +75,8 @@ pour_param_result_t pour_params_set(pour_params_t *params, uint8_t id, int32_t v
     return POUR_PARAM_OUT_OF_RANGE;
   }
   switch (id) {
-#define POUR_PARAM_SET(pid, name, unit, lo, hi, type, field) \
-  case pid: params->field = (type)value; break;
+#define POUR_PARAM_SET(pid, name, unit, def, lo, hi, type, group, member, doc) \
+  case pid: params->POUR_PARAM_IN_##group(member) = (type)value; break;
     POUR_PARAMS(POUR_PARAM_SET)
 #undef POUR_PARAM_SET
     default: break;

@@ -4,35 +4,22 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-/* docs/safety.md gives the reasons for each default. */
-#define DEFAULT_SLEW_PER_TICK 3277        /* a full -1 -> +1 swing (65535 LSB) in 20 ticks */
-#define DEFAULT_THETA_MIN_URAD (-87266)   /* -5 deg: a little past upright, never backwards over */
-#define DEFAULT_THETA_MAX_URAD 2356194    /* 135 deg: the hard stop of the bucket's tilt */
-#define DEFAULT_OMEGA_MAX_URAD_S 2000000  /* 2 rad/s: 93 °C liquid stays in the bucket (docs/safety.md) */
-#define DEFAULT_ALPHA_MAX_URAD_S2 3400000 /* 3.4 rad/s²: ω_max reached in one 1.7 Hz slosh period */
-#define DEFAULT_OMEGA_SLACK_URAD_S 800000 /* 0.8 rad/s: K · slack = 0.4 τ_max holds the full bucket */
-#define DEFAULT_TORQUE_PER_RAD_S 16384    /* 0.5 τ_max per rad/s: stable with 2 ticks of latency */
-#define DEFAULT_SLOW_OMEGA_URAD_S 160000  /* fill schedule: 0.16 rad/s past the knee keeps a full bucket < 3 % */
-#define DEFAULT_KNEE_DECEL_URAD_S2 10000000 /* 10 rad/s²: 2 rad/s down to the slow speed within 11° */
-#define DEFAULT_SLOW_TORQUE_FF 1638       /* 0.05 τ_max = 1 N·m */
-#define DEFAULT_SLOW_KI_PER_S 5u          /* the integral takes up the full bucket's gravity in about a second */
+#include "pour/params.h"
+
 #define KNEE_SPAN_MAX_URAD 8388608        /* knee - θ saturates at 2^23 µrad (8.4 rad) in the braking curve */
+
+/* The defaults are the declaration's rows of group safety (POUR_PARAMS, pour/params.h, which gives the reasons
+ * with docs/safety.md); the other groups' rows live elsewhere. */
+#define SAFETY_ROW_safety(member, type, value) config.member = (type)(value);
+#define SAFETY_ROW_stop(member, type, value)
+#define SAFETY_ROW_sensors(member, type, value)
+#define SAFETY_ROW_supervisor(member, type, value)
+#define SAFETY_ROW_port(member, type, value)
+#define SAFETY_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) SAFETY_ROW_##group(member, type, def)
 
 pour_safety_config_t pour_safety_default_config(void) {
   pour_safety_config_t config;
-  config.tau_limit = POUR_Q15_MAX;
-  config.slew_per_tick = DEFAULT_SLEW_PER_TICK;
-  config.theta_min_urad = DEFAULT_THETA_MIN_URAD;
-  config.theta_max_urad = DEFAULT_THETA_MAX_URAD;
-  config.omega_max_urad_s = DEFAULT_OMEGA_MAX_URAD_S;
-  config.alpha_max_urad_s2 = DEFAULT_ALPHA_MAX_URAD_S2;
-  config.omega_slack_urad_s = DEFAULT_OMEGA_SLACK_URAD_S;
-  config.torque_per_rad_s = DEFAULT_TORQUE_PER_RAD_S;
-  config.knee_theta_urad = 0; /* no schedule: the rig file gives the knee (docs/safety.md) */
-  config.slow_omega_urad_s = DEFAULT_SLOW_OMEGA_URAD_S;
-  config.knee_decel_urad_s2 = DEFAULT_KNEE_DECEL_URAD_S2;
-  config.slow_torque_ff = DEFAULT_SLOW_TORQUE_FF;
-  config.slow_ki_per_s = DEFAULT_SLOW_KI_PER_S;
+  POUR_PARAMS(SAFETY_DEFAULT)
   return config;
 }
 
@@ -43,7 +30,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   const pour_safety_config_t *c = config;
   if (c->tau_limit <= 0 || c->slew_per_tick <= 0 || c->theta_max_urad <= c->theta_min_urad ||
       c->omega_max_urad_s <= 0 || c->omega_max_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->alpha_max_urad_s2 < 1000 ||
-      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->torque_per_rad_s <= 0 ||
+      c->omega_slack_urad_s <= 0 || c->omega_slack_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->governor_gain <= 0 ||
       c->knee_theta_urad < 0 || c->knee_theta_urad > POUR_SAFETY_KNEE_MAX_URAD || c->slow_omega_urad_s <= 0 ||
       c->slow_omega_urad_s > POUR_SAFETY_OMEGA_MAX_URAD_S || c->knee_decel_urad_s2 < 1000 ||
       c->knee_decel_urad_s2 > POUR_SAFETY_DECEL_MAX_URAD_S2 || c->slow_torque_ff < 0) {
@@ -53,7 +40,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   safety->torque = 0;
   safety->active = 0u;
   safety->alpha_step_urad_s = (int32_t)(((int64_t)c->alpha_max_urad_s2 + 500) / 1000);
-  safety->gain_q32 = (int32_t)(((int64_t)c->torque_per_rad_s * ((int64_t)1 << 32) + 500000) / 1000000);
+  safety->gain_q32 = (int32_t)(((int64_t)c->governor_gain * ((int64_t)1 << 32) + 500000) / 1000000);
   safety->ceiling_urad_s = c->omega_slack_urad_s;
   safety->floor_urad_s = -c->omega_slack_urad_s;
   safety->integral_mq15 = 0;

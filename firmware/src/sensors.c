@@ -3,27 +3,35 @@
 
 #include <stddef.h>
 
-/* docs/safety.md gives the reasons for each default. */
-#define DEFAULT_ENCODER_BITS 17u
+#include "pour/params.h"
+
+/* docs/safety.md gives the reasons for each default; encoder_bits's and jump_max_urad's are the declaration's
+ * (POUR_PARAMS). */
 #define DEFAULT_BANDWIDTH_RAD_S 300u /* θ̇ noise 10 mrad/s rms from 17-bit counts; stable governor loop */
 #define DEFAULT_SCALE_MIN_G (-2000)  /* a tared cell reads a little below zero, never 2 kg below */
 #define DEFAULT_SCALE_MAX_G 30000    /* the load cells' range: 12.4 kg of liquid (fill +20 %) fits twice */
 #define DEFAULT_MASS_MIN_G 1000      /* below 1 kg there is no pour to measure */
-#define DEFAULT_JUMP_MAX_URAD 10000  /* 10 mrad: the loop lags that far only beyond 900 rad/s² */
 #define JUMP_MAX_LIMIT_URAD 1000000  /* · 32² stays below 2^31 */
 #define TWO_PI_URAD_Q8 1608495439u   /* round(2π · 10^6 · 2^8): one turn [µrad] Q8 */
 #define BANDWIDTH_MAX_RAD_S 1000u    /* ωn T = 1: the loop's double pole at 0 (deadbeat); beyond, unstable */
 
 _Static_assert((-3 >> 1) == -2, "arithmetic right shift required"); /* rounding shifts, as Python's >> */
 
+/* The declaration's rows of group sensors (POUR_PARAMS, pour/params.h); the other groups' live elsewhere. */
+#define SENSORS_ROW_safety(member, type, value)
+#define SENSORS_ROW_stop(member, type, value)
+#define SENSORS_ROW_sensors(member, type, value) c.member = (type)(value);
+#define SENSORS_ROW_supervisor(member, type, value)
+#define SENSORS_ROW_port(member, type, value)
+#define SENSORS_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) SENSORS_ROW_##group(member, type, def)
+
 pour_sensors_config_t pour_sensors_default_config(void) {
   pour_sensors_config_t c;
-  c.encoder_bits = DEFAULT_ENCODER_BITS;
+  POUR_PARAMS(SENSORS_DEFAULT)
   c.bandwidth_rad_s = DEFAULT_BANDWIDTH_RAD_S;
   c.scale_min_g = DEFAULT_SCALE_MIN_G;
   c.scale_max_g = DEFAULT_SCALE_MAX_G;
   c.mass_min_g = DEFAULT_MASS_MIN_G;
-  c.jump_max_urad = DEFAULT_JUMP_MAX_URAD;
   return c;
 }
 

@@ -4,12 +4,11 @@
 #include <stddef.h>
 
 #include "pour/faults.h"
+#include "pour/params.h"
 
 /* docs/safety.md gives the reason for each default; the figures come from 20 held-out pours of the shipped
  * policy and 5 of the hand-written baseline in the simulator (tau_max 20 N·m, 10 kg of liquid), re-tuned for
  * the estimated θ̇, the motion envelope and the 80 Hz load cells (firmware 3). */
-#define DEFAULT_THETA_MARGIN_URAD 87266     /* 5 deg past the envelope's limits */
-#define DEFAULT_OMEGA_MAX_URAD_S 4000000    /* 4 rad/s: twice the envelope's speed limit */
 #define DEFAULT_WINDOW_MS 10u
 #define DEFAULT_TORQUE_MIN 11469            /* 0.35 tau_max = 7 N·m, 30 % above the liquid's worst gravity torque */
 #define DEFAULT_OMEGA_AGAINST_URAD_S 300000 /* 0.3 rad/s */
@@ -24,11 +23,20 @@
 #define VOLUME_GAP_MAX 16u                  /* ticks credited to a volume change, at most: an 80 Hz load cell
                                              * holds its reading 12.5 ms, 16 leave room for its jitter */
 
+/* theta_margin_urad's and omega_max_urad_s's defaults are the declaration's rows of group supervisor
+ * (POUR_PARAMS, pour/params.h); the other groups' live elsewhere. */
+#define SUPERVISOR_ROW_safety(member, type, value)
+#define SUPERVISOR_ROW_stop(member, type, value)
+#define SUPERVISOR_ROW_sensors(member, type, value)
+#define SUPERVISOR_ROW_supervisor(member, type, value) c.member = (type)(value);
+#define SUPERVISOR_ROW_port(member, type, value)
+#define SUPERVISOR_DEFAULT(id, name, unit, def, lo, hi, type, group, member, doc) \
+  SUPERVISOR_ROW_##group(member, type, def)
+
 pour_supervisor_config_t pour_supervisor_default_config(void) {
   pour_supervisor_config_t c;
   c.checks = POUR_CHECK_ALL;
-  c.theta_margin_urad = DEFAULT_THETA_MARGIN_URAD;
-  c.omega_max_urad_s = DEFAULT_OMEGA_MAX_URAD_S;
+  POUR_PARAMS(SUPERVISOR_DEFAULT)
   c.window_ms = DEFAULT_WINDOW_MS;
   c.torque_min = DEFAULT_TORQUE_MIN;
   c.omega_against_urad_s = DEFAULT_OMEGA_AGAINST_URAD_S;

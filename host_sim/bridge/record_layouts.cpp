@@ -6,39 +6,13 @@
 #include "poursim/record_layouts.h"
 
 #include <cstddef>
-#include <cstdint>
 #include <type_traits>
 
-extern "C" {
-#include "pour/control.h"
-#include "pour/obs.h"
-#include "pour/params.h"
-#include "pour/sensors.h"
-}
-#include "poursim/checks.h"
-#include "poursim/poursim.h"
-#include "poursim/weights_file.h"
+#include "record_kinds.hpp"
 
 namespace {
 
-template <typename T, typename = void> struct Kind;
-template <> struct Kind<int8_t> { static constexpr const char *name = "i8"; };
-template <> struct Kind<uint8_t> { static constexpr const char *name = "u8"; };
-template <> struct Kind<int16_t> { static constexpr const char *name = "i16"; };
-template <> struct Kind<uint16_t> { static constexpr const char *name = "u16"; };
-template <> struct Kind<int32_t> { static constexpr const char *name = "i32"; };
-template <> struct Kind<uint32_t> { static constexpr const char *name = "u32"; };
-template <> struct Kind<int64_t> { static constexpr const char *name = "i64"; };
-template <> struct Kind<uint64_t> { static constexpr const char *name = "u64"; };
-template <> struct Kind<float> { static constexpr const char *name = "f32"; };
-template <> struct Kind<double> { static constexpr const char *name = "f64"; };
-template <> struct Kind<bool> { static constexpr const char *name = "bool"; };
-template <> struct Kind<const char *> { static constexpr const char *name = "cstr"; };
-template <> struct Kind<double *> { static constexpr const char *name = "f64*"; };
-template <> struct Kind<const double *> { static constexpr const char *name = "f64*"; };
-template <> struct Kind<int32_t *> { static constexpr const char *name = "i32*"; };
-template <> struct Kind<poursim_reward_t> { static constexpr const char *name = "poursim_reward_t"; };
-template <> struct Kind<pour_sensors_t> { static constexpr const char *name = "pour_sensors_t"; };
+using poursim_kinds::Kind;
 
 template <typename M> using Elem = typename std::remove_all_extents<M>::type;
 template <typename M> constexpr size_t count_of() { return std::is_array<M>::value ? std::extent<M>::value : 1; }
@@ -100,7 +74,7 @@ const poursim_record_field_t kTable[] = {
     F(poursim_weights_file_t, has_float_reference), F(poursim_weights_file_t, w_float),
     // pour.bench.params
     F(pour_param_info_t, id), F(pour_param_info_t, name), F(pour_param_info_t, unit), F(pour_param_info_t, min),
-    F(pour_param_info_t, max),
+    F(pour_param_info_t, max), F(pour_param_info_t, default_value),
     // the firmware core (pour.core)
     F(pour_sensors_t, seq), F(pour_sensors_t, encoder), F(pour_sensors_t, scale_rotating_g),
     F(pour_sensors_t, scale_target_g),

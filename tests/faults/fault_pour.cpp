@@ -180,7 +180,7 @@ Result run(const Scenario &sc, uint32_t seed, const poursim_config_t &base) {
     const bool toward_zero = (last >= 0 && cmd >= 0 && cmd <= last) || (last <= 0 && cmd <= 0 && cmd >= last);
     if (!toward_zero && (step > ccfg.safety.slew_per_tick || step < -ccfg.safety.slew_per_tick)) r.slew_violations++;
     if (cmd > ccfg.safety.tau_limit || cmd < -ccfg.safety.tau_limit) r.clamp_violations++;
-    const int64_t w = ctl.state.omega_urad_s, k_gain = ccfg.safety.torque_per_rad_s;
+    const int64_t w = ctl.state.omega_urad_s, k_gain = ccfg.safety.governor_gain;
     const int64_t hi = std::max<int64_t>((ccfg.safety.omega_max_urad_s - w) * k_gain / 1000000, 0);
     const int64_t lo = std::min<int64_t>((-ccfg.safety.omega_max_urad_s - w) * k_gain / 1000000, 0);
     if (out.power && (cmd > hi + 1 || cmd < lo - 1)) r.band_violations++;

@@ -106,11 +106,11 @@ class ControlModel {
                "torque %d -> %d breaks the slew limit %d (mode %u -> %u)", torque_, out.torque, s.slew_per_tick, mode_,
                out.mode);
     // ... and no torque that speeds the bucket beyond ±omega_max: τ <= max(K (ω_max - θ̇), 0) and
-    // τ >= min(-K (ω_max + θ̇), 0), K = torque_per_rad_s per rad/s, 1 LSB for rounding.
+    // τ >= min(-K (ω_max + θ̇), 0), K = governor_gain per rad/s, 1 LSB for rounding.
     if (out.power && omega != INT32_MIN) {
       const int64_t w = std::clamp<int64_t>(omega, -POUR_SAFETY_OMEGA_MAX_URAD_S, POUR_SAFETY_OMEGA_MAX_URAD_S);
-      const int64_t hi = (static_cast<int64_t>(s.omega_max_urad_s) - w) * s.torque_per_rad_s / 1000000;
-      const int64_t lo = (-static_cast<int64_t>(s.omega_max_urad_s) - w) * s.torque_per_rad_s / 1000000;
+      const int64_t hi = (static_cast<int64_t>(s.omega_max_urad_s) - w) * s.governor_gain / 1000000;
+      const int64_t lo = (-static_cast<int64_t>(s.omega_max_urad_s) - w) * s.governor_gain / 1000000;
       FUZZ_CHECK(out.torque <= std::max<int64_t>(hi, 0) + 1 && out.torque >= std::min<int64_t>(lo, 0) - 1,
                  "torque %d speeds the bucket beyond the band at %d urad/s", out.torque, omega);
     }
@@ -170,7 +170,7 @@ pour_control_config_t fuzz_control_config(Provider &fdp) {
   c.safety.omega_max_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
   c.safety.alpha_max_urad_s2 = fdp.template ConsumeIntegralInRange<int32_t>(1000, INT32_MAX);
   c.safety.omega_slack_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
-  c.safety.torque_per_rad_s = fdp.template ConsumeIntegralInRange<q15_t>(1, 32767);
+  c.safety.governor_gain = fdp.template ConsumeIntegralInRange<q15_t>(1, 32767);
   c.safety.knee_theta_urad = fdp.ConsumeBool() ? 0 : fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_KNEE_MAX_URAD);
   c.safety.slow_omega_urad_s = fdp.template ConsumeIntegralInRange<int32_t>(1, POUR_SAFETY_OMEGA_MAX_URAD_S);
   c.safety.knee_decel_urad_s2 = fdp.template ConsumeIntegralInRange<int32_t>(1000, POUR_SAFETY_DECEL_MAX_URAD_S2);

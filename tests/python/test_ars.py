@@ -8,7 +8,7 @@ import pytest
 
 from pour.policy import export
 from pour.sim import envs
-from pour.train import ars, reinforce, trainer
+from pour.train import ars, reinforce, rundir, trainer
 from pour.train import config as cfgmod
 
 TOY = {"seed": 3, "iterations": 6, "workers": 1,
@@ -31,7 +31,7 @@ def _cfg(**changes):
 
 def _v_target(w, n=8):
     env = envs.ToyEnv(11, 10, 3.0)
-    seeds = trainer.episode_seeds(77, trainer.STREAM_TEST, 0, n)
+    seeds = rundir.episode_seeds(77, rundir.STREAM_TEST, 0, n)
     return float(np.mean([env.rollout(w, s, True).metrics["v_target"] for s in seeds]))
 
 
@@ -39,7 +39,7 @@ def test_ars_from_zero_learns_to_pour_the_toy(tmp_path):
     res = trainer.train(_cfg(iterations=20), tmp_path / "r", quiet=True)
     assert _v_target(np.zeros((6, 11))) == 0.0   # the zero policy pushes the bucket against its rest
     assert _v_target(res.best_w) > 0.15 and res.best_score > 0.05
-    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
     assert ck["history_w"].shape == (20, 6, 11)
     np.testing.assert_array_equal(ck["history_w"][-1], res.w)
 
@@ -98,7 +98,7 @@ def test_v2_normalised_search_learns_the_toy_and_resumes_bit_identically(tmp_pat
     v2 = _cfg(iterations=20, ars={"normalize_states": True, "state_std_min": 0.02})
     res = trainer.train(v2, tmp_path / "a", quiet=True)
     assert _v_target(res.best_w) > 0.15
-    ck = trainer.load_checkpoint(tmp_path / "a" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "a" / "checkpoint.npz")
     assert ck["state_n"] > 0 and np.all(ck["state_m2"] >= 0)
     trainer.train(v2, tmp_path / "b", quiet=True, stop_after=7)
     b = trainer.train(v2, tmp_path / "b", quiet=True)
@@ -110,15 +110,15 @@ def test_v2_normalised_search_learns_the_toy_and_resumes_bit_identically(tmp_pat
 
 def test_features_limit_the_search_to_their_gains(tmp_path):
     res = trainer.train(_cfg(ars={"features": ["theta", "bias"]}), tmp_path / "r", quiet=True)
-    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
     assert not ck["history_w"][:, [1, 2, 3, 4]].any()        # omega and the volumes keep their 0 gains
     assert ck["history_w"][:, 0].any() and ck["history_w"][:, 5].any() and res.w[[0, 5]].any()
 
 
 def test_random_init_is_seeded_and_scaled():
-    a = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
-    b = trainer.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
-    c = trainer.initial_params(_cfg(seed=9, policy={"init": "random", "init_scale": 0.1}))
+    a = rundir.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
+    b = rundir.initial_params(_cfg(policy={"init": "random", "init_scale": 0.1}))
+    c = rundir.initial_params(_cfg(seed=9, policy={"init": "random", "init_scale": 0.1}))
     np.testing.assert_array_equal(a, b)
     assert a.shape == (6, 11) and not np.array_equal(a, c) and 0 < np.abs(a).max() < 0.5
 
@@ -174,15 +174,15 @@ def test_bad_options_are_refused_by_name(change, message):
 
 def test_state_from_another_config_is_refused(tmp_path):
     trainer.train(_cfg(), tmp_path / "ars", quiet=True, stop_after=1)
-    with pytest.raises(trainer.TrainError, match="different config"):
+    with pytest.raises(rundir.TrainError, match="different config"):
         trainer.train(_cfg(ars={"noise": 0.2}), tmp_path / "ars", quiet=True)
-    with pytest.raises(trainer.TrainError, match="different config"):   # V1-t's state under V2-t
+    with pytest.raises(rundir.TrainError, match="different config"):   # V1-t's state under V2-t
         trainer.train(_cfg(ars={"normalize_states": True}), tmp_path / "ars", quiet=True)
     pg = _cfg(algo={"kind": "pg", "entropy_coef": 0.0, "batch_episodes": 4})
-    with pytest.raises(trainer.TrainError, match="different config"):
+    with pytest.raises(rundir.TrainError, match="different config"):
         trainer.train(pg, tmp_path / "ars", quiet=True)
     trainer.train(pg, tmp_path / "pg", quiet=True, stop_after=1)
-    with pytest.raises(trainer.TrainError, match="different config"):
+    with pytest.raises(rundir.TrainError, match="different config"):
         trainer.train(_cfg(), tmp_path / "pg", quiet=True)
 
 
@@ -196,9 +196,9 @@ def test_non_finite_parameters_stop_the_run_and_keep_the_best(tmp_path, monkeypa
         return (step * np.inf if len(calls) == 4 else step), sigma
 
     monkeypatch.setattr(ars, "ars_step", exploding)
-    with pytest.raises(trainer.TrainError, match=r"iteration 3: the parameters diverged .* best validated weights"):
+    with pytest.raises(rundir.TrainError, match=r"iteration 3: the parameters diverged .* best validated weights"):
         trainer.train(_cfg(), tmp_path / "r", quiet=True)
-    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
     assert int(ck["iteration"]) == 3 and np.all(np.isfinite(ck["params"]))
     doc = export.load_policy(tmp_path / "r")
     np.testing.assert_array_equal(export.weights_of(doc, "best"), ck["best_w"])
@@ -220,9 +220,9 @@ def test_a_collapsing_return_stops_the_run_and_keeps_the_best(tmp_path, monkeypa
     cfg = _cfg(iterations=20, eval={"collapse": 0.5, "collapse_patience": 2})
     assert trainer.train(cfg, tmp_path / "ok", quiet=True, stop_after=7).best_score > 0.05  # a best to fall from
     monkeypatch.setattr(ars, "ars_step", collapsing)
-    with pytest.raises(trainer.TrainError, match=r"iteration 7: the return collapsed .* 2 evaluations in a row"):
+    with pytest.raises(rundir.TrainError, match=r"iteration 7: the return collapsed .* 2 evaluations in a row"):
         trainer.train(cfg, tmp_path / "r", quiet=True)
-    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
     assert int(ck["iteration"]) == 8
     best = export.weights_of(export.load_policy(tmp_path / "r"), "best")
     np.testing.assert_array_equal(best, ck["best_w"])
@@ -239,7 +239,7 @@ def test_cem_from_zero_learns_to_pour_the_toy_reproducibly_and_resumes(tmp_path)
     again = trainer.train(_cfg(iterations=12, workers=2, **CEM), tmp_path / "s", quiet=True)
     np.testing.assert_array_equal(res.w, again.w)
     assert (tmp_path / "r" / "policy.json").read_bytes() == (tmp_path / "s" / "policy.json").read_bytes()
-    with pytest.raises(trainer.TrainError, match="different config"):   # CEM's state under ARS's config
+    with pytest.raises(rundir.TrainError, match="different config"):   # CEM's state under ARS's config
         trainer.train(_cfg(iterations=12), tmp_path / "s", quiet=True)
 
 
@@ -257,8 +257,8 @@ def test_pour_results_reach_finds_the_first_confirmed_iteration(tmp_path, monkey
     monkeypatch.setattr(results, "BAR_SPILLED_PCT", 5.0)
     monkeypatch.setattr(results, "PREFILTER", (0.05, 1.0))
     got = results.reach(tmp_path / "r", 4)
-    log = trainer.read_log(tmp_path / "r" / "log.csv")
-    hist = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")["history_w"]
+    log = rundir.read_log(tmp_path / "r" / "log.csv")
+    hist = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")["history_w"]
     env = envs.ToyEnv(11, 10, 10.0)
 
     def passes(i):
@@ -288,8 +288,38 @@ def test_pour_results_reach_finds_the_first_confirmed_iteration(tmp_path, monkey
 def test_pour_results_reach_refuses_a_run_without_history(tmp_path):
     from pour.eval import results
     trainer.train(_cfg(iterations=2), tmp_path / "r", quiet=True)
-    ck = trainer.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
+    ck = rundir.load_checkpoint(tmp_path / "r" / "checkpoint.npz")
     del ck["history_w"]
-    trainer.save_checkpoint(tmp_path / "r" / "checkpoint.npz", ck)
+    rundir.save_checkpoint(tmp_path / "r" / "checkpoint.npz", ck)
     with pytest.raises(ValueError, match="no W history"):
         results.reach(tmp_path / "r", 2)
+
+
+@pytest.mark.parametrize("kind", ["ars", "cem"])
+def test_python_m_trainer_runs_the_search_methods_as_the_entry_point_does(tmp_path, kind):
+    """`python -m pour.train.trainer` runs the trainer as __main__, a second copy of the module: the methods
+    come from the registry (pour.train.methods), not from a table the search module fills when imported, so
+    that copy finds them too, and its run is the in-process one."""
+    import subprocess
+    import sys
+    import tomllib
+
+    doc = {**TOY, "iterations": 2, "algo": {**TOY["algo"], "kind": kind}}
+    if kind == "cem":
+        doc["ars"] = {}
+        doc["cem"] = {"population": 4, "elites": 2}
+    lines = []
+    for k, v in doc.items():
+        if not isinstance(v, dict):
+            lines.append(f"{k} = {json.dumps(v)}")
+    for k, v in doc.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            lines += [f"{kk} = {json.dumps(vv)}" for kk, vv in v.items()]
+    toml = tmp_path / "c.toml"
+    toml.write_text("\n".join(lines) + "\n")
+    r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(toml), "--out", str(tmp_path / "m"), "--quiet"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    trainer.train(cfgmod.from_dict(tomllib.loads(toml.read_text())), tmp_path / "in", quiet=True)
+    assert (tmp_path / "m" / "policy.json").read_bytes() == (tmp_path / "in" / "policy.json").read_bytes()

@@ -63,6 +63,8 @@ def test_config_list_names_the_dbc_parameters_without_a_bus():
     r = bench("--channel", "nosuchcan0", "config", "list")
     assert r.returncode == 0, r.stderr
     assert "  4 omega_max" in r.stdout and " 22 scale_target_tare" in r.stdout, r.stdout
+    # each with its range and its compiled default, in SI units (the firmware's table through libpoursim)
+    assert "  4 omega_max  [1e-06 .. 2 rad/s; default 2 rad/s]" in r.stdout.splitlines(), r.stdout
 
 
 def candump_log(path, node: int = 0, samples: int = 300, drive: bool = False) -> None:
@@ -379,8 +381,8 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         base = ["--interface", "virtual", "--channel", channel]
         assert bench_cli.main(base + ["config", "get", "omega_max", "stop_timeout"]) == 0
         out = capsys.readouterr().out.splitlines()
-        assert out == ["omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; raw 1500000 urad/s)",
-                       "stop_timeout 4 s (range 0.001 .. 65.535 s; raw 4000 ms)"], out
+        assert out == ["omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; default 2 rad/s; raw 1500000 urad/s)",
+                       "stop_timeout 4 s (range 0.001 .. 65.535 s; default 5 s; raw 4000 ms)"], out
         assert bench_cli.main(base + ["config", "get", "--raw", "omega_max"]) == 0
         assert capsys.readouterr().out == "omega_max 1500000\n"
         assert bench_cli.main(base + ["config", "set", "omega_max", "1.75"]) == 0
@@ -388,9 +390,10 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         assert node.params[4] == 1750000
         dump = tmp_path / "node0.json"
         assert bench_cli.main(base + ["config", "dump", str(dump)]) == 0
-        assert f"{dump}: 28 parameters of node 0" in capsys.readouterr().out
+        count = len(bp.table())  # every row of the firmware's table
+        assert f"{dump}: {count} parameters of node 0" in capsys.readouterr().out
         saved = bp.load_dump(dump, bp.table())
-        assert saved["omega_max"] == 1750000 and saved["theta_max"] == 2356194 and len(saved) == 28
+        assert saved["omega_max"] == 1750000 and saved["theta_max"] == 2356194 and len(saved) == count
         # Another set in force: theta_max below the dump's theta_min, so writing theta_min first is refused.
         node.params.update({2: -80000, 3: 50000, 4: 1000})
         doc = json.loads(dump.read_text())
@@ -398,7 +401,7 @@ def test_config_get_set_dump_and_restore_in_si_units(tmp_path, capsys):
         dump.write_text(json.dumps(doc))
         node.writes.clear()
         assert bench_cli.main(base + ["config", "restore", str(dump)]) == 0
-        assert "28 parameters restored" in capsys.readouterr().out
+        assert f"{count} parameters restored" in capsys.readouterr().out
         assert node.params[2] == 100000 and node.params[3] == 2356194 and node.params[4] == 1750000
         assert [pid for pid, _ in node.writes].index(2) > [pid for pid, _ in node.writes].index(3)
 

@@ -13,7 +13,7 @@ import cantools
 import pytest
 
 from conftest import BUILD_DIR, SOURCE_DIR
-from pour import libpoursim
+from pour import functions
 from pour.can import dbc
 
 SEED = 20261123
@@ -390,7 +390,7 @@ def test_the_heartbeat_carries_one_signal_per_fault_the_core_names(db):
     hb = db.get_message_by_name("Heartbeat")
     signals = {s.name: 1 << (s.start - 8) for s in hb.signals if s.name.startswith("Fault_")}
     assert signals == FAULT_BITS
-    assert sorted(signals.values()) == [1 << i for i in range(16) if libpoursim.fault_name(1 << i) is not None]
+    assert sorted(signals.values()) == [1 << i for i in range(16) if functions.fault_name(1 << i) is not None]
 
 
 def test_the_dbc_protocol_is_the_firmware_version():

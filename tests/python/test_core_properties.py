@@ -81,7 +81,7 @@ def safety_configs(draw):
         omega_max_urad_s=draw(st.integers(1, core.SPEED_BAND_MAX_URAD_S)),
         alpha_max_urad_s2=draw(st.integers(1000, 2_000_000_000)),
         omega_slack_urad_s=draw(st.integers(1, core.SPEED_BAND_MAX_URAD_S)),
-        torque_per_rad_s=draw(st.integers(1, Q15_MAX)))
+        governor_gain=draw(st.integers(1, Q15_MAX)))
 
 
 @st.composite
@@ -124,7 +124,7 @@ def _between_zero_and(x: int, ref: int) -> bool:
 def test_envelope_holds_every_rule_after_every_tick(case):
     cfg, ticks = case
     env = core.Envelope(cfg)
-    k_per_urad = cfg.torque_per_rad_s / 1e6  # Q15 torque per µrad/s of speed margin
+    k_per_urad = cfg.governor_gain / 1e6  # Q15 torque per µrad/s of speed margin
     alpha_step = (cfg.alpha_max_urad_s2 + 500) // 1000
     prev, ceiling, floor = 0, cfg.omega_slack_urad_s, -cfg.omega_slack_urad_s
     for req, theta, omega in ticks:
@@ -181,7 +181,7 @@ def test_envelope_force_sets_the_torque_at_once_and_slews_from_it(case, forced):
 def test_envelope_refuses_a_bad_config():
     for bad in ({"tau_limit": 0}, {"slew_per_tick": 0}, {"theta_min_urad": 5, "theta_max_urad": 5},
                 {"omega_max_urad_s": 0}, {"alpha_max_urad_s2": 999}, {"omega_slack_urad_s": 0},
-                {"torque_per_rad_s": 0}, {"omega_max_urad_s": core.SPEED_BAND_MAX_URAD_S + 1}):
+                {"governor_gain": 0}, {"omega_max_urad_s": core.SPEED_BAND_MAX_URAD_S + 1}):
         with pytest.raises(core.CoreError, match="EINVAL"):
             core.Envelope(core.safety_config(**bad))
 
@@ -397,8 +397,6 @@ def test_fill_schedule_knee_is_the_hydrostatic_onset_less_3_degrees(fill_depth):
     fills cover both shapes of the liquid at the onset (a triangle below half the depth, a trapezoid above).
     A fill at or below fill_schedule_l gets no schedule."""
     lib = poursim.load_library()
-    lib.poursim_ideal_retained.argtypes = [ctypes.c_double] * 4
-    lib.poursim_ideal_retained.restype = ctypes.c_double
     rig = poursim.make_config({"fill_depth": fill_depth, "fill_schedule_l": 1.0})
     depth = rig["bucket_height"] - rig["bucket_wall"]
     onset = core.control_config(rig).safety.knee_theta_urad * 1e-6 + np.radians(3.0)

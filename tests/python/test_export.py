@@ -15,7 +15,7 @@ from pour.policy import export, weights_h
 from pour.policy import fixedpoint as fp
 from pour.sim import envs
 from pour.train import config as cfgmod
-from pour.train import trainer
+from pour.train import rundir, trainer
 
 SRC = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 CC = shutil.which("cc") or shutil.which("gcc")
@@ -179,7 +179,7 @@ def test_quantised_policy_agrees_with_float_on_visited_states(tmp_path):
     w = export.weights_of(doc)
     env = envs.ToyEnv(11, 10, 4.0)
     from pour.eval import evaluate
-    xs = np.concatenate([env.rollout(w, s, True).x for s in trainer.episode_seeds(2, trainer.STREAM_TEST, 0, 5)])
+    xs = np.concatenate([env.rollout(w, s, True).x for s in rundir.episode_seeds(2, rundir.STREAM_TEST, 0, 5)])
     agree = evaluate.agreement(w, res, xs)
     assert agree >= 0.99
 

@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import pour.sim.gym_env  # noqa: F401  (registers the ids)
-from pour import libpoursim
+from pour import functions
 from pour.sim import envs
 
 
@@ -137,7 +137,7 @@ def test_a_fault_terminates_the_episode_and_it_is_no_success():
         n += 1
     assert terminated and not truncated and n < env.max_decisions
     assert info["faults"] != 0 and info["is_success"] is False
-    assert info["fault_names"] == libpoursim.fault_names(info["faults"]) and info["fault_names"]
+    assert info["fault_names"] == functions.fault_names(info["faults"]) and info["fault_names"]
     with pytest.raises(gym.error.ResetNeeded):
         env.step(0)
 

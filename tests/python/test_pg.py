@@ -6,7 +6,7 @@ import pytest
 from pour.policy import linear
 from pour.sim import envs
 from pour.train import config as cfgmod
-from pour.train import reinforce, trainer
+from pour.train import pg, reinforce, rundir
 
 
 def _problem(seed=0, t=7, f=6, a=5):
@@ -117,7 +117,7 @@ def test_nan_reward_gives_a_clear_gradient_error():
     ep = envs.Episode(np.ones((4, 6)), np.zeros(4, dtype=int), np.array([1.0, np.nan, 0.0, 0.0]),
                       {"v_target": 0, "v_spill": 0, "finish_s": 0})
     with pytest.raises(reinforce.GradientError, match=r"iteration 7: gradient has .* non-finite.*lower algo.lr"):
-        trainer.update(cfg, np.zeros((6, 11)), [ep, ep], reinforce.Adam((6, 11), 0.1), 7)
+        pg.update(cfg, np.zeros((6, 11)), [ep, ep], reinforce.Adam((6, 11), 0.1), 7)
 
 
 def test_overflowing_weights_give_a_clear_gradient_error():
@@ -128,7 +128,7 @@ def test_overflowing_weights_give_a_clear_gradient_error():
     ep = envs.Episode(np.ones((4, 6)), np.array([0, 1, 2, 3]), np.full(4, 1e307),
                       {"v_target": 0, "v_spill": 0, "finish_s": 0})
     with pytest.raises(reinforce.GradientError, match="non-finite"):
-        trainer.update(cfg, np.zeros((6, 11)), [ep], None, 0)
+        pg.update(cfg, np.zeros((6, 11)), [ep], None, 0)
 
 
 def test_feedback_parameterisation_gradient_matches_finite_differences():
@@ -194,11 +194,11 @@ def test_update_keeps_the_feedback_policy_inside_the_trust_region():
                             "algo": {"batch_episodes": 4, "lr": 0.25, "max_kl": 0.02}, "env": {"kind": "toy"}})
     env = envs.make_env("toy", 11, 10, 1.0, {})
     p0 = np.array(cfg.policy.init_beta, dtype=np.float64)
-    w0 = trainer.weights(cfg, p0)
+    w0 = rundir.weights(cfg, p0)
     eps = [env.rollout(w0, s, False) for s in range(4)]
-    p1, st = trainer.update(cfg, p0, eps, reinforce.Adam(p0.shape, cfg.algo.lr), 0)
+    p1, st = pg.update(cfg, p0, eps, reinforce.Adam(p0.shape, cfg.algo.lr), 0)
     x = np.concatenate([e.x for e in eps])
-    kl = reinforce.mean_kl(w0, trainer.weights(cfg, p1), x)
+    kl = reinforce.mean_kl(w0, rundir.weights(cfg, p1), x)
     assert 0 < kl <= 0.02 and st["kl"] == pytest.approx(kl, rel=1e-12)
     assert st["step_scale"] < 1.0 and st["lr"] == 0.25
     # Adam's first step is lr x sign(g) before the trust region scales it down.

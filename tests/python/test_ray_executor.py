@@ -25,7 +25,7 @@ import ray  # noqa: E402
 
 from pour.train import config as cfgmod  # noqa: E402
 from pour.sim import envs  # noqa: E402
-from pour.train import executors, trainer  # noqa: E402
+from pour.train import executors, rundir, trainer  # noqa: E402
 
 TOY = {"seed": 11, "iterations": 4, "workers": 2,
        "policy": {"n_actions": 5, "decision_period_ms": 10},
@@ -113,7 +113,7 @@ def test_simulator_run_on_ray_is_bit_identical_and_workers_find_libpoursim(local
     trainer.train(cfg, tmp_path / "local", quiet=True)
     trainer.train(cfg, tmp_path / "ray", quiet=True, make_runner=executors.RayRunner)
     assert_same_run(tmp_path / "local", tmp_path / "ray")
-    w0 = trainer.weights(cfg, np.array(beta))
+    w0 = rundir.weights(cfg, np.array(beta))
     assert json.loads((tmp_path / "ray" / "policy.json").read_text())["w"] != w0.tolist()
 
 

@@ -163,18 +163,18 @@ def like_run(tmp_path_factory):
 def test_a_run_like_a_training_config_is_read_as_the_trainers_are(like_run):
     from pour.eval import plots, results
     from pour.sim import envs
-    from pour.train import trainer
+    from pour.train import rundir
 
     run, w = like_run
-    log = trainer.read_log(run / "log.csv")
-    hist = trainer.load_checkpoint(run / "checkpoint.npz")["history_w"]
+    log = rundir.read_log(run / "log.csv")
+    hist = rundir.load_checkpoint(run / "checkpoint.npz")["history_w"]
     assert [int(r["episodes"]) for r in log] == [2, 4, 6] and hist.shape == (3, 6, 11)
     doc = json.loads((run / "policy.json").read_text())
     assert np.array_equal(np.array(doc["w"]), hist[-1]) and np.array_equal(hist[-1], w)
     assert not np.array_equal(hist[0], hist[-1])   # PPO updated the actor (128 decisions an update)
     # Each row is the trainer's validation of that W: the same seeds (seed 4's), the same C rollouts.
     env = envs.ToyEnv(11, 10, 1.0)
-    seeds = trainer.episode_seeds(4, trainer.STREAM_VALID, 0, 2)
+    seeds = rundir.episode_seeds(4, rundir.STREAM_VALID, 0, 2)
     for row, wi in zip(log, hist):
         ms = [env.rollout(wi, s, True).metrics for s in seeds]
         assert float(row["eval_v_target"]) == pytest.approx(np.mean([m["v_target"] for m in ms]))
@@ -244,19 +244,19 @@ def test_an_mlp_run_is_read_through_the_env(tmp_path):
     policy.json: pour-export refuses it)."""
     from pour.eval import results
     from pour.train import config as cfgmod
-    from pour.train import trainer
+    from pour.train import rundir
 
     (tmp_path / "toy.toml").write_text(LIKE)
     run = tmp_path / "run"
     final = sb3_ppo.train_run(tmp_path / "toy.toml", run, episodes=6, every=2, seed=4, actor="mlp",
                               n_steps=128, batch_size=64)
-    log = trainer.read_log(run / "log.csv")
-    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    log = rundir.read_log(run / "log.csv")
+    ck = rundir.load_checkpoint(run / "checkpoint.npz")
     assert [int(r["episodes"]) for r in log] == [2, 4, 6] and ck["history_mlp_0"].shape == (3, 5, 64)
     assert all(np.array_equal(ck[f"history_mlp_{k}"][-1], final[k]) for k in range(6))
     assert not np.array_equal(ck["history_mlp_4"][0], ck["history_mlp_4"][-1])   # PPO updated the actor
     cfg = cfgmod.load(tmp_path / "toy.toml")
-    seeds = trainer.episode_seeds(4, trainer.STREAM_VALID, 0, 2)
+    seeds = rundir.episode_seeds(4, rundir.STREAM_VALID, 0, 2)
     for i, row in enumerate(log):
         ev = sb3_ppo.mlp_validation(cfg, [ck[f"history_mlp_{k}"][i] for k in range(6)], seeds)
         assert float(row["eval_v_target"]) == pytest.approx(ev["eval_v_target"])

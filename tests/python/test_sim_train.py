@@ -14,7 +14,7 @@ from pour.eval import evaluate
 from pour.policy import weights_h
 from pour.sim import adapter, envs, poursim
 from pour.train import config as cfgmod
-from pour.train import trainer
+from pour.train import rundir, trainer
 
 SRC = Path(os.environ.get("POUR_SOURCE_DIR", Path(__file__).resolve().parents[2]))
 
@@ -82,7 +82,7 @@ def test_one_training_iteration_on_the_simulator(tmp_path):
                             "algo": {"batch_episodes": 2}, "eval": {"every": 1, "episodes": 2},
                             "env": {"kind": "sim", "episode_s": 0.8}})
     res = trainer.train(cfg, tmp_path / "r", quiet=True)
-    w0 = trainer.weights(cfg, np.array(beta))
+    w0 = rundir.weights(cfg, np.array(beta))
     assert res.iterations == 1 and not np.array_equal(res.w, w0)
     assert (tmp_path / "r" / "policy.json").exists()
 

@@ -13,7 +13,7 @@ import pytest
 
 from pour.train import config as cfgmod
 from pour.sim import envs
-from pour.train import trainer
+from pour.train import methods, pg, rundir, trainer
 
 TOY = {"seed": 5, "iterations": 6, "workers": 1,
        "policy": {"n_actions": 5, "decision_period_ms": 10},
@@ -102,13 +102,13 @@ def test_killed_run_resumes_with_no_finished_iteration_lost(tmp_path):
 
 def test_learning_rate_decays_linearly_to_lr_final():
     cfg = _cfg(iterations=5, algo={"lr": 0.1, "lr_final": 0.02})
-    assert [round(trainer.learning_rate(cfg, i), 12) for i in range(5)] == [0.1, 0.08, 0.06, 0.04, 0.02]
-    assert trainer.learning_rate(_cfg(), 3) == 0.1
+    assert [round(pg.learning_rate(cfg, i), 12) for i in range(5)] == [0.1, 0.08, 0.06, 0.04, 0.02]
+    assert pg.learning_rate(_cfg(), 3) == 0.1
 
 
 def test_resume_with_another_config_is_refused(tmp_path):
     trainer.train(_cfg(), tmp_path / "r", quiet=True, stop_after=1)
-    with pytest.raises(trainer.TrainError, match="different config"):
+    with pytest.raises(rundir.TrainError, match="different config"):
         trainer.train(_cfg(seed=99), tmp_path / "r", quiet=True)
     trainer.train(_cfg(workers=2), tmp_path / "r", quiet=True, stop_after=1)  # workers do not matter
 
@@ -118,7 +118,7 @@ def test_training_improves_the_toy_policy(tmp_path):
                algo={"batch_episodes": 8, "lr": 0.15, "entropy_coef": 0.0})
     res = trainer.train(cfg, tmp_path / "t", quiet=True)
     env = envs.ToyEnv(5, 10, 6.0)
-    seeds = trainer.episode_seeds(123, trainer.STREAM_TEST, 0, 8)
+    seeds = rundir.episode_seeds(123, rundir.STREAM_TEST, 0, 8)
     before = np.mean([env.rollout(np.zeros((6, 5)), s, False).metrics["v_target"] for s in seeds])
     after = np.mean([env.rollout(res.w, s, False).metrics["v_target"] for s in seeds])
     assert before < 0.05  # the uniform policy hardly tilts the bucket
@@ -190,6 +190,40 @@ def test_cli_reports_bad_files_and_values_with_exit_code_2(tmp_path):
     assert "iterations = -5" in r.stderr
 
 
+def test_an_unknown_kind_is_refused_naming_every_registered_method(tmp_path):
+    """The config, pour-train and trainer.train (a config built by hand) name the registry's kinds."""
+    want = "algo.kind = 'ppo': expected one of the training methods 'vanilla', 'pg', 'ars', 'cem'"
+    assert list(methods.METHODS) == ["vanilla", "pg", "ars", "cem"]
+    with pytest.raises(cfgmod.ConfigError) as exc:
+        cfgmod.from_dict({**TOY, "algo": {"kind": "ppo"}})
+    assert str(exc.value) == want
+    p = tmp_path / "ppo.toml"
+    _toml({**TOY, "algo": {"kind": "ppo"}}, p)
+    r = subprocess.run([sys.executable, "-m", "pour.train.trainer", str(p), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert (r.returncode, r.stderr) == (2, f"pour-train: error: {p}: {want}\n")
+    import dataclasses
+    cfg = _cfg()
+    unchecked = dataclasses.replace(cfg, algo=dataclasses.replace(cfg.algo, kind="ppo"))
+    with pytest.raises(cfgmod.ConfigError, match=want):
+        trainer.train(unchecked, tmp_path / "hand", quiet=True)
+    assert not (tmp_path / "hand").exists()
+
+
+def test_the_trainer_runs_the_method_the_registry_maps_the_kind_to(tmp_path, monkeypatch):
+    """trainer.train looks algo.kind up in methods.METHODS: replacing an entry changes what runs."""
+    calls = []
+
+    def stub(cfg, run_dir, resume, quiet, stop_after, make_runner):
+        calls.append((cfg.algo.kind, run_dir, resume, quiet, stop_after, make_runner))
+        return "ran"
+
+    monkeypatch.setitem(methods.METHODS, "pg", stub)
+    assert trainer.train(_cfg(), str(tmp_path / "r"), quiet=True, stop_after=2) == "ran"
+    assert calls == [("pg", tmp_path / "r", True, True, 2, trainer.Runner)]
+    assert methods.METHODS["vanilla"] is pg.train and methods.METHODS["cem"] is methods.METHODS["ars"]
+
+
 def test_unknown_toy_option_is_an_env_error():
     with pytest.raises(envs.EnvError, match="unknown option 'gravty'"):
         envs.make_env("toy", 5, 10, 1.0, {"gravty": 9.8})
@@ -230,7 +264,7 @@ def test_rollback_undoes_a_step_that_drops_the_return_and_resumes_bit_identicall
         best = max(best, ret) if i not in rolled else best
     # Each undone step shrinks the trust region by rollback_shrink.
     first = rolled[0]
-    sched = [trainer.max_kl(cfg, i) for i in range(12)]
+    sched = [pg.max_kl(cfg, i) for i in range(12)]
     assert float(rows[first + 1]["kl_bound"]) == pytest.approx(sched[first + 1] * 0.1, rel=1e-9)
     trainer.train(cfg, tmp_path / "part", quiet=True, stop_after=first + 1)
     trainer.train(cfg, tmp_path / "part", quiet=True)

@@ -91,7 +91,7 @@ static void test_golden_SafetyEnvelopeRepeatsItsRecordedCommandsAndLimits(void) 
     config.omega_max_urad_s = g->config[4];
     config.alpha_max_urad_s2 = g->config[5];
     config.omega_slack_urad_s = g->config[6];
-    config.torque_per_rad_s = (q15_t)g->config[7];
+    config.governor_gain = (q15_t)g->config[7];
     pour_safety_t safety;
     TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
     for (unsigned t = 0; t < POUR_GOLDEN_SAFETY_LEN; ++t) {
@@ -133,7 +133,7 @@ static void replay_control(const int32_t *cfg, const pour_golden_tick_t *ticks) 
   config.safety.omega_max_urad_s = cfg[8];
   config.safety.alpha_max_urad_s2 = cfg[9];
   config.safety.omega_slack_urad_s = cfg[10];
-  config.safety.torque_per_rad_s = (q15_t)cfg[11];
+  config.safety.governor_gain = (q15_t)cfg[11];
   config.sensors.encoder_bits = (uint8_t)cfg[12];
   config.sensors.bandwidth_rad_s = (uint16_t)cfg[13];
   /* The vectors pin the envelope's state machine on scripted, not physical, states; the supervisor that

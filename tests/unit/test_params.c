@@ -73,6 +73,9 @@ static void test_params_set_RefusesAnEnvelopeBeyondTheSafetyCase(void) {
       {POUR_PARAM_ID_slow_omega, 2000000},      {POUR_PARAM_ID_stop_return_speed, 2000000},
       {POUR_PARAM_ID_stop_rest_omega, 2000000}, {POUR_PARAM_ID_alpha_max, 3400000},
       {POUR_PARAM_ID_governor_gain, 16384},     {POUR_PARAM_ID_stop_gain, 16384},
+      /* the supervisor's and the estimator's limits: tighter is accepted, looser is not */
+      {POUR_PARAM_ID_supervisor_theta_margin, 87266}, {POUR_PARAM_ID_supervisor_omega_max, 4000000},
+      {POUR_PARAM_ID_jump_max, 10000},
   };
   for (unsigned i = 0; i < sizeof k_cases / sizeof k_cases[0]; ++i) {
     TEST_ASSERT_EQUAL_INT32(k_cases[i].limit, pour_param_info(k_cases[i].id)->max);
@@ -86,6 +89,10 @@ static void test_params_set_RefusesAnEnvelopeBeyondTheSafetyCase(void) {
   TEST_ASSERT_EQUAL_MEMORY(&before, &params, sizeof params);
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_omega_max, 2000000));
   TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_governor_gain, 16384));
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_supervisor_omega_max, 3000000));
+  TEST_ASSERT_EQUAL_INT32(3000000, params.control.supervisor.omega_max_urad_s);
+  TEST_ASSERT_EQUAL_INT(POUR_PARAM_OK, pour_params_set(&params, POUR_PARAM_ID_jump_max, 5000));
+  TEST_ASSERT_EQUAL_INT32(5000, params.control.sensors.jump_max_urad);
   params = before;
 }
 

@@ -56,7 +56,7 @@ static void test_safety_init_RefusesBadConfigs(void) {
   config.omega_slack_urad_s = 0;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
   config = pour_safety_default_config();
-  config.torque_per_rad_s = 0;
+  config.governor_gain = 0;
   TEST_ASSERT_EQUAL_INT(POUR_EINVAL, pour_safety_init(&safety, &config));
 }
 

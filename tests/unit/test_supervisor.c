@@ -83,7 +83,7 @@ static pour_sensors_t sample_now(void) {
 /* The envelope's bars on this tick's command: within ±tau_limit; a step beyond the slew only toward zero
  * (less torque never waits); and never a torque that speeds the bucket up beyond ±omega_max, judged on the
  * speed the controller estimated (the only one it has): τ <= max(K (ω_max - θ̇), 0) and
- * τ >= min(-K (ω_max + θ̇), 0), K = torque_per_rad_s per rad/s, ±1 LSB for rounding. */
+ * τ >= min(-K (ω_max + θ̇), 0), K = governor_gain per rad/s, ±1 LSB for rounding. */
 static void check_envelope(void) {
   const pour_safety_config_t *sc = &config.safety;
   const int32_t t = out.torque;
@@ -93,8 +93,8 @@ static void check_envelope(void) {
   TEST_ASSERT_TRUE(toward_zero || (step <= sc->slew_per_tick && step >= -sc->slew_per_tick));
   TEST_ASSERT_TRUE(t <= sc->tau_limit && t >= -sc->tau_limit);
   const int64_t w = ctl.state.omega_urad_s;
-  const int64_t hi = ((int64_t)sc->omega_max_urad_s - w) * sc->torque_per_rad_s / 1000000;
-  const int64_t lo = (-(int64_t)sc->omega_max_urad_s - w) * sc->torque_per_rad_s / 1000000;
+  const int64_t hi = ((int64_t)sc->omega_max_urad_s - w) * sc->governor_gain / 1000000;
+  const int64_t lo = (-(int64_t)sc->omega_max_urad_s - w) * sc->governor_gain / 1000000;
   TEST_ASSERT_TRUE(t <= (hi > 0 ? hi : 0) + 1);
   TEST_ASSERT_TRUE(t >= (lo < 0 ? lo : 0) - 1);
   last_torque = out.torque;

@@ -47,6 +47,15 @@ def test_flashed_image_boots_to_heartbeat():
     assert "heartbeat at" in r.stdout
 
 
+def test_drive_telemetry_goes_out_with_every_heartbeat():
+    # A heartbeat tick queues four frames (Torque, Heartbeat, Identity, DriveTelemetry) into FDCAN1's TX FIFO
+    # of three: before board_loop.c kept what does not fit for the next tick, DriveTelemetry never left (0 of 10).
+    r = run("--elf", ELF, "--seconds", "1", "--print-can")
+    assert r.returncode == 0, r.stderr
+    ids = [line.split()[3] for line in r.stdout.splitlines() if " tx " in line]
+    assert ids.count("001") == 10 and ids.count("004") == 10 and ids.count("007") == 10, sorted(set(ids))
+
+
 def test_missed_watchdog_refresh_resets_the_chip():
     r = run("--elf", ELF, "--seconds", "3", "--stall-core-at", "500", "--stall-core-ms", "300",
             "--stop-on-reset")
@@ -70,9 +79,7 @@ def test_ecc_error_on_the_calibration_page_does_not_loop_the_board():
     assert any(line.split()[3] == "001" for line in r.stdout.splitlines() if " tx " in line), r.stdout
 
 
-def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
-    # IWDG at LSI / 4 with RLR 99: 12.5 ms at 32 kHz, then a page erase (24.47 ms max): the chip resets inside it.
-    body = """
+IWDG_RLR_99 = """
     ldr r0, =0x40003000
     ldr r1, =0xCCCC
     str r1, [r0]
@@ -82,6 +89,31 @@ def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
     str r1, [r0, #4]
     movs r1, #99
     str r1, [r0, #8]
+"""
+# RVU and PVU clear (5 LSI periods), then the key 0xAAAA loads the new RLR into the counter (RM0440 §41.3.2).
+IWDG_RELOAD = """
+3:  ldr r2, [r0, #0xC]
+    cmp r2, #0
+    bne 3b
+    ldr r1, =0xAAAA
+    str r1, [r0]
+"""
+
+
+def test_a_new_watchdog_reload_value_waits_for_the_next_reload(tmp_path):
+    # RM0440 §41.3.2: started by 0xCCCC, the counter counts down from its reset value 0xFFF (512 ms at LSI / 4 and
+    # 32 kHz); RLR 99 (12.5 ms) is loaded only by the next 0xAAAA, once RVU has cleared.
+    r = run("--elf", image(tmp_path, IWDG_RLR_99 + "1: b 1b"), "--seconds", "0.4", "--stop-on-reset")
+    assert r.returncode == 0 and "reset at" not in r.stderr, r.stderr
+    r = run("--elf", image(tmp_path, IWDG_RLR_99 + IWDG_RELOAD + "1: b 1b"), "--seconds", "0.4", "--stop-on-reset")
+    assert "IWDG: no refresh within 12 ms" in r.stderr, r.stderr
+    at = float(r.stderr.split("reset at ")[1].split(" ms")[0])
+    assert 12.0 < at < 13.5, r.stderr
+
+
+def test_watchdog_shorter_than_page_erase_is_caught(tmp_path):
+    # IWDG at LSI / 4 with RLR 99: 12.5 ms at 32 kHz, then a page erase (24.47 ms max): the chip resets inside it.
+    body = IWDG_RLR_99 + IWDG_RELOAD + """
     ldr r0, =0x40022000
     ldr r1, =0x45670123
     str r1, [r0, #8]

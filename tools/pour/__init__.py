@@ -1,7 +1,8 @@
 """pour: offline tools for the soymilk-pouring controller.
 
-    pour.paths, pour.atomic, pour.libpoursim, pour.records   shared: the build tree and the package data,
-                  atomic writes, libpoursim.so opened once, the ctypes records built from its layout table
+    pour.paths, pour.atomic, pour.libpoursim, pour.records, pour.functions   shared: the build tree and the
+                  package data, atomic writes, libpoursim.so opened once, the ctypes records built from its
+                  layout table, its functions declared from its function table
     pour.core     the firmware core through ctypes: its config, envelope, estimator and control pipeline
     pour.cli      shared: every program's --version and its progress bars (tqdm, off with --quiet)
     pour.policy   the policy as the firmware runs it: float softmax-linear (linear), its bit-exact
@@ -10,8 +11,10 @@
     pour.sim      the simulator: libpoursim's binding (poursim), the episode record (episode), the trainer's
                   episode sources (envs, adapter), the Gymnasium environment (gym_env) and the named rig
                   distributions of configs/sim (rigs)
-    pour.train    REINFORCE: run config (config), gradients (reinforce), rollout executors (executors),
-                  the training loop (trainer), the Ray benchmark (ray_bench)
+    pour.train    the trainer: run config (settings, config), the training methods' registry (methods):
+                  policy gradient (pg, its maths in reinforce) and random search (ars), the run directory
+                  they share (rundir), pour-train (trainer), the executors training and evaluation run
+                  episodes on (executors), the Ray benchmark (ray_bench)
     pour.eval     held-out evaluation and figures: evaluate, robustness, robust_scale, results, sweep,
                   plots, render
     pour.lcm      the LCM link's tools: channels, messages, sensors, cmd, run, spy, logfile, live_view

@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: MIT
 """libpoursim.so, opened once for the whole package.
 
-One shared library holds the simulator (its entry points declared by pour.sim.poursim) and the firmware core
-(declared by pour.core), so both bindings open it here and neither imports the other. pour.paths says
-where it is looked for.
+One shared library holds the simulator (pour.sim.poursim) and the firmware core (pour.core), so both bindings
+open it here and neither imports the other; its records and its functions are declared from its own tables
+(pour.records, pour.functions). pour.paths says where it is looked for.
 """
 from __future__ import annotations
 
@@ -45,26 +45,3 @@ def load() -> C.CDLL:
     raise SimError("libpoursim.so not found (looked at: " + ", ".join(map(str, tried)) +
                    "); reinstall the package from a checkout (pip install ./tools builds it in), build it with "
                    "`cmake --workflow --preset host`, or set POUR_SIM_LIB")
-
-
-def _name(fn_name: str, value: int, ctype: type) -> str | None:
-    fn = getattr(load(), fn_name)
-    fn.argtypes, fn.restype = [ctype], C.c_char_p
-    name = fn(value)
-    return name.decode() if name is not None else None
-
-
-def fault_name(bit: int) -> str | None:
-    """The firmware core's name of one POUR_FAULT_* bit ("STALE_INPUT", ...; pour_fault_name), None for
-    anything else."""
-    return _name("pour_fault_name", int(bit) & 0xFFFF, C.c_uint16)
-
-
-def fault_names(faults: int) -> list[str]:
-    """The names of the bits set in a fault word, lowest bit first (bits the core does not name are left out)."""
-    return [n for n in (fault_name(1 << i) for i in range(16) if faults >> i & 1) if n is not None]
-
-
-def mode_name(mode: int) -> str | None:
-    """The firmware core's name of a mode ("IDLE", "RUN", "FAULT", "ESTOP"; pour_mode_name), None outside."""
-    return _name("pour_mode_name", int(mode) & 0xFF, C.c_uint8)

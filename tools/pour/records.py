@@ -18,7 +18,7 @@ from typing import Iterable
 from pour import libpoursim
 from pour.libpoursim import SimError
 
-_SCALARS: dict[str, type] = {
+SCALARS: dict[str, type] = {   # the tables' scalar kinds (pour.functions reads them too)
     "i8": C.c_int8, "u8": C.c_uint8, "i16": C.c_int16, "u16": C.c_uint16, "i32": C.c_int32, "u32": C.c_uint32,
     "i64": C.c_int64, "u64": C.c_uint64, "f32": C.c_float, "f64": C.c_double, "bool": C.c_bool, "cstr": C.c_char_p,
 }
@@ -58,10 +58,10 @@ def library_table() -> list[FieldLayout]:
 
 
 def _ctype(kind: str, built: dict[str, type]) -> type:
-    if kind in _SCALARS:
-        return _SCALARS[kind]
-    if kind.endswith("*") and kind[:-1] in _SCALARS:
-        return C.POINTER(_SCALARS[kind[:-1]])
+    if kind in SCALARS:
+        return SCALARS[kind]
+    if kind.endswith("*") and kind[:-1] in SCALARS:
+        return C.POINTER(SCALARS[kind[:-1]])
     if kind in built:
         return built[kind]
     raise SimError(f"libpoursim's record table names a field kind {kind!r} that pour.records does not know")

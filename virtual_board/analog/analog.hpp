@@ -89,6 +89,7 @@ class Plant {
   uint64_t periods() const { return periods_; }
   double torque() const { return torque_; }
   double r_phase() const;
+  double l_phase() const;  // [H], the d axis's (the motor model's ld = lq)
   double pwm_hz() const;
   int encoder_cpr() const;
   int pole_pairs() const;

@@ -61,6 +61,7 @@ void Plant::reset() {
 
 double Plant::pwm_hz() const { return impl_->params.pwm_hz; }
 double Plant::r_phase() const { return impl_->params.r_phase; }
+double Plant::l_phase() const { return impl_->params.ld; }
 int Plant::encoder_cpr() const { return impl_->params.encoder_cpr; }
 int Plant::pole_pairs() const { return impl_->params.pole_pairs; }
 double Plant::deadtime_s() const { return impl_->params.deadtime_s; }

@@ -5,11 +5,29 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rig_sensors.hpp"
+
+extern "C" {
+#include "pour/drive.h"
+}
+
 namespace vb {
+
+double default_gear_efficiency() { return pour_drive_default_config().gear_efficiency_q15 / 32768.0; }
+
+double gear_load_at_motor(double tau_out, double omega_m, double ratio, double eta) {
+  return tau_out * omega_m >= 0.0 ? tau_out / (ratio * eta) : tau_out * eta / ratio;
+}
 
 WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
   if (!(std::isfinite(o.stiffness_nm_per_rad) && o.stiffness_nm_per_rad > 0.0)) {
     error_ = "world coupling: stiffness_nm_per_rad must be a finite number > 0";
+    plant_ = nullptr;
+    return;
+  }
+  eta_ = o.gear_efficiency == 0.0 ? default_gear_efficiency() : o.gear_efficiency;
+  if (!(std::isfinite(eta_) && eta_ >= 0.5 && eta_ <= 1.0)) {
+    error_ = "world coupling: gear_efficiency must be in 0.5 .. 1 (or 0: host_sim's full drive's)";
     plant_ = nullptr;
     return;
   }
@@ -40,6 +58,12 @@ WorldCoupling::WorldCoupling(const WorldCouplingOptions& o, Plant* plant) : plan
   tau_max_ = ep->tau_max;
   poursim_observe(world_, &obs_);
   if (o.brake) set_brake(true);
+  // The bucket is mounted where the shaft stands now (a world created mid-run, after the empty rig's
+  // calibration): the gear's zero and the world's time start here.
+  if (plant_ != nullptr) {
+    theta_m0_ = plant_->theta();
+    t0_ = plant_->time_s();
+  }
   if (plant_ != nullptr) plant_->set_load([this](double t, double th, double w) { return load(t, th, w); });
 }
 
@@ -75,7 +99,7 @@ uint64_t WorldCoupling::trajectory_hash() const { return world_ != nullptr ? pou
 double WorldCoupling::load(double t, double theta_m, double omega_m) {
   if (!ok()) return 0.0;
   // The physics step that ended at t: the gear's torque averaged over its PWM periods, into the world.
-  const double next = static_cast<double>(obs_.step + 1u) * dt_;
+  const double next = t0_ + static_cast<double>(obs_.step + 1u) * dt_;
   if (t + 1e-12 >= next && samples_ > 0) {
     last_torque_ = sum_ / samples_;
     sum_ = 0.0;
@@ -88,10 +112,79 @@ double WorldCoupling::load(double t, double theta_m, double omega_m) {
     }
   }
   // The gear: the shaft's angle over N against the bucket's, a spring and a damper at the output.
-  const double tau_out = o_.stiffness_nm_per_rad * (theta_m / n_ - obs_.theta) + o_.damping_nms * (omega_m / n_ - obs_.omega);
+  const double tau_out = o_.stiffness_nm_per_rad * ((theta_m - theta_m0_) / n_ - obs_.theta) + o_.damping_nms * (omega_m / n_ - obs_.omega);
   sum_ += tau_out;
   ++samples_;
-  return tau_out / n_;  // at the motor (an ideal gear: the torque scales by N, the losses are the world's)
+  return gear_load_at_motor(tau_out, omega_m, n_, eta_);
+}
+
+// ------------------------------------------------------------------------------------------ EmptyBucket
+namespace {
+// The empty bucket's inertia about its axis: tests/sim/test_calibration.cpp's 0.038 kg m^2 at the output is
+// the 2 kg bucket about its centre and the rotor through 1:20 (2.4e-5 x 20^2 = 0.0096); the plant carries
+// the rotor, so the bucket alone is the difference.
+constexpr double kEmptyBucketOutputInertia = 0.038;  // [kg m^2], the bucket and the rotor through the gear
+}  // namespace
+
+EmptyBucket::EmptyBucket(const WorldCouplingOptions& o, Plant* plant) : plant_(plant), o_(o) {
+  c_ = poursim_default_config();
+  eta_ = o.gear_efficiency == 0.0 ? default_gear_efficiency() : o.gear_efficiency;
+  inertia_ = kEmptyBucketOutputInertia - c_.motor_rotor_inertia * c_.gear_ratio * c_.gear_ratio;
+  brake_ = true;
+  rng_ = 0x9E3779B97F4A7C15ull ^ o.seed;
+  theta_m0_ = plant->theta();
+  t0_ = plant->time_s();
+  encoder_ = poursim::encoder_count(0.0, c_.encoder_bits);
+  plant_->set_load([this](double t, double th, double w) { return load(t, th, w); });
+}
+
+EmptyBucket::~EmptyBucket() { plant_->set_load(nullptr); }
+
+double EmptyBucket::gauss() {
+  // Box-Muller on a 64-bit LCG (Knuth's MMIX constants): seeded, the same on every host.
+  auto uniform = [this]() {
+    rng_ = rng_ * 6364136223846793005ull + 1442695040888963407ull;
+    return (static_cast<double>(rng_ >> 11) + 0.5) / 9007199254740992.0;
+  };
+  const double u1 = uniform(), u2 = uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+}
+
+bool EmptyBucket::sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const {
+  const pour_can_sensors_t m = {static_cast<uint8_t>(step_ & 0xFFu), encoder_, static_cast<int16_t>(scale_rot_),
+                                static_cast<int16_t>(scale_tgt_)};
+  return pour_can_pack_sensors(node_id, &m, frame) == POUR_OK;
+}
+
+double EmptyBucket::load(double t, double theta_m, double omega_m) {
+  const double ts = t_last_ < 0.0 ? 0.0 : t - t_last_;
+  t_last_ = t;
+  const double tau = o_.stiffness_nm_per_rad * ((theta_m - theta_m0_) / c_.gear_ratio - theta_) +
+                     o_.damping_nms * (omega_m / c_.gear_ratio - omega_);
+  // The bucket: the gear's torque against the joint's friction (Coulomb, sticking below it, and viscous);
+  // the brake holds it up to brake_torque (poursim_set_brake's rating).
+  const double hold = c_.friction_coulomb + (brake_ ? c_.brake_torque : 0.0);
+  const double moving = omega_;
+  if (std::fabs(moving) < 1e-4 && std::fabs(tau) <= hold) {
+    omega_ = 0.0;
+  } else {
+    const double dir = std::fabs(moving) >= 1e-4 ? (moving > 0 ? 1.0 : -1.0) : (tau > 0 ? 1.0 : -1.0);
+    const double acc = (tau - hold * dir - c_.friction_viscous * omega_) / inertia_;
+    const double w = omega_ + acc * ts;
+    omega_ = (w * omega_ < 0.0) ? 0.0 : w;  // friction stops the bucket, never reverses it
+  }
+  theta_ += omega_ * ts;
+  // The rig's sensors at each 1 ms step of the world's clock (dt), as poursim_obs_t reads them.
+  while (t + 1e-12 >= t0_ + static_cast<double>(step_ + 1u) * c_.dt) {
+    ++step_;
+    encoder_ = poursim::encoder_count(theta_, c_.encoder_bits);
+    auto reading = [this]() {
+      return static_cast<int32_t>(std::round(c_.scale_noise_g * gauss() / c_.scale_resolution_g) * c_.scale_resolution_g);
+    };
+    scale_rot_ = reading();
+    scale_tgt_ = reading();
+  }
+  return gear_load_at_motor(tau, omega_m, c_.gear_ratio, eta_);
 }
 
 }  // namespace vb

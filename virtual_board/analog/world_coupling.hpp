@@ -8,7 +8,9 @@
 //   ... run the board: each 1 kHz physics step is taken from inside the plant's PWM periods ...
 //   world.sensors();   // the scales, for the board's CAN bridge (Sensors frames)
 //
-// The gear is a torsional spring and damper between the shaft (theta_m / N) and the bucket (theta_b): the
+// The gear is a torsional spring and damper between the shaft ((theta_m - its angle when the bucket was
+// coupled) / N) and the bucket (theta_b), behind a gearbox that loses (1 - eta) of the power crossing it
+// (gear_load_at_motor): the
 // plant's rotor integrates at the PWM rate, the bucket at the world's dt, each seeing the other's state of
 // the last step (lockstep, no wall clock, deterministic for a seed). The world runs its ideal drive
 // (drive 0) as a pure torque source: it applies the gear's average torque of the last physics step (after
@@ -28,6 +30,14 @@ extern "C" {  // the C header carries no linkage of its own
 }
 
 namespace vb {
+// The torque the gear's output torque tau_out puts on the motor [N m]: / N, and through the gearbox's
+// efficiency eta, whose loss the motor pays when it drives (tau_out and the shaft's speed omega_m one way)
+// and the bucket pays when it drives the motor.
+double gear_load_at_motor(double tau_out, double omega_m, double ratio, double eta);
+double default_gear_efficiency();  // host_sim's full drive's (see WorldCouplingOptions::gear_efficiency)
+}  // namespace vb
+
+namespace vb {
 
 struct WorldCouplingOptions {
   uint32_t seed = 1;              // the world's reset seed (liquid arrangement, load cells' noise)
@@ -36,6 +46,10 @@ struct WorldCouplingOptions {
   // the spring about 0.5 of critical.
   double stiffness_nm_per_rad = 2000.0;
   double damping_nms = 4.4;
+  // The gearbox's efficiency: it loses (1 - eta) of the power that crosses it, whichever way it flows, as
+  // host_sim's full drive has it (host_sim/physics/foc_drive.cpp, which takes the value of the drive's
+  // configuration, gear_efficiency_q15: 0.90; no vendor figure for the rig's gearhead). 0 takes that value.
+  double gear_efficiency = 0.0;
   bool brake = false;             // the holding brake engaged from the start
 };
 
@@ -78,6 +92,7 @@ class WorldCoupling {
 
  private:
   double load(double t, double theta_m, double omega_m);  // the plant's load at the motor [N m]
+  double eta_ = 1.0;
   poursim_world_t* world_ = nullptr;
   Plant* plant_ = nullptr;
   WorldCouplingOptions o_;
@@ -85,7 +100,39 @@ class WorldCoupling {
   poursim_obs_t obs_{};
   double n_ = 20.0, dt_ = 0.001, tau_max_ = 1000.0;
   double sum_ = 0.0, last_torque_ = 0.0;
+  double theta_m0_ = 0.0, t0_ = 0.0;  // the shaft's angle and the plant's time when the bucket was coupled
   int samples_ = 0;
+};
+
+// The rig before the fill (the bench calibrates the drive with the rotating bucket empty: the interlock of
+// firmware/ports/common/calibration_flow.h refuses more than 200 g on its scale): the empty bucket on its
+// bearing through the same gear spring, a rigid inertia about its centre (its centre of mass on the axis: no
+// gravity torque), host_sim's joint friction and holding brake, and the rig's sensors as the world's read
+// (the output encoder of encoder_bits, both scales tared empty, with the load cells' noise).
+class EmptyBucket {
+ public:
+  // Installs the plant's load; the gear's zero is the shaft's angle now.
+  EmptyBucket(const WorldCouplingOptions& o, Plant* plant);
+  ~EmptyBucket();
+  EmptyBucket(const EmptyBucket&) = delete;
+  EmptyBucket& operator=(const EmptyBucket&) = delete;
+  void set_brake(bool engaged) { brake_ = engaged; }
+  bool sensors_frame(uint8_t node_id, pour_can_frame_t* frame) const;
+  double bucket_theta() const { return theta_; }
+  uint32_t steps() const { return step_; }
+
+ private:
+  double load(double t, double theta_m, double omega_m);
+  Plant* plant_;
+  WorldCouplingOptions o_;
+  double eta_ = 1.0;
+  poursim_config_t c_{};
+  double inertia_ = 0.0, theta_ = 0.0, omega_ = 0.0, theta_m0_ = 0.0, t0_ = 0.0, t_last_ = -1.0;
+  uint32_t step_ = 0, encoder_ = 0;
+  int32_t scale_rot_ = 0, scale_tgt_ = 0;
+  bool brake_ = true;
+  uint64_t rng_ = 0;
+  double gauss();
 };
 
 }  // namespace vb

@@ -582,11 +582,21 @@ std::string Board::open_can() {
   return {};
 }
 
+void Board::to_bus(const CanFrame& f) {
+  if (can_fd_ < 0) return;
+  can_frame cf{};
+  cf.can_id = f.id;
+  cf.can_dlc = f.dlc;
+  std::memcpy(cf.data, f.data, 8);
+  (void)!write(can_fd_, &cf, sizeof cf);
+}
+
 void Board::bridge() {
   while (!fdcan_.transmitted.empty()) {
     const CanFrame f = fdcan_.transmitted.front();
     fdcan_.transmitted.pop_front();
     ++frames_tx_;
+    if (on_tx) on_tx(f);
     if ((f.id & 0x1Fu) == 1u && first_heartbeat_ps_ == UINT64_MAX) first_heartbeat_ps_ = now_ps();
     if (opt_.print_can) {
       std::printf("%.3f ms tx %03x [%u]", static_cast<double>(now_ps()) / 1e9, f.id, f.dlc);
@@ -627,7 +637,7 @@ int Board::run() {
       core_reset(false);
       if (opt_.stop_on_reset) break;
     }
-    if (now_ps() >= end_ps) break;
+    if (now_ps() >= end_ps || finish_) break;
     if (opt_.until_heartbeat && first_heartbeat_ps_ != UINT64_MAX) break;
     // Pending exceptions, highest priority first, while they preempt.
     for (int guard = 0; guard < 4; ++guard) {
@@ -687,9 +697,13 @@ int Board::run() {
     }
     if (opt_.stall_core_at_ms >= 0 && now_ps() >= static_cast<uint64_t>(opt_.stall_core_at_ms * 1e9) && !stalled_once_) {
       // Injection: the core stops fetching (a hung bus) for stall_core_ms; the IWDG is not refreshed.
+      // The watchdog's reset, if it comes first, ends the stall (the models run on to it).
       stalled_once_ = true;
-      insns_ += (cycles_until_ps(now_ps() + static_cast<uint64_t>(opt_.stall_core_ms * 1e9)) * 1000u) / opt_.cpi_milli;
-      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, static_cast<double>(now_ps()) / 1e9);
+      const uint64_t at = now_ps();
+      uint64_t until = at + static_cast<uint64_t>(opt_.stall_core_ms * 1e9);
+      if (iwdg_.running()) until = std::min(until, std::max(at, iwdg_.expiry_ps()));
+      insns_ += (cycles_until_ps(until) * 1000u + opt_.cpi_milli - 1u) / opt_.cpi_milli;
+      std::fprintf(stderr, "virtual board: core stalled %.1f ms at %.3f ms (injected)\n", opt_.stall_core_ms, static_cast<double>(at) / 1e9);
     }
     systick_advance();
     for (Peripheral* m : models_) m->advance();

@@ -5,6 +5,7 @@
 #include <unicorn/unicorn.h>
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -71,6 +72,12 @@ class Board : public BoardLink, public TimeSource {
   double wall_s() const { return wall_s_; }
   const std::string& stopped() const { return stopped_; }
   Gpio& gpio(int port) { return port == 0 ? gpioa_ : port == 1 ? gpiob_ : gpioc_; }
+  // The bus seen from the host's side without SocketCAN (virtual_board/src/rig.hpp): a frame into FDCAN1's
+  // RX path as one from the bus arrives, and every frame the board puts on the bus.
+  void receive_frame(const CanFrame& f) { fdcan_.receive(f); }
+  void to_bus(const CanFrame& f);  // onto the SocketCAN bus when bridged (another node's frame: candump sees it)
+  std::function<void(const CanFrame&)> on_tx;
+  void finish() { finish_ = true; }  // the run ends normally after this slice (a host script's end)
 
  private:
   friend class Scs;
@@ -154,7 +161,7 @@ class Board : public BoardLink, public TimeSource {
   uint64_t first_heartbeat_ps_ = UINT64_MAX, exceptions_taken_ = 0, frames_tx_ = 0, idle_cycles_ = 0;
   unsigned resets_ = 0;
   double wall_s_ = 0;
-  bool trace_ = false;
+  bool trace_ = false, finish_ = false;
   uint64_t iterations_ = 0;
   std::unique_ptr<Profiler> profiler_;  // --profile
 };

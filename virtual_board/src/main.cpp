@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // pour_virtual_board: the flashed pour_firmware.elf on an emulated STM32G431 (docs/virtual-board.md).
+#include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -9,17 +11,20 @@
 
 #include "analog.hpp"
 #include "board.hpp"
+#include "rig.hpp"
 
 namespace {
 
 // The analog chain's plant, stepped by the board as one more model: it covers no address, and its next event
-// is the next PWM period's start (virtual_board/analog/analog.hpp).
+// is the next PWM period's start (virtual_board/analog/analog.hpp). A reset of the chip does not reset it:
+// the motor, its rotor's angle and speed, the bus capacitor's charge and the bucket on the gear are outside
+// the MCU (TIM4's count restarts at 0 with TIM1's outputs off, as their models' resets have it).
 class PlantStep : public vb::Peripheral {
  public:
   explicit PlantStep(vb::Plant* p) : Peripheral("plant", 0, 0), plant_(p) {}
   bool read(uint32_t, unsigned, uint32_t*) override { return false; }
   bool write(uint32_t, unsigned, uint32_t) override { return false; }
-  void reset() override { plant_->reset(); }
+  void reset() override {}
   void advance() override { plant_->step_to_cycle(link_); }
   uint64_t next_event() const override { return plant_->next_step_cycle(link_); }
 
@@ -32,9 +37,31 @@ const char* kUsage =
     "                          [--print-can]\n"
     "                          [--realtime] [--estop open|closed] [--ecc-page N] [--stall-core-at MS --stall-core-ms MS]\n"
     "                          [--stop-on-reset] [--cpi-milli N] [--bench] [--profile]\n"
+    "                          [--world | --empty-rig | --pour [--reset-before-pour]] [--seed N]\n"
+    "                          [--estop-at MS] [--overcurrent-at MS [--overcurrent-a A]]\n"
+    "                          [--episode-s S] [--hold-s S] [--csv FILE] [--brake-ms MS] [--gear-stiffness K]\n"
+    "                          [--read-calibration] [--clear-at MS] [--fill-at MS] [--corrupt-page N]\n"
     "Runs the STM32G431 image (default build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf) on the virtual\n"
     "B-G431B-ESC1. Exit 0 at the end of the run, 1 if the board stopped (an unmapped access, a register no model\n"
-    "covers, a configuration the manual forbids), 2 on bad input.\n";
+    "covers, a configuration the manual forbids), 2 on bad input.\n"
+    "  --world         host_sim's bucket world (seed --seed) behind the gear from power-on: the rig's Sensors frame\n"
+    "                  into FDCAN1 every 1 ms physics step, the holding brake on PB3\n"
+    "  --seed N        the world's (the liquid, the scales' noise) and the converters' noise (default 1)\n"
+    "  --empty-rig     the same with the rotating bucket empty (the bench's calibration: pour-bench calibrate)\n"
+    "  --pour          the bench's script, in emulated time (docs/virtual-board.md): the empty rig, CalibrationStart,\n"
+    "                  the outcome, the bucket filled (held by the brake), ClearErrors, the pour, Stop after\n"
+    "                  --episode-s (10) of RUN, --hold-s (1.5) more, a reset and CalibrationRead; prints R, L, poured,\n"
+    "                  spilled, theta. --reset-before-pour: the reset and the read-back before the pour instead.\n"
+    "                  Exit 1 if a step fails (the reason on stderr)\n"
+    "  --gear-stiffness K  the gear's spring at the output [N m/rad] (default 2000, assumed), its damping scaled\n"
+    "  --brake-ms MS   the brake holds MS after PB3 falls (default 20, assumed); released at once\n"
+    "  --csv FILE      with --pour: the world's every step from RUN on (host_sim --csv's columns)\n"
+    "  --read-calibration  with --world or --empty-rig: CalibrationRead 50 ms after the first heartbeat\n"
+    "  --clear-at MS       with --world or --empty-rig: ClearErrors at MS emulated\n"
+    "  --fill-at MS        with --empty-rig: the bucket filled at MS (once the brake holds): host_sim's world\n"
+    "  --corrupt-page N    page 62 or 63 starts with a double-word of zeros (a write cut short)\n"
+    "  --estop-at MS   the e-stop contact opens at MS emulated; --overcurrent-at MS: --overcurrent-a A (-50: out of\n"
+    "                  the phase, through its shunt) added to phase U's current from MS on\n";
 
 int bad(const std::string& msg) {
   std::fprintf(stderr, "pour_virtual_board: %s\n", msg.c_str());
@@ -129,7 +156,13 @@ std::string load_elf(const std::string& path, const std::vector<uint8_t>& b, std
 int main(int argc, char** argv) {
   vb::Options o;
   o.elf = "build/cortex-m4/firmware/ports/cortex-m4/pour_firmware.elf";
-  bool bench = false;
+  bool bench = false, seconds_given = false;
+  vb::RigOptions rig;
+  vb::AnalogOptions ao;
+  double overcurrent_at_ms = -1.0;
+  int corrupt_page = -1;
+  ao.fault_phase_overcurrent_a = 0.0;
+  double overcurrent_a = -50.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* name) -> const char* {
@@ -158,6 +191,7 @@ int main(int argc, char** argv) {
         if (!(v = value("--seconds"))) return bad("--seconds needs a number");
         o.seconds = std::stod(v);
         if (!(o.seconds > 0 && o.seconds < 1e6)) return bad("--seconds must be in (0, 1e6)");
+        seconds_given = true;
       } else if (a == "--until-heartbeat") o.until_heartbeat = true;
       else if (a == "--print-can") o.print_can = true;
       else if (a == "--realtime") o.realtime = true;
@@ -184,6 +218,61 @@ int main(int argc, char** argv) {
         if (!(v = value(a.c_str()))) return bad("--stall-core-ms needs milliseconds");
         o.stall_core_ms = std::stod(v);
         if (!(o.stall_core_ms > 0)) return bad("--stall-core-ms must be positive");
+      } else if (a == "--world") rig.world = true;
+      else if (a == "--empty-rig") rig.empty = true;
+      else if (a == "--read-calibration") rig.read_calibration = true;
+      else if (a == "--fill-at") {
+        if (!(v = value(a.c_str()))) return bad("--fill-at needs milliseconds");
+        rig.fill_at_ms = std::stod(v);
+        if (!(rig.fill_at_ms >= 0 && rig.fill_at_ms < 1e9)) return bad("--fill-at must be in 0 .. 1e9 ms");
+      } else if (a == "--clear-at") {
+        if (!(v = value(a.c_str()))) return bad("--clear-at needs milliseconds");
+        rig.clear_at_ms = std::stod(v);
+        if (!(rig.clear_at_ms >= 0 && rig.clear_at_ms < 1e9)) return bad("--clear-at must be in 0 .. 1e9 ms");
+      }
+      else if (a == "--corrupt-page") {
+        if (!(v = value(a.c_str()))) return bad("--corrupt-page needs a page number");
+        corrupt_page = std::stoi(v);
+        if (corrupt_page < 62 || corrupt_page > 63) return bad("--corrupt-page must be 62 or 63 (the data pages)");
+      }
+      else if (a == "--pour") rig.pour = true;
+      else if (a == "--reset-before-pour") rig.reset_before_pour = true;
+      else if (a == "--csv") {
+        if (!(v = value(a.c_str()))) return bad("--csv needs a file");
+        rig.csv = v;
+        if (rig.csv.empty()) return bad("--csv needs a file");
+      }
+      else if (a == "--seed") {
+        if (!(v = value(a.c_str()))) return bad("--seed needs a number");
+        const long long s = std::stoll(v);
+        if (s < 0 || s > 0xFFFFFFFFll) return bad("--seed must be in 0 .. 4294967295");
+        rig.seed = static_cast<uint32_t>(s);
+        ao.seed = static_cast<uint64_t>(s);
+      } else if (a == "--estop-at") {
+        if (!(v = value(a.c_str()))) return bad("--estop-at needs milliseconds");
+        rig.estop_at_ms = std::stod(v);
+        if (!(rig.estop_at_ms >= 0 && rig.estop_at_ms < 1e9)) return bad("--estop-at must be in 0 .. 1e9 ms");
+      } else if (a == "--overcurrent-at") {
+        if (!(v = value(a.c_str()))) return bad("--overcurrent-at needs milliseconds");
+        overcurrent_at_ms = std::stod(v);
+        if (!(overcurrent_at_ms >= 0 && overcurrent_at_ms < 1e9)) return bad("--overcurrent-at must be in 0 .. 1e9 ms");
+      } else if (a == "--overcurrent-a") {
+        if (!(v = value(a.c_str()))) return bad("--overcurrent-a needs amperes");
+        overcurrent_a = std::stod(v);
+        if (!(std::fabs(overcurrent_a) <= 1000.0) || overcurrent_a == 0.0) return bad("--overcurrent-a must be in -1000 .. 1000 A, not 0");
+      } else if (a == "--gear-stiffness") {
+        if (!(v = value(a.c_str()))) return bad("--gear-stiffness needs N m/rad");
+        rig.gear_stiffness = std::stod(v);
+        if (!(rig.gear_stiffness >= 100 && rig.gear_stiffness <= 1e5)) return bad("--gear-stiffness must be in 100 .. 1e5 N m/rad");
+      } else if (a == "--brake-ms") {
+        if (!(v = value(a.c_str()))) return bad("--brake-ms needs milliseconds");
+        rig.brake_ms = std::stod(v);
+        if (!(rig.brake_ms >= 0 && rig.brake_ms <= 1000)) return bad("--brake-ms must be in 0 .. 1000");
+      } else if (a == "--episode-s" || a == "--hold-s") {
+        if (!(v = value(a.c_str()))) return bad(a + " needs seconds");
+        const double s = std::stod(v);
+        if (!(s > 0 && s <= 600)) return bad(a + " must be in (0, 600]");
+        (a == "--episode-s" ? rig.episode_s : rig.hold_s) = s;
       } else {
         return bad("unknown option " + a + " (--help)");
       }
@@ -191,22 +280,56 @@ int main(int argc, char** argv) {
       return bad("bad number for " + a + ": " + (v ? v : ""));
     }
   }
+  if (rig.reset_before_pour && !rig.pour) return bad("--reset-before-pour needs --pour");
+  if (!rig.csv.empty() && !rig.pour) return bad("--csv needs --pour");
+  if (rig.fill_at_ms >= 0 && !rig.empty) return bad("--fill-at needs --empty-rig");
+  if ((rig.read_calibration || rig.clear_at_ms >= 0) && !(rig.world || rig.empty)) {
+    return bad("--read-calibration and --clear-at need --world or --empty-rig");
+  }
+  if (!rig.csv.empty() && rig.csv == o.elf) return bad("--csv must not name the image");
+  if ((rig.world ? 1 : 0) + (rig.empty ? 1 : 0) + (rig.pour ? 1 : 0) > 1) {
+    return bad("--world, --empty-rig and --pour exclude each other (--pour fills the bucket itself)");
+  }
+  const bool with_rig = rig.world || rig.pour || rig.empty;
+  if (!with_rig && (rig.estop_at_ms >= 0 || overcurrent_at_ms >= 0)) return bad("--estop-at and --overcurrent-at need --world, --empty-rig or --pour");
+  if (rig.pour && !seconds_given) o.seconds = 60.0;
+  rig.timeout_s = o.seconds;
+  if (overcurrent_at_ms >= 0) {
+    ao.fault_phase_overcurrent_a = overcurrent_a;
+    ao.fault_at_s = overcurrent_at_ms * 1e-3;
+  }
+  for (double t : {rig.estop_at_ms, overcurrent_at_ms, o.stall_core_at_ms}) {
+    if (t >= 0 && (rig.fault_at_ms < 0 || t < rig.fault_at_ms)) rig.fault_at_ms = t;
+  }
   std::ifstream f(o.elf, std::ios::binary);
   if (!f) return bad("cannot read " + o.elf);
   const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   std::vector<uint8_t> flash;
   const std::string err = load_elf(o.elf, bytes, &flash);
   if (!err.empty()) return bad(err);
+  if (corrupt_page >= 0) {
+    // A block whose write stopped after its first double-word, programmed 0 (not the block's magic): the rest
+    // of the page erased.
+    std::fill_n(flash.begin() + static_cast<long>(corrupt_page) * 2048, 8, uint8_t{0});
+  }
   std::fprintf(stderr, "virtual board: %s sha256 %s\n", o.elf.c_str(), sha256(bytes).c_str());
+  vb::AnalogSet analog;  // before the board: the plant outlives the models (and the rig's load on it)
   vb::Board board(o);
   board.load(flash);
-  vb::AnalogSet analog;
-  analog = vb::make_analog_models(vb::AnalogOptions{});
+  analog = vb::make_analog_models(ao);
   for (auto& m : analog.peripherals) board.add_model(std::move(m));
   board.add_model(std::make_unique<PlantStep>(analog.plant.get()));
+  vb::Rig* the_rig = nullptr;
+  if (with_rig) {
+    auto r = std::make_unique<vb::Rig>(rig, &board, analog.plant.get());
+    if (!r->error().empty()) return bad(r->error());
+    the_rig = r.get();
+    r->watch(analog.tim1);
+    board.add_model(std::move(r));  // after the plant: each step's frame leaves once the world has stepped
+  }
   const std::string e = board.init();
   if (!e.empty()) return bad(e);
-  const int rc = board.run();
+  int rc = board.run();
   const double emu = static_cast<double>(board.now_ps()) / 1e12;
   if (board.first_heartbeat_ps() != UINT64_MAX) {
     std::printf("heartbeat at %.3f ms emulated\n", static_cast<double>(board.first_heartbeat_ps()) / 1e9);
@@ -215,6 +338,10 @@ int main(int argc, char** argv) {
     std::printf("emulated %.3f s in %.3f s wall: ratio %.2f; %llu instructions, %llu exceptions, %llu frames, %u resets\n", emu,
                 board.wall_s(), board.wall_s() > 0 ? emu / board.wall_s() : 0.0, (unsigned long long)board.instructions(),
                 (unsigned long long)board.exceptions_taken(), (unsigned long long)board.frames_tx(), board.resets());
+  }
+  if (the_rig != nullptr) {
+    const int rr = the_rig->report();
+    if (rc == 0) rc = rr;
   }
   if (o.until_heartbeat && board.first_heartbeat_ps() == UINT64_MAX && rc == 0) {
     std::fprintf(stderr, "virtual board: no heartbeat within %.3f s\n", o.seconds);

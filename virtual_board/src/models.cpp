@@ -180,12 +180,23 @@ void Iwdg::reset() {
   SvdRegisters::reset();
   running_ = unlocked_ = false;
   reload_ps_ = busy_until_ps_ = 0;
+  domain_pr_ = 0;
+  domain_rl_ = 0xFFFu;
+  loaded_ps_ = 0;
 }
 
-uint64_t Iwdg::timeout_ps() const {
-  const uint32_t pr = regs_.at(0x04) & 7u;
-  const uint32_t rl = regs_.at(0x08) & 0xFFFu;
-  return (uint64_t)(rl + 1u) * (4u << (pr > 6u ? 6u : pr)) * 1000000000000ull / lsi_hz;
+void Iwdg::settle() {
+  if (t_->now_ps() < busy_until_ps_) return;
+  domain_pr_ = regs_.at(0x04) & 7u;
+  domain_rl_ = regs_.at(0x08) & 0xFFFu;
+}
+
+void Iwdg::reload(bool start) {
+  settle();
+  reload_ps_ = t_->now_ps();
+  // Started by 0xCCCC, the counter counts down from its reset value 0xFFF (RM0440 §41.3.2); 0xAAAA loads RLR.
+  const uint32_t count = start ? 0xFFFu : domain_rl_;
+  loaded_ps_ = (uint64_t)(count + 1u) * (4u << (domain_pr_ > 6u ? 6u : domain_pr_)) * 1000000000000ull / lsi_hz;
 }
 
 uint32_t Iwdg::on_read(uint32_t offset, uint32_t stored) {
@@ -199,12 +210,12 @@ void Iwdg::on_write(uint32_t offset, uint32_t old, uint32_t* value) {
   if (offset == 0x00) {
     const uint32_t key = *value & 0xFFFFu;
     if (key == 0xCCCCu) {
-      if (!running_) reload_ps_ = now;
+      if (!running_) reload(true);
       running_ = true;
     } else if (key == 0x5555u) {
       unlocked_ = true;
     } else if (key == 0xAAAAu) {
-      reload_ps_ = now;
+      reload(false);
       unlocked_ = false;
     } else {
       unlocked_ = false;
@@ -217,6 +228,7 @@ void Iwdg::on_write(uint32_t offset, uint32_t old, uint32_t* value) {
       *value = old;  // write-protected (RM0440 §41.3.6): ignored by the chip
       return;
     }
+    settle();  // what an earlier write had settled stays in the domain until this one does
     busy_until_ps_ = now + 5ull * 1000000000000ull / lsi_hz;
     regs_[0x0C] |= offset == 0x04 ? 1u : offset == 0x08 ? 2u : 4u;
   }

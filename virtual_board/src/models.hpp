@@ -95,9 +95,13 @@ class Iwdg : public SvdRegisters {
   void reset() override;
   void advance() override;
   uint64_t next_event() const override;
-  uint64_t timeout_ps() const;
+  // The timeout of the count running: the reload value and prescaler in the counter's (LSI) domain when the
+  // counter was last reloaded (RM0440 §41.3.2: a key 0xAAAA reloads IWDG_RLR's value into the counter; a new
+  // RLR or PR reaches that domain only after RVU / PVU clear, 5 LSI periods, and the count under way keeps
+  // the value it was loaded with). A PR change is taken at the next reload (the image writes one value).
+  uint64_t timeout_ps() const { return loaded_ps_; }
   bool running() const { return running_; }
-  uint64_t expiry_ps() const { return running_ ? reload_ps_ + timeout_ps() : UINT64_MAX; }
+  uint64_t expiry_ps() const { return running_ ? reload_ps_ + loaded_ps_ : UINT64_MAX; }
   uint32_t lsi_hz = 32000u;  // datasheet LSI typical 32 kHz (29.5 .. 34 kHz: board_facts.h LSI_MAX_HZ)
 
  protected:
@@ -106,8 +110,11 @@ class Iwdg : public SvdRegisters {
 
  private:
   TimeSource* t_;
+  void settle();   // RLR / PR into the counter's domain once RVU / PVU have cleared
+  void reload(bool start);  // the counter loaded: 0xFFF at the start, else the domain's RLR
   bool running_ = false, unlocked_ = false;
-  uint64_t reload_ps_ = 0, busy_until_ps_ = 0;
+  uint64_t reload_ps_ = 0, busy_until_ps_ = 0, loaded_ps_ = 0;
+  uint32_t domain_pr_ = 0, domain_rl_ = 0xFFFu;  // the reset values (RM0440 §41.4.2, §41.4.3)
 };
 
 // FLASH interface (RM0440 §3.7) and the two data pages at the end of the 128 KB (62, 63), which are

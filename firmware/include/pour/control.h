@@ -22,15 +22,16 @@
  * 4: parameters and calibration over CAN, the transitions of docs/safety.md (torque continuity, refusals).
  * 5: the drive (DRIVE fault, DriveTelemetry, calibration results), ExperimentStart.
  * 6: CalibrationResult's 5-bit Status (the interlock's refusals) and Stored in bits 5..7; the Crystal signal.
+ * 7: parameters 28-30, the supervisor's tilt margin and overspeed limit and the estimator's jump limit.
  * It is the DBC's protocol number (VERSION "pour CAN protocol N"), which test_can_dbc pins. */
-#define POUR_FIRMWARE_VERSION 6u
+#define POUR_FIRMWARE_VERSION 7u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {
   q15_t torque_max;             /* |stop torque| <= this, Q15, > 0 (then the envelope's clamp and slew) */
   int32_t return_speed_urad_s;  /* toward upright at no more than this [µrad/s], > 0 */
   uint16_t return_gain_per_s;   /* speed reference = -gain * θ [1/s], >= 1 */
-  q15_t torque_per_rad_s;       /* torque per rad/s of speed error, Q15, > 0 */
+  q15_t gain;                   /* torque per rad/s of speed error, Q15 per rad/s, > 0 */
   int32_t rest_theta_urad;      /* done when |θ| <= this ... [µrad], > 0 */
   int32_t rest_omega_urad_s;    /* ... and |θ̇| <= this [µrad/s], > 0 */
   uint16_t timeout_ms;          /* brake anyway after this long [ms], >= 1 */

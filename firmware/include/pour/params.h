@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* The controller's tunable parameters: one table (POUR_PARAMS) gives each its id, name, unit, range and the
- * field it lives in; defaults come from the modules' own default configs. Values are int32 in the field's
- * unit. Get/set by id with range checks, the sample correction (encoder zero, scale tare and factor), a
- * storage blob with a version and a CRC-32, and putting a new set in force in the core. Pure: no I/O.
+/* The controller's tunable parameters: one table (POUR_PARAMS) gives each its id, name, unit, default, range
+ * and the field it lives in. The modules' default configs take their defaults from it, the node's get/set and
+ * range checks, the bus's value lists (can/pour.dbc), the docs' tables and Python's field table are generated
+ * from it or read it (scripts/param_table.py checks that each agrees). Values are int32 in the field's unit.
+ * Get/set by id with range checks, the sample correction (encoder zero, scale tare and factor), a storage blob
+ * with a version and a CRC-32, and putting a new set in force in the core. Pure: no I/O.
  * The motor's parameters and the current-loop bandwidth join the table with the motor library. */
 #ifndef POUR_PARAMS_H
 #define POUR_PARAMS_H
@@ -17,7 +19,7 @@
 
 #define POUR_PARAM_FACTOR_ONE 1000000 /* a scale factor of 1.0 [ppm] */
 
-/* The safety case's ranges (docs/safety.md, "The motion envelope", "Defaults and why"), not the types': a
+/* The safety case's ranges (docs/safety.md, "Ranges the node accepts"), not the types': a
  * write beyond them is refused (POUR_PARAM_OUT_OF_RANGE) on the node, over CAN and from flash. They are compiled
  * in; widening one is a reviewed change of this file and a new firmware build, never a bus write. */
 #define POUR_PARAM_OMEGA_ENVELOPE_URAD_S 2000000   /* 2 rad/s: the hot-liquid limit, omega_max's default */
@@ -25,50 +27,121 @@
 #define POUR_PARAM_GAIN_ENVELOPE 16384             /* 0.5 tau_max per rad/s: the stiffest stable governor */
 #define POUR_PARAM_THETA_LOW_URAD (-87266)         /* -5 deg: a little past upright, never backwards over */
 #define POUR_PARAM_THETA_HIGH_URAD 2356194         /* 135 deg: the hard stop of the bucket's tilt */
+/* The supervisor's and the estimator's limits a commissioning engineer may tighten but not loosen: beyond them
+ * a fault is detected later or not at all (docs/safety.md, "Ranges the node accepts"; docs/hazards.md). */
+#define POUR_PARAM_THETA_MARGIN_URAD 87266         /* 5 deg: POSITION at most this far past the envelope's limits */
+#define POUR_PARAM_OVERSPEED_URAD_S 4000000        /* 4 rad/s: OVERSPEED at most twice the hot-liquid limit */
+#define POUR_PARAM_JUMP_URAD 10000                 /* 10 mrad: a count at most this far off its prediction */
 
-/* X(id, name, unit, min, max, C type, field of pour_params_t). Ids are the bus's (ParamId in can/pour.dbc,
- * whose value table names them alike; tests/python/test_can_dbc.py keeps the two equal). */
-#define POUR_PARAMS(X)                                                                                         \
-  /* the motion envelope (pour_safety_config_t) */                                                            \
-  X(0, tau_limit, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.tau_limit)                                    \
-  X(1, slew_per_tick, "Q15", 1, POUR_Q15_MAX, q15_t, control.safety.slew_per_tick)                            \
-  X(2, theta_min, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD, int32_t, control.safety.theta_min_urad)                         \
-  X(3, theta_max, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD, int32_t, control.safety.theta_max_urad)                         \
-  X(4, omega_max, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_max_urad_s)        \
-  X(5, alpha_max, "urad/s2", 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, int32_t, control.safety.alpha_max_urad_s2)                     \
-  X(6, omega_slack, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.omega_slack_urad_s)    \
-  X(7, governor_gain, "Q15/(rad/s)", 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, control.safety.torque_per_rad_s)                 \
-  /* the controlled stop (pour_stop_config_t) */                                                              \
-  X(8, stop_torque_max, "Q15", 1, POUR_Q15_MAX, q15_t, control.stop.torque_max)                               \
-  X(9, stop_return_speed, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.stop.return_speed_urad_s) \
-  X(10, stop_return_gain, "1/s", 1, UINT16_MAX, uint16_t, control.stop.return_gain_per_s)                     \
-  X(11, stop_gain, "Q15/(rad/s)", 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, control.stop.torque_per_rad_s)                      \
-  X(12, stop_rest_theta, "urad", 1, 3141593, int32_t, control.stop.rest_theta_urad)                          \
-  X(13, stop_rest_omega, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.stop.rest_omega_urad_s)  \
-  X(14, stop_timeout, "ms", 1, UINT16_MAX, uint16_t, control.stop.timeout_ms)                                 \
-  /* the node and the encoder */                                                                              \
-  X(15, node_id, "", 0, 63, uint8_t, node_id)                                                                 \
-  X(16, encoder_bits, "bits", POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, uint8_t, control.sensors.encoder_bits) \
-  X(17, encoder_zero, "counts", 0, 16777215, int32_t, encoder_zero)                                           \
-  /* the gearbox between the motor and the output shaft (the drive's: motor torque = output torque / ratio) */ \
-  X(18, gear_ratio, "1/1000", 1000, 1000000, int32_t, gear_ratio_milli)                                       \
-  /* the load cells: grams = (reading - tare) * factor */                                                     \
-  X(19, scale_rotating_factor, "ppm", 500000, 2000000, int32_t, scale_rotating_factor_ppm)                    \
-  X(20, scale_rotating_tare, "g", -32767, 32767, int32_t, scale_rotating_tare_g)                             \
-  X(21, scale_target_factor, "ppm", 500000, 2000000, int32_t, scale_target_factor_ppm)                        \
-  X(22, scale_target_tare, "g", -32767, 32767, int32_t, scale_target_tare_g)                                 \
-  /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */          \
-  X(23, knee_theta, "urad", 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, control.safety.knee_theta_urad)           \
-  X(24, slow_omega, "urad/s", 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, control.safety.slow_omega_urad_s)    \
-  X(25, knee_decel, "urad/s2", 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, control.safety.knee_decel_urad_s2) \
-  X(26, slow_torque_ff, "Q15", 0, POUR_Q15_MAX, q15_t, control.safety.slow_torque_ff)                         \
-  X(27, slow_ki, "1/s", 0, UINT16_MAX, uint16_t, control.safety.slow_ki_per_s)
+/* X(id, name, unit, default, min, max, C type, group, member, doc). The row's field is
+ * POUR_PARAM_IN_<group>(member) of pour_params_t: the group names the config struct it lives in, and that
+ * struct's default config (pour_safety_default_config, pour_sensors_default_config,
+ * pour_supervisor_default_config, pour_control_default_config's stop, and pour_params_default for the port's
+ * own) sets each member to the row's default, so a default is written once, here. doc says in one line why it
+ * is the default (docs/safety.md shows it, beside the longer arguments of "Defaults and why"). Ids are the
+ * bus's: ParamId's value lists in can/pour.dbc are what scripts/param_table.py dbc --write writes from this
+ * table. A default outside [min, max], two rows on one id or two of one name fail the build: scripts/
+ * param_table.py check names the rows, and the compiler (params.c) refuses them too. */
+#define POUR_PARAMS(X)                                                                                               \
+  /* the motion envelope (pour_safety_config_t; docs/safety.md, "Defaults and why") */                               \
+  X(0, tau_limit, "Q15", POUR_Q15_MAX, 1, POUR_Q15_MAX, q15_t, safety, tau_limit,                                    \
+    "1.0 tau_max: the policy was trained against tau_max; lower it on a bench to be gentle")                         \
+  X(1, slew_per_tick, "Q15", 3277, 1, POUR_Q15_MAX, q15_t, safety, slew_per_tick,                                    \
+    "a full -1 to +1 swing in 20 ms (two decision periods): no torque steps into the gearbox or the liquid")         \
+  X(2, theta_min, "urad", POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,          \
+    int32_t, safety, theta_min_urad,                                                                                 \
+    "-5 deg: a little past upright so the bucket can settle, never backwards over")                                  \
+  X(3, theta_max, "urad", POUR_PARAM_THETA_HIGH_URAD, POUR_PARAM_THETA_LOW_URAD, POUR_PARAM_THETA_HIGH_URAD,         \
+    int32_t, safety, theta_max_urad,                                                                                 \
+    "135 deg: the bucket's hard stop (the simulator's joint limit): never push into it")                             \
+  X(4, omega_max, "urad/s", POUR_PARAM_OMEGA_ENVELOPE_URAD_S, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety,  \
+    omega_max_urad_s,                                                                                                \
+    "2 rad/s: 93 degC liquid stays in the bucket (the hot-liquid limit)")                                            \
+  X(5, alpha_max, "urad/s2", POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, 1000, POUR_PARAM_ALPHA_ENVELOPE_URAD_S2, int32_t,    \
+    safety, alpha_max_urad_s2,                                                                                       \
+    "3.4 rad/s^2: omega_max reached in one period of the 1.7 Hz slosh mode, which the ramp then leaves at rest")     \
+  X(6, omega_slack, "urad/s", 800000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, omega_slack_urad_s,      \
+    "0.8 rad/s: K * slack = 0.4 tau_max holds and starts the full bucket, above the supervisor's torque_min")        \
+  X(7, governor_gain, "Q15/(rad/s)", POUR_PARAM_GAIN_ENVELOPE, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, safety,           \
+    governor_gain,                                                                                                   \
+    "0.5 tau_max per rad/s: the stiffest governor stable on the lightest load with 2 ticks of latency")              \
+  /* the controlled stop (pour_stop_config_t; docs/safety.md, "Defaults", controlled stop) */                        \
+  X(8, stop_torque_max, "Q15", 16384, 1, POUR_Q15_MAX, q15_t, stop, torque_max,                                      \
+    "0.5 tau_max: decelerates 16 rad/s in well under 0.2 s, gently enough not to throw the liquid")                  \
+  X(9, stop_return_speed, "urad/s", 1000000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, return_speed_urad_s,\
+    "1 rad/s: back toward upright slowly, no slosh over the lip")                                                    \
+  X(10, stop_return_gain, "1/s", 2, 1, UINT16_MAX, uint16_t, stop, return_gain_per_s,                                \
+    "the speed reference falls to 0 over the last half radian")                                                      \
+  X(11, stop_gain, "Q15/(rad/s)", 16384, 1, POUR_PARAM_GAIN_ENVELOPE, q15_t, stop, gain,                             \
+    "0.5 tau_max per rad/s of speed error")                                                                          \
+  X(12, stop_rest_theta, "urad", 87266, 1, 3141593, int32_t, stop, rest_theta_urad,                                  \
+    "5 deg of upright: at rest, as the fault tests measure it")                                                      \
+  X(13, stop_rest_omega, "urad/s", 50000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, stop, rest_omega_urad_s,     \
+    "0.05 rad/s: at rest, as the fault tests measure it")                                                            \
+  X(14, stop_timeout, "ms", 5000, 1, UINT16_MAX, uint16_t, stop, timeout_ms,                                         \
+    "from 135 deg at 1 rad/s takes 2.4 s: twice that, then brake anyway")                                            \
+  /* the node, the encoder, the gearbox and the load cells (the port's own, and pour_sensors_config_t) */            \
+  X(15, node_id, "", 0, 0, 63, uint8_t, port, node_id,                                                               \
+    "the port binds it at start-up (its command line, the board's stored set)")                                      \
+  X(16, encoder_bits, "bits", 17, POUR_ENCODER_BITS_MIN, POUR_ENCODER_BITS_MAX, uint8_t, sensors, encoder_bits,      \
+    "the bench rig's absolute encoder (47.9 urad a count)")                                                          \
+  X(17, encoder_zero, "counts", 0, 0, 16777215, int32_t, port, encoder_zero,                                         \
+    "uncalibrated: the raw count read upright, set by the calibration")                                              \
+  X(18, gear_ratio, "1/1000", 1000, 1000, 1000000, int32_t, port, gear_ratio_milli,                                  \
+    "motor turns per output turn (the drive's: motor torque = output torque / ratio); 1 until the rig's is set")     \
+  X(19, scale_rotating_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port,                         \
+    scale_rotating_factor_ppm,                                                                                       \
+    "uncalibrated: grams = (reading - tare) * factor, factor 1.0")                                                   \
+  X(20, scale_rotating_tare, "g", 0, -32767, 32767, int32_t, port, scale_rotating_tare_g,                            \
+    "uncalibrated: no tare (the reading with the rotating bucket empty)")                                            \
+  X(21, scale_target_factor, "ppm", POUR_PARAM_FACTOR_ONE, 500000, 2000000, int32_t, port, scale_target_factor_ppm,  \
+    "uncalibrated: factor 1.0")                                                                                      \
+  X(22, scale_target_tare, "g", 0, -32767, 32767, int32_t, port, scale_target_tare_g,                                \
+    "uncalibrated: no tare")                                                                                         \
+  /* the motion envelope's fill schedule (pour_safety_config_t; docs/safety.md, "Fill schedule") */                  \
+  X(23, knee_theta, "urad", 0, 0, POUR_SAFETY_KNEE_MAX_URAD, int32_t, safety, knee_theta_urad,                       \
+    "0: off; the rig file gives the knee, its fill's onset angle less 3 deg")                                        \
+  X(24, slow_omega, "urad/s", 160000, 1, POUR_PARAM_OMEGA_ENVELOPE_URAD_S, int32_t, safety, slow_omega_urad_s,       \
+    "0.16 rad/s past the knee: 11-12 L leave no faster than the target takes them")                                  \
+  X(25, knee_decel, "urad/s2", 10000000, 1000, POUR_SAFETY_DECEL_MAX_URAD_S2, int32_t, safety, knee_decel_urad_s2,   \
+    "10 rad/s^2: 2 rad/s down to 0.16 rad/s within 0.2 rad (11 deg) before the knee")                                \
+  X(26, slow_torque_ff, "Q15", 1638, 0, POUR_Q15_MAX, q15_t, safety, slow_torque_ff,                                 \
+    "0.05 tau_max = 1 N m: the part of the load the integral need not build up")                                     \
+  X(27, slow_ki, "1/s", 5, 0, UINT16_MAX, uint16_t, safety, slow_ki_per_s,                                           \
+    "K * 5/s * 0.16 rad/s = 8 N m/s: the integral takes up a full bucket's 3-5 N m within a second")                 \
+  /* the supervisor's limits and the estimator's jump limit (docs/safety.md, "Ranges the node accepts") */           \
+  X(28, supervisor_theta_margin, "urad", POUR_PARAM_THETA_MARGIN_URAD, 1, POUR_PARAM_THETA_MARGIN_URAD, int32_t,     \
+    supervisor, theta_margin_urad,                                                                                   \
+    "5 deg past the envelope's limits: an overshoot no nominal pour shows (nominal -0.0 .. 128.4 deg)")              \
+  X(29, supervisor_omega_max, "urad/s", POUR_PARAM_OVERSPEED_URAD_S, 1, POUR_PARAM_OVERSPEED_URAD_S, int32_t,        \
+    supervisor, omega_max_urad_s,                                                                                    \
+    "4 rad/s, twice the envelope's limit: a speed the governor could not hold (its droop is <= 0.54 rad/s)")         \
+  X(30, jump_max, "urad", POUR_PARAM_JUMP_URAD, 1, POUR_PARAM_JUMP_URAD, int32_t, sensors, jump_max_urad,            \
+    "10 mrad: the loop lags that far only beyond 900 rad/s^2; a count further off its prediction jumped")
 
-#define POUR_PARAM_COUNT 28u
+/* One name per parameter. A row's name is the one the bus (ParamId), pour-bench, the docs and the node's table
+ * use; its member is that name without its group's prefix (stop_ for the controlled stop's rows, supervisor_
+ * for the supervisor's, none for the others) and with its unit's suffix: _urad, _urad_s, _urad_s2, _ms,
+ * _per_s (1/s), _ppm, _g, _milli (1/1000); none for Q15, Q15/(rad/s), bits, counts and plain numbers. So
+ * theta_max is safety.theta_max_urad, stop_timeout stop.timeout_ms, governor_gain safety.governor_gain; Python
+ * and the simulator's bridge reach a field by its C path (control.safety.theta_max_urad). scripts/param_table.py
+ * check holds every row to this rule. A rig file's fill_schedule_l is no parameter: it is the fill [L] from
+ * which the simulator sets a rig's knee_theta. */
+
+/* Where each group's members live in pour_params_t. */
+#define POUR_PARAM_IN_safety(member) control.safety.member
+#define POUR_PARAM_IN_stop(member) control.stop.member
+#define POUR_PARAM_IN_sensors(member) control.sensors.member
+#define POUR_PARAM_IN_supervisor(member) control.supervisor.member
+#define POUR_PARAM_IN_port(member) member
+
+/* The number of rows (ids 0 .. count - 1). */
+#define POUR_PARAM_PLUS_ONE(...) +1u
+#define POUR_PARAM_COUNT (0u POUR_PARAMS(POUR_PARAM_PLUS_ONE))
 
 /* POUR_PARAM_ID_<name>: each parameter's id, from the table. */
 typedef enum {
-#define POUR_PARAM_ENUM(id, name, unit, lo, hi, type, field) POUR_PARAM_ID_##name = id,
+#define POUR_PARAM_ENUM(id, name, unit, def, lo, hi, type, group, member, doc) POUR_PARAM_ID_##name = id,
   POUR_PARAMS(POUR_PARAM_ENUM)
 #undef POUR_PARAM_ENUM
 } pour_param_id_t;
@@ -91,6 +164,7 @@ typedef struct {
   const char *unit;
   int32_t min; /* valid values: min .. max, inclusive */
   int32_t max;
+  int32_t default_value; /* the compiled default (the port's own node id aside) */
 } pour_param_info_t;
 
 /* How a parameter request or a stored set is judged. */
@@ -111,7 +185,8 @@ const char *pour_param_result_name(pour_param_result_t result);
 const pour_param_info_t *pour_param_info(uint8_t id);
 
 /* The defaults: control as given (the port's command line on top of pour_control_default_config), node_id,
- * no encoder zero offset, gear ratio 1, factors 1.0, tares 0. */
+ * and the port's own rows (group port) at their declared defaults: no encoder zero offset, gear ratio 1,
+ * factors 1.0, tares 0. */
 void pour_params_default(pour_params_t *params, const pour_control_config_t *control, uint8_t node_id);
 
 /* The value of id; POUR_PARAM_UNKNOWN_ID otherwise (*value untouched). */

@@ -28,7 +28,7 @@ typedef struct {
   int32_t omega_max_urad_s;   /* speed limit: no torque that speeds |θ̇| up beyond it [µrad/s], > 0 */
   int32_t alpha_max_urad_s2;  /* the speed band widens at most this fast [µrad/s²], >= 1000 */
   int32_t omega_slack_urad_s; /* the band reaches this far beyond the current speed [µrad/s], > 0 */
-  q15_t torque_per_rad_s;     /* governor gain: torque bound per rad/s of speed margin, Q15, > 0 */
+  q15_t governor_gain;        /* torque bound per rad/s of speed margin, Q15 per rad/s, > 0 */
   /* The fill schedule (docs/safety.md, "Fill schedule"): off while knee_theta_urad is 0. */
   int32_t knee_theta_urad;    /* past this tilt the ceiling is slow_omega [µrad], 0 (off) .. KNEE_MAX */
   int32_t slow_omega_urad_s;  /* the ceiling past the knee (at most omega_max) [µrad/s], 1 .. OMEGA_MAX */
@@ -42,7 +42,7 @@ typedef struct {
   q15_t torque;   /* last commanded torque, Q15 */
   uint8_t active; /* POUR_LIMIT_* bits of the last command */
   int32_t alpha_step_urad_s;  /* alpha_max · 1 ms: the band's widening per tick [µrad/s] */
-  int32_t gain_q32;           /* torque_per_rad_s / 10^6: Q15 torque per µrad/s, Q32 (< 2^28) */
+  int32_t gain_q32;           /* governor_gain / 10^6: Q15 torque per µrad/s, Q32 (< 2^28) */
   int32_t ceiling_urad_s;     /* speed band: no torque that speeds θ̇ beyond [floor, ceiling] [µrad/s] */
   int32_t floor_urad_s;
   int32_t integral_mq15;      /* the fill schedule's integral [Q15 / 1000], 0 .. tau_limit · 500 */
@@ -57,7 +57,7 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
 /* Shapes a requested torque by angle limits, clamp, the speed band, slew, then cuts toward zero whatever still
  * lies beyond the band or an angle limit (less torque never waits for the slew). The band follows the
  * estimated speed omega_urad_s: ceiling = min(omega_max, ceiling + alpha step, max(θ̇, 0) + slack), floor
- * likewise, torque within [K (floor - θ̇), K (ceiling - θ̇)] (K = torque_per_rad_s, each bound within
+ * likewise, torque within [K (floor - θ̇), K (ceiling - θ̇)] (K = governor_gain, each bound within
  * ±tau_limit): beyond the band the bound changes sign and brakes, against gravity too. With a knee, the
  * ceiling is also at most sqrt(slow² + 2 · knee_decel · (knee - θ)) before the knee and slow past it; where
  * that limit is below omega_max the upper bound is min(K (ceiling - θ̇) + slow_torque_ff + I,

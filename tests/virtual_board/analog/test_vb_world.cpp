@@ -30,8 +30,39 @@ struct Run {
   bool ok = false;
 };
 
-// `amplitude` of the vector (negative: 90 degrees behind the rotor; 0: all three compares at 0, every low side
-// on), `seconds` of it.
+// The vector `amplitude` ahead of the rotor (negative: 90 degrees behind it; 0: all three compares at 0, every
+// low side on), from TIM4's count, one PWM period per step().
+class Drive {
+ public:
+  Drive(Board& b, double amplitude) : b_(b), a_(amplitude), cpr_(b.set.plant->encoder_cpr()), pp_(b.set.plant->pole_pairs()) {
+    b.w("TIM4", 0x08, 3u);
+    b.w("TIM4", 0x18, 1u | (1u << 8));
+    b.w("TIM4", 0x00, 1u);
+    if (amplitude != 0.0) tim1_pwm(b, ARR_20KHZ / 2, ARR_20KHZ / 2, ARR_20KHZ / 2);
+    else tim1_pwm(b, 0, 0, 0);
+  }
+  void step() {
+    if (a_ != 0.0) {
+      const uint16_t c = static_cast<uint16_t>(b_.r("TIM4", 0x24));
+      total_ += static_cast<int16_t>(static_cast<uint16_t>(c - last_));
+      last_ = c;
+      const double th = 2.0 * kPi * static_cast<double>(total_) / cpr_ * pp_ + kPi / 2.0;
+      double d[3];
+      for (int k = 0; k < 3; ++k) d[k] = 0.5 + a_ * std::cos(th - 2.0 * kPi * k / 3.0);
+      compares(b_, d);
+    }
+    b_.run_s(50e-6);
+  }
+
+ private:
+  Board& b_;
+  double a_;
+  int cpr_, pp_;
+  int32_t total_ = 0;
+  uint16_t last_ = 0;
+};
+
+// `amplitude` of the vector, `seconds` of it.
 Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
   vb::AnalogOptions o;
   o.seed = seed;
@@ -46,26 +77,10 @@ Run run(double amplitude, double seconds, bool brake, uint32_t seed) {
     return r;
   }
   r.remaining0 = world.remaining();
-  b.w("TIM4", 0x08, 3u);
-  b.w("TIM4", 0x18, 1u | (1u << 8));
-  b.w("TIM4", 0x00, 1u);
-  if (amplitude != 0.0) tim1_pwm(b, ARR_20KHZ / 2, ARR_20KHZ / 2, ARR_20KHZ / 2);
-  else tim1_pwm(b, 0, 0, 0);
-  const int cpr = b.set.plant->encoder_cpr(), pp = b.set.plant->pole_pairs();
+  Drive drive(b, amplitude);
   const int periods = static_cast<int>(seconds * 20000.0);
-  int32_t total = 0;
-  uint16_t last = 0;
   for (int n = 0; n < periods && world.ok(); ++n) {
-    if (amplitude != 0.0) {
-      const uint16_t c = static_cast<uint16_t>(b.r("TIM4", 0x24));
-      total += static_cast<int16_t>(static_cast<uint16_t>(c - last));
-      last = c;
-      const double th = 2.0 * kPi * static_cast<double>(total) / cpr * pp + kPi / 2.0;
-      double d[3];
-      for (int k = 0; k < 3; ++k) d[k] = 0.5 + amplitude * std::cos(th - 2.0 * kPi * k / 3.0);
-      compares(b, d);
-    }
-    b.run_s(50e-6);
+    drive.step();
     r.theta_max = std::fmax(r.theta_max, std::fabs(world.bucket_theta()));
     r.peak_gear_nm = std::fmax(r.peak_gear_nm, std::fabs(world.gear_torque()));
     if (r.t_leaves < 0.0 && world.remaining() < r.remaining0 - 0.01) r.t_leaves = world.obs().t;
@@ -136,6 +151,48 @@ int main() {
     CHECK(a.hash != c.hash, "seed 8 differs from seed 7");
     std::printf("determinism: seed 7 hash %016llx twice, seed 8 %016llx\n", static_cast<unsigned long long>(a.hash),
                 static_cast<unsigned long long>(c.hash));
+  }
+  {  // The gearbox (gear_load_at_motor): the motor pays the loss when it drives, the bucket when it drives back.
+    const double drive_nm = vb::gear_load_at_motor(10.0, 1.0, 20.0, 0.9), back_nm = vb::gear_load_at_motor(10.0, -1.0, 20.0, 0.9);
+    CHECK(std::fabs(drive_nm - 10.0 / (20.0 * 0.9)) < 1e-12 && std::fabs(back_nm - 10.0 * 0.9 / 20.0) < 1e-12,
+          "10 N m at the output: %.4f N m at the motor driving, %.4f driven back", drive_nm, back_nm);
+    CHECK(std::fabs(vb::default_gear_efficiency() - 29491.0 / 32768.0) < 1e-12, "host_sim's full drive's 0.90: %.5f",
+          vb::default_gear_efficiency());
+  }
+  {  // The empty rig: the positive torque turns the empty bucket; its Sensors frame reads the angle and empty
+     // scales (the load cells' noise only); with the brake engaged it is held.
+    for (bool brake : {false, true}) {
+      vb::AnalogOptions o;
+      Board b(o);
+      vb::WorldCouplingOptions wo;
+      vb::EmptyBucket empty(wo, b.set.plant.get());
+      empty.set_brake(brake);
+      Drive drive(b, 0.12);
+      double theta_max = 0.0;
+      for (int n = 0; n < 10000; ++n) {  // 0.5 s
+        drive.step();
+        theta_max = std::fmax(theta_max, std::fabs(empty.bucket_theta()));
+      }
+      pour_can_frame_t f{};
+      pour_can_sensors_t m{};
+      CHECK(empty.sensors_frame(0u, &f) && pour_can_unpack_sensors(&f, &m) == POUR_CAN_RX_OK, "the empty rig's frame packs");
+      CHECK(empty.steps() >= 499u && empty.steps() <= 500u, "lockstep: %u steps in 0.5 s", empty.steps());
+      CHECK(std::abs(m.scale_rotating_g) <= 3 && std::abs(m.scale_target_g) <= 3, "empty scales: %d g, %d g", m.scale_rotating_g,
+            m.scale_target_g);
+      if (brake) {
+        CHECK(theta_max < 0.1 * kPi / 180.0, "held by the brake: |theta| max %.2e rad", theta_max);
+      } else {
+        const double th = empty.bucket_theta();
+        CHECK(th > 0.1, "the empty bucket turned: %.3f rad", th);
+        CHECK(std::fabs(b.set.plant->theta() / 20.0 - th) < 0.02, "the shaft follows through the gear: %.4f vs %.4f rad",
+              b.set.plant->theta() / 20.0, th);
+        // the frame is the step's sample (the bucket has moved on since, within one step)
+        const double enc = static_cast<double>(m.encoder) * 2.0 * kPi / (1u << poursim_default_config().encoder_bits);
+        CHECK(std::fabs(enc - th) < 0.01, "the output encoder reads the angle: %.4f vs %.4f rad", enc, th);
+        std::printf("empty rig: theta %.3f rad after 0.5 s, encoder %u, scales %d / %d g\n", th, m.encoder, m.scale_rotating_g,
+                    m.scale_target_g);
+      }
+    }
   }
   {  // Bad options: a one-line error, no world, the plant left without a load.
     const double bad[][2] = {{0.0, 4.4}, {-1.0, 4.4}, {NAN, 4.4}, {2000.0, -1.0}, {2000.0, INFINITY}};

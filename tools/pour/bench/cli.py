@@ -270,7 +270,8 @@ def run(a: argparse.Namespace) -> int:
         table = _param_table()
         for pid, name in bn.param_names(bn.load_dbc()).items():
             prm = table.get(name)
-            print(f"{pid:3d} {name}" + (f"  [{prm.range_text()}]" if prm else ""))
+            default = f"{prm.to_si(prm.default):.6g} {prm.si_unit}".rstrip() if prm else ""
+            print(f"{pid:3d} {name}" + (f"  [{prm.range_text()}; default {default}]" if prm else ""))
         return 0
     table: dict[str, bp.Param] = {}
     if a.cmd == "config" and not getattr(a, "raw", False) and a.config_cmd != "save":

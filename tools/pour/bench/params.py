@@ -1,19 +1,19 @@
 # SPDX-License-Identifier: MIT
-"""The controller's parameters in SI units, for pour-bench config: each parameter's unit and range come from the
-firmware's own table (POUR_PARAMS in firmware/include/pour/params.h, read through libpoursim's
-pour_param_info), the value on the bus is that unit's integer, and SI maps each firmware unit to its SI one.
+"""The controller's parameters in SI units, for pour-bench config: each parameter's unit, default and range come
+from the firmware's own table (POUR_PARAMS in firmware/include/pour/params.h, read through libpoursim's
+pour_param_info; no list is kept here), the value on the bus is that unit's integer, and SI maps each firmware
+unit to its SI one.
 A dump is a JSON file of every parameter's raw value with its SI reading; a restore checks the whole file
 against the table before it writes anything."""
 from __future__ import annotations
 
-import ctypes as C
 import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from pour import atomic, libpoursim, records
+from pour import atomic, functions
 
 # Firmware unit -> (SI unit, SI per firmware unit). Q15 torques are fractions of the node's full-scale torque
 # (Identity.TauMax), named as such.
@@ -48,6 +48,7 @@ class Param:
     unit: str   # the firmware's (the bus value's)
     min: int    # raw, inclusive
     max: int
+    default: int  # raw, as compiled (the node id the port's own)
 
     @property
     def si_unit(self) -> str:
@@ -78,21 +79,23 @@ class Param:
         return f"{self.to_si(self.min):.6g} .. {self.to_si(self.max):.6g} {self.si_unit}".rstrip()
 
     def describe(self, raw: int) -> str:
-        """`omega_max 1.5 rad/s (range 1e-06 .. 6.28319 rad/s; raw 1500000 urad/s)`."""
+        """`omega_max 1.5 rad/s (range 1e-06 .. 2 rad/s; default 2 rad/s; raw 1500000 urad/s)`."""
         si = f"{self.to_si(raw):.6g} {self.si_unit}".rstrip()
-        return f"{self.name} {si} (range {self.range_text()}; raw {raw} {self.unit})".replace(" )", ")")
+        default = f"{self.to_si(self.default):.6g} {self.si_unit}".rstrip()
+        return (f"{self.name} {si} (range {self.range_text()}; default {default}; "
+                f"raw {raw} {self.unit})").replace(" )", ")")
 
 
 def table() -> dict[str, Param]:
     """Every parameter of the firmware's table, by name, in id order (SimError without libpoursim)."""
-    fn = libpoursim.load().pour_param_info
-    fn.argtypes, fn.restype = [C.c_uint8], C.POINTER(records.record("pour_param_info_t"))
+    fn = functions.library().pour_param_info
     out: dict[str, Param] = {}
     for pid in range(256):
         row = fn(pid)
         if row:
             r = row.contents
-            out[r.name.decode()] = Param(int(r.id), r.name.decode(), r.unit.decode(), int(r.min), int(r.max))
+            out[r.name.decode()] = Param(int(r.id), r.name.decode(), r.unit.decode(), int(r.min), int(r.max),
+                                          int(r.default_value))
     return out
 
 

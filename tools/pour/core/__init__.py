@@ -29,7 +29,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from pour import libpoursim, records
+from pour import functions, records
 
 q15 = C.c_int16
 POLICY_MAX_ACTIONS = 16
@@ -52,54 +52,10 @@ def _r(name: str) -> type:
     return records.record(RECORDS[name])
 
 
-_lib: C.CDLL | None = None
-
-
-def load() -> C.CDLL:
-    """libpoursim (pour.libpoursim opens it) with the core's entry points declared; SimError if it is missing."""
-    global _lib
-    if _lib is not None:
-        return _lib
-    lib = libpoursim.load()
-    P, V, err = C.POINTER, C.c_void_p, [C.c_char_p, C.c_size_t]
-    sig: dict[str, tuple[list[Any], Any]] = {
-        "pour_status_name": ([C.c_int], C.c_char_p),
-        "pour_sensors_theta_urad": ([C.c_uint32, C.c_uint8], C.c_int32),
-        "poursim_sizeof": ([C.c_char_p], C.c_size_t),
-        "poursim_fw_config_size": ([], C.c_size_t),
-        "poursim_fw_config_init": ([V, V], None),
-        "poursim_fw_config_field": ([C.c_int], C.c_char_p),
-        "poursim_fw_config_set": ([V, C.c_char_p, C.c_int64], C.c_int),
-        "poursim_fw_config_get": ([V, C.c_char_p, P(C.c_int64)], C.c_int),
-        "poursim_envelope_create": ([V] + err, V),
-        "poursim_envelope_destroy": ([V], None),
-        "poursim_envelope_apply": ([V, q15, C.c_int32, C.c_int32], q15),
-        "poursim_envelope_force": ([V, q15], None),
-        "poursim_envelope_active": ([V], C.c_uint8),
-        "poursim_envelope_torque": ([V], q15),
-        "poursim_envelope_band": ([V, P(C.c_int32), P(C.c_int32)], None),
-        "poursim_estimator_create": ([V] + err, V),
-        "poursim_estimator_destroy": ([V], None),
-        "poursim_estimator_reset": ([V], None),
-        "poursim_estimator_update": ([V, P(_r("SensorSample")), P(_r("PlantState"))], C.c_int),
-        "poursim_core_create": ([V, C.c_int, C.c_int, C.c_int, P(C.c_int16), P(C.c_int16), C.c_int32, C.c_int32,
-                                 C.c_int32, C.c_int32, C.c_uint32] + err, V),
-        "poursim_core_destroy": ([V], None),
-        "poursim_core_update": ([V, P(_r("ControlInput"))], C.c_int),
-        "poursim_core_state": ([V, P(_r("PlantState"))], None),
-        "poursim_core_decide": ([V], None),
-        "poursim_core_request": ([V, C.c_uint8, q15], None),
-        "poursim_core_shape": ([V, P(_r("ControlOutput"))], None),
-        "poursim_core_step": ([V, P(_r("ControlInput")), P(_r("ControlOutput"))], None),
-    }
-    try:
-        for name, (args, res) in sig.items():
-            fn = getattr(lib, name)
-            fn.argtypes, fn.restype = args, res
-    except AttributeError as e:
-        raise libpoursim.SimError(f"libpoursim does not export the firmware core (missing symbol: {e})") from e
-    _lib = lib
-    return lib
+def load() -> functions.Functions:
+    """libpoursim's functions, the core's among them, declared from the library's own function table
+    (pour.functions); SimError if it is missing."""
+    return functions.library()
 
 
 def _names(fn: Any, count: int) -> dict[int, str]:
@@ -111,7 +67,7 @@ def _names(fn: Any, count: int) -> dict[int, str]:
     return out
 
 
-fault_name, fault_names, mode_name = libpoursim.fault_name, libpoursim.fault_names, libpoursim.mode_name
+fault_name, fault_names, mode_name = functions.fault_name, functions.fault_names, functions.mode_name
 
 
 def __getattr__(name: str) -> Any:

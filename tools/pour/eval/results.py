@@ -10,7 +10,6 @@ same seeds. Writes results/results.md and results/results.json.
 from __future__ import annotations
 
 import json
-import multiprocessing as mp
 import os
 import sys
 from pathlib import Path
@@ -23,7 +22,7 @@ from pour.eval import evaluate
 from pour.policy import export, weights_h
 from pour.sim import envs
 from pour.sim.episode import FINISH_MAX_S, POURED_MIN_PCT, SPILLED_MAX_PCT
-from pour.train import trainer
+from pour.train import executors, rundir
 
 FIRST_SEED = 1_000_001  # held-out: training and validation seeds come from SeedSequence streams
 
@@ -50,22 +49,14 @@ def host_sim_row(name: str, args: Sequence[str], n: int, build_dir: str | None) 
                 [e["finish_s"] for e in per], [e["return"] for e in per], [e["reversals"] for e in per])
 
 
-_SIMS: dict[tuple[str, int, int], Any] = {}
-
-
-def _greedy_metrics(job: tuple) -> dict[str, float]:
+def _greedy_metrics(kind: str, n_actions: int, period_ms: int, policy: Any, seed: int) -> dict[str, float]:
     """One held-out episode of 10 s on the nominal rig: a W through the C rollout, an MLP actor (a tuple of its
     layers) through the Gymnasium env, which runs the same simulator and firmware pipeline tick by tick."""
-    kind, n_actions, period_ms, policy, seed = job
     if isinstance(policy, tuple):
         from pour.sim import gym_env  # _run_policies made sure the gym extra is there
-        key = ("env:" + kind, n_actions, period_ms)
-        if key not in _SIMS:
-            _SIMS[key] = gym_env.PourEnv(kind, n_actions, period_ms, 10.0)
-        return gym_env.greedy_metrics(_SIMS[key], gym_env.mlp_actor(policy), seed)
-    if (kind, n_actions, period_ms) not in _SIMS:
-        _SIMS[(kind, n_actions, period_ms)] = envs.make_env(kind, n_actions, period_ms, 10.0)
-    return dict(_SIMS[(kind, n_actions, period_ms)].rollout(policy, seed, True).metrics)
+        env = executors.cached(gym_env.PourEnv, kind, n_actions, period_ms, 10.0)
+        return gym_env.greedy_metrics(env, gym_env.mlp_actor(policy), seed)
+    return dict(executors.cached(envs.make_env, kind, n_actions, period_ms, 10.0).rollout(policy, seed, True).metrics)
 
 
 def _mlp_layers(state: dict[str, Any], prefix: str) -> list[np.ndarray]:
@@ -76,7 +67,7 @@ def _run_policies(run: Path) -> tuple[tuple[str, int, int], dict[str, Any], list
     """A run's (env kind, n_actions, decision period), its output policies ('best', 'last') and its validated
     history: W arrays for the trainer's and the linear actors' runs (policy.json, history_w), tuples of layers for
     an MLP actor's (actor.json, pour.examples.sb3_ppo --actor mlp: history_mlp_<k>)."""
-    ck = trainer.load_checkpoint(run / "checkpoint.npz")
+    ck = rundir.load_checkpoint(run / "checkpoint.npz")
     if (run / "actor.json").exists():
         try:
             doc = json.loads((run / "actor.json").read_text(encoding="utf-8"))
@@ -108,12 +99,13 @@ def _jobs(runs: Sequence[Path], n: int, which: str) -> list[tuple]:
     return jobs
 
 
-def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best") -> dict[str, Any]:
+def float_rows(name: str, runs: Sequence[Path], n: int, which: str = "best", workers: int | None = None
+               ) -> dict[str, Any]:
     """The output policies of several runs (which 'best': policy.json's best_w, the best greedy-validated
     weights, or the last ones for configs with eval.select_best = false; 'last': the final weights),
-    greedy, n held-out episodes each, pooled."""
+    greedy, n held-out episodes each, pooled; on `workers` processes (default: one a core), same figures."""
     jobs = _jobs(runs, n, which)
-    ms = _held_out(jobs)
+    ms = _held_out(jobs, workers)
     p = [100 * m["v_target"] for m in ms]
     s = [100 * m["v_spill"] for m in ms]
     f = [m["finish_s"] for m in ms]
@@ -131,10 +123,9 @@ PREFILTER = (0.95, 0.02)   # validation V_target >= , V_spill <=
 MAX_CHECKS = 12            # held-out confirmations per run at most (each costs n episodes of 10 s)
 
 
-def _held_out(jobs: list[tuple]) -> list[dict[str, float]]:
-    # Episodes are independent and seeded: run them on every core, results in job order.
-    with mp.get_context("fork").Pool(min(len(jobs), os.cpu_count() or 1)) as pool:
-        return pool.map(_greedy_metrics, jobs, chunksize=1)
+def _held_out(jobs: list[tuple], workers: int | None = None) -> list[dict[str, float]]:
+    # Episodes are independent and seeded: run them on every core (or `workers`), results in job order.
+    return executors.starmap(_greedy_metrics, jobs, workers or os.cpu_count() or 1)
 
 
 def reach(run: Path, n: int) -> dict[str, Any]:
@@ -142,7 +133,7 @@ def reach(run: Path, n: int) -> dict[str, Any]:
     of 10 s: its training episodes and wall time then (None when it never did), from the actor history in its
     checkpoint (W, or an MLP's layers, _run_policies) and the validation columns of its log."""
     spec, _, history = _run_policies(run)
-    log = trainer.read_log(run / "log.csv")
+    log = rundir.read_log(run / "log.csv")
     checks = 0
     for i, row in enumerate(log):
         vt, vs = float(row["eval_v_target"]), float(row["eval_v_spill"])
@@ -187,7 +178,7 @@ def reach_row(name: str, runs: Sequence[Path], n: int) -> dict[str, Any]:
 
 
 def _last_log_row(run: Path) -> dict[str, str]:
-    rows = trainer.read_log(run / "log.csv")
+    rows = rundir.read_log(run / "log.csv")
     if not rows:
         raise ValueError(f"{run}/log.csv has no rows")
     return rows[-1]
@@ -220,7 +211,7 @@ def init_row(config_path: str, n: int) -> dict[str, Any]:
     """The policy a training config starts from, greedy, on the held-out seeds."""
     from pour.train import config
     cfg = config.load(config_path)
-    w = trainer.weights(cfg, trainer.initial_params(cfg))
+    w = rundir.weights(cfg, rundir.initial_params(cfg))
     sim = envs.make_env("sim", cfg.policy.n_actions, cfg.policy.decision_period_ms, 10.0)
     ms = [sim.rollout(w, seed, True).metrics for seed in range(FIRST_SEED, FIRST_SEED + n)]
     return _row(f"initial policy of {Path(config_path).name}", "greedy float, C rollout",

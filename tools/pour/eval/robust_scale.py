@@ -122,28 +122,21 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
     factors = fill_factors(repeats)
     fills = [[]] if repeats == 1 else [[f"fill_depth={poursim.default_config()['fill_depth'] * f!r}"]
                                        for f in factors]
-    ray = executors.import_ray()
-    owns = executors.connect(address, num_cpus)
-    refs: list[Any] = []
-    try:
-        cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+    with executors.RayTasks(address, num_cpus) as ray:
+        cpus = ray.cpus()
         k = per_task or max(1, min(200, math.ceil(rigs / (2 * cpus))))
-        task = ray.remote(num_cpus=1, max_retries=executors.MAX_RETRIES, retry_exceptions=False)(run_batch)
         t0 = time.monotonic()
         jobs = [(r, s) for r in range(repeats) for s in range(first_seed, first_seed + rigs, k)]
-        refs = [task.remote(exe, header, s, min(k, first_seed + rigs - s), sets + fills[r]) for r, s in jobs]
         what = f"{rigs} rigs" if repeats == 1 else f"{rigs} rigs x {repeats} repeats"
-        batches = executors.gather(ray, refs, what, quiet)
+        batches = ray.starmap(run_batch, [(exe, header, s, min(k, first_seed + rigs - s), sets + fills[r])
+                                          for r, s in jobs], what, quiet)
         per = [dict(e, repeat=r) if repeats > 1 else e for (r, _), batch in zip(jobs, batches) for e in batch]
         wall = time.monotonic() - t0
-    finally:
-        if owns:
-            ray.shutdown()
     rigs_per = per if repeats == 1 else per_rig(per)
     rows = reduce(rigs_per, sets)
     out.mkdir(parents=True, exist_ok=True)
     meta = {"header": header, "rigs": rigs, "repeats": repeats, "first_seed": first_seed, "per_task": k,
-            "tasks": len(refs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand,
+            "tasks": len(jobs), "cluster_cpus": cpus, "wall_s": round(wall, 1), "rand": rand,
             "fill_schedule_l": fill_schedule_l}
     doc = {**meta, "rows": rows, "per_episode": per} if repeats == 1 else \
         {**meta, "fill_factors": factors, "rows": rows, "per_rig": rigs_per, "per_episode": per}
@@ -153,7 +146,7 @@ def run(header: str, out: Path, rigs: int, first_seed: int, per_task: int | None
         f"a rig's figures are the means of its repeats (peaks the worst), \"worst spill\" is the worst rig's "
         f"mean, and the worst single episode spilled {max(e['spilled_pct'] for e in per):.1f} %.")
     atomic.write_atomic(out / "robust_scale.md",
-                        f"Randomised rigs: {', '.join(sets)}; {rigs} rigs in {len(refs)} Ray tasks of {k} on "
+                        f"Randomised rigs: {', '.join(sets)}; {rigs} rigs in {len(jobs)} Ray tasks of {k} on "
                         f"{cpus} CPUs, {wall:.0f} s.{how}\n\n" + robustness.table(rows, Path(header).name, first_seed,
                                                                      "episodes" if repeats == 1 else "rigs"))
     robustness.plot(rows, out / "robust_scale.png")

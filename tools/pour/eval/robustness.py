@@ -5,18 +5,18 @@ the rig's uncertainty, on seeds never used in training.
   pour-eval robust --header policy/weights.h --out results/robustness
 
 Each scene is one host_sim run (`--policy H --set KEY=VALUE ...`); scenes run in parallel, one process a
-core. Writes robustness.json, robustness.md (the table) and robustness.png.
+core (pour.train.executors.starmap's threads, each waiting on its host_sim). Writes robustness.json, robustness.md (the table) and robustness.png.
 """
 from __future__ import annotations
 
 import json
 import math
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from pour import atomic, cli
+from pour.train import executors
 
 # The issue's bars (README, "Robustness").
 NOMINAL_POURED_PCT, NOMINAL_SPILLED_PCT, NOMINAL_FINISH_S, NOMINAL_ALL_THREE = 98.0, 1.0, 6.0, 0.90
@@ -157,8 +157,7 @@ def run(header: str, out: Path, nominal_episodes: int, edge_episodes: int, seed:
             progress.update(episodes[scene.name])
             return judge(scene, s)
 
-        with ThreadPoolExecutor(max_workers=max(1, workers)) as ex:
-            rows = list(ex.map(one, todo))
+        rows = executors.starmap(one, [(sc,) for sc in todo], workers, threads=True)   # host_sim subprocesses
     doc = {"header": header, "seed": seed, "nominal_episodes": nominal_episodes, "edge_episodes": edge_episodes,
            "rig": list(rig_sets[1::2]), "rows": rows, "all_bars_met": all(r["bar_met"] for r in rows)}
     atomic.write_atomic(out / "robustness.json", json.dumps(doc, indent=1) + "\n")

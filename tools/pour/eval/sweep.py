@@ -139,10 +139,10 @@ def point_label(point: dict[str, Any]) -> str:
 
 def run_trial(doc: dict[str, Any], run_dir: str, held_out: int) -> dict[str, Any]:
     """Trains (or resumes, or finds finished) one run, then its output policy greedy on held-out seeds."""
-    from pour.train import trainer
+    from pour.train import rundir, trainer
     cfg = cfgmod.from_dict(doc)
     res = trainer.train(cfg, run_dir, quiet=True)
-    log = trainer.read_log(Path(run_dir) / "log.csv")
+    log = rundir.read_log(Path(run_dir) / "log.csv")
     env = envs.make_env(cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms, HELD_OUT_EPISODE_S,
                         cfg.env.options)
     eps = [env.rollout(res.best_w, s, True) for s in range(results.FIRST_SEED, results.FIRST_SEED + held_out)]
@@ -173,17 +173,10 @@ def run(config_path: str, out: Path, pts: list[dict[str, Any]], seeds: Sequence[
     jobs = [(t["doc"], str((out / "runs" / t["trial"]).resolve()), held_out) for t in trials]
     desc = f"{len(jobs)} trials"
     if executor == "local":
-        outs = [run_trial(*j) for j in cli.progress(jobs, len(jobs), desc, quiet, unit="trial")]
+        outs = executors.starmap(run_trial, jobs, desc=desc, quiet=quiet, unit="trial")
     else:
-        ray = executors.import_ray()
-        owns = executors.connect(address, num_cpus)
-        try:
-            task = ray.remote(num_cpus=1, max_retries=executors.MAX_RETRIES, retry_exceptions=False)(run_trial)
-            # An error or Ctrl-C stops the other trials (each resumes on re-run).
-            outs = executors.gather(ray, [task.remote(*j) for j in jobs], desc, quiet)
-        finally:
-            if owns:
-                ray.shutdown()
+        with executors.RayTasks(address, num_cpus) as ray:
+            outs = ray.starmap(run_trial, jobs, desc, quiet)   # an error or Ctrl-C stops the other trials
     for t, o in zip(trials, outs):
         t.update(o)
     return report(out, config_path, trials, pts, held_out, command)

@@ -153,7 +153,7 @@ def train_linear(steps: int, seed: int = 1, env_id: str = ENV_ID, **kwargs: Any)
 
 def mlp_validation(cfg: Any, layers: Sequence[np.ndarray], seeds: Sequence[int]) -> dict[str, float]:
     """An MLP actor greedy on the validation seeds through the Gymnasium env (cfg's rig and episode length):
-    the log's eval_* columns, as trainer.greedy_validation gives them for a W through the C rollouts (the
+    the log's eval_* columns, as rundir.greedy_validation gives them for a W through the C rollouts (the
     score is the env's reward, which has no reversal cost)."""
     env = gym_env.PourEnv(cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms, cfg.env.episode_s,
                           cfg.env.options)
@@ -179,9 +179,9 @@ def _validation_callback(cfg: Any, run_dir: Path, episodes: int, every: int, see
 
     from stable_baselines3.common.callbacks import BaseCallback
 
-    from pour.train import trainer
+    from pour.train import rundir
 
-    valid_seeds = trainer.episode_seeds(seed, trainer.STREAM_VALID, 0, cfg.eval.episodes)
+    valid_seeds = rundir.episode_seeds(seed, rundir.STREAM_VALID, 0, cfg.eval.episodes)
     config = cfg.to_dict()
     del config["workers"]
     keeps = "policy.json" if actor == "linear" else "checkpoint.npz"
@@ -204,16 +204,16 @@ def _validation_callback(cfg: Any, run_dir: Path, episodes: int, every: int, see
             if not all(np.all(np.isfinite(a)) for a in (snap if actor == "mlp" else [snap])):
                 raise ExampleError(f"PPO diverged after {self.done} episodes: the actor is not finite; "
                                    f"{run_dir / keeps} keeps the best validated weights")
-            ev = trainer.greedy_validation(cfg, runner, snap, valid_seeds)[0] if actor == "linear" else \
+            ev = rundir.greedy_validation(cfg, runner, snap, valid_seeds)[0] if actor == "linear" else \
                 mlp_validation(cfg, snap, valid_seeds)
             if ev["eval_score"] > self.best_score or self.best is None:
                 self.best, self.best_score = snap, float(ev["eval_score"])
-            row = dict.fromkeys(trainer.LOG_FIELDS, np.nan)
+            row = dict.fromkeys(rundir.LOG_FIELDS, np.nan)
             row.update(ev, iteration=len(self.rows), episodes=self.done, wall_s=time.monotonic() - self.t0,
                        best_score=self.best_score)
-            self.rows.append({k: trainer._fmt(v) for k, v in row.items()})
+            self.rows.append({k: rundir.fmt(v) for k, v in row.items()})
             self.history.append(snap)
-            trainer.write_log(run_dir / "log.csv", self.rows)
+            rundir.write_log(run_dir / "log.csv", self.rows)
             fields = dict(learner="stable-baselines3 PPO", config=config, seed=int(seed), episodes=self.done,
                           ppo=dict(PPO_DEFAULTS), critic=list(CRITIC), best_score=self.best_score)
             state: dict[str, Any] = {"episodes": self.done, "wall_s": row["wall_s"]}
@@ -226,7 +226,7 @@ def _validation_callback(cfg: Any, run_dir: Path, episodes: int, every: int, see
                 for k in range(len(snap)):
                     state[f"history_mlp_{k}"] = np.array([h[k] for h in self.history])
                     state[f"best_mlp_{k}"] = self.best[k]
-            trainer.save_checkpoint(run_dir / "checkpoint.npz", state)
+            rundir.save_checkpoint(run_dir / "checkpoint.npz", state)
             self.due = min(self.due + every, episodes)
             return self.done < episodes
 
@@ -250,7 +250,7 @@ def train_run(config_path: str | Path, run_dir: str | Path, episodes: int, every
     `every`: a run directory pour-results --reach reads (log.csv, checkpoint.npz's actor history, and
     policy.json or actor.json). Returns the final actor: W [6][n_actions], or the MLP's layers."""
     from pour.train import config as cfgmod
-    from pour.train import trainer
+    from pour.train import executors
 
     if episodes < 1 or not 1 <= every <= episodes:
         raise ExampleError(f"episodes = {episodes}, validate every {every}: expected 1 <= every <= episodes")
@@ -260,7 +260,7 @@ def train_run(config_path: str | Path, run_dir: str | Path, episodes: int, every
     if cfg.eval.episodes < 1:
         raise ExampleError(f"{config_path}: eval.episodes = 0: the run needs validation episodes")
     run_dir = _make_dir(run_dir)
-    with trainer.Runner(cfg) as runner:   # its workers fork before torch starts
+    with executors.Runner(cfg) as runner:   # its workers fork before torch starts
         env = gym_env.PourEnv(cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
                               cfg.env.episode_s, cfg.env.options)
         model = make_model(env, seed, actor, **ppo_kwargs)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import matplotlib
 
-from pour import cli, libpoursim
+from pour import cli, functions
 from pour.lcm import channels, messages, sensors
 
 
@@ -96,8 +96,8 @@ class LiveView:
         if s is None:
             return "controller: no POUR_STATUS yet"
         faults = s.faults & 0xFFFF
-        named = f" ({', '.join(libpoursim.fault_names(faults))})" if faults else ""
-        return (f"controller {libpoursim.mode_name(s.mode) or s.mode}  faults 0x{faults:04x}{named}"
+        named = f" ({', '.join(functions.fault_names(faults))})" if faults else ""
+        return (f"controller {functions.mode_name(s.mode) or s.mode}  faults 0x{faults:04x}{named}"
                 f"  overruns {s.overruns}  dropped {s.messages_dropped}")
 
 

@@ -324,9 +324,9 @@ def _fault_text(faults: int) -> str:
     if not faults:
         return "none"
     try:
-        from pour import libpoursim
-        return f"{', '.join(libpoursim.fault_names(faults))} (0x{faults:04x})"
-    except libpoursim.SimError:
+        from pour import functions
+        return f"{', '.join(functions.fault_names(faults))} (0x{faults:04x})"
+    except functions.SimError:
         return f"0x{faults:04x} (names: libpoursim not found)"
 
 

@@ -173,7 +173,7 @@ def _control_script(rng: np.random.Generator) -> list[tuple[bool, tuple, bool, b
 
 
 # Per control config: tau_limit, slew_per_tick, theta_min, theta_max, input_timeout_ms, safe_torque, sampled,
-# seed, omega_max, alpha_max, omega_slack, torque_per_rad_s, encoder_bits, bandwidth (test_golden.c's order).
+# seed, omega_max, alpha_max, omega_slack, governor_gain, encoder_bits, bandwidth (test_golden.c's order).
 CONTROL_CONFIGS = (
     ("greedy, default config",
      (32767, 3277, -87266, 2356194, 20, 0, 0, 1, 2000000, 3400000, 800000, 16384, 17, 300)),
@@ -187,7 +187,7 @@ def control_config(row: tuple) -> core.ControlConfig:
     c = core.control_config()
     s = c.safety
     (s.tau_limit, s.slew_per_tick, s.theta_min_urad, s.theta_max_urad, c.input_timeout_ms, c.safe_torque, sampled,
-     c.seed, s.omega_max_urad_s, s.alpha_max_urad_s2, s.omega_slack_urad_s, s.torque_per_rad_s,
+     c.seed, s.omega_max_urad_s, s.alpha_max_urad_s2, s.omega_slack_urad_s, s.governor_gain,
      c.sensors.encoder_bits, c.sensors.bandwidth_rad_s) = row
     c.policy_mode = 1 if sampled else 0
     c.supervisor.checks = 0  # the vectors are scripted, not physical, states
@@ -333,10 +333,10 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
     lines += ["};", f"#define POUR_GOLDEN_N_SAMPLED {N_SAMPLED}", f"#define POUR_GOLDEN_SAMPLED_LEN {SAMPLED_LEN}", ""]
     configs = [core.safety_config(tau_limit=32767, slew_per_tick=3277, theta_min_urad=-87266, theta_max_urad=2356194,
                                   omega_max_urad_s=2000000, alpha_max_urad_s2=3400000, omega_slack_urad_s=800000,
-                                  torque_per_rad_s=16384),
+                                  governor_gain=16384),
                core.safety_config(tau_limit=20000, slew_per_tick=3000, theta_min_urad=-1000, theta_max_urad=2000000,
                                   omega_max_urad_s=3000000, alpha_max_urad_s2=50000000, omega_slack_urad_s=200000,
-                                  torque_per_rad_s=32767)]
+                                  governor_gain=32767)]
     lines += ["/* pour_safety_apply: config (tau_limit, slew_per_tick, theta_min, theta_max, omega_max, alpha_max,",
               " * omega_slack, torque_per_rad_s), then per tick requested torque, θ and θ̇ -> command and active limits */",
               f"typedef struct {{ int32_t config[8]; int32_t requested[{SAFETY_LEN}]; int32_t theta[{SAFETY_LEN}]; "
@@ -359,7 +359,7 @@ def golden_vectors_text(source_dir: Path = SOURCE_DIR, seed: int = 20261123) -> 
             tq.append(env.apply(r, theta, omega))
             act.append(env.active)
             omega = int(np.clip(omega, -4000000, 4000000))
-        lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad, cfg.omega_max_urad_s, cfg.alpha_max_urad_s2, cfg.omega_slack_urad_s, cfg.torque_per_rad_s])}, "
+        lines.append(f"    {{{_c_array([cfg.tau_limit, cfg.slew_per_tick, cfg.theta_min_urad, cfg.theta_max_urad, cfg.omega_max_urad_s, cfg.alpha_max_urad_s2, cfg.omega_slack_urad_s, cfg.governor_gain])}, "
                      f"{_c_array(req)}, {_c_array(th)}, {_c_array(om)}, {_c_array(tq)}, {_c_array(act)}}},")
     lines += ["};", f"#define POUR_GOLDEN_N_SAFETY {len(configs)}", f"#define POUR_GOLDEN_SAFETY_LEN {SAFETY_LEN}", ""]
     lines += _estimator_lines(rng)

@@ -13,7 +13,7 @@ from typing import Mapping, Sequence, Union
 
 import numpy as np
 
-from pour import atomic, libpoursim, records
+from pour import atomic, functions, libpoursim, records
 from pour.policy import fixedpoint as fp
 
 FORMAT = 1
@@ -219,18 +219,12 @@ def write_weights_h(path: PathLike, w_float: np.ndarray, levels: Sequence[float]
 _ERR_LEN = 256  # POURSIM_ERR_LEN
 
 
-def _parser() -> ctypes.CDLL:
-    """libpoursim with its weights.h loader declared: the one parser, shared with host_sim."""
+def _parser() -> functions.Functions:
+    """libpoursim's functions, its weights.h loader among them: the one parser, shared with host_sim."""
     try:
-        lib = libpoursim.load()
+        return functions.library()
     except libpoursim.SimError as e:
         raise WeightsHError(f"reading a weights.h needs libpoursim's parser: {e}") from None
-    lib.poursim_weights_parse.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p,
-                                          ctypes.POINTER(records.record("poursim_weights_file_t")), ctypes.c_char_p, ctypes.c_size_t]
-    lib.poursim_weights_load.argtypes = [ctypes.c_char_p, ctypes.POINTER(records.record("poursim_weights_file_t")), ctypes.c_char_p,
-                                         ctypes.c_size_t]
-    lib.poursim_weights_parse.restype = lib.poursim_weights_load.restype = ctypes.c_int
-    return lib
 
 
 def _from_struct(f: ctypes.Structure) -> WeightsH:

@@ -27,7 +27,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from pour import libpoursim
+from pour import functions
 from pour.policy import linear
 from pour.sim import envs, episode, gym_ids
 
@@ -115,7 +115,7 @@ class PourEnv(gym.Env):
         info = {"v_target": float(self._plant.v_tgt), "v_spill": float(self._plant.v_spill),
                 "t_s": self._k * self.period * 1e-3, "faults": faults}
         if terminated:
-            info["fault_names"] = libpoursim.fault_names(faults)
+            info["fault_names"] = functions.fault_names(faults)
         if terminated or truncated:
             self._started = False
             info["is_success"] = self._success(faults)

@@ -25,7 +25,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from pour import libpoursim, records
+from pour import functions, libpoursim, records
 from pour.libpoursim import SimError  # the binding's error, raised by the loader too
 
 N_FEATURES = 6
@@ -57,87 +57,15 @@ def __getattr__(name: str) -> type:
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-_lib: C.CDLL | None = None
-
-
 def library_candidates() -> list[Path]:
     """Where load_library() looks, in order ($POUR_SIM_LIB alone when it is set)."""
     return libpoursim.candidates()
 
 
-def load_library() -> C.CDLL:
-    """Loads libpoursim once, with the simulator's entry points declared; SimError says where it looked if it
-    is not there."""
-    global _lib
-    if _lib is not None:
-        return _lib
-    lib = libpoursim.load()
-    try:
-        _declare(lib)
-    except AttributeError as e:
-        raise SimError(f"libpoursim at {lib._name} is not usable (missing symbol: {e})") from e
-    _lib = lib
-    return lib
-
-
-def _declare(lib: C.CDLL) -> None:
-    P = C.POINTER
-    err = [C.c_char_p, C.c_size_t]
-    sig = {
-        "poursim_config_new": ([C.c_void_p], C.c_void_p),
-        "poursim_config_free": ([C.c_void_p], None),
-        "poursim_config_key": ([C.c_int], C.c_char_p),
-        "poursim_config_key_info": ([C.c_char_p, P(C.c_int), P(C.c_double), P(C.c_double), P(C.c_double),
-                                     P(C.c_char_p), P(C.c_char_p)], C.c_int),
-        "poursim_config_get": ([C.c_void_p, C.c_char_p, P(C.c_double)] + err, C.c_int),
-        "poursim_config_validate": ([C.c_void_p] + err, C.c_int),
-        "poursim_config_load": ([C.c_char_p, C.c_void_p] + err, C.c_int),
-        "poursim_config_set": ([C.c_void_p, C.c_char_p, C.c_char_p] + err, C.c_int),
-        "poursim_config_write": ([C.c_void_p, C.c_char_p] + err, C.c_int),
-        "poursim_create": ([C.c_void_p] + err, C.c_void_p),
-        "poursim_reset": ([C.c_void_p, C.c_uint32], C.c_int),
-        "poursim_step": ([C.c_void_p, C.c_double, P(_r("ObsStruct"))], C.c_int),
-        "poursim_step_servo": ([C.c_void_p, C.c_double, P(_r("ObsStruct"))], C.c_int),
-        "poursim_set_brake": ([C.c_void_p, C.c_int], C.c_int),
-        "poursim_world_error": ([C.c_void_p], C.c_char_p),
-        "poursim_max_density_ratio": ([C.c_void_p], C.c_double),
-        "poursim_measure_retention": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double,
-                                       P(_r("RetentionStruct"))] + err, C.c_int),
-        "poursim_measure_slosh": ([C.c_void_p, C.c_uint32, C.c_int, C.c_double, C.c_double, C.c_double,
-                                   P(C.c_double), C.c_int, P(_r("SloshStruct"))] + err, C.c_int),
-        "poursim_observe": ([C.c_void_p, P(_r("ObsStruct"))], None),
-        "poursim_episode_config": ([C.c_void_p], C.c_void_p),
-        "poursim_measure_drive": ([C.c_void_p, P(_r("DriveCheckStruct"))] + err, C.c_int),
-        "poursim_measure_sensors": ([C.c_void_p, C.c_uint32, P(_r("SensorCheckStruct"))] + err, C.c_int),
-        "poursim_destroy": ([C.c_void_p], None),
-        "poursim_particle_count": ([C.c_void_p], C.c_int),
-        "poursim_particles": ([C.c_void_p, P(C.c_float), P(C.c_float), C.c_int], C.c_int),
-        "poursim_particle_regions": ([C.c_void_p, P(C.c_uint8), C.c_int], C.c_int),
-        "poursim_max_overlap": ([C.c_void_p], C.c_double),
-        "poursim_max_wall_penetration": ([C.c_void_p], C.c_double),
-        "poursim_trajectory_hash": ([C.c_void_p], C.c_uint64),
-        "poursim_rollout": ([C.c_void_p, P(_r("PolicyStruct")), C.c_uint32, P(_r("BuffersStruct")), P(_r("EpisodeStruct"))], C.c_int),
-        "poursim_version": ([], C.c_char_p),
-        "poursim_sizeof": ([C.c_char_p], C.c_size_t),
-        "poursim_default_reward": ([], _r("RewardStruct")),
-        "poursim_reward_validate": ([P(_r("RewardStruct"))] + err, C.c_int),
-        "poursim_features": ([P(_r("PolicyStruct")), C.c_double, C.c_double, C.c_double, C.c_double, C.c_double,
-                              P(C.c_double)], None),
-        "poursim_fraction_to_q15": ([C.c_double], C.c_int16),
-        "poursim_stepper_create": ([C.c_void_p, P(_r("RewardStruct")), C.c_int] + err, C.c_void_p),
-        "poursim_stepper_destroy": ([C.c_void_p], None),
-        "poursim_stepper_reset": ([C.c_void_p, C.c_uint32] + err, C.c_int),
-        "poursim_stepper_advance": ([C.c_void_p, C.c_int, C.c_double, C.c_int, P(C.c_double), P(C.c_int16)] + err,
-                                    C.c_int),
-        "poursim_stepper_obs": ([C.c_void_p, P(_r("ObsStruct"))], None),
-        "poursim_stepper_state": ([C.c_void_p, P(records.record("pour_state_t"))], None),
-        "poursim_stepper_faults": ([C.c_void_p], C.c_int),
-        "poursim_stepper_episode": ([C.c_void_p, P(_r("EpisodeStruct"))], None),
-    }
-    for name, (args, res) in sig.items():
-        fn = getattr(lib, name)
-        fn.argtypes = args
-        fn.restype = res
+def load_library() -> functions.Functions:
+    """libpoursim's functions, declared from the library's own function table (pour.functions); SimError
+    says where it looked if it is not there."""
+    return functions.library()
 
 
 def _err() -> C.Array:

@@ -1,1 +1,2 @@
-"""The trainer: REINFORCE on the softmax-linear policy, its config and its rollout executors."""
+"""The trainer: its config, its training methods (a registry of them), their shared run directory and the
+executors training and evaluation run episodes on."""

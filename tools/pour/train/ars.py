@@ -22,7 +22,7 @@ differencing around one point, so it jumps between basins that a local estimate 
 Both use common random numbers: every candidate of an iteration runs on the same episode seeds (rigs), so a
 difference in return is the policy's and not the rig's. The draws come from (seed, STREAM_SEARCH,
 iteration) through numpy's SeedSequence, so a run needs no RNG state to resume and is bit-identical
-whatever the number of workers. The run directory is pour-train's (trainer.py): the same log, checkpoint
+whatever the number of workers. The run directory is every method's (rundir.py): the same log, checkpoint
 and policy.json, plus `history_w` (the centre's W after every iteration) in the checkpoint.
 
 Divergence: parameters that are not finite, or a centre whose greedy validation score stays far below the
@@ -31,7 +31,6 @@ policy.json on disk still hold the best validated weights, which pour-export exp
 """
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -40,24 +39,22 @@ from typing import Any
 import numpy as np
 
 from pour.policy import weights_h
-from pour.train import config as cfgmod
-from pour.train import reinforce, trainer
-
-STREAM_SEARCH = 3  # the draws' stream (trainer.STREAM_TRAIN, _VALID, _TEST and _INIT are 0, 1, 2, 4)
+from pour.train import rundir
+from pour.train.settings import TrainConfig
 
 
-def draws(cfg: cfgmod.TrainConfig, it: int, n: int, shape: tuple) -> np.ndarray:
+def draws(cfg: TrainConfig, it: int, n: int, shape: tuple) -> np.ndarray:
     """The iteration's standard normal draws, [n][*shape] (ARS's directions, CEM's candidates' noise)."""
-    rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, STREAM_SEARCH, it]))
+    rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, rundir.STREAM_SEARCH, it]))
     return rng.standard_normal((n, *shape))
 
 
-def step_size(cfg: cfgmod.TrainConfig, it: int) -> float:
-    return trainer.linear_schedule(cfg.ars.step_size, cfg.ars.step_size_final, it, cfg.iterations)
+def step_size(cfg: TrainConfig, it: int) -> float:
+    return rundir.linear_schedule(cfg.ars.step_size, cfg.ars.step_size_final, it, cfg.iterations)
 
 
-def noise(cfg: cfgmod.TrainConfig, it: int) -> float:
-    return trainer.geometric_schedule(cfg.ars.noise, cfg.ars.noise_final, it, cfg.iterations)
+def noise(cfg: TrainConfig, it: int) -> float:
+    return rundir.geometric_schedule(cfg.ars.noise, cfg.ars.noise_final, it, cfg.iterations)
 
 
 class StateStats:
@@ -117,15 +114,13 @@ def cem_update(cands: np.ndarray, returns: np.ndarray, elites: int, min_std: flo
     return best.mean(axis=0), np.maximum(best.std(axis=0), min_std)
 
 
-def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, stop_after: int | None,
-          make_runner: Any) -> trainer.RunResult:
-    """trainer.train for algo.kind 'ars' and 'cem' (same arguments, same run directory)."""
-    run_dir.mkdir(parents=True, exist_ok=True)
-    ckpt_path, log_path, cfg_path = run_dir / "checkpoint.npz", run_dir / "log.csv", run_dir / "config.json"
-    digest = cfg.digest()
-    r, n_act = cfg.ars, cfg.policy.n_actions
+def train(cfg: TrainConfig, run_dir: Path, resume: bool, quiet: bool, stop_after: int | None,
+          make_runner: Any) -> rundir.RunResult:
+    """trainer.train for algo.kind 'ars' and 'cem' (pour.train.methods)."""
+    run = rundir.Run(cfg, run_dir)
+    r = cfg.ars
     gamma_d = cfg.algo.gamma ** cfg.policy.decision_period_ms
-    params = trainer.initial_params(cfg)
+    params = rundir.initial_params(cfg)
     std = np.full(params.shape, cfg.cem.init_std)   # CEM's spread (unused by ARS)
     stats = StateStats()                            # V2-t's state statistics (ars.normalize_states)
     names = r.features or list(weights_h.FEATURE_NAMES)  # the rows ARS moves (ars.features)
@@ -135,22 +130,16 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
     def to_w(p: np.ndarray) -> np.ndarray:
         if cfg.algo.kind == "ars" and r.normalize_states:
             p = state_coords(p, stats.mean, stats.std(r.state_std_min))
-        return trainer.weights(cfg, p)
+        return rundir.weights(cfg, p)
 
     w = to_w(params)
     best_w, best_score, start, wall_prev = w.copy(), -np.inf, 0, 0.0
     best_ep: dict[str, np.ndarray] = {}
     history: list[np.ndarray] = []
     n_low = 0  # evaluations in a row far below the best (eval.collapse)
-    rows: list[dict[str, Any]] = []
-    if ckpt_path.exists() and resume:
-        st = trainer.load_checkpoint(ckpt_path)
-        if str(st["config_digest"]) != digest or "history_w" not in st:
-            raise trainer.TrainError(
-                f"{run_dir}: checkpoint was made with a different config (digest "
-                f"{str(st['config_digest'])[:12]} vs {digest[:12]}, algo.kind = {cfg.algo.kind!r} needs its own "
-                "state); "
-                "use a new run directory or --fresh")
+    st, rows = run.open(resume, quiet, lambda s: "history_w" in s,
+                        f", algo.kind = {cfg.algo.kind!r} needs its own state")
+    if st is not None:
         params, best_w, best_score = np.array(st["params"]), np.array(st["best_w"]), float(st["best_score"])
         stats = StateStats(float(st.get("state_n", 0.0)), st.get("state_mean"), st.get("state_m2"))
         w = to_w(params)
@@ -158,24 +147,15 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
         history = list(np.array(st["history_w"]))
         std = np.array(st["cem_std"])
         best_ep = {k: st[k] for k in st if k.startswith("best_ep_")}
-        rows = [row for row in trainer.read_log(log_path) if int(row["iteration"]) < start]
-        if not quiet:
-            print(f"[pour-train] resuming {run_dir} at iteration {start}", file=sys.stderr)
-    else:
-        for p in (ckpt_path, log_path):
-            if p.exists():
-                p.unlink()
-    trainer.atomic_write_bytes(cfg_path, (json.dumps(cfg.to_dict(), indent=2, sort_keys=True) + "\n").encode())
-    trainer.write_log(log_path, rows)
 
-    valid_seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_VALID, 0, cfg.eval.episodes)
+    valid_seeds = rundir.episode_seeds(cfg.seed, rundir.STREAM_VALID, 0, cfg.eval.episodes)
     is_ars, c, v = cfg.algo.kind == "ars", cfg.cem, cfg.eval
     per_iteration = 2 * r.directions * r.episodes_per_direction if is_ars else c.population * c.episodes_per_candidate
     t0 = time.monotonic()
     with make_runner(cfg) as runner:
-        for it in trainer.iterations(cfg, start, stop_after):
+        for it in rundir.iterations(cfg, start, stop_after):
             m = r.episodes_per_direction if is_ars else c.episodes_per_candidate
-            seeds = trainer.episode_seeds(cfg.seed, trainer.STREAM_TRAIN, it, m)
+            seeds = rundir.episode_seeds(cfg.seed, rundir.STREAM_TRAIN, it, m)
             if is_ars:
                 deltas = draws(cfg, it, r.directions, params.shape) * searched
                 nu = noise(cfg, it)
@@ -184,7 +164,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                 cands = params + std * draws(cfg, it, c.population, params.shape)
             ws = [to_w(p) for p in cands]
             eps = runner.run_each([wk for wk in ws for _ in seeds], seeds * len(ws), greedy=True)
-            rets = np.array([trainer.episode_return(e, gamma_d) for e in eps]) * cfg.algo.reward_scale
+            rets = np.array([rundir.episode_return(e, gamma_d) for e in eps]) * cfg.algo.reward_scale
             per_cand = rets.reshape(len(ws), m).mean(axis=1)
             alpha, sigma = step_size(cfg, it), float(np.std(per_cand))
             with np.errstate(over="ignore", invalid="ignore"):
@@ -196,7 +176,7 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                     new_params, std = cem_update(cands, per_cand, c.elites, c.min_std)
                     step = new_params - params
             if not (np.all(np.isfinite(new_params)) and np.all(np.isfinite(std))):
-                raise trainer.TrainError(
+                raise rundir.TrainError(
                     f"{run_dir}: iteration {it}: the parameters diverged (non-finite after a step, sigma_R "
                     f"{sigma:g}); stopped. The best validated weights (score {best_score:.6g}) "
                     "are kept in checkpoint.npz and policy.json: pour-export exports them; lower ars.step_size")
@@ -205,12 +185,8 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                 stats.add(e.x)
             w = to_w(params)
             history.append(w.copy())
-            ib = int(np.argmax(rets))
-            if not best_ep or rets[ib] > float(best_ep["best_ep_return"]):
-                e = eps[ib]
-                best_ep = {"best_ep_x": e.x, "best_ep_actions": e.actions, "best_ep_rewards": e.rewards,
-                           "best_ep_return": np.array(rets[ib]), "best_ep_iteration": np.array(it)}
-            ev, se = trainer.validate(cfg, runner, w, valid_seeds, it)
+            best_ep = rundir.best_episode(best_ep, eps, rets, it)
+            ev, se = rundir.validate(cfg, runner, w, valid_seeds, it)
             collapsed = ""
             if np.isfinite(ev["eval_score"]):
                 sc = ev["eval_score"]
@@ -227,31 +203,21 @@ def train(cfg: cfgmod.TrainConfig, run_dir: Path, resume: bool, quiet: bool, sto
                     best_score, best_w = sc, w.copy()
             wall = wall_prev + time.monotonic() - t0
             row = {"iteration": it, "episodes": (it + 1) * per_iteration, "wall_s": wall,
-                   "return_mean": rets.mean(), "return_std": rets.std(), "return_min": rets.min(),
-                   "return_max": rets.max(), "reward_sum_mean": np.mean([np.sum(e.rewards) for e in eps]),
-                   "v_target_mean": np.mean([e.metrics["v_target"] for e in eps]),
-                   "v_spill_mean": np.mean([e.metrics["v_spill"] for e in eps]),
-                   "finish_s_mean": np.mean([e.metrics["finish_s"] for e in eps]),
-                   "entropy_mean": np.nan, "grad_norm": float(np.linalg.norm(step)), "lr": alpha,
+                   **rundir.batch_columns(rets, eps), "entropy_mean": np.nan, "grad_norm": float(np.linalg.norm(step)), "lr": alpha,
                    "kl_bound": np.nan, "kl": np.nan, "step_scale": 1.0, "rolled_back": 0, **ev,
                    "best_score": best_score}
-            rows.append({k: trainer._fmt(v) for k, v in row.items()})
-            state = {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1,
-                     "wall_s": wall, "config_digest": digest, "history_w": np.array(history), "n_low": n_low,
-                     "cem_std": std, "state_n": stats.n, "state_mean": stats.mean, "state_m2": stats.m2,
-                     **best_ep}
-            trainer.write_log(log_path, rows)
-            trainer.write_policy_json(run_dir / "policy.json", cfg, runner.tau_max_nm, it + 1, w, best_w, best_score)
-            trainer.save_checkpoint(ckpt_path, state)
+            rows.append({k: rundir.fmt(v) for k, v in row.items()})
+            run.save(rows, runner.tau_max_nm,
+                     {"params": params, "w": w, "best_w": best_w, "best_score": best_score, "iteration": it + 1,
+                      "wall_s": wall, "config_digest": run.digest, "history_w": np.array(history), "n_low": n_low,
+                      "cem_std": std, "state_n": stats.n, "state_mean": stats.mean, "state_m2": stats.m2,
+                      **best_ep})
             if not quiet:
                 print(f"[pour-train] it {it + 1}/{cfg.iterations} R {rets.mean():9.3f} ±{rets.std():7.3f} "
                       f"tgt {row['v_target_mean']:.3f} spill {row['v_spill_mean']:.3f} |step| {row['grad_norm']:.4f} "
                       f"eval {ev['eval_score']:.4f} best {best_score:.4f} [{wall:6.1f} s]", file=sys.stderr, flush=True)
             if collapsed:
-                raise trainer.TrainError(collapsed)
+                raise rundir.TrainError(collapsed)
         runner.close()
-    final = trainer.load_checkpoint(ckpt_path) if ckpt_path.exists() else {"iteration": start, "wall_s": wall_prev}
-    return trainer.RunResult(run_dir, w, best_w, best_score, int(final["iteration"]), float(final["wall_s"]))
+    return run.result(w, best_w, best_score, start, wall_prev)
 
-
-trainer.SEARCH_METHODS.update(ars=train, cem=train)

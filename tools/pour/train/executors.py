@@ -1,13 +1,17 @@
 # SPDX-License-Identifier: MIT
-"""The executors of the trainer's rollouts: the local process pool (Runner, the default) and Ray
-(`pour-train --executor ray`, RayRunner), with the connection to a cluster.
+"""The executors training and evaluation run their work on: in this process, a local pool of forked
+processes or of threads, or Ray (`--executor ray`, `--ray-address`), with the connection to a cluster.
 
-Both have one interface (run(w, seeds, greedy) -> episodes in seed order, tau_max_nm, close(), a context
-manager), so the training loop does not know which one it drives. Runner forks `workers` processes, each
-with its own episode source (one libpoursim world each). Each RayRunner task runs a contiguous batch of episodes (by default one batch per CPU of the cluster, so the per-task cost of
-scheduling and of moving the weights is paid once per batch, not once per episode). The seeds come from
-the run's config through the driver; a worker only evaluates (W, seed) -> episode, which is a pure
-function, so a run on Ray is bit-identical to the same run on the local pool.
+Two interfaces. The trainer's episodes: Runner (the local pool, the default) and RayRunner have one
+interface (run(w, seeds, greedy) -> episodes in seed order, tau_max_nm, close(), a context manager), so the
+training loop does not know which one it drives. Runner forks `workers` processes, each with its own
+episode source (one libpoursim world each). Each RayRunner task runs a contiguous batch of episodes (by
+default one batch per CPU of the cluster, so the per-task cost of scheduling and of moving the weights is
+paid once per batch, not once per episode). The seeds come from the run's config through the driver; a
+worker only evaluates (W, seed) -> episode, which is a pure function, so a run on Ray is bit-identical to
+the same run on the local pool. Any other work (pour-results' held-out episodes, pour-eval robust's
+scenes, pour-sweep's trials, pour-robust-scale's batches): starmap(fn, jobs) here, or RayTasks.starmap on
+Ray, fn(*job) for each job, the results in job order, whatever ran them.
 
 Faults: a task whose worker process dies (killed, out of memory, node lost) is run again, up to
 `max_retries` times, by Ray; a re-run gives the same episodes because nothing depends on the worker.
@@ -32,13 +36,14 @@ import signal
 import socket
 import subprocess
 import sys
-from typing import Any, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
 from pour import cli
 from pour.sim import envs
-from pour.train import config as cfgmod
+from pour.train.settings import TrainConfig
 
 # Loopback only unless the user names another host: a local instance never binds a public interface.
 LOCAL_NODE_IP = "127.0.0.1"
@@ -164,7 +169,48 @@ def _current_cluster() -> str | None:
         return None
 
 
-# --- the local pool (the default executor) ---------------------------------------------------------
+# --- local work: in this process, on forked processes or on threads --------------------------------
+
+def fork_pool(workers: int, initializer: Callable[..., None] | None = None, initargs: tuple = ()) -> Any:
+    """A pool of `workers` forked processes (fork: each starts with this process's state, no re-import)."""
+    return mp.get_context("fork").Pool(workers, initializer, initargs)
+
+
+def _star(call: tuple[Callable[..., Any], tuple]) -> Any:
+    fn, job = call
+    return fn(*job)
+
+
+def starmap(fn: Callable[..., Any], jobs: Sequence[tuple], workers: int = 1, threads: bool = False,
+            desc: str | None = None, quiet: bool = True, unit: str = "task") -> list[Any]:
+    """fn(*job) for each job, the results in job order: in this process (one worker, or one job), on
+    `workers` forked processes, or on as many threads (threads: fn waits on a subprocess, host_sim, or is
+    a closure); a progress bar on stderr unless quiet. An exception of fn is raised as itself."""
+    calls = [(fn, tuple(j)) for j in jobs]
+    n = max(1, min(workers, len(calls)))
+    if n == 1:
+        return [_star(c) for c in cli.progress(calls, len(calls), desc, quiet, unit=unit)]
+    if threads:
+        with ThreadPoolExecutor(max_workers=n) as ex:
+            return list(cli.progress(ex.map(_star, calls), len(calls), desc, quiet, unit=unit))
+    with fork_pool(n) as pool:
+        return list(cli.progress(pool.imap(_star, calls, chunksize=1), len(calls), desc, quiet, unit=unit))
+
+
+_MADE: dict[str, Any] = {}   # this process's episode sources, by what made them
+
+
+def cached(make: Callable[..., Any], *args: Any) -> Any:
+    """make(*args) (an episode source: envs.make_env, gym_env.PourEnv), built once per process and kept: a
+    pool's or a Ray worker runs many tasks."""
+    key = json.dumps([make.__module__, make.__qualname__, args], sort_keys=True, default=str)
+    made = _MADE.get(key)
+    if made is None:
+        made = _MADE[key] = make(*args)
+    return made
+
+
+# --- the trainer's local pool (the default executor) --------------------------------------------------
 
 _ENV: Any = None
 
@@ -182,14 +228,14 @@ def _run(job: tuple) -> envs.Episode:
 class Runner:
     """Runs episodes in order on `workers` processes (or in-process for one worker)."""
 
-    def __init__(self, cfg: cfgmod.TrainConfig):
+    def __init__(self, cfg: TrainConfig):
         self.env_args = (cfg.env.kind, cfg.policy.n_actions, cfg.policy.decision_period_ms,
                          cfg.env.episode_s, cfg.env.options)
         _init_worker(self.env_args)  # fail early and clearly in the parent (missing library, bad option)
         self.tau_max_nm = float(_ENV.tau_max_nm)
         self.pool = None
         if cfg.workers > 1:
-            self.pool = mp.get_context("fork").Pool(cfg.workers, _init_worker, (self.env_args,))
+            self.pool = fork_pool(cfg.workers, _init_worker, (self.env_args,))
 
     def run(self, w: np.ndarray, seeds: Sequence[int], greedy: bool) -> list[envs.Episode]:
         return self.run_each([w] * len(seeds), seeds, greedy)
@@ -217,16 +263,13 @@ class Runner:
             self.pool = None
 
 
-# --- the task ---------------------------------------------------------------------------------------
-
-_ENVS: dict[str, Any] = {}   # this worker process's environments, by their arguments
-
+# --- Ray tasks: plain ones (RayTasks) and the trainer's episodes (RayRunner) -----------------------
 
 def rollout_batch(env_args: tuple, w: np.ndarray, seeds: Sequence[int], greedy: bool,
                   kill_marker: str | None = None) -> tuple[str, list[envs.Episode]]:
     """The body of one Ray task: the episodes of seeds, in order, and the id of the node that ran them.
 
-    The environment is built once per worker process and kept (a Ray worker runs many tasks).
+    The environment is built once per worker process and kept (cached).
     kill_marker is fault injection for the tests: the first task to create that file SIGKILLs its own
     worker process, as the OOM killer or a lost node would."""
     if kill_marker is not None:
@@ -238,10 +281,7 @@ def rollout_batch(env_args: tuple, w: np.ndarray, seeds: Sequence[int], greedy: 
             os.write(fd, str(os.getpid()).encode())
             os.close(fd)
             os.kill(os.getpid(), signal.SIGKILL)
-    key = json.dumps(env_args, sort_keys=True, default=str)
-    env = _ENVS.get(key)
-    if env is None:
-        env = _ENVS[key] = envs.make_env(*env_args)
+    env = cached(envs.make_env, *env_args)
     import ray
     node = ray.get_runtime_context().get_node_id()
     return node, [env.rollout(w, int(s), greedy) for s in seeds]
@@ -260,7 +300,37 @@ def batches(seeds: Sequence[int], n_tasks: int) -> list[list[int]]:
     return out
 
 
-class RayRunner:
+class RayTasks:
+    """Plain Ray tasks of one CPU each (pour-sweep's trials, pour-robust-scale's batches), on a connection
+    made as connect() makes it and shut down at the end if this made it; a context manager."""
+
+    def __init__(self, address: str | None = None, num_cpus: int | None = None):
+        self.ray = import_ray()
+        self.owns_ray = connect(address, num_cpus)
+
+    def cpus(self) -> int:
+        """The cluster's CPUs (at least 1)."""
+        return max(1, int(self.ray.cluster_resources().get("CPU", 1)))
+
+    def starmap(self, fn: Callable[..., Any], jobs: Sequence[tuple], desc: str, quiet: bool = False) -> list[Any]:
+        """starmap() on Ray: one task a job, each re-run up to MAX_RETRIES times if its worker dies; the results
+        in job order, with gather()'s progress bar; an error or Ctrl-C cancels the unfinished tasks."""
+        task = self.ray.remote(num_cpus=1, max_retries=MAX_RETRIES, retry_exceptions=False)(fn)
+        return gather(self.ray, [task.remote(*j) for j in jobs], desc, quiet)
+
+    def close(self) -> None:
+        if self.owns_ray and self.ray.is_initialized():
+            self.ray.shutdown()
+        self.owns_ray = False
+
+    def __enter__(self) -> Any:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+class RayRunner(RayTasks):
     """Runner's interface on Ray tasks. address: see connect(); episodes_per_task: batch size
     (default: the episodes of a call spread evenly, one batch per CPU of the cluster)."""
 
@@ -273,8 +343,7 @@ class RayRunner:
                          cfg.env.episode_s, cfg.env.options)
         # Fail early and clearly in the driver (missing library, bad option), as the local runner does.
         self.tau_max_nm = float(envs.make_env(*self.env_args).tau_max_nm)
-        self.ray = import_ray()
-        self.owns_ray = connect(address, num_cpus)
+        super().__init__(address, num_cpus)
         self.episodes_per_task = episodes_per_task
         self.kill_marker = kill_marker
         self.max_retries = max_retries
@@ -350,15 +419,7 @@ class RayRunner:
 
     def close(self) -> None:
         self.cancel()
-        if self.owns_ray and self.ray.is_initialized():
-            self.ray.shutdown()
-        self.owns_ray = False
-
-    def __enter__(self) -> "RayRunner":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
+        super().close()
 
 
 def gather(ray: Any, refs: Sequence[Any], desc: str, quiet: bool = False) -> list[Any]:

@@ -11,7 +11,6 @@ load average is printed before and after: the figures move with it.
 """
 from __future__ import annotations
 
-import multiprocessing as mp
 import os
 import time
 
@@ -104,11 +103,11 @@ def main() -> int:
     print("|---|---|---|---|---|---|---|---|")
     for cpus in (1, 2):
         cfg = _cfg(args.env, args.episode_s, cpus)
-        with mp.get_context("fork").Pool(cpus) as pool:
+        with executors.fork_pool(cpus) as pool:
             bulk, rt = pool_task_overhead(pool)
         runner = executors.Runner(cfg)
         if runner.pool is None:   # one worker runs in-process; measure a pool of one as the comparison
-            runner.pool = mp.get_context("fork").Pool(1, executors._init_worker, (runner.env_args,))
+            runner.pool = executors.fork_pool(1, executors._init_worker, (runner.env_args,))
         wall = throughput(runner, args.episodes)
         runner.close()
         ideal = cpus / t_ep

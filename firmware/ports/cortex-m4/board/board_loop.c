@@ -32,10 +32,31 @@ void pour_board_loop_init(pour_can_node_t *node) {
   pour_board_drive_set_calibration(calibration_tick);
 }
 
+/* The FDCAN's TX FIFO holds 3 frames (the STM32G4's fixed message RAM, RM0440 "FDCAN message RAM": 3 Tx
+ * buffers; fdcan.h), each on the bus for 111 bit times, while a heartbeat tick queues 4 at once (torque,
+ * heartbeat, identity, drive telemetry) and a calibration's outcome a 5th: what does not fit waits for the next
+ * tick's transmit, ahead of that tick's own frames and in order (the virtual board found DriveTelemetry never
+ * sent: docs/virtual-board.md). Full, the backlog drops the newest. */
+static pour_can_frame_t backlog[POUR_CAN_NODE_MAX_TX];
+static uint8_t backlog_n;
+
 void pour_board_transmit(const pour_can_frame_t *tx, uint8_t n) {
-  for (uint8_t i = 0; i < n; ++i) {
-    (void)pour_hal_can_transmit(&tx[i]);
+  uint8_t kept = 0u;
+  for (uint8_t i = 0; i < backlog_n; ++i) {
+    if (kept == 0u && pour_hal_can_transmit(&backlog[i]) >= 0) {
+      continue;
+    }
+    backlog[kept++] = backlog[i];
   }
+  for (uint8_t i = 0; i < n; ++i) {
+    if (kept == 0u && pour_hal_can_transmit(&tx[i]) >= 0) {
+      continue;
+    }
+    if (kept < POUR_CAN_NODE_MAX_TX) {
+      backlog[kept++] = tx[i];
+    }
+  }
+  backlog_n = kept;
 }
 
 void pour_board_loop_tick(pour_control_t *ctl, pour_can_node_t *node, uint32_t overruns) {
