@@ -124,6 +124,21 @@ def test_profile_counts_each_handler_and_the_step_with_and_without_what_preempts
     assert 0 < step["preempted"] < step["calls"], out
 
 
+def test_profile_of_the_flashed_image_pouring_holds_the_decision_tick_to_the_bar():
+    # The closed loop (--pour: calibrated, the rig's states over the bus, the shipped policy in RUN): every
+    # decision on the exact image, its step <= 1,000 instructions of its own; no softmax anywhere (a greedy
+    # policy), which would add ~485 to the decision tick and fail the bar.
+    excs, funcs, out = profile("--elf", ELF, "--pour", "--seed", "1")
+    decide, step = funcs["pour_policy_decide"], funcs["pour_control_step"]
+    assert decide["calls"] >= 1000, out  # 10 s of RUN, a decision every 10 ms
+    assert 0 < step["worst"] <= 1000, out
+    assert decide["worst"] < step["worst"], out
+    for name in ("pour_policy_softmax_q15", "pour_policy_fill_probs"):
+        assert funcs.get(name, {"calls": 0})["calls"] == 0, out
+    isr = excs["pour_board_drive_isr"]
+    assert isr["entries"] > 190000 and isr["share_worst"] < 100.0, out  # 20 kHz over the pour, within its period
+
+
 def test_profile_of_the_flashed_image_names_its_handlers_and_holds_the_step_to_the_bar():
     excs, funcs, out = profile("--elf", ELF, "--seconds", "1")
     isr, tick = excs["pour_board_drive_isr"], excs["pour_hal_timer_isr"]
