@@ -78,7 +78,7 @@ bench_core() {
   local image_flash=$((t + d)) image_ram=$((d + b)) drive_flash=0 drive_ram=0 softfloat
   # The B-G431B-ESC1's drivers, each object (the image links them all since the current loop's interrupt is
   # wired; the sum of the motor drivers' objects on top of the image is kept as an upper bound).
-  for o in "$port"/CMakeFiles/pour_firmware.dir/*.obj; do
+  for o in $(find "$port"/CMakeFiles/pour_firmware.dir -name '*.obj' | sort); do # board/, drivers/, ../common/
     case "$(basename "$o")" in
       main.c.obj|startup.c.obj|hal_timer.c.obj|hal_motor.c.obj) continue ;;
     esac
