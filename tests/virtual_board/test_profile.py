@@ -153,3 +153,17 @@ def test_profile_of_the_flashed_image_names_its_handlers_and_holds_the_step_to_t
     # A greedy image computes no softmax in any tick.
     for name in ("pour_policy_softmax_q15", "pour_policy_fill_probs"):
         assert funcs.get(name, {"calls": 0})["calls"] == 0, out
+
+
+def test_profile_of_an_image_without_symbols_is_refused_in_one_line(tmp_path: Path):
+    assert CC, "arm-none-eabi-gcc is needed (scripts/setup.sh's toolchain)"
+    src, elf = tmp_path / "nesting.S", tmp_path / "stripped.elf"
+    src.write_text(NESTING)
+    subprocess.run([CC, "-mcpu=cortex-m4", "-mthumb", "-nostdlib", "-Wl,-Ttext=0x08000000", "-Wl,-e,start", "-s",
+                    "-o", str(elf), str(src)], check=True, capture_output=True)
+    r = subprocess.run([VB, "--profile", "--elf", str(elf), "--seconds", "0.01"], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2, r.stderr
+    errors = [x for x in r.stderr.splitlines() if x.startswith("pour_virtual_board:")]
+    assert len(errors) == 1 and "--profile" in errors[0] and "symbols" in errors[0], r.stderr
+    assert "Traceback" not in r.stderr and "profile:" not in r.stdout
