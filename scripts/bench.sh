@@ -169,7 +169,7 @@ bench_motor() {
   printf '   bars: interrupt worst %s instructions (bar 850: %s), as the board runs it %s (a quarter of the 50 us period at 170 MHz: 2125 cycles); stack %s B (bar 1024: %s)\n' \
     "$worst" "$(verdict "${worst:-99999}" 850)" "${board_worst:-?}" "$total_stack" "$(verdict "${total_stack:-99999}" 1024)"
   echo "-- the full drive in the simulator (bench_motor; traces in build/host/bench/):"
-  if ! cmake --build --preset host -j2 --target bench_motor >/dev/null; then
+  if ! { cmake --preset host && cmake --build --preset host -j2 --target bench_motor; } >/dev/null; then
     echo "error: the host build failed" >&2; return 1
   fi
   mkdir -p build/host/bench
