@@ -352,8 +352,10 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
   }
   if (in->stop) {
     if (ctl->mode == POUR_MODE_RUN) {
+      /* The run ends held: with samples still coming, a new run would start at the next one (the virtual
+       * board's finding, docs/virtual-board.md). Only a Reset arms the next run (docs/can.md: Stop + Reset). */
       ctl->mode = POUR_MODE_IDLE;
-      ctl->held = ctl->experiment.kind != (uint8_t)POUR_EXPERIMENT_NONE; /* an experiment's run ends held */
+      ctl->held = true;
     } else {
       count_refused(ctl); /* nothing to end */
     }
@@ -440,6 +442,14 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
 }
 
 const pour_state_t *pour_control_state(const pour_control_t *ctl) { return &ctl->state; }
+
+void pour_control_hold(pour_control_t *ctl) {
+  if (ctl->mode == POUR_MODE_IDLE) {
+    ctl->held = true;
+  }
+}
+
+bool pour_control_held(const pour_control_t *ctl) { return ctl->held; }
 
 bool pour_control_clear_acceptable(const pour_control_t *ctl, const pour_control_input_t *in) {
   if (in->estop || in->link_fault) {
