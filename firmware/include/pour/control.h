@@ -23,8 +23,9 @@
  * 5: the drive (DRIVE fault, DriveTelemetry, calibration results), ExperimentStart.
  * 6: CalibrationResult's 5-bit Status (the interlock's refusals) and Stored in bits 5..7; the Crystal signal.
  * 7: parameters 28-30, the supervisor's tilt margin and overspeed limit and the estimator's jump limit.
+ * 8: no run starts on its own: a Stop ends the run held, the board boots held (Heartbeat's Held) until a Reset.
  * It is the DBC's protocol number (VERSION "pour CAN protocol N"), which test_can_dbc pins. */
-#define POUR_FIRMWARE_VERSION 7u
+#define POUR_FIRMWARE_VERSION 8u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {

@@ -63,7 +63,12 @@ PHASE void report_forever(void) {
  * configuration lives only in its own function's frame, so the two are never on the stack together. */
 PHASE pour_status_t controller_init(void) {
   const pour_control_config_t config = pour_control_default_config();
-  return pour_control_init(&controller, &config, &pour_weights_compiled);
+  const pour_status_t status = pour_control_init(&controller, &config, &pour_weights_compiled);
+  /* Booted held: after any reset (power-on, the watchdog's, a software or a pin reset) no run starts until the
+   * host sends Reset, even with the rig's samples coming (IEC 60204-1 §7.5 and §9.2.5.4.1: no restart on its
+   * own after a reset or a power restoration; docs/safety.md). */
+  pour_control_hold(&controller);
+  return status;
 }
 
 PHASE pour_status_t drive_init(void) {
