@@ -146,7 +146,10 @@ def test_a_missed_watchdog_refresh_mid_pour_resets_the_chip_and_ends_with_the_bu
     at = float(r.stderr.split("reset at ")[1].split(" ms")[0])
     assert "IWDG: no refresh within 10 ms" in r.stderr and FAULT_MS + 9.0 < at < FAULT_MS + 11.0, r.stderr
     held(r.stdout)
-    assert re.search(r"end at .* brake engaged, mode FAULT, .* resets 1", r.stdout), r.stdout
+    # No restart on its own (IEC 60204-1 §9.2.5.4.1; docs/safety.md): the image boots held, and with the rig's
+    # samples still coming it stays IDLE with the brake engaged, Heartbeat's Held set, until a Reset (none sent).
+    assert re.search(r"end at .* brake engaged, mode IDLE, faults 0x0000, resets 1, .*, held 1", r.stdout), r.stdout
+    assert "after the fault: RUN never re-entered" in r.stdout, r.stdout
 
 
 def test_a_pour_after_a_reset_runs_on_a_stale_encoder_offset_and_ends_held():

@@ -168,7 +168,8 @@ bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in);
  * the hold as it was). */
 void pour_control_hold(pour_control_t *ctl);
 
-/* Whether the axis is held in IDLE awaiting a Reset (pour_control_hold, a Stop, an experiment's end). */
+/* Whether no run is armed (pour_control_hold, a Stop, an experiment's end): IDLE waits for a Reset; in FAULT a clear
+ * leaves the axis so. */
 bool pour_control_held(const pour_control_t *ctl);
 
 /* Whether a ClearErrors with these inputs would be acted on, the drive's fault word aside: the e-stop
