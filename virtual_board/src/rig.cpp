@@ -320,6 +320,10 @@ void Rig::advance() {
         } else if (mode_ == POUR_MODE_FAULT && now >= last_clear_ms_ + 300.0) {
           send(POUR_CAN_CMD_CLEAR_ERRORS);  // pour-bench clear: a board that latched the wait in FAULT
           last_clear_ms_ = now;
+        } else if (now > stage_ms_ + 3000.0 && init_status_ < 0 && init_status_ != 99) {
+          refused_status_ = init_status_;  // RUN refused by name (Identity.InitStatus): the pour ends held
+          stop_ms_ = now;
+          stage_ = Stage::Stopped;
         } else if (now > stage_ms_ + 3000.0) {
           fail(std::string("the board did not enter RUN within 3 s of the fill (mode ") + mode_name(mode_) + ")");
         }
@@ -400,6 +404,7 @@ int Rig::report() {
                     : " (differs from the measurement)");
   }
   if (run_ms_ >= 0.0) std::printf("pour: RUN at %.1f ms (world step %u)\n", run_ms_, run_step_);
+  if (refused_status_ != 0) std::printf("pour: RUN refused for 3 s, init status %d (pour_status_t)\n", refused_status_);
   if (have_episode_) {
     std::printf("episode (%.3f s after RUN): poured %.2f %%, spilled %.2f %%, theta %.2f deg\n", o_.episode_s, 100.0 * poured_,
                 100.0 * spilled_, theta_episode_ * kDeg);

@@ -93,6 +93,7 @@ class Rig : public Peripheral {
   uint16_t faults_ = 0, drive_faults_ = 0;  // Heartbeat's, DriveTelemetry's (pour/drive_faults.h)
   double stage_ms_ = 0.0, last_clear_ms_ = -1e9, last_reset_ms_ = -1e9;
   bool held_ = false;       // Heartbeat's Held: the board waits for a Reset
+  int refused_status_ = 0;  // Identity.InitStatus when the board refused RUN for 3 s after the fill
   double rerun_ms_ = -1.0;  // RUN seen again after the fault (the board restarting on its own)
   int cal_results_ = 0;
   pour_can_calibration_result_t cal_{}, readback_{};

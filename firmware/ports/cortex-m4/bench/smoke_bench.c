@@ -84,6 +84,9 @@ uint32_t pour_clock_crystal(void) { return SMOKE_CRYSTAL_HZ; }
 
 /* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
 pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
+/* The scripted motor's encoder count is a function of the bucket's angle alone (pour_hal_can_poll): an absolute
+ * encoder, whose offset a reset does not lose. */
+bool pour_hal_calibration_offset_kept(void) { return true; }
 int pour_hal_calibration_reason(void) { return 0; }
 /* The block as the drive's default configuration would have measured it. */
 pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {

@@ -72,11 +72,24 @@ PHASE pour_status_t controller_init(void) {
 }
 
 PHASE pour_status_t drive_init(void) {
-  /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
+  /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. A stored
+   * calibration whose electrical offset did not survive the reset (pour_hal_calibration_offset_kept) is the same
+   * for the drive: it would commutate up to 180 electrical degrees off (the virtual board's finding,
+   * docs/virtual-board.md), so RUN waits for a CalibrationStart in this power cycle, and Identity says why
+   * (POUR_EALIGN). R, L and the pole pairs stay stored (the block is not touched). */
   const bool calibrated = pour_hal_calibration_load() == POUR_OK;
+  const bool offset = calibrated && pour_hal_calibration_offset_kept();
   const pour_drive_config_t drive = pour_drive_default_config();
-  const pour_status_t status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, calibrated);
-  return status == POUR_OK && !calibrated ? POUR_ECALIBRATION : status; /* what Identity says until then */
+  const pour_status_t status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, offset);
+  if (status != POUR_OK || offset) {
+    return status;
+  }
+  return calibrated ? POUR_EALIGN : POUR_ECALIBRATION; /* what Identity says until then */
+}
+
+/* The start-up statuses under which the loop still runs, RUN refused, so that a CalibrationStart can fix them. */
+static bool waits_for_calibration(pour_status_t status) {
+  return status == POUR_ECALIBRATION || status == POUR_EALIGN;
 }
 
 /* The start-up: the board at safe levels, the clock, the watchdog, the controller, the drive and the node.
@@ -104,7 +117,7 @@ PHASE bool start_up(pour_status_t *status_out) {
     status = drive_init();
   }
   pour_can_node_config_t nc = pour_can_node_default_config();
-  if (status == POUR_OK || status == POUR_ECALIBRATION) {
+  if (status == POUR_OK || waits_for_calibration(status)) {
     /* The stored parameters before the first tick (a stored node id too); a set that cannot be trusted is
      * refused as a policy or a clock would be. */
     const pour_status_t params = pour_board_params_init(&controller, nc.node_id);
@@ -147,7 +160,7 @@ int main(void) {
     for (;;) {
     }
   }
-  if (status != POUR_OK && status != POUR_ECALIBRATION) {
+  if (status != POUR_OK && !waits_for_calibration(status)) {
     report_forever();
   }
   run();
