@@ -101,6 +101,7 @@ typedef struct {
 typedef struct {
   pour_control_config_t config;
   pour_policy_t policy;
+  uint32_t policy_rng0;   /* the policy's PRNG state as init left it: a Reset puts it back */
   pour_safety_t safety;
   pour_mode_t mode;
   uint16_t faults;
