@@ -50,11 +50,12 @@ static void start_afresh(pour_control_t *ctl) {
   /* The envelope starts again from the command on the wire, not from the safe torque or zero: a run that
    * starts in the same tick ramps from what the motor has now, through the slew limit. */
   const q15_t on_wire = ctl->safety.torque;
-  (void)pour_safety_init(&ctl->safety, &ctl->config.safety);
+  pour_safety_restart(&ctl->safety); /* validated at init */
   pour_safety_force(&ctl->safety, on_wire);
-  if (ctl->policy.weights != NULL) {
-    (void)pour_policy_init(&ctl->policy, ctl->policy.weights, ctl->config.policy_mode, ctl->config.seed);
-  }
+  /* The policy as init left it: only its PRNG moves during a run (the weights were validated at init, and
+   * validating them again here, their content hash, would cost a Reset's tick ~2,700 instructions more than a
+   * decision's on the Cortex-M4: virtual_board --profile). */
+  ctl->policy.rng = ctl->policy_rng0;
   ctl->ms_since_fresh = 0u;
   ctl->ms_to_decision = 0u;
   const pour_state_t zero_state = {0u, 0, 0, 0, 0, 0};
@@ -131,6 +132,7 @@ pour_status_t pour_control_init(pour_control_t *ctl, const pour_control_config_t
   if (status != POUR_OK) {
     return status;
   }
+  ctl->policy_rng0 = ctl->policy.rng;
   start(ctl, config, weights->decision_period_ms);
   return POUR_OK;
 }
@@ -145,6 +147,7 @@ pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control
     return status;
   }
   ctl->policy.weights = NULL;
+  ctl->policy.rng = ctl->policy_rng0 = 0u; /* no policy: its PRNG unused */
   start(ctl, config, decision_period_ms);
   return POUR_OK;
 }
@@ -352,8 +355,10 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
   }
   if (in->stop) {
     if (ctl->mode == POUR_MODE_RUN) {
+      /* The run ends held: with samples still coming, a new run would start at the next one (the virtual
+       * board's finding, docs/virtual-board.md). Only a Reset arms the next run (docs/can.md: Stop + Reset). */
       ctl->mode = POUR_MODE_IDLE;
-      ctl->held = ctl->experiment.kind != (uint8_t)POUR_EXPERIMENT_NONE; /* an experiment's run ends held */
+      ctl->held = true;
     } else {
       count_refused(ctl); /* nothing to end */
     }
@@ -440,6 +445,14 @@ STAGE bool update_stage(pour_control_t *ctl, const pour_control_input_t *in) {
 }
 
 const pour_state_t *pour_control_state(const pour_control_t *ctl) { return &ctl->state; }
+
+void pour_control_hold(pour_control_t *ctl) {
+  if (ctl->mode == POUR_MODE_IDLE) {
+    ctl->held = true;
+  }
+}
+
+bool pour_control_held(const pour_control_t *ctl) { return ctl->held; }
 
 bool pour_control_clear_acceptable(const pour_control_t *ctl, const pour_control_input_t *in) {
   if (in->estop || in->link_fault) {

@@ -19,6 +19,8 @@ const char *pour_status_name(pour_status_t status) {
       return "POUR_EBOOT";
     case POUR_EPARAMS:
       return "POUR_EPARAMS";
+    case POUR_EALIGN:
+      return "POUR_EALIGN";
   }
   return "POUR_E?";
 }

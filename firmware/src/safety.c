@@ -47,6 +47,14 @@ pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t
   return POUR_OK;
 }
 
+void pour_safety_restart(pour_safety_t *safety) {
+  safety->torque = 0;
+  safety->active = 0u;
+  safety->ceiling_urad_s = safety->config.omega_slack_urad_s;
+  safety->floor_urad_s = -safety->config.omega_slack_urad_s;
+  safety->integral_mq15 = 0;
+}
+
 /* Zero for a torque that would drive further past an angle limit, else the torque itself. */
 static q15_t angle_cut(const pour_safety_config_t *c, q15_t torque, int32_t theta_urad, uint8_t *active) {
   if (torque > 0 && theta_urad >= c->theta_max_urad) {

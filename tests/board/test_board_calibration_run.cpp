@@ -183,11 +183,15 @@ void boot() {
   const pour_control_config_t cc = pour_control_default_config();
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_control_init_external(&ctl, &cc, 1u));
   const bool calibrated = pour_hal_calibration_load() == POUR_OK;
+  // The board's rule (main.c, hal_calibration.h): the stored electrical offset does not survive a boot (TIM4
+  // counts from 0, no index), so a stored block alone does not let the drive follow a torque.
+  const bool offset = false;
   const pour_drive_config_t dc = pour_drive_default_config();
-  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, static_cast<int32_t>(kTauMax * 1000), calibrated));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_board_drive_init(&dc, static_cast<int32_t>(kTauMax * 1000), offset));
   pour_can_node_config_t nc = pour_can_node_default_config();
   const pour_status_t params = pour_board_params_init(&ctl, nc.node_id);
-  nc.identity.init_status = static_cast<int8_t>(params != POUR_OK ? params : calibrated ? POUR_OK : POUR_ECALIBRATION);
+  nc.identity.init_status =
+      static_cast<int8_t>(params != POUR_OK ? params : calibrated ? POUR_EALIGN : POUR_ECALIBRATION);
   nc.can_calibrate = true;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_node_init(&node, &nc));
   pour_can_calibration_result_t r;
@@ -357,9 +361,11 @@ static void test_board_calibration_run_UncalibratedToRunWithoutAReset(void) {
   TEST_ASSERT_TRUE(plant.theta_max <= 10.0 * kPi / 180);
 }
 
-// The calibration stored, a real boot finds it: the drive measures its offsets and runs, the core goes to RUN
-// on the first sample without a ClearErrors, and a CalibrationStart in RUN is refused.
-static void test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot(void) {
+// The calibration stored, the next boot finds the block but not its electrical offset (TIM4 from 0, no index):
+// Identity says POUR_EALIGN, the drive holds its CALIBRATION fault and a ClearErrors does not let the core
+// run; a CalibrationStart in this power cycle finds the offset again (R, L, pole pairs as stored), Identity
+// says 0 and after a ClearErrors the core runs.
+static void test_board_calibration_run_TheNextBootWaitsForTheOffset(void) {
   boot();
   for (uint32_t ms = 0; ms < kClearMs; ++ms) {
     if (ms == kStartMs) send(POUR_CAN_CMD_CALIBRATION_START);
@@ -372,18 +378,38 @@ static void test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot(
   TEST_ASSERT_TRUE(timeouts_set >= 2);
   TEST_ASSERT_TRUE(timeout_at_save_us > POUR_BOARD_FLASH_PAGE_ERASE_MAX_US);
   TEST_ASSERT_UINT32_WITHIN(1000u, POUR_WATCHDOG_TIMEOUT_MS * 1000u, timeout_after_us);
+  pour_calibration_t first{};
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_load(&f, &first)); // the block the first power cycle stored
   plant_reset(); // power cycled: the same flash page
+  std::memset(regs, 0, sizeof regs); // the flash interface's register file as at the start (its page kept)
   boot();
-  TEST_ASSERT_EQUAL_INT8(POUR_OK, node.config.identity.init_status);
-  for (uint32_t ms = 0; ms < 300; ++ms) {
-    if (ms == 200) send(POUR_CAN_CMD_CALIBRATION_START);
-    tick(ms, ms < 100 ? 0.0 : kTilt);
+  TEST_ASSERT_EQUAL_INT8(POUR_EALIGN, node.config.identity.init_status);
+  // The register file does not model a page erase (it programs plain memory): the page as an erase leaves it,
+  // once the boot has read the block, so that this power cycle's save can program it again.
+  std::memset(page, 0xFF, sizeof page);
+  for (uint32_t ms = 0; ms < 150; ++ms) {
+    if (ms == 100) send(POUR_CAN_CMD_CLEAR_ERRORS);
+    tick(ms, 0.0);
   }
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_FAULT, ctl.mode); // the clear refused: the drive's word stays set
+  TEST_ASSERT_BITS_HIGH(POUR_DRIVE_FAULT_CALIBRATION, pour_board_drive_faults());
+  TEST_ASSERT_TRUE(brake_line);
+  for (uint32_t ms = 150; ms < kClearMs + 300; ++ms) {
+    if (ms == kStartMs) send(POUR_CAN_CMD_CALIBRATION_START);
+    if (ms == kClearMs) send(POUR_CAN_CMD_CLEAR_ERRORS);
+    tick(ms, ms < kClearMs + 100 ? 0.0 : kTilt);
+  }
+  TEST_ASSERT_EQUAL_INT(2, (int)plant.results.size());
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_MEASURING, plant.results[0].status);
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, plant.results[0].stored); // the block was kept meanwhile
+  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, plant.results[1].status);
+  TEST_ASSERT_EQUAL_INT8(POUR_OK, node.config.identity.init_status);
+  pour_calibration_t again{};
+  TEST_ASSERT_EQUAL_INT(POUR_CAL_OK, pour_calibration_load(&f, &again));
+  TEST_ASSERT_EQUAL_UINT32(first.pole_pairs, again.pole_pairs);
+  TEST_ASSERT_UINT32_WITHIN(first.r_phase_uohm / 50u, first.r_phase_uohm, again.r_phase_uohm);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, ctl.mode);
   TEST_ASSERT_EQUAL_HEX16(0u, pour_board_drive_faults());
-  TEST_ASSERT_EQUAL_INT(1, (int)plant.results.size());
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_REFUSED_RUNNING, plant.results[0].status);
-  TEST_ASSERT_EQUAL_UINT8(POUR_CAN_CAL_OK, plant.results[0].stored);
   TEST_ASSERT_EQUAL_INT(0, (int)plant.unpowered_released);
   TEST_ASSERT_DOUBLE_WITHIN(1.0 * kPi / 180, kTilt, plant.theta);
 }
@@ -528,7 +554,7 @@ int main(void) {
   RUN_TEST(test_board_params_AWriteASaveAndTheNextBootKeepIt);
   RUN_TEST(test_board_params_TareAndZeroCorrectWhatTheCoreSees);
   RUN_TEST(test_board_params_ACorruptStoredSetIsRefusedByName);
-  RUN_TEST(test_board_calibration_run_TheStoredCalibrationIsFoundAtTheNextBoot);
+  RUN_TEST(test_board_calibration_run_TheNextBootWaitsForTheOffset);
   RUN_TEST(test_board_calibration_run_ASlippedCouplingIsClearedOnlyByACalibration);
   return UNITY_END();
 }

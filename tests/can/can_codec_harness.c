@@ -4,7 +4,7 @@
  *   pack <msg> <node> <raw fields...>   -> "ok <id> <dlc> <hex>" | "einval"
  *   unpack <msg> <id> <dlc> <hex>       -> "ok <raw fields...>" | "rx <pour_can_rx_t>"
  * msg: sensors (seq_low encoder scale_rotating scale_target), torque (seq torque action mode limits),
- * heartbeat (mode faults rx_dropped overruns counter refused), estop (assert), identity (hash tau_max fw init),
+ * heartbeat (mode faults rx_dropped overruns counter refused held), estop (assert), identity (hash tau_max fw init),
  * param_read (id), param_value and param_write (id value), param_ack (request id result), tare (scales),
  * experiment_start (kind),
  * clear_errors, stop, reset, param_save, zero and calibration_read (no fields).
@@ -94,9 +94,9 @@ static void do_pack(const char *msg, long *v, int n) {
   } else if (strcmp(msg, "torque") == 0 && n == 6) {
     pour_can_torque_t m = {(uint16_t)v[1], (q15_t)v[2], (uint8_t)v[3], (uint8_t)v[4], (uint8_t)v[5]};
     print_frame(pour_can_pack_torque(node, &m, &f), &f);
-  } else if (strcmp(msg, "heartbeat") == 0 && n == 7) {
+  } else if (strcmp(msg, "heartbeat") == 0 && n == 8) {
     pour_can_heartbeat_t m = {(uint8_t)v[1], (uint16_t)v[2], (uint16_t)v[3], (uint16_t)v[4], (uint8_t)v[5],
-                              (uint8_t)v[6]};
+                              (uint8_t)v[6], (uint8_t)v[7]};
     print_frame(pour_can_pack_heartbeat(node, &m, &f), &f);
   } else if (strcmp(msg, "estop") == 0 && n == 2) {
     pour_can_estop_t m = {(uint8_t)v[1]};
@@ -184,8 +184,9 @@ static void do_unpack(const char *msg, char *rest) {
   } else if (strcmp(msg, "heartbeat") == 0) {
     pour_can_heartbeat_t m = {0};
     rc = pour_can_unpack_heartbeat(&f, &m);
-    snprintf(out, sizeof out, "%u %u %u %u %u %u", (unsigned)m.mode, (unsigned)m.faults, (unsigned)m.rx_dropped,
-             (unsigned)m.overruns, (unsigned)m.counter, (unsigned)m.refused);
+    snprintf(out, sizeof out, "%u %u %u %u %u %u %u", (unsigned)m.mode, (unsigned)m.faults,
+             (unsigned)m.rx_dropped, (unsigned)m.overruns, (unsigned)m.counter, (unsigned)m.refused,
+             (unsigned)m.held);
   } else if (strcmp(msg, "estop") == 0) {
     pour_can_estop_t m = {0};
     rc = pour_can_unpack_estop(&f, &m);

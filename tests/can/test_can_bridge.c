@@ -150,7 +150,7 @@ static void test_bridge_DropsTorqueForASampleNeverSent(void) {
 }
 
 static void test_bridge_HeartbeatBecomesStatus(void) {
-  pour_can_heartbeat_t hb = {2, 0x0101, 17, 4, 9, 3};
+  pour_can_heartbeat_t hb = {2, 0x0101, 17, 4, 9, 3, 0};
   pour_can_frame_t f;
   TEST_ASSERT_EQUAL_INT(POUR_OK, pour_can_pack_heartbeat(2, &hb, &f));
   pour_torque_t tq;

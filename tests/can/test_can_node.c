@@ -288,6 +288,46 @@ static void receive_command(uint8_t cmd) {
   TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_node_receive(&node, &f));
 }
 
+/* The heartbeat's Held of a core booted held (as the board's main.c does): the stream of samples starts no
+ * run, the heartbeat says Held in IDLE, until the host's Reset frame arms the run; a Stop holds it again. */
+static uint8_t held_bit(void) {
+  pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
+  pour_control_output_t out;
+  memset(&out, 0, sizeof out);
+  out.mode = (uint8_t)ctl.mode;
+  pour_can_node_set_held(&node, pour_control_held(&ctl));
+  TEST_ASSERT_EQUAL_UINT8(2, pour_can_node_status_frames(&node, &out, 0, tx));
+  pour_can_heartbeat_t hb;
+  TEST_ASSERT_EQUAL_INT(POUR_CAN_RX_OK, pour_can_unpack_heartbeat(&tx[0], &hb));
+  TEST_ASSERT_EQUAL_UINT8(hb.held, (uint8_t)(tx[0].data[2] >> 7)); /* bit 23 (can/pour.dbc, Held) */
+  return hb.held;
+}
+
+static void test_can_node_HeldAtBootUntilAResetFrameAndAfterAStop(void) {
+  pour_control_hold(&ctl);
+  pour_control_output_t out;
+  uint32_t seq = 1u;
+  for (int i = 0; i < 50; ++i) {
+    send_sample(seq++, 100u);
+    core_tick(&out);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+    TEST_ASSERT_TRUE(out.brake);
+  }
+  TEST_ASSERT_EQUAL_UINT8(1u, held_bit());
+  receive_command(POUR_CAN_CMD_RESET);
+  send_sample(seq++, 100u);
+  core_tick(&out);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_EQUAL_UINT8(0u, held_bit());
+  receive_command(POUR_CAN_CMD_STOP);
+  for (int i = 0; i < 50; ++i) {
+    send_sample(seq++, 100u);
+    core_tick(&out);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  }
+  TEST_ASSERT_EQUAL_UINT8(1u, held_bit());
+}
+
 /* A bench with no host stream: commands alone never arm the watchdog, so the e-stop, its release and the clear
  * leave an idle node IDLE (docs/bringup.md step 5), however long the bus then stays silent; the first sample
  * arms it, and then silence trips it. */
@@ -914,5 +954,6 @@ int main(void) {
   RUN_TEST(test_can_node_ExperimentStart_OfAnUnknownKindIsDropped);
   RUN_TEST(test_can_node_HardwiredLineHeldDropsAClearAndOutranksTheBus);
   RUN_TEST(test_can_node_HeartbeatCountsRefusedCommands);
+  RUN_TEST(test_can_node_HeldAtBootUntilAResetFrameAndAfterAStop);
   return UNITY_END();
 }

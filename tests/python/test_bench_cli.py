@@ -91,7 +91,7 @@ def candump_log(path, node: int = 0, samples: int = 300, drive: bool = False) ->
         if k % 100 == 0:
             late = k >= 200
             frame(t, "Heartbeat", Mode=2 if late else 1, **{**faults, "Fault_StaleInput": int(late)}, RxDropped=0,
-                  Overruns=0, Counter=k // 100, Refused=0)
+                  Overruns=0, Counter=k // 100, Refused=0, Held=0)
             frame(t, "Identity", WeightsHash=0x1234, TauMax=2000, FwVersion=3, InitStatus=0)
             if drive:  # Iq 2 A, bus 24 V; the drive's overcurrent latched with the late heartbeat
                 frame(t, "DriveTelemetry", Id=0, Iq=1000, Vbus=24000, Crystal=6, **{
@@ -316,6 +316,20 @@ def test_faults_names_the_drives_faults_from_its_telemetry(drive, needle, capsys
     assert rc == 0, out
     lines = out.out.splitlines()
     assert lines[0].startswith("node 0: mode FAULT, faults Drive,") and lines[1] == needle, out.out
+
+
+@pytest.mark.parametrize("held", [1, 0])
+def test_faults_says_a_held_node_waits_for_a_reset(held, capsys):
+    """Heartbeat's Held (protocol 8: the board boots held, a Stop holds): pour-bench says RUN waits for a Reset."""
+    from pour.bench import cli as bench_cli
+    channel = f"heldnode{held}"
+    with _FakeNode(channel, {}, mode="IDLE", faults=dict(Held=held)):
+        rc = bench_cli.main(["--interface", "virtual", "--channel", channel, "faults"])
+    out = capsys.readouterr()
+    assert rc == 0, out
+    first = out.out.splitlines()[0]
+    assert first.startswith("node 0: mode IDLE, faults none,"), out.out
+    assert first.endswith(", held (RUN waits for a Reset: pour-bench reset)") == bool(held), out.out
 
 
 def test_without_socketcan_the_error_points_to_the_no_can_hardware_doc(monkeypatch, capsys):

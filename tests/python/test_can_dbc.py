@@ -24,7 +24,7 @@ N_RANDOM = 400
 MESSAGES = {
     "sensors": ("Sensors", ["Seq", "Encoder", "ScaleRotating", "ScaleTarget"]),
     "torque": ("Torque", ["Seq", "Torque", "Action", "Mode", "Limits"]),
-    "heartbeat": ("Heartbeat", ["Mode", "Faults", "RxDropped", "Overruns", "Counter", "Refused"]),
+    "heartbeat": ("Heartbeat", ["Mode", "Faults", "RxDropped", "Overruns", "Counter", "Refused", "Held"]),
     "estop": ("Estop", ["Assert"]),
     "identity": ("Identity", ["WeightsHash", "TauMax", "FwVersion", "InitStatus"]),
     "clear_errors": ("ClearErrors", []),
@@ -288,7 +288,7 @@ def test_cantools_decode_of_candump_log_shows_units(db, harness, source_dir):
     """What a bench engineer runs: candump -L lines piped through cantools decode."""
     lines = []
     frames = [("sensors", [7, 131071, -5, 12345]),
-              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5, 2]), ("estop", [1]),
+              ("torque", [7, -16384, 2, 1, 2]), ("heartbeat", [1, 0x0121, 3, 4, 5, 2, 1]), ("estop", [1]),
               ("identity", [0x1234ABCD, 2000, 2, 0]), ("clear_errors", []), ("stop", []), ("reset", []),
               ("calibration_start", []), ("calibration_result", [7, 2, 0, 0, 0, 0, 0]),
               ("calibration_read", []), ("calibration_result", [19, 0, 1, 4, 450, 220, 12]),

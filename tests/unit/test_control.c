@@ -275,11 +275,73 @@ static void test_control_step_EachRunStartsTheEstimateAfresh(void) {
   step(false);
   in.stop = false;
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  in.reset = true; /* the next run: the host's Stop + Reset (docs/can.md) */
+  step(false);
+  in.reset = false;
   sense(0, 4000, 0); /* half of it was poured out by hand */
   step(true);
   TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
   TEST_ASSERT_EQUAL_INT16(32767, ctl.state.v_rotating);
   TEST_ASSERT_EQUAL_INT32(4000, ctl.estimator.m0_g);
+}
+
+/* A Stop ends the run held: samples keep coming (a rig's sensor node streams all the time) and none starts a
+ * new run, the brake engaged and the power off, until a Reset arms one (the virtual board's finding). */
+static void test_control_stop_HoldsTheAxisWhileSamplesKeepComing(void) {
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  in.stop = true;
+  step(true);
+  in.stop = false;
+  for (int i = 0; i < 2000; ++i) {
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+    TEST_ASSERT_TRUE(out.brake);
+    TEST_ASSERT_FALSE(out.power);
+    TEST_ASSERT_TRUE(pour_control_held(&ctl));
+  }
+  TEST_ASSERT_EQUAL_INT16(config.safe_torque, out.torque);
+  TEST_ASSERT_EQUAL_UINT32(0u, out.refused);
+  in.reset = true; /* the Reset arms the next run: it starts on the next fresh sample */
+  step(false);
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  TEST_ASSERT_FALSE(pour_control_held(&ctl));
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_FALSE(out.brake);
+}
+
+/* A port's boot (pour_control_hold after init): no run starts on the stream until a Reset; a clear of a fault
+ * meanwhile does not arm one either. */
+static void test_control_hold_AtBootNoRunUntilAReset(void) {
+  pour_control_hold(&ctl);
+  for (int i = 0; i < 100; ++i) {
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+    TEST_ASSERT_TRUE(out.brake);
+  }
+  in.estop = true; /* an e-stop and its clear in between: still held */
+  step(true);
+  in.estop = false;
+  step(true);
+  in.clear_faults = true;
+  step(true);
+  in.clear_faults = false;
+  TEST_ASSERT_EQUAL_HEX16(0u, out.faults);
+  for (int i = 0; i < 100; ++i) {
+    step(true);
+    TEST_ASSERT_EQUAL_UINT8(POUR_MODE_IDLE, out.mode);
+  }
+  TEST_ASSERT_TRUE(pour_control_held(&ctl));
+  in.reset = true;
+  step(true); /* a Reset and a sample in one tick: the run starts in it */
+  in.reset = false;
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  pour_control_hold(&ctl); /* in RUN it does nothing: a Stop ends a run */
+  step(true);
+  TEST_ASSERT_EQUAL_UINT8(POUR_MODE_RUN, out.mode);
+  TEST_ASSERT_FALSE(pour_control_held(&ctl));
 }
 
 /* Moving forward slowly (0.3 rad/s) past θ_max: forward torque before it, none from the first sample past it. */
@@ -562,6 +624,8 @@ int main(void) {
   RUN_TEST(test_control_step_BadInputInIdleAlsoFaults);
   RUN_TEST(test_control_step_VolumeSumCheckRefusesWhenArmed);
   RUN_TEST(test_control_step_EachRunStartsTheEstimateAfresh);
+  RUN_TEST(test_control_stop_HoldsTheAxisWhileSamplesKeepComing);
+  RUN_TEST(test_control_hold_AtBootNoRunUntilAReset);
   RUN_TEST(test_control_step_NoForwardTorquePastMaxAngle);
   RUN_TEST(test_control_step_IsDeterministic);
   RUN_TEST(test_control_request_OfThePolicysLevelsRepeatsItsRun);

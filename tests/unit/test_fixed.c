@@ -31,6 +31,7 @@ static void test_fixed_status_name_NamesEveryStatus(void) {
   TEST_ASSERT_EQUAL_STRING("POUR_ECALIBRATION", pour_status_name(POUR_ECALIBRATION));
   TEST_ASSERT_EQUAL_STRING("POUR_EBOOT", pour_status_name(POUR_EBOOT));
   TEST_ASSERT_EQUAL_STRING("POUR_EPARAMS", pour_status_name(POUR_EPARAMS));
+  TEST_ASSERT_EQUAL_STRING("POUR_EALIGN", pour_status_name(POUR_EALIGN));
   TEST_ASSERT_EQUAL_STRING("POUR_E?", pour_status_name((pour_status_t)-99));
 }
 

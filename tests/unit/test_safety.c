@@ -481,6 +481,26 @@ static void test_safety_schedule_ClosedLoopPoursAtTheSlowSpeedPastTheKnee(void) 
   TEST_ASSERT_GREATER_THAN_INT32(1500000, unscheduled.peak_urad_s);
 }
 
+/* A restart (a Reset's) leaves the envelope's run state as init does, whatever a run left in it. */
+static void test_safety_restart_IsInitsRunState(void) {
+  config = pour_safety_default_config();
+  pour_safety_t fresh;
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&fresh, &config));
+  TEST_ASSERT_EQUAL_INT(POUR_OK, pour_safety_init(&safety, &config));
+  for (int i = 0; i < 200; ++i) {
+    (void)pour_safety_apply(&safety, 30000, MID_URAD, 3000000); /* pushing hard while moving fast */
+  }
+  TEST_ASSERT_NOT_EQUAL(0, safety.torque);
+  pour_safety_restart(&safety);
+  TEST_ASSERT_EQUAL_INT16(fresh.torque, safety.torque);
+  TEST_ASSERT_EQUAL_UINT8(fresh.active, safety.active);
+  TEST_ASSERT_EQUAL_INT32(fresh.alpha_step_urad_s, safety.alpha_step_urad_s);
+  TEST_ASSERT_EQUAL_INT32(fresh.gain_q32, safety.gain_q32);
+  TEST_ASSERT_EQUAL_INT32(fresh.ceiling_urad_s, safety.ceiling_urad_s);
+  TEST_ASSERT_EQUAL_INT32(fresh.floor_urad_s, safety.floor_urad_s);
+  TEST_ASSERT_EQUAL_INT32(fresh.integral_mq15, safety.integral_mq15);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_safety_init_StartsAtZeroTorque);
@@ -504,5 +524,6 @@ int main(void) {
   RUN_TEST(test_safety_schedule_IntegralLiftsTheBoundWithoutWindup);
   RUN_TEST(test_safety_schedule_NeverPushesBeyondTheSpeedLimit);
   RUN_TEST(test_safety_schedule_ClosedLoopPoursAtTheSlowSpeedPastTheKnee);
+  RUN_TEST(test_safety_restart_IsInitsRunState);
   return UNITY_END();
 }

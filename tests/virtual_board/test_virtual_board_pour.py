@@ -65,15 +65,19 @@ def test_the_calibration_is_stored_and_read_back_after_a_reset(pour):
     r, _ = pour
     assert "reset at" in r.stderr and "the bench's reset (NRST)" in r.stderr, r.stderr
     line = next(x for x in r.stdout.splitlines() if x.startswith("read back after the reset"))
-    # Identity.InitStatus 0: the boot found a valid block (-5 uncalibrated); Stored 0: POUR_CAN_CAL_OK
-    assert "init status 0," in line and "stored 0," in line and "(as measured)" in line, line
+    # Stored 0 (POUR_CAN_CAL_OK): the boot found the block intact, as measured; Identity.InitStatus -8
+    # (POUR_EALIGN; -5 would be uncalibrated): its electrical offset is not trusted after the reset
+    assert "init status -8," in line and "stored 0," in line and "(as measured)" in line, line
 
 
 def test_the_shipped_policy_pours_at_least_98_percent_and_spills_at_most_1(pour):
     out = pour[0].stdout
     assert number(r"poured ([0-9.]+) %, spilled", out) >= 98.0, out
     assert number(r"episode .* spilled ([0-9.]+) %", out) <= 1.0, out
-    assert re.search(r"end at .* brake engaged, mode IDLE, faults 0x0000, resets 0", out), out
+    # the end as the read-back's reset left it: held (Held 1), RUN refused until a CalibrationStart (the drive's
+    # CALIBRATION 0x0200: the offset is not trusted after a reset, POUR_EALIGN)
+    assert re.search(r"end at .* brake engaged, mode FAULT, faults 0x0800, resets 0, drive faults 0x0200, held 1",
+                     out), out
 
 
 def test_the_pour_agrees_with_host_sims_full_drive_of_the_same_seed(pour):
@@ -146,19 +150,28 @@ def test_a_missed_watchdog_refresh_mid_pour_resets_the_chip_and_ends_with_the_bu
     at = float(r.stderr.split("reset at ")[1].split(" ms")[0])
     assert "IWDG: no refresh within 10 ms" in r.stderr and FAULT_MS + 9.0 < at < FAULT_MS + 11.0, r.stderr
     held(r.stdout)
-    assert re.search(r"end at .* brake engaged, mode FAULT, .* resets 1", r.stdout), r.stdout
+    # No restart on its own (IEC 60204-1 §9.2.5.4.1; docs/safety.md): the image boots held (Heartbeat's Held) and
+    # does not trust the stored offset (the drive's CALIBRATION 0x0200, POUR_EALIGN): with the rig's samples
+    # still coming it never enters RUN again, the brake engaged.
+    assert re.search(r"end at .* brake engaged, mode FAULT, faults 0x0800, resets 1, drive faults 0x0200, held 1",
+                     r.stdout), r.stdout
+    assert "after the fault: RUN never re-entered" in r.stdout, r.stdout
 
 
-def test_a_pour_after_a_reset_runs_on_a_stale_encoder_offset_and_ends_held():
+def test_a_pour_after_a_reset_is_refused_until_the_offset_is_found_again():
     # The finding (docs/virtual-board.md): the stored electrical offset is the angle at TIM4's count 0, and
     # the image sets the count to 0 at every start (encoder_tim4.c), wherever the rotor stands. The calibration
     # leaves the shaft ~0.22 rad (~100 electrical degrees) from where it stood at power-on, so a pour after
-    # a reset commutates ~100 deg off: the supervisor latches TORQUE_SIGN and the bucket stays held.
+    # a reset would commutate ~100 deg off (before the fix: TORQUE_SIGN 35 ms into RUN). Now the boot does not
+    # trust the offset: RUN is refused by name (Identity.InitStatus -8, POUR_EALIGN; the drive's CALIBRATION
+    # fault 0x0200 in DriveTelemetry) while the block stays stored (Stored 0), the bucket held upright.
     r = fault_run("--reset-before-pour")
-    assert "init status 0, stored 0," in r.stdout, r.stdout
+    assert "init status -8, stored 0," in r.stdout, r.stdout
     elec = number(r"\(([0-9.]+) electrical deg from where it stood at power-on\)", r.stdout)
     assert 45.0 < elec < 315.0, r.stdout
-    assert re.search(r"end at .* theta (-?[0-5]\.[0-9]+) deg, brake engaged, mode FAULT, faults 0x0020", r.stdout), r.stdout
+    assert "pour: RUN at" not in r.stdout and "pour: RUN refused for 3 s, init status -8" in r.stdout, r.stdout
+    assert re.search(r"end at .* theta -?0\.[0-9]+ deg, brake engaged, mode FAULT, faults 0x0800, resets 0, "
+                     r"drive faults 0x0200, held 1", r.stdout), r.stdout
 
 
 @pytest.mark.parametrize("fault", [["--corrupt-page", "63"], ["--ecc-page", "63"]], ids=["corrupt", "ecc"])

@@ -127,6 +127,8 @@ void Rig::frame(const CanFrame& cf) {
         heartbeat_ = true;
         mode_ = h.mode;
         faults_ = h.faults;
+        held_ = h.held != 0u;
+        if (fault_seen_ms_ >= 0.0 && mode_ == POUR_MODE_RUN && rerun_ms_ < 0.0) rerun_ms_ = now;
       }
       break;
     }
@@ -312,9 +314,16 @@ void Rig::advance() {
         if (mode_ == POUR_MODE_RUN) {
           run_ms_ = now;
           run_step_ = world_ ? world_->steps() : 0u;
+        } else if (mode_ == POUR_MODE_IDLE && held_ && now >= last_reset_ms_ + 300.0) {
+          send(POUR_CAN_CMD_RESET);  // pour-bench reset: the board boots held, and a clear leaves it held
+          last_reset_ms_ = now;
         } else if (mode_ == POUR_MODE_FAULT && now >= last_clear_ms_ + 300.0) {
           send(POUR_CAN_CMD_CLEAR_ERRORS);  // pour-bench clear: a board that latched the wait in FAULT
           last_clear_ms_ = now;
+        } else if (now > stage_ms_ + 3000.0 && init_status_ < 0 && init_status_ != 99) {
+          refused_status_ = init_status_;  // RUN refused by name (Identity.InitStatus): the pour ends held
+          stop_ms_ = now;
+          stage_ = Stage::Stopped;
         } else if (now > stage_ms_ + 3000.0) {
           fail(std::string("the board did not enter RUN within 3 s of the fill (mode ") + mode_name(mode_) + ")");
         }
@@ -395,6 +404,7 @@ int Rig::report() {
                     : " (differs from the measurement)");
   }
   if (run_ms_ >= 0.0) std::printf("pour: RUN at %.1f ms (world step %u)\n", run_ms_, run_step_);
+  if (refused_status_ != 0) std::printf("pour: RUN refused for 3 s, init status %d (pour_status_t)\n", refused_status_);
   if (have_episode_) {
     std::printf("episode (%.3f s after RUN): poured %.2f %%, spilled %.2f %%, theta %.2f deg\n", o_.episode_s, 100.0 * poured_,
                 100.0 * spilled_, theta_episode_ * kDeg);
@@ -411,8 +421,13 @@ int Rig::report() {
                 mode_after_clear_ == POUR_MODE_RUN ? "RUN was entered" : "RUN never entered");
   }
   if (end_ms_ >= 0.0) {
-    std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u, drive faults 0x%04x\n", end_ms_,
-                theta_end_ * kDeg, brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - script_resets_, drive_faults_);
+    std::printf("end at %.1f ms: theta %.2f deg, brake %s, mode %s, faults 0x%04x, resets %u, drive faults 0x%04x, held %d\n",
+                end_ms_, theta_end_ * kDeg, brake_ ? "engaged" : "released", mode_name(mode_), faults_, resets_ - script_resets_,
+                drive_faults_, held_ ? 1 : 0);
+    if (fault_seen_ms_ >= 0.0) {
+      if (rerun_ms_ < 0.0) std::printf("after the fault: RUN never re-entered\n");
+      else std::printf("after the fault: RUN again at %.1f ms\n", rerun_ms_);
+    }
     if (world_) std::printf("world: poured %.2f %%, spilled %.2f %%, left %.2f %%\n", 100.0 * world_->poured(), 100.0 * world_->spilled(),
                             100.0 * world_->remaining());
   }

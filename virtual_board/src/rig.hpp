@@ -91,7 +91,10 @@ class Rig : public Peripheral {
   bool heartbeat_ = false;
   int mode_ = -1, init_status_ = 99;
   uint16_t faults_ = 0, drive_faults_ = 0;  // Heartbeat's, DriveTelemetry's (pour/drive_faults.h)
-  double stage_ms_ = 0.0, last_clear_ms_ = -1e9;
+  double stage_ms_ = 0.0, last_clear_ms_ = -1e9, last_reset_ms_ = -1e9;
+  bool held_ = false;       // Heartbeat's Held: the board waits for a Reset
+  int refused_status_ = 0;  // Identity.InitStatus when the board refused RUN for 3 s after the fill
+  double rerun_ms_ = -1.0;  // RUN seen again after the fault (the board restarting on its own)
   int cal_results_ = 0;
   pour_can_calibration_result_t cal_{}, readback_{};
   bool have_cal_ = false, have_readback_ = false, read_sent_ = false, clear_sent_ = false;

@@ -75,7 +75,7 @@ pour_status_t pour_can_pack_torque(uint8_t node_id, const pour_can_torque_t *msg
 pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_t *msg,
                                       pour_can_frame_t *frame) {
   if (msg == NULL || frame == NULL || node_id > POUR_CAN_NODE_ID_MAX || msg->mode > POUR_CAN_MODE_MAX ||
-      msg->refused > POUR_CAN_REFUSED_MAX) {
+      msg->refused > POUR_CAN_REFUSED_MAX || msg->held > 1u) {
     return POUR_EINVAL;
   }
   frame_begin(frame, node_id, POUR_CAN_CMD_HEARTBEAT, POUR_CAN_DLC_HEARTBEAT);
@@ -83,6 +83,7 @@ pour_status_t pour_can_pack_heartbeat(uint8_t node_id, const pour_can_heartbeat_
   /* Faults occupy bits 8..23: the core's bits in byte 1, the CAN node's in byte 2. */
   uint16_t faults = (uint16_t)(msg->faults & POUR_CAN_HEARTBEAT_FAULT_MASK);
   put_u16(&frame->data[1], faults);
+  frame->data[2] = (uint8_t)(frame->data[2] | (uint8_t)(msg->held << 7)); /* Held: bit 23, above every fault */
   put_u16(&frame->data[3], msg->rx_dropped);
   put_u16(&frame->data[5], msg->overruns);
   frame->data[7] = msg->counter;
@@ -307,6 +308,7 @@ pour_can_rx_t pour_can_unpack_heartbeat(const pour_can_frame_t *frame, pour_can_
   msg->mode = (uint8_t)(frame->data[0] & 0x0Fu);
   msg->refused = (uint8_t)(frame->data[0] >> 4);
   msg->faults = (uint16_t)(get_u16(&frame->data[1]) & POUR_CAN_HEARTBEAT_FAULT_MASK);
+  msg->held = (uint8_t)(frame->data[2] >> 7);
   msg->rx_dropped = get_u16(&frame->data[3]);
   msg->overruns = get_u16(&frame->data[5]);
   msg->counter = frame->data[7];

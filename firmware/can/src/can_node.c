@@ -239,6 +239,7 @@ uint8_t pour_can_node_status_frames(pour_can_node_t *node, const pour_control_ou
   hb.rx_dropped = (uint16_t)(pour_can_node_dropped(node) & 0xFFFFu);
   hb.overruns = (uint16_t)(overruns & 0xFFFFu);
   hb.counter = node->heartbeat_counter;
+  hb.held = node->held ? 1u : 0u; /* in FAULT too: a clear then leaves the axis held, awaiting a Reset */
   hb.refused = (uint8_t)((out->refused + node->commands.clears_dropped) & POUR_CAN_REFUSED_MAX);
   if (pour_can_pack_heartbeat(node->config.node_id, &hb, &tx[0]) != POUR_OK ||
       pour_can_pack_identity(node->config.node_id, &node->config.identity, &tx[1]) != POUR_OK) {
@@ -296,6 +297,8 @@ void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemet
   node->drive = *drive;
   node->have_drive = true;
 }
+
+void pour_can_node_set_held(pour_can_node_t *node, bool held) { node->held = held; }
 
 void pour_can_node_report_calibration(pour_can_node_t *node, const pour_can_calibration_result_t *result) {
   node->calibration = *result;

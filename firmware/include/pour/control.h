@@ -23,8 +23,9 @@
  * 5: the drive (DRIVE fault, DriveTelemetry, calibration results), ExperimentStart.
  * 6: CalibrationResult's 5-bit Status (the interlock's refusals) and Stored in bits 5..7; the Crystal signal.
  * 7: parameters 28-30, the supervisor's tilt margin and overspeed limit and the estimator's jump limit.
+ * 8: no run starts on its own: a Stop ends the run held, the board boots held (Heartbeat's Held) until a Reset.
  * It is the DBC's protocol number (VERSION "pour CAN protocol N"), which test_can_dbc pins. */
-#define POUR_FIRMWARE_VERSION 7u
+#define POUR_FIRMWARE_VERSION 8u
 
 /* The controlled stop (docs/safety.md gives the reasons for the defaults). */
 typedef struct {
@@ -74,7 +75,7 @@ typedef struct {
   bool clear_faults; /* request to clear latched faults (acted on in FAULT once the active stop is over, and
                       * only while link_fault and drive_faults are clear in the same tick) */
   bool link_fault;   /* level: the transport's command watchdog has tripped; latches POUR_FAULT_LINK */
-  bool stop;         /* one-shot: the host ends the run, RUN -> IDLE (safe torque) */
+  bool stop;         /* one-shot: the host ends the run, RUN -> IDLE held (safe torque, brake) until a Reset */
   bool reset;        /* one-shot: start a new run from the power-on state; refused in RUN, ESTOP, active stop */
   uint16_t drive_faults; /* level: the drive's latched fault word (POUR_DRIVE_FAULT_*; 0: none, or no drive of
                           * its own); any bit latches POUR_FAULT_DRIVE */
@@ -100,6 +101,7 @@ typedef struct {
 typedef struct {
   pour_control_config_t config;
   pour_policy_t policy;
+  uint32_t policy_rng0;   /* the policy's PRNG state as init left it: a Reset puts it back */
   pour_safety_t safety;
   pour_mode_t mode;
   uint16_t faults;
@@ -126,7 +128,8 @@ typedef struct {
   bool experiment_asked;  /* a pour_control_experiment waits for the next update */
   uint8_t experiment_kind; /* ... of this kind */
   uint8_t experiment_answer; /* pour_control_experiment_answer_t of the latest request */
-  bool held;              /* an experiment ended in IDLE: the brake holds until a Reset or another experiment */
+  bool held;              /* IDLE with no run armed: after a Stop, an experiment's end or pour_control_hold (a port's
+                           * boot); the brake holds and no sample starts a run until a Reset (or an experiment) */
   bool drive_untrusted;   /* a drive fault since the last clear came with a drive that no longer follows a torque */
 } pour_control_t;
 
@@ -154,9 +157,21 @@ pour_status_t pour_control_init_external(pour_control_t *ctl, const pour_control
  * reset, input (a seq that does not advance makes the sample not fresh; the estimator turns a fresh one into
  * the state, restarted in IDLE so that a run starts from its first sample; an implausible sample or state:
  * BAD_INPUT), timeout (STALE_INPUT, with SEQ if repeated samples were refused; armed in RUN only), IDLE ->
- * RUN on the first fresh sample, supervisor (RUN). Returns whether a decision is due: in RUN, on its first
- * tick and every decision period after. */
+ * RUN on the first fresh sample unless held (pour_control_hold, a Stop), supervisor (RUN). Returns whether a
+ * decision is due: in RUN, on its first tick and every decision period after. */
 bool pour_control_update(pour_control_t *ctl, const pour_control_input_t *in);
+
+/* No run starts on its own: in IDLE, the axis is held (brake engaged, the safe torque) and no fresh sample
+ * starts a run until a Reset arms one (or an experiment is accepted). A port calls it after init, so that after
+ * any reset of the MCU (power-on, watchdog, software, pin) a rig whose samples keep coming does not resume the
+ * pour by itself (IEC 60204-1 §7.5, §9.2.5.4.1: no restart after a reset or a power restoration); a Stop in
+ * RUN leaves the axis held the same way. Outside IDLE it does nothing (a fault's clear returns to IDLE with
+ * the hold as it was). */
+void pour_control_hold(pour_control_t *ctl);
+
+/* Whether no run is armed (pour_control_hold, a Stop, an experiment's end): IDLE waits for a Reset; in FAULT a clear
+ * leaves the axis so. */
+bool pour_control_held(const pour_control_t *ctl);
 
 /* Whether a ClearErrors with these inputs would be acted on, the drive's fault word aside: the e-stop
  * released, no link fault, the core in FAULT with its active stop over (or in ESTOP, the line released

@@ -21,7 +21,10 @@ typedef enum {
   POUR_ECORRUPT = -4,    /* weights whose content hash does not match */
   POUR_ECALIBRATION = -5, /* no valid drive calibration (none stored, corrupt, an older format, out of range) */
   POUR_EBOOT = -6,        /* the option bytes would boot the ROM bootloader (B-G431B-ESC1: nSWBOOT0, nBOOT0) */
-  POUR_EPARAMS = -7       /* stored parameters corrupt, of another layout, out of range, or refused by the core */
+  POUR_EPARAMS = -7,      /* stored parameters corrupt, of another layout, out of range, or refused by the core */
+  POUR_EALIGN = -8        /* a valid drive calibration is stored, but its electrical offset is not trusted in this
+                           * power cycle (the motor encoder has no index; its count starts at 0 at every boot):
+                           * RUN is refused until a CalibrationStart finds it again */
 } pour_status_t;
 
 /* Name of a status value, for logs and error messages. */

@@ -54,6 +54,11 @@ pour_safety_config_t pour_safety_default_config(void);
 /* Validates the config; the envelope starts at zero torque, its speed band at ±omega_slack (at rest). */
 pour_status_t pour_safety_init(pour_safety_t *safety, const pour_safety_config_t *config);
 
+/* The envelope's run state as pour_safety_init leaves it (zero torque, no limit active, the governor's bounds and
+ * integral from rest), its config and the values derived from it kept: what a Reset restarts, without init's
+ * check and its two 64-bit divisions (~300 instructions on the Cortex-M4). */
+void pour_safety_restart(pour_safety_t *safety);
+
 /* Shapes a requested torque by angle limits, clamp, the speed band, slew, then cuts toward zero whatever still
  * lies beyond the band or an angle limit (less torque never waits for the slew). The band follows the
  * estimated speed omega_urad_s: ceiling = min(omega_max, ceiling + alpha step, max(θ̇, 0) + slack), floor

@@ -70,8 +70,9 @@ static uint8_t store(pour_calibration_flow_t *flow, pour_can_node_t *node, const
   flow->stored = POUR_CAL_OK;
   flow->stored_now = true;
   flow->calibration = c;
-  if (node->config.identity.init_status == (int8_t)POUR_ECALIBRATION) {
-    node->config.identity.init_status = (int8_t)POUR_OK; /* Identity no longer says uncalibrated */
+  if (node->config.identity.init_status == (int8_t)POUR_ECALIBRATION ||
+      node->config.identity.init_status == (int8_t)POUR_EALIGN) {
+    node->config.identity.init_status = (int8_t)POUR_OK; /* Identity no longer says uncalibrated, nor unaligned */
   }
   return POUR_CAN_CAL_OK;
 }

@@ -162,9 +162,18 @@ def _confirm_motion(a: argparse.Namespace, n: bn.Node, want: int) -> None:
         raise bn.BenchError(f"'{a.cmd}' not confirmed")
 
 
+# Identity.InitStatus values a bench acts on (pour_status_t, pour/fixed.h).
+INIT_STATUS = {
+    -5: " (POUR_ECALIBRATION: no valid drive calibration; run pour-bench calibrate)",
+    -7: " (POUR_EPARAMS: the stored parameters are refused)",
+    -8: " (POUR_EALIGN: the stored electrical offset is not trusted after the reset; run pour-bench calibrate)",
+}
+
+
 def _print_state(st: bn.NodeState) -> None:
     print(f"node {st.node_id}: mode {st.mode}, faults {', '.join(st.faults) or 'none'}, "
-          f"rx_dropped {st.rx_dropped}, overruns {st.overruns}, refused {st.refused}")
+          f"rx_dropped {st.rx_dropped}, overruns {st.overruns}, refused {st.refused}"
+          + (", held (RUN waits for a Reset: pour-bench reset)" if st.held else ""))
 
 
 def _print_drive(n: bn.Node, timeout: float) -> None:
@@ -305,7 +314,7 @@ def run(a: argparse.Namespace) -> int:
             assert st.identity is not None
             i = st.identity
             print(f"node {st.node_id}: policy 0x{i.weights_hash:08x}, tau_max {i.tau_max_nm:.2f} N.m, firmware "
-                  f"{i.fw_version}, init status {i.init_status}")
+                  f"{i.fw_version}, init status {i.init_status}{INIT_STATUS.get(i.init_status, '')}")
             if i.fw_version != bench.protocol:
                 print(f"pour-bench: warning: firmware {i.fw_version} and this DBC (protocol {bench.protocol}) "
                       f"differ: some frames may be misread", file=sys.stderr)

@@ -157,6 +157,7 @@ class NodeState:
     rx_dropped: int = 0
     overruns: int = 0
     refused: int = 0  # commands refused or dropped by the node, mod 16 (Heartbeat.Refused)
+    held: bool = False  # no run armed: after the board's boot or a Stop, RUN waits for a Reset (Heartbeat.Held)
     counter: int | None = None
     identity: Identity | None = None
     t_heartbeat: float | None = None
@@ -290,6 +291,7 @@ class Bench:
             st.mode = str(st.mode)
             st.faults = [f.removeprefix("Fault_") for f in self._faults if sig[f]]
             st.rx_dropped, st.overruns, st.refused = sig["RxDropped"], sig["Overruns"], sig["Refused"]
+            st.held = bool(sig.get("Held", 0))  # protocol 8 on
             st.t_heartbeat = now
             st.heartbeats += 1
         elif name == "DriveTelemetry":

@@ -147,6 +147,8 @@ typedef struct {
   uint16_t overruns;   /* missed control deadlines, wraps */
   uint8_t counter;     /* +1 per heartbeat, wraps */
   uint8_t refused;     /* commands refused or dropped (Stop, Reset, ClearErrors), mod 16 (bits 4..7) */
+  uint8_t held;        /* 1: no run armed (after a boot of the board or a Stop; in FAULT, a clear leaves it so):
+                        * RUN waits for a Reset (bit 23) */
 } pour_can_heartbeat_t;
 
 typedef struct {

@@ -69,6 +69,7 @@ typedef struct {
   uint8_t experiment_kind;                   /* ... of this kind */
   bool have_drive;                           /* the port has a drive of its own: DriveTelemetry is sent */
   pour_can_drive_telemetry_t drive;          /* its latest state */
+  bool held;                                 /* the core's pour_control_held, for the heartbeat's Held */
 } pour_can_node_t;
 
 /* Node 0, watchdog 50 ms (above the core's input timeout, so the core trips first), heartbeat 100 ms,
@@ -85,6 +86,10 @@ void pour_can_node_set_calibration(pour_can_node_t *node, const pour_can_calibra
 /* The drive's state for the next DriveTelemetry (a port with a drive of its own calls it every tick; from
  * the first call on, a DriveTelemetry frame follows every heartbeat). */
 void pour_can_node_set_drive(pour_can_node_t *node, const pour_can_drive_telemetry_t *drive);
+
+/* Whether the core holds the axis awaiting a Reset (pour_control_held), for the next heartbeat's Held: a port
+ * calls it every tick before pour_can_node_end_tick (false until it does). */
+void pour_can_node_set_held(pour_can_node_t *node, bool held);
 
 /* The measurement's outcome (status POUR_CAN_CAL_*, the calibration stored), sent unasked as a
  * CalibrationResult at the end of a tick (after a pending request's answer, if any: one a tick). */

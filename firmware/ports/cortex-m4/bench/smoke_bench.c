@@ -6,6 +6,7 @@
  * follow the drive's references (tests/board/ideal_drive.h), and the bucket moves with that motor's torque.
  * The script, by tick:
  *     10..169  states of a bucket that moves with the torque (StateA + StateB frames, seq counting)
+ *         40  Reset: the image boots held, so the states before it start no run (the heartbeat says Held)
  *         60  CalibrationRead (while running)
  *   100..119  the hardwired e-stop line asserted
  *        130  ClearErrors
@@ -49,6 +50,7 @@
 #define ESTOP_TO 120u
 #define CLEAR_AT 130u
 #define READ_AT 60u
+#define RESET_AT 40u
 #define STATES_TO 170u
 #define PERIODS_PER_TICK 20u /* 20 kHz PWM under the 1 kHz loop */
 #define VBUS_MV 24000u
@@ -65,6 +67,7 @@ static struct {
   uint32_t feeds, heartbeats, identities, bad_identity, slew_steps, led_shows, led_wrong;
   uint32_t periods, gates_on_calibrating, released_calibrating, compares, iq_sign_wrong, iq_sign_checked;
   uint32_t telemetry, telemetry_faulted, telemetry_iq_wrong, calibration_read, calibration_wrong;
+  uint32_t ran_before_reset, held_at_boot; /* torque frames in RUN before the Reset; heartbeats saying Held then */
   bool ran_after_read, ran, estop_same_tick, estop_latched, ran_again, stale_at_end;
   q15_t peak, last_torque;
   uint8_t last_mode;
@@ -81,6 +84,9 @@ uint32_t pour_clock_crystal(void) { return SMOKE_CRYSTAL_HZ; }
 
 /* The scripted bench's drive is calibrated (the refusal is the board's, tested in tests/board). */
 pour_status_t pour_hal_calibration_load(void) { return POUR_OK; }
+/* The scripted motor's encoder count is a function of the bucket's angle alone (pour_hal_can_poll): an absolute
+ * encoder, whose offset a reset does not lose. */
+bool pour_hal_calibration_offset_kept(void) { return true; }
 int pour_hal_calibration_reason(void) { return 0; }
 /* The block as the drive's default configuration would have measured it. */
 pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
@@ -193,6 +199,9 @@ void pour_hal_can_poll(void) {
   if (tick == READ_AT) {
     (void)pour_can_pack_command(0, POUR_CAN_CMD_CALIBRATION_READ, &rx[rx_n++]);
   }
+  if (tick == RESET_AT) {
+    (void)pour_can_pack_command(0, POUR_CAN_CMD_RESET, &rx[rx_n++]);
+  }
 }
 
 int pour_hal_can_receive(pour_can_frame_t *frame) {
@@ -220,6 +229,9 @@ static void on_torque(const pour_can_torque_t *t) {
   seen.last_torque = t->torque;
   seen.last_mode = t->mode;
   seen.led_wrong += led_mode == t->mode ? 0u : 1u; /* the LED shows the mode of the tick's torque frame */
+  if (tick < RESET_AT && t->mode == POUR_MODE_RUN) {
+    seen.ran_before_reset++;
+  }
   if (tick < ESTOP_FROM && t->mode == POUR_MODE_RUN) {
     seen.ran = true;
     seen.peak = t->torque > seen.peak ? t->torque : seen.peak;
@@ -249,6 +261,7 @@ int pour_hal_can_transmit(const pour_can_frame_t *frame) {
   } else if (pour_can_unpack_heartbeat(frame, &hb) == POUR_CAN_RX_OK) {
     seen.heartbeats++;
     seen.last_faults = hb.faults;
+    seen.held_at_boot += tick < RESET_AT && hb.held == 1u ? 1u : 0u;
   } else if (pour_can_unpack_drive_telemetry(frame, &dt) == POUR_CAN_RX_OK) {
     seen.telemetry++;
     seen.telemetry_faulted += dt.drive_faults != 0u ? 1u : 0u;
@@ -284,12 +297,14 @@ void pour_hal_watchdog_feed(void) {
                   seen.released_calibrating == 0u && seen.compares > 0u && seen.iq_sign_checked > 0u &&
                   seen.iq_sign_wrong == 0u && seen.telemetry == seen.heartbeats && seen.telemetry_faulted == 0u &&
                   seen.telemetry_iq_wrong == 0u && seen.calibration_read == 1u && seen.calibration_wrong == 0u &&
-                  seen.ran_after_read;
+                  seen.ran_after_read && seen.ran_before_reset == 0u && seen.held_at_boot > 0u;
   printf("smoke: current loop %u periods (gates on %u, brake released %u while measuring its offsets), %u with "
          "compares, q current against the torque %u of %u; drive telemetry %u (%u faulted, %u not the loop's)\n",
          (unsigned)seen.periods, (unsigned)seen.gates_on_calibrating, (unsigned)seen.released_calibrating,
          (unsigned)seen.compares, (unsigned)seen.iq_sign_wrong, (unsigned)seen.iq_sign_checked,
          (unsigned)seen.telemetry, (unsigned)seen.telemetry_faulted, (unsigned)seen.telemetry_iq_wrong);
+  printf("smoke: booted held: %u heartbeat(s) saying Held, RUN before the Reset %u tick(s)\n",
+         (unsigned)seen.held_at_boot, (unsigned)seen.ran_before_reset);
   printf("smoke: CalibrationRead answered with the stored block %u time(s), other calibration frames %u, RUN "
          "after it %d\n", (unsigned)seen.calibration_read, (unsigned)seen.calibration_wrong, (int)seen.ran_after_read);
   printf("smoke: %u ticks, watchdog fed %u; ran %d (peak torque %d); e-stop: zero torque, brake, power off in its "

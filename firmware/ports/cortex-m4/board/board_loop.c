@@ -87,6 +87,7 @@ void pour_board_loop_tick(pour_control_t *ctl, pour_can_node_t *node, uint32_t o
   pour_board_drive_telemetry(&drive);
   drive.crystal_4mhz = (uint8_t)(pour_clock_crystal() / 4000000u);
   pour_can_node_set_drive(node, &drive);
+  pour_can_node_set_held(node, pour_control_held(ctl)); /* the heartbeat's Held: RUN waits for a Reset */
   pour_can_frame_t tx[POUR_CAN_NODE_MAX_TX];
   pour_board_transmit(tx, pour_can_node_end_tick(node, &out, overruns, tx));
   pour_can_frame_t ack;

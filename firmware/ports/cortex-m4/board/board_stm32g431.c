@@ -264,6 +264,8 @@ pour_status_t pour_hal_calibration_load(void) {
 
 int pour_hal_calibration_reason(void) { return (int)calibration_status; }
 
+bool pour_hal_calibration_offset_kept(void) { return false; } /* TIM4 from 0 at every start, no index: hal_calibration.h */
+
 pour_cal_status_t pour_hal_calibration_stored(pour_calibration_t *cal) {
   *cal = calibration;
   return calibration_status;

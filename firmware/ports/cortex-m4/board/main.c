@@ -63,15 +63,33 @@ PHASE void report_forever(void) {
  * configuration lives only in its own function's frame, so the two are never on the stack together. */
 PHASE pour_status_t controller_init(void) {
   const pour_control_config_t config = pour_control_default_config();
-  return pour_control_init(&controller, &config, &pour_weights_compiled);
+  const pour_status_t status = pour_control_init(&controller, &config, &pour_weights_compiled);
+  /* Booted held: after any reset (power-on, the watchdog's, a software or a pin reset) no run starts until the
+   * host sends Reset, even with the rig's samples coming (IEC 60204-1 §7.5 and §9.2.5.4.1: no restart on its
+   * own after a reset or a power restoration; docs/safety.md). */
+  pour_control_hold(&controller);
+  return status;
 }
 
 PHASE pour_status_t drive_init(void) {
-  /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. */
+  /* Uncalibrated, the drive never follows a torque (RUN refused) until a CalibrationStart calibrates it. A stored
+   * calibration whose electrical offset did not survive the reset (pour_hal_calibration_offset_kept) is the same
+   * for the drive: it would commutate up to 180 electrical degrees off (the virtual board's finding,
+   * docs/virtual-board.md), so RUN waits for a CalibrationStart in this power cycle, and Identity says why
+   * (POUR_EALIGN). R, L and the pole pairs stay stored (the block is not touched). */
   const bool calibrated = pour_hal_calibration_load() == POUR_OK;
+  const bool offset = calibrated && pour_hal_calibration_offset_kept();
   const pour_drive_config_t drive = pour_drive_default_config();
-  const pour_status_t status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, calibrated);
-  return status == POUR_OK && !calibrated ? POUR_ECALIBRATION : status; /* what Identity says until then */
+  const pour_status_t status = pour_board_drive_init(&drive, pour_weights_compiled.tau_max_mnm, offset);
+  if (status != POUR_OK || offset) {
+    return status;
+  }
+  return calibrated ? POUR_EALIGN : POUR_ECALIBRATION; /* what Identity says until then */
+}
+
+/* The start-up statuses under which the loop still runs, RUN refused, so that a CalibrationStart can fix them. */
+static bool waits_for_calibration(pour_status_t status) {
+  return status == POUR_ECALIBRATION || status == POUR_EALIGN;
 }
 
 /* The start-up: the board at safe levels, the clock, the watchdog, the controller, the drive and the node.
@@ -99,7 +117,7 @@ PHASE bool start_up(pour_status_t *status_out) {
     status = drive_init();
   }
   pour_can_node_config_t nc = pour_can_node_default_config();
-  if (status == POUR_OK || status == POUR_ECALIBRATION) {
+  if (status == POUR_OK || waits_for_calibration(status)) {
     /* The stored parameters before the first tick (a stored node id too); a set that cannot be trusted is
      * refused as a policy or a clock would be. */
     const pour_status_t params = pour_board_params_init(&controller, nc.node_id);
@@ -142,7 +160,7 @@ int main(void) {
     for (;;) {
     }
   }
-  if (status != POUR_OK && status != POUR_ECALIBRATION) {
+  if (status != POUR_OK && !waits_for_calibration(status)) {
     report_forever();
   }
   run();
