@@ -38,6 +38,7 @@ struct Point {
 
 struct Result {
   poursim_slosh_t slosh{};
+  double half[2] = {-1, -1}; // damping of seeds 1..N/2 and N/2+1..N alone: the estimate's scatter
   double hydro = -1, weir = -1, cpu_s = 0, wall_s = 0, sim_s = 0;
 };
 
@@ -46,16 +47,18 @@ struct Result {
 // restitution and friction; the pressure's stiffness), one or two at a time from the defaults.
 const char *const kDefaultSweep[] = {
     "default",
+    "fluid_viscosity=20",
     "fluid_viscosity=10",
-    "fluid_viscosity=3",
     "fluid_viscosity=2",
-    "fluid_viscosity=1",
     "fluid_viscosity=0.5",
     "fluid_viscosity=0",
     "fluid_agitation=0.3",
-    "fluid_viscosity=2,fluid_agitation=0.95",   // the default's kick √σ·v_T, less friction
-    "fluid_viscosity=1.25,fluid_agitation=1.2", // the same kick again
-    "fluid_viscosity=0.5,fluid_agitation=1.9",  // and again
+    "fluid_agitation=1.0",
+    "fluid_agitation=1.5",
+    "fluid_agitation=2.0",
+    "fluid_agitation=3.0",
+    "fluid_viscosity=2,fluid_agitation=1.5",
+    "fluid_viscosity=10,fluid_agitation=1.0",
     "restitution_wall=0.5",
     "friction=0",
     "fluid_stiffness=30000",
@@ -98,14 +101,12 @@ void weir_curve(double w, double depth, double fill, double rate, int samples, d
     const double th_k = k * kDeg;
     for (; rate * t < th_k; t += dt) {
       const double th = rate * t, lip = -0.5 * w * std::sin(th) + depth * std::cos(th);
-      // The level that holds a in the section extended above the lip (the head is small beside the depth).
-      if (area_below(w, 3.0 * depth, th, lip) >= a) continue;
-      double lo = lip, hi = lip + depth;
-      for (int it = 0; it < 50; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (area_below(w, 3.0 * depth, th, mid) < a ? lo : hi) = mid;
-      }
-      const double head = 0.5 * (lo + hi) - lip;
+      // What the section below the lip cannot hold stands over the free surface at the lip's level: the
+      // head is that excess over the surface's length (d area / d level just below the lip).
+      const double below = area_below(w, depth, th, lip);
+      if (below >= a) continue;
+      const double eps = 1e-5, surface = (below - area_below(w, depth, th, lip - eps)) / eps;
+      const double head = surface > 1e-6 ? (a - below) / surface : a / w;
       a = std::max(0.0, a - (2.0 / 3.0) * kCdWeir * std::sqrt(2.0 * kG) * std::pow(head, 1.5) * dt);
     }
     kept[k] = a / a0;
@@ -174,6 +175,16 @@ int measure(const Point &p, int slosh_seeds, int ret_seeds, Result *r) {
   r->sim_s = slosh_seeds * (c.settle_s + 4.3);
   r->cpu_s = cpu_now() - c0;
   r->wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (int h = 0; h < 2 && slosh_seeds >= 2; ++h) {
+    poursim_slosh_t s;
+    const int n = h == 0 ? slosh_seeds / 2 : slosh_seeds - slosh_seeds / 2;
+    const uint32_t first = h == 0 ? 1u : static_cast<uint32_t>(1 + slosh_seeds / 2);
+    if (poursim_measure_slosh(&c, first, n, 12 * kDeg, 0.3, 4.0, nullptr, 0, &s, err, sizeof err) != POURSIM_OK) {
+      std::fprintf(stderr, "bench_slosh: %s: %s\n", p.label.c_str(), err);
+      return 1;
+    }
+    r->half[h] = s.damping;
+  }
   if (ret_seeds == 0) return 0;
   poursim_config_t cr = c;
   const double depth = c.bucket_height - c.bucket_wall;
@@ -230,7 +241,8 @@ int write_json(const std::string &path, const std::vector<Point> &pts, const std
   std::fprintf(f, "  \"method\": {\"slosh\": \"poursim_measure_slosh: 12 deg in 0.3 s, held 4 s, seeds 1-%d\", "
                   "\"hydro\": \"retention RMS gap against a level surface, 0.02 rad/s to 125 deg, fill %.0f %%, seeds 1-%d\", "
                   "\"weir\": \"retention RMS gap against a sharp-crested weir (C_d %.2f), 0.1 rad/s to 125 deg, fill %.0f %%, "
-                  "seeds 1-%d\", \"speed\": \"simulated seconds of the slosh runs per CPU second\"},\n",
+                  "seeds 1-%d\", \"damping_halves\": \"the same fit on each half of the seeds alone (its scatter)\", "
+                  "\"speed\": \"simulated seconds (settling included) of the full-seed slosh run per CPU second\"},\n",
                slosh_seeds, 100 * kFill, ret_seeds, kCdWeir, 100 * kFill, ret_seeds);
   std::fprintf(f, "  \"bars\": {\"damping\": %.3g, \"weir_rms\": %.3g, \"hydro_rms\": %.3g},\n", kBarDamping, kBarWeir,
                kBarHydro);
@@ -242,10 +254,11 @@ int write_json(const std::string &path, const std::vector<Point> &pts, const std
       set += (k ? ", " : "") + json_str(pts[i].set[k].first) + ": " + pts[i].set[k].second;
     set += "}";
     std::fprintf(f,
-                 "    {\"label\": %s, \"set\": %s, \"damping\": %s, \"freq_hz\": %s, \"freq_theory_hz\": %s, "
+                 "    {\"label\": %s, \"set\": %s, \"damping\": %s, \"damping_halves\": [%s, %s], \"freq_hz\": %s, \"freq_theory_hz\": %s, "
                  "\"amplitude_m\": %s, \"noise_m\": %s, \"hydro_rms\": %s, \"weir_rms\": %s, \"x_real_time\": %s, "
                  "\"x_real_time_wall\": %s, \"meets_bars\": %s}%s\n",
-                 json_str(pts[i].label).c_str(), set.c_str(), num(r.slosh.damping).c_str(), num(r.slosh.freq).c_str(),
+                 json_str(pts[i].label).c_str(), set.c_str(), num(r.slosh.damping).c_str(), num(r.half[0]).c_str(),
+                 num(r.half[1]).c_str(), num(r.slosh.freq).c_str(),
                  num(r.slosh.freq_theory).c_str(), num(r.slosh.amplitude).c_str(), num(r.slosh.noise).c_str(),
                  num(r.hydro).c_str(), num(r.weir).c_str(), num(r.sim_s / r.cpu_s).c_str(),
                  num(r.sim_s / r.wall_s).c_str(), meets(r) ? "true" : "false", i + 1 < pts.size() ? "," : "");
@@ -314,7 +327,7 @@ int main(int argc, char **argv) {
   std::printf("slosh sweep: %zu points; slosh seeds 1-%d, retention seeds 1-%d; bars: damping <= %.2f, weir <= %.0f %%, "
               "hydrostatics <= %.0f %%\n",
               pts.size(), slosh_seeds, ret_seeds, kBarDamping, 100 * kBarWeir, 100 * kBarHydro);
-  std::printf("%-42s %8s %8s %8s %8s %8s %8s %6s\n", "point", "damping", "f [Hz]", "vs tank", "hydro", "weir", "x real", "bars");
+  std::printf("%-42s %8s %13s %8s %8s %8s %8s %8s %6s\n", "point", "damping", "halves", "f [Hz]", "vs tank", "hydro", "weir", "x real", "bars");
   std::fflush(stdout);
   std::vector<Result> res(pts.size());
   for (size_t i = 0; i < pts.size(); ++i) {
@@ -323,7 +336,8 @@ int main(int argc, char **argv) {
     char hydro[16] = "-", weir[16] = "-";
     if (r.hydro >= 0) std::snprintf(hydro, sizeof hydro, "%.1f %%", 100 * r.hydro);
     if (r.weir >= 0) std::snprintf(weir, sizeof weir, "%.1f %%", 100 * r.weir);
-    std::printf("%-42s %8.3f %8.3f %+7.1f%% %8s %8s %7.1fx %6s\n", pts[i].label.c_str(), r.slosh.damping, r.slosh.freq,
+    std::printf("%-42s %8.3f  %5.3f/%5.3f %8.3f %+7.1f%% %8s %8s %7.1fx %6s\n", pts[i].label.c_str(), r.slosh.damping,
+                r.half[0], r.half[1], r.slosh.freq,
                 100 * (r.slosh.freq / r.slosh.freq_theory - 1), hydro, weir, r.sim_s / r.cpu_s,
                 ret_seeds == 0 ? "-" : meets(r) ? "met" : "no");
     std::fflush(stdout);
