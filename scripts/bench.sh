@@ -4,6 +4,7 @@
 #   scripts/bench.sh              all sections but fuzz
 #   scripts/bench.sh core         only the named sections (see SECTIONS below)
 #   scripts/bench.sh fuzz 60      the fuzz targets, 60 s each (default 300)
+#   scripts/bench.sh slosh        the slosh-damping sweep into results/slosh (~7 min; only when asked)
 #   scripts/bench.sh suite        ./scripts/test.sh's wall time by preset (build, tests), warm or cold as found
 #   scripts/bench.sh suite-all    the same for ./scripts/test.sh --all
 set -uo pipefail
