@@ -4,6 +4,7 @@
 #   scripts/bench.sh              all sections but fuzz
 #   scripts/bench.sh core         only the named sections (see SECTIONS below)
 #   scripts/bench.sh fuzz 60      the fuzz targets, 60 s each (default 300)
+#   scripts/bench.sh slosh        the slosh-damping sweep into results/slosh (~7 min; only when asked)
 #   scripts/bench.sh suite        ./scripts/test.sh's wall time by preset (build, tests), warm or cold as found
 #   scripts/bench.sh suite-all    the same for ./scripts/test.sh --all
 set -uo pipefail
@@ -243,6 +244,29 @@ bench_sim() {
   cmake --build --preset host -j2 --target bench_fluid >/dev/null && ./build/host/bin/bench_fluid | sed 's/^/   /'
 }
 
+# --- section: slosh — the slosh-damping sweep (issue 38; docs/simulator.md, "Slosh damping") ------------
+# At each point of a sweep over the liquid's dissipative keys (the defaults with one or two keys set; no
+# default changes): the slosh's damping ratio (and that of each half of its 16 seeds: the estimate's
+# scatter) and frequency against the tank's first mode, the retention's RMS gap against hydrostatics
+# (0.02 rad/s) and against a sharp-crested weir (0.1 rad/s, C_d 0.6), and the speed. Bars: damping <= 0.03
+# with the weir <= 3 % and hydrostatics <= 4 %. Writes results/slosh/slosh_sweep.json and the plot
+# slosh_tradeoff.png. About 7 min on one core.
+bench_slosh() {
+  local log
+  log=$(mktemp)
+  echo "== slosh: damping against the retention's errors and speed (150 particles) =="
+  if ! { cmake --preset host && cmake --build --preset host -j2 --target bench_slosh; } >"$log" 2>&1; then
+    cat "$log"
+    rm -f "$log"
+    echo "error: the host build of bench_slosh failed" >&2
+    return 1
+  fi
+  rm -f "$log"
+  mkdir -p results/slosh
+  ./build/host/bin/bench_slosh --json results/slosh/slosh_sweep.json | sed 's/^/   /' || return 1
+  .venv/bin/python scripts/slosh_plot.py results/slosh/slosh_sweep.json results/slosh/slosh_tradeoff.png | sed 's/^/   /'
+}
+
 # --- section: can — the pour CAN protocol: bus load, and the full loop on real SocketCAN ------------------
 # Bus load at 1 kHz from the DBC (frame bits with and without worst-case stuffing; bar 50 % of 1 Mbit/s).
 # Then, in a user-mode Linux guest (tests/can/uml_run.py) on vcan0: a 10 s pour in lockstep through
@@ -453,7 +477,7 @@ bench_suite_run() {
 bench_suite() { bench_suite_run; }
 bench_suite-all() { bench_suite_run --all; }
 
-SECTIONS=(core motor lcm sim can weights fuzz suite suite-all vboard)
+SECTIONS=(core motor lcm sim can weights fuzz suite suite-all vboard slosh)
 wanted=()
 for a in "$@"; do
   # `fuzz 600`: the number is the seconds each fuzz target runs.

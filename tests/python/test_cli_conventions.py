@@ -17,7 +17,7 @@ from lcm_helpers import compiled_weights
 VERSION = re.search(r'^version = "([0-9.]+)"$', (SOURCE_DIR / "tools" / "pyproject.toml").read_text(),
                     re.MULTILINE).group(1)
 C_PROGRAMS = ["host_sim", "pour_controller", "can_bridge", "fault_pour",
-              "bench_fluid", "bench_motor", "bench_weights_parse", "lcm_loop_driver"]  # the last four: benchmarks, test drivers
+              "bench_fluid", "bench_motor", "bench_slosh", "bench_weights_parse", "lcm_loop_driver"]  # the last five: benchmarks, test drivers
 WITH_WEIGHTS = {"pour_controller", "fault_pour"}
 SCRIPTS = ["setup.sh", "build.sh", "demo.sh", "test.sh", "bench.sh", "flash.sh"]
 ENTRY_POINTS = sorted(e.name for e in metadata.distribution("pour-tools").entry_points
