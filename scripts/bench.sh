@@ -78,7 +78,7 @@ bench_core() {
   local image_flash=$((t + d)) image_ram=$((d + b)) drive_flash=0 drive_ram=0 softfloat
   # The B-G431B-ESC1's drivers, each object (the image links them all since the current loop's interrupt is
   # wired; the sum of the motor drivers' objects on top of the image is kept as an upper bound).
-  for o in "$port"/CMakeFiles/pour_firmware.dir/*.obj; do
+  for o in $(find "$port"/CMakeFiles/pour_firmware.dir -name '*.obj' | sort); do # board/, drivers/, ../common/
     case "$(basename "$o")" in
       main.c.obj|startup.c.obj|hal_timer.c.obj|hal_motor.c.obj) continue ;;
     esac
@@ -401,12 +401,14 @@ print("%d/%d lines (%.1f %%)" % (t["covered"], t["count"], t["percent"]))' || ec
 }
 
 # --- section: vboard — the flashed image's interrupts and 1 kHz step, counted on the virtual board ---------
-# pour_virtual_board --profile over 10 s emulated of pour_firmware.elf (the file scripts/flash.sh flashes):
-# each exception handler by its vector and the ELF's symbol, instructions of its own and with what nests in
-# it, and its share of the 50 us current-loop period at 170 MHz; the 1 kHz loop tick (pour_board_loop_tick)
-# and the core's step (pour_control_step) in it, with and without the interrupts that preempt them. Cycles
-# are a model: instructions x CPI 1.000 + 12 + 10 per exception (docs/virtual-board.md, "Cycle counts").
-# Bar: the control step <= 1,000 instructions excluding interrupts (ctest py_test_vboard_profile).
+# pour_virtual_board --profile on pour_firmware.elf (the file scripts/flash.sh flashes), idle for 10 s and in
+# the closed-loop pour (--pour: calibrated, the shipped policy deciding): each exception handler by its vector
+# and the ELF's symbol, instructions of its own and with what nests in it, and its share of the 50 us
+# current-loop period at 170 MHz; the 1 kHz loop tick (pour_board_loop_tick), the core's step
+# (pour_control_step) and the decision (pour_policy_decide), with and without the interrupts that preempt
+# them. Cycles are a model: instructions x CPI 1.000 + 12 + 10 per exception (docs/virtual-board.md,
+# "Cycle counts"). Bar: the control step <= 1,000 instructions excluding interrupts, in the pour (every
+# decision tick) and idle (ctest py_test_vboard_profile).
 bench_vboard() {
   local log out worst
   log=$(mktemp)
@@ -416,13 +418,18 @@ bench_vboard() {
     cat "$log"; rm -f "$log"; echo "error: the build of the image or of the virtual board failed" >&2; return 1
   fi
   rm -f "$log"
-  if ! out=$(build/host/bin/pour_virtual_board --seconds 10 --profile 2>&1); then
-    echo "$out"; echo "error: the virtual board stopped" >&2; return 1
-  fi
-  grep -E '^(profile:|virtual board:)' <<<"$out" | sed -e 's/^profile: /   /' -e 's/^virtual board: /   /'
-  worst=$(sed -nE 's/^profile: function pour_control_step[^:]*: [0-9]+ calls, instructions excluding interrupts mean [0-9.]+ worst ([0-9]+).*/\1/p' <<<"$out")
-  printf '   bar: the control step on the image, worst %s instructions excluding interrupts (bar 1000: %s)\n' \
-    "${worst:-?}" "$([ "${worst:-99999}" -le 1000 ] && echo within || echo OVER)"
+  local what args
+  for what in idle pour; do
+    if [ "$what" = idle ]; then args=(--seconds 10); else args=(--pour --seed 1); fi
+    echo "-- $what (pour_virtual_board ${args[*]} --profile):"
+    if ! out=$(build/host/bin/pour_virtual_board "${args[@]}" --profile 2>&1); then
+      echo "$out"; echo "error: the virtual board stopped" >&2; return 1
+    fi
+    grep -E '^(profile:|virtual board: .*sha256|episode)' <<<"$out" | sed -e 's/^profile: /   /' -e 's/^virtual board: /   /' -e 's/^episode/   episode/'
+    worst=$(sed -nE 's/^profile: function pour_control_step[^:]*: [0-9]+ calls, instructions excluding interrupts mean [0-9.]+ worst ([0-9]+).*/\1/p' <<<"$out")
+    printf '   bar: the control step on the image (%s), worst %s instructions excluding interrupts (bar 1000: %s)\n' \
+      "$what" "${worst:-?}" "$([ "${worst:-99999}" -le 1000 ] && echo within || echo OVER)"
+  done
 }
 
 # --- section: suite, suite-all — the test suite's wall time ------------------------------------------

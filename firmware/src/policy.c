@@ -302,11 +302,13 @@ static unsigned logits_i32(const pour_policy_t *policy, const pour_obs_t *obs, i
     s = __smlsd(x45, (int32_t)w2, s) >> f;
 #else
   for (; pw != end; pw += 3, ++o) {
-    int32_t s = half;
+    /* The bias first: every partial sum then includes it, as sums_fit_i32's bound does (a sum of the
+     * observations' terms alone may leave int32). Each pair's sum, |x w + x' w'| <= 2 * 32767 * 32768, fits. */
+    int32_t s = half + (int16_t)(uint16_t)(pw[2] >> 16) * POUR_Q15_ONE_INT;
     for (unsigned k = 0; k < 3u; ++k) {
       const int32_t lo = (int16_t)(uint16_t)(pw[k] & 0xFFFFu);
       const int32_t hi = (int16_t)(uint16_t)(pw[k] >> 16);
-      s += obs->x[2u * k] * lo + (k < 2u ? obs->x[2u * k + 1u] : POUR_Q15_ONE_INT) * hi;
+      s += obs->x[2u * k] * lo + (k < 2u ? obs->x[2u * k + 1u] * hi : 0);
     }
     s >>= f;
 #endif

@@ -265,4 +265,5 @@ extern "C" void poursim_core_shape(poursim_core_t *core, pour_control_output_t *
 }
 extern "C" void poursim_core_step(poursim_core_t *core, const pour_control_input_t *in, pour_control_output_t *out) {
   pour_control_step(&core->ctl, in, out);
+  pour_control_probs(&core->ctl, out); /* Python's Output.probs: the latest decision's, as the Linux port reports */
 }

@@ -103,6 +103,23 @@ static void test_pwm_short_low_sides_ZeroesTheComparesNow(void) {
   TEST_ASSERT_TRUE(pour_pwm_enabled(&pwm));
 }
 
+/* A faulted drive calls it on every interrupt: UG restarts the counter (RM0440), so only the first call may
+ * generate one, and a compare or an enable in between makes the next short a new one. */
+static void test_pwm_short_low_sides_UpdatesOnlyOnEnteringTheShort(void) {
+  const uint16_t c[3] = {2000u, 1000u, 3000u};
+  pour_pwm_set_compares(&pwm, c);
+  pour_pwm_short_low_sides(&pwm);
+  regs[POUR_TIM1_EGR] = 0u; /* write-only on the chip: the memory keeps the last write */
+  pour_pwm_short_low_sides(&pwm);
+  pour_pwm_short_low_sides(&pwm);
+  TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_TIM1_EGR]);
+  TEST_ASSERT_TRUE(pour_pwm_enabled(&pwm));
+  pour_pwm_set_compares(&pwm, c);
+  pour_pwm_short_low_sides(&pwm);
+  TEST_ASSERT_EQUAL_HEX32(1u, regs[POUR_TIM1_EGR]);
+  TEST_ASSERT_EQUAL_HEX32(0u, regs[POUR_TIM1_CCR1]);
+}
+
 int main(void) {
   UNITY_BEGIN();
   RUN_TEST(test_pwm_deadtime_code_RoundsUpInBothRanges);
@@ -112,5 +129,6 @@ int main(void) {
   RUN_TEST(test_pwm_enable_SwitchesTheBridgeChannels);
   RUN_TEST(test_pwm_break_LeavesTheBridgeOffUntilCleared);
   RUN_TEST(test_pwm_short_low_sides_ZeroesTheComparesNow);
+  RUN_TEST(test_pwm_short_low_sides_UpdatesOnlyOnEnteringTheShort);
   return UNITY_END();
 }

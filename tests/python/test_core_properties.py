@@ -405,3 +405,17 @@ def test_fill_schedule_knee_is_the_hydrostatic_onset_less_3_degrees(fill_depth):
     litres = 1000 * np.pi * (rig["bucket_inner_width"] / 2) ** 2 * fill_depth
     off = poursim.make_config({"fill_depth": fill_depth, "fill_schedule_l": round(litres + 0.01, 2)})
     assert core.control_config(off).safety.knee_theta_urad == 0
+
+
+def test_a_greedy_decisions_probabilities_reach_python(example_weights):
+    # The step computes no softmax for a greedy policy (pour_control_step); the binding asks for the latest
+    # decision's probabilities (pour_control_probs), as the Linux port's POUR_TORQUE does: they sum to one in
+    # Q15 and their argmax is the action taken.
+    ctl = core.Controller(example_weights, core.control_config())
+    before = ctl.step(None)
+    assert not any(before.probs)  # no decision yet
+    o = ctl.step((1, 1 << 10, 9000, 0))
+    assert o.mode == core.MODE_RUN, o
+    n = len(example_weights.levels_q15)
+    assert abs(sum(o.probs[:n]) - 32768) <= n and not any(o.probs[n:]), o.probs
+    assert max(range(n), key=lambda a: (o.probs[a], -a)) == o.action, o

@@ -49,6 +49,7 @@ pour_status_t pour_pwm_init(pour_pwm_t *pwm, volatile uint32_t *regs, const pour
     return POUR_EINVAL;
   }
   pwm->regs = regs;
+  pwm->shorted = false;
   pwm->period = (uint16_t)period;
   volatile uint32_t *r = regs;
   r[POUR_TIM1_BDTR] = 0u; /* MOE off first */
@@ -83,6 +84,7 @@ pour_status_t pour_pwm_init(pour_pwm_t *pwm, volatile uint32_t *regs, const pour
 
 void pour_pwm_set_compares(pour_pwm_t *pwm, const uint16_t compare[3]) {
   volatile uint32_t *r = pwm->regs;
+  pwm->shorted = false;
   r[POUR_TIM1_CCR1] = compare[0] > pwm->period ? pwm->period : compare[0];
   r[POUR_TIM1_CCR2] = compare[1] > pwm->period ? pwm->period : compare[1];
   r[POUR_TIM1_CCR3] = compare[2] > pwm->period ? pwm->period : compare[2];
@@ -90,19 +92,27 @@ void pour_pwm_set_compares(pour_pwm_t *pwm, const uint16_t compare[3]) {
 
 /* Off is the channels disabled under a set MOE (OSSR: their inactive level), not MOE cleared: a cleared
  * MOE means the break, whose idle levels are all off until the break is cleared. */
-void pour_pwm_enable(pour_pwm_t *pwm, bool on) { pwm->regs[POUR_TIM1_CCER] = on ? CCER_BRIDGE : 0u; }
+void pour_pwm_enable(pour_pwm_t *pwm, bool on) {
+  pwm->shorted = false;
+  pwm->regs[POUR_TIM1_CCER] = on ? CCER_BRIDGE : 0u;
+}
 
 void pour_pwm_short_low_sides(pour_pwm_t *pwm) {
+  if (pwm->shorted) {
+    return; /* already: no second update event (it would restart the counter) */
+  }
   const uint16_t zero[3] = {0u, 0u, 0u};
   pour_pwm_set_compares(pwm, zero);
   pwm->regs[POUR_TIM1_EGR] = POUR_MSK(TIM1, EGR, UG); /* now, not at the next period */
   pour_pwm_enable(pwm, true); /* after a break MOE stays clear: the bridge stays off, the brake holds */
+  pwm->shorted = true;
 }
 
 bool pour_pwm_break_fired(const pour_pwm_t *pwm) { return (pwm->regs[POUR_TIM1_SR] & POUR_MSK(TIM1, SR, BIF)) != 0u; }
 
 void pour_pwm_clear_break(pour_pwm_t *pwm) {
   volatile uint32_t *r = pwm->regs;
+  pwm->shorted = false;
   r[POUR_TIM1_CCER] = 0u;
   r[POUR_TIM1_SR] = ~POUR_MSK(TIM1, SR, BIF); /* rc_w0 */
   r[POUR_TIM1_BDTR] |= POUR_MSK(TIM1, BDTR, MOE); /* the hardware keeps it clear while the break is active */

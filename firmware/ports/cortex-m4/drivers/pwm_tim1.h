@@ -89,6 +89,7 @@ typedef struct {
 typedef struct {
   volatile uint32_t *regs;
   uint16_t period; /* ARR: counts from the bottom to the top of the centre-aligned count */
+  bool shorted;    /* the low sides shorted by pour_pwm_short_low_sides, until a compare or enable changes it */
 } pour_pwm_t;
 
 /* B-G431B-ESC1: 170 MHz, 20 kHz, 800 ns dead time (pour/board_facts.h), break filter 6 samples at f_DTS / 4. */
@@ -109,7 +110,10 @@ void pour_pwm_set_compares(pour_pwm_t *pwm, const uint16_t compare[3]);
 void pour_pwm_enable(pour_pwm_t *pwm, bool on);
 
 /* All three low sides on (compares 0) while MOE is set: the motor's phases shorted (a software fault's
- * damping). After a break MOE stays clear and the bridge stays off. */
+ * damping). After a break MOE stays clear and the bridge stays off. The update event that applies it at once
+ * (EGR.UG) is generated on entering the short only: UG also re-initialises the counter (RM0440, TIM1_EGR;
+ * the stm32g4 SVD's UG field), so one on every call of a faulted drive's 20 kHz interrupt restarted the PWM
+ * period, and the ADC trigger with it, before it ended (the virtual board saw the interrupt at 31.95 kHz). */
 void pour_pwm_short_low_sides(pour_pwm_t *pwm);
 
 /* true once the break input has fired (SR.BIF), until pour_pwm_clear_break. */
