@@ -159,15 +159,17 @@ def test_the_estop_opened_mid_pour_ends_with_the_bucket_held(estop):
 def test_a_phase_overcurrent_mid_pour_trips_the_break_and_ends_with_the_bucket_held():
     r = fault_run("--overcurrent-at", str(FAULT_MS))
     held(r.stdout)
-    # the comparator's break cleared MOE within the PWM period the current rose in (the comparators are
-    # evaluated once a period: 50 us), long before the 1 kHz loop's next tick; then the drive's fault
-    # (Heartbeat's Fault_Drive): the loop saw the cut
-    assert number(r"TIM1 MOE 0 \(the bridge off\) ([0-9.]+) ms after the fault", r.stdout) < 0.051, r.stdout
+    # the comparator's break cleared MOE within two PWM periods (50 us each: the low side's shunt carries the
+    # phase current only while that low side conducts), long before the 1 kHz loop's next tick; then the
+    # drive's fault (Heartbeat's Fault_Drive): the loop saw the cut
+    assert number(r"TIM1 MOE 0 \(the bridge off\) ([0-9.]+) ms after the fault", r.stdout) < 0.101, r.stdout
     # docs/bringup.md: the power is cut only once the brake holds (its 20 ms here, --brake-ms)
     power = number(r"PA15 low \(the power stage off\) ([0-9.]+) ms after", r.stdout)
     assert power > number(r"the brake holding ([0-9.]+) ms after", r.stdout), r.stdout
-    # ... and DriveTelemetry names it: POUR_DRIVE_FAULT_HW_OVERCURRENT (0x0002, pour/drive_faults.h)
-    assert re.search(r"end at .* mode FAULT, faults 0x0800, resets 0, drive faults 0x0002", r.stdout), r.stdout
+    # ... and DriveTelemetry names it: POUR_DRIVE_FAULT_HW_OVERCURRENT (0x0002, pour/drive_faults.h), with
+    # what the software saw of the same current
+    m = re.search(r"end at .* mode FAULT, faults 0x0800, resets 0, drive faults 0x([0-9a-f]{4})", r.stdout)
+    assert m and int(m.group(1), 16) & 0x0002, r.stdout
 
 
 def test_a_missed_watchdog_refresh_mid_pour_resets_the_chip_and_ends_with_the_bucket_held():
