@@ -3,6 +3,7 @@
 """Worst-case stack depth of functions in a linked image, from GCC's call graph (-fcallgraph-info=su).
 
     stack_depth.py GRAPH.ci [GRAPH.ci ...] --root NAME [--root NAME ...] [--entry NAME ...]
+                   [--indirect CALLER=TARGET[,TARGET ...] ...]
 
 The cortex-m4 images are linked with -flto, so the per-object .su files of -fstack-usage do not exist and
 functions are inlined across files; the link writes one .ci file per ltrans unit, whose nodes carry each
@@ -13,10 +14,13 @@ the source; GCC's clone suffixes such as .constprop or .isra are ignored) this p
 
 BYTES being the deepest chain of frames from NAME (PATH, joined by '>'). An indirect call may reach any
 function that no one calls directly, other than the roots and the --entry names (the vector table's
-handlers): the worst of those is taken. Library helpers (memset, __aeabi_ldivmod, ...) come with no frame
+handlers): the worst of those is taken, unless --indirect names what CALLER's indirect calls may reach (a
+function pointer with known values, e.g. a hook set once at start-up): then those targets alone, each of
+which must be in the graph. Library helpers (memset, __aeabi_ldivmod, ...) come with no frame
 size: those in HELPER_FRAMES are counted with the frame read from the library's disassembly, any other one
 reachable from the root is listed as uncounted. Recursion, a dynamic frame or a root that is not in the graph is
-an error (exit status 2).
+an error (exit status 2), and so is an --indirect whose caller or target is not in the graph or whose caller
+makes no indirect call.
 """
 from __future__ import annotations
 
@@ -43,6 +47,10 @@ HELPER_FRAMES = {
     "__builtin_memcpy": 0,
     # libc_nano.a(lib_a-memset.o): `push {r4, r5, lr}`, no call.
     "__builtin_memset": 12,
+    # The same two functions as a call by their own name (a node titled "memset" labelled with string.h's
+    # declaration, beside the built-in's: the graph keeps one of them).
+    "memcpy": 0,
+    "memset": 12,
 }
 
 
@@ -92,12 +100,30 @@ class Graph:
     def titles(self, name: str) -> list[str]:
         return [t for t, n in self.name.items() if n == name and t != INDIRECT]
 
-    def depths(self, roots: list[str], entries: list[str]) -> dict[str, tuple[int, list[str], set[str]]]:
+    def depths(self, roots: list[str], entries: list[str], indirect: dict[str, list[str]] | None = None
+               ) -> dict[str, tuple[int, list[str], set[str]]]:
         self.resolve()
         starts = {r: self.titles(r) for r in roots}
         for r, ts in starts.items():
             if not ts:
                 raise GraphError(f"function {r} is not in the call graph (inlined into its caller, or absent)")
+        bound: dict[str, list[str]] = {}  # caller's title -> the titles its indirect calls may reach
+        for caller, targets in (indirect or {}).items():
+            callers = self.titles(caller)
+            if not callers:
+                raise GraphError(f"--indirect: function {caller} is not in the call graph (inlined, or absent)")
+            with_indirect = [t for t in callers if INDIRECT in self.calls.get(t, ())]
+            if not with_indirect:
+                raise GraphError(f"--indirect: {caller} makes no indirect call in the call graph")
+            titles = []
+            for target in targets:
+                ts = [t for t in self.titles(target) if self.frame.get(t) is not None]
+                if not ts:
+                    raise GraphError(f"--indirect: target {target} of {caller} is not in the call graph "
+                                     "(inlined, or absent)")
+                titles += ts
+            for t in with_indirect:
+                bound[t] = titles
         called = {self.name[d] for ds in self.calls.values() for d in ds}
         excluded = set(roots) | set(entries)
         orphans = [t for t in self.frame
@@ -115,7 +141,11 @@ class Graph:
             if t == INDIRECT:
                 own, targets, label = 0, orphans, []
             else:
-                own, targets, label = self.frame.get(t), sorted(self.calls.get(t, ())), [self.name.get(t, t)]
+                own, label = self.frame.get(t), [self.name.get(t, t)]
+                calls = self.calls.get(t, set())
+                if t in bound:
+                    calls = (calls - {INDIRECT}) | set(bound[t])
+                targets = sorted(calls)
             depth, path, helpers = 0, [], set() if own is not None else {self.name.get(t, t)}
             for d in targets:
                 sub = visit(d)
@@ -137,12 +167,22 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("graphs", nargs="+", type=Path, help="the .ci files of one image's link")
     p.add_argument("--root", action="append", required=True, help="a function whose deepest chain to print")
     p.add_argument("--entry", action="append", default=[], help="a vector-table handler (never an indirect target)")
+    p.add_argument("--indirect", action="append", default=[], metavar="CALLER=TARGET[,TARGET...]",
+                   help="the only functions CALLER's indirect calls may reach (each must be in the graph)")
     a = p.parse_args(argv)
+    indirect: dict[str, list[str]] = {}
+    for spec in a.indirect:
+        caller, _, targets = spec.partition("=")
+        names = [n for n in targets.split(",") if n]
+        if not caller or not names or len(names) != len(targets.split(",")):
+            print(f"stack_depth: error: --indirect {spec!r}: expected CALLER=TARGET[,TARGET...]", file=sys.stderr)
+            return 2
+        indirect.setdefault(caller, []).extend(names)
     g = Graph()
     try:
         for path in a.graphs:
             g.read(path)
-        depths = g.depths(a.root, a.entry)
+        depths = g.depths(a.root, a.entry, indirect)
     except GraphError as e:
         print(f"stack_depth: error: {e}", file=sys.stderr)
         return 2

@@ -149,3 +149,44 @@ def test_a_file_that_is_not_a_call_graph_is_refused(tmp_path):
     assert r.returncode == 2 and "not a GCC call graph" in r.stderr
     r = run(str(tmp_path / "missing.ci"), "--root", "main")
     assert r.returncode == 2 and "cannot read" in r.stderr
+
+
+PLACEHOLDER = 'node: { title: "__indirect_call" label: "Indirect Call Placeholder" shape : ellipse }'
+
+
+def test_an_indirect_call_bounded_by_its_named_targets(tmp_path):
+    # As flash_g4.c's pour_flash_write_page calls its stall hook: a pointer whose only value the caller knows.
+    # Unbounded, the call may reach tick (nobody calls it directly), which reaches write_page again.
+    g = graph(tmp_path, PLACEHOLDER, node("run", 32), node("tick", 400), node("save", 40), node("write_page", 24),
+              node("stall", 8), node("hook", 96), edge("run", "save"), edge("tick", "save"),
+              edge("save", "write_page"), edge("write_page", "__indirect_call"))
+    r = run(str(g), "--root", "run")
+    assert r.returncode == 2 and "recursion through" in r.stderr and not r.stdout
+    r = run(str(g), "--root", "run", "--indirect", "write_page=stall")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "run 104 run>save>write_page>stall"
+    # several targets: the deepest counts
+    r = run(str(g), "--root", "run", "--indirect", "write_page=stall,hook")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "run 192 run>save>write_page>hook"
+    # only the named caller is bounded: another indirect call still takes the worst uncalled function
+    g2 = graph(tmp_path, PLACEHOLDER, node("run", 32), node("write_page", 24), node("stall", 8), node("hook", 96),
+               node("other", 16), edge("run", "write_page"), edge("run", "other"),
+               edge("write_page", "__indirect_call"), edge("other", "__indirect_call"))
+    r = run(str(g2), "--root", "run", "--indirect", "write_page=stall")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "run 144 run>other>hook"
+
+
+def test_an_indirect_bound_naming_what_is_not_there_is_refused(tmp_path):
+    g = graph(tmp_path, PLACEHOLDER, node("run", 32), node("write_page", 24), node("stall", 8), node("plain", 8),
+              edge("run", "write_page"), edge("run", "plain"), edge("write_page", "__indirect_call"))
+    for spec, says in (("write_page=flash_stall", "target flash_stall of write_page is not in the call graph"),
+                       ("write_pages=stall", "function write_pages is not in the call graph"),
+                       ("plain=stall", "plain makes no indirect call"),
+                       ("write_page", "expected CALLER=TARGET"), ("write_page=stall,", "expected CALLER=TARGET"),
+                       ("=stall", "expected CALLER=TARGET")):
+        r = run(str(g), "--root", "run", "--indirect", spec)
+        assert r.returncode == 2, spec
+        assert says in r.stderr and len(r.stderr.strip().splitlines()) == 1 and not r.stdout, (spec, r.stderr)
+        assert "Traceback" not in r.stderr

@@ -9,6 +9,7 @@
 #include <stdio.h>
 
 #include "icount.h"
+#include "pour/board_facts.h"
 #include "pour/drive.h"
 
 #define N_CALLS 20000u
@@ -23,14 +24,24 @@ static uint32_t next(void) {
 
 static pour_drive_t drv;
 
+/* The board's analog chain (pour/board_facts.h): the amplifiers' bias at zero current, the sign of a phase
+ * current against its count, and the bus divider. */
+#define BIAS POUR_BOARD_OFFSET_NOMINAL_COUNTS
+#define SIGN POUR_BOARD_CURRENT_SIGN
+/* the ADC count of a bus voltage [mV] */
+#define VBUS_COUNTS(mv)                                                                                      \
+  ((uint16_t)(((uint64_t)(mv) * 4096u * 1000u + (uint64_t)POUR_BOARD_ADC_VREF_MV * POUR_BOARD_VBUS_DIVIDER_MILLI / 2u) / \
+              ((uint64_t)POUR_BOARD_ADC_VREF_MV * POUR_BOARD_VBUS_DIVIDER_MILLI)))
+#define VBUS_24V VBUS_COUNTS(24000u)
+
 /* phase currents within ±3 A summing to zero (no trip), the bus between 23.5 and 25.4 V (flux braking
  * from 24.5 V), any encoder position */
 static void make_sample(pour_drive_sample_t *s) {
   const int32_t ia = (int32_t)(next() % 201u) - 100, ib = (int32_t)(next() % 201u) - 100;
-  s->adc_phase[0] = (uint16_t)(2048 + ia);
-  s->adc_phase[1] = (uint16_t)(2048 + ib);
-  s->adc_phase[2] = (uint16_t)(2048 - ia - ib);
-  s->adc_vbus = (uint16_t)(1522u + next() % 123u);
+  s->adc_phase[0] = (uint16_t)(BIAS + SIGN * ia);
+  s->adc_phase[1] = (uint16_t)(BIAS + SIGN * ib);
+  s->adc_phase[2] = (uint16_t)(BIAS - SIGN * (ia + ib));
+  s->adc_vbus = (uint16_t)(VBUS_COUNTS(23500u) + next() % (VBUS_COUNTS(25400u) - VBUS_COUNTS(23500u) + 1u));
   s->encoder = (uint16_t)(next() & 4095u);
 }
 
@@ -40,12 +51,12 @@ static void make_sample(pour_drive_sample_t *s) {
 static int bench_calibration(uint64_t insn_per_kilotick, uint32_t empty) {
   const pour_drive_config_t config = pour_drive_default_config();
   if (pour_drive_init(&drv, &config) != POUR_OK) return 1;
-  const pour_drive_sample_t idle = {{2048, 2048, 2048}, 1554, 0};
+  const pour_drive_sample_t idle = {{BIAS, BIAS, BIAS}, VBUS_24V, 0};
   pour_drive_output_t out;
   for (int n = 0; n < POUR_CURRENT_SENSE_CAL_SAMPLES; ++n) pour_drive_isr(&drv, &idle, &out);
   if (pour_drive_calibrate(&drv) != POUR_OK) return 1;
-  const double r = 0.2865, k = 1.0 - exp(-5e-5 * r / 150.5e-6), vbus = 1554.0 * 3.3 * 19.17 / 4096.0;
-  const double counts_per_amp = 0.003 * 9.14 * 4096.0 / 3.3;
+  const double r = 0.2865, k = 1.0 - exp(-5e-5 * r / 150.5e-6), vbus = VBUS_24V * (POUR_BOARD_ADC_VREF_MV / 1e3) * (POUR_BOARD_VBUS_DIVIDER_MILLI / 1e3) / 4096.0;
+  const double counts_per_amp = SIGN * (POUR_BOARD_SHUNT_UOHM / 1e6) * (POUR_BOARD_AMP_GAIN_MILLI / 1e3) * 4096.0 / (POUR_BOARD_ADC_VREF_MV / 1e3);
   double ia = 0.0, ib = 0.0, angle = 0.0;
   double duty[3] = {0.5, 0.5, 0.5};
   uint32_t worst = 0u, last = 0u;
@@ -54,9 +65,9 @@ static int bench_calibration(uint64_t insn_per_kilotick, uint32_t empty) {
   while (drv.state == POUR_DRIVE_MEASURING && n < 100000u) {
     const double a = ia, b = -0.5 * ia + 0.8660254 * ib, c = -0.5 * ia - 0.8660254 * ib;
     const int32_t count = (int32_t)floor(angle / 6.283185307 * 4096.0 / 8.0);
-    pour_drive_sample_t s = {{(uint16_t)(2048.0 + a * counts_per_amp + 0.5), (uint16_t)(2048.0 + b * counts_per_amp + 0.5),
-                              (uint16_t)(2048.0 + c * counts_per_amp + 0.5)},
-                             1554u, (uint16_t)(count & 4095)};
+    pour_drive_sample_t s = {{(uint16_t)(BIAS + a * counts_per_amp + 0.5), (uint16_t)(BIAS + b * counts_per_amp + 0.5),
+                              (uint16_t)(BIAS + c * counts_per_amp + 0.5)},
+                             VBUS_24V, (uint16_t)(count & 4095)};
     /* each leg less the dead time's share with the sign of its current (what the modulation compensates) */
     const double i_leg[3] = {a, b, c};
     double v[3];
@@ -107,7 +118,7 @@ int main(void) {
   }
   pour_drive_sample_t s;
   pour_drive_output_t out;
-  const pour_drive_sample_t idle = {{2048, 2048, 2048}, 1554, 0};
+  const pour_drive_sample_t idle = {{BIAS, BIAS, BIAS}, VBUS_24V, 0};
   for (int n = 0; n < POUR_CURRENT_SENSE_CAL_SAMPLES; ++n) pour_drive_isr(&drv, &idle, &out);
 
   uint32_t empty = 0u;

@@ -11,7 +11,11 @@ static pour_params_t params;
 
 pour_status_t pour_board_params_init(pour_control_t *ctl, uint8_t node_id) {
   pour_params_default(&params, &ctl->config, node_id);
-  pour_params_t stored = params;
+  /* The candidate from flash beside the set in force: static, not on the start-up's stack, where it sat
+   * under the drive's interrupt (enabled before this runs) in the thread's deepest chain (scripts/bench.sh
+   * motor, stack). The start-up runs once, in thread mode only. */
+  static pour_params_t stored;
+  stored = params;
   uint8_t bad_id = 0u;
   const int st = pour_params_store_load(pour_hal_params_flash(), &stored, &bad_id);
   if (st == 1) {

@@ -19,8 +19,7 @@ int pour_params_store_load(const pour_flash_t *flash, pour_params_t *params, uin
   if (blank == 0xFFFFFFFFu) {
     return 1;
   }
-  uint8_t buf[BLOB_WORDS * 4u];
-  memcpy(buf, w, sizeof buf); /* little-endian, as the blob */
+  const uint8_t *buf = (const uint8_t *)w; /* little-endian, as the blob (one copy on the stack, not two) */
   /* The blob's own length from its header (count at bytes 6..7), within what a blob can be. */
   const uint32_t count = (uint32_t)buf[6] | ((uint32_t)buf[7] << 8);
   const uint32_t len = 8u + 5u * count + 4u;
@@ -28,14 +27,13 @@ int pour_params_store_load(const pour_flash_t *flash, pour_params_t *params, uin
 }
 
 int pour_params_store_save(const pour_flash_t *flash, const pour_params_t *params) {
-  uint8_t buf[BLOB_WORDS * 4u];
-  memset(buf, 0xFF, sizeof buf);
+  uint32_t w[BLOB_WORDS];
+  uint8_t *buf = (uint8_t *)w; /* the blob's bytes in the words the flash programs (little-endian) */
+  memset(buf, 0xFF, sizeof w);
   const uint32_t n = pour_params_serialize(params, buf, POUR_PARAMS_BLOB_MAX);
   if (n == 0u) {
     return POUR_FLASH_BAD_ARGS;
   }
-  uint32_t w[BLOB_WORDS];
-  memcpy(w, buf, sizeof w);
   const uint32_t n_words = ((n + 7u) / 8u) * 2u;
   return pour_flash_write_page(flash, w, n_words);
 }
