@@ -253,7 +253,7 @@ def test_lost_samples_are_warned_about(tmp_path):
 
 
 def test_the_controllers_faults_are_printed_by_name(monkeypatch):
-    from pour import libpoursim
+    from pour import functions, libpoursim
     from pour.lcm import logfile
     assert logfile._fault_text(0) == "none"
     assert logfile._fault_text(0x0002 | 0x0800) == "ESTOP, DRIVE (0x0802)"
@@ -261,5 +261,5 @@ def test_the_controllers_faults_are_printed_by_name(monkeypatch):
     def no_library(faults):
         raise libpoursim.SimError("libpoursim.so not found")
 
-    monkeypatch.setattr(libpoursim, "fault_names", no_library)
+    monkeypatch.setattr(functions, "fault_names", no_library)
     assert logfile._fault_text(0x0002) == "0x0002 (names: libpoursim not found)"
